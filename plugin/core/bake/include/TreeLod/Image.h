@@ -1,0 +1,40 @@
+// Image: a float RGBA picture for the CPU renderer and the image metrics.
+// Values are display-encoded (sRGB) in [0, 1] unless a function says otherwise;
+// rows run top to bottom, pixels are interleaved RGBA.
+#pragma once
+
+#include "TreeLod/Result.h"
+
+#include <glm/glm.hpp>
+
+#include <string>
+#include <vector>
+
+namespace TreeLod
+{
+    struct Image
+    {
+        int width = 0;
+        int height = 0;
+        std::vector<glm::vec4> pixels; ///< width * height
+
+        Image() = default;
+        Image(int w, int h, const glm::vec4& fill = glm::vec4(0.0f))
+            : width(w), height(h), pixels(std::size_t(w) * h, fill) {}
+
+        glm::vec4& at(int x, int y) { return pixels[std::size_t(y) * width + x]; }
+        const glm::vec4& at(int x, int y) const { return pixels[std::size_t(y) * width + x]; }
+        bool empty() const { return pixels.empty(); }
+    };
+
+    /// Read a PNG (or any format OpenImageIO knows) as RGBA in [0, 1]; grey and RGB get
+    /// alpha 1, palette images keep their tRNS alpha.
+    Result<Image> readImage(const std::string& path);
+
+    /// Write an 8-bit RGBA PNG atomically (values clamped to [0, 1]).
+    Result<void> writePng(const std::string& path, const Image& image);
+
+    /// sRGB <-> linear transfer (IEC 61966-2-1), per channel.
+    float srgbToLinear(float c);
+    float linearToSrgb(float c);
+}
