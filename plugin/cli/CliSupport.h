@@ -1,0 +1,29 @@
+// Shared plumbing of the CLI: exit codes, error printing, progress display.
+#pragma once
+
+#include "TreeLod/Progress.h"
+#include "TreeLod/Result.h"
+
+#include <functional>
+#include <string>
+
+namespace TreeLod
+{
+    enum ExitCode
+    {
+        EXIT_OK = 0,
+        EXIT_FAILURE_RUN = 1, ///< could not do the work (e.g. no GL context)
+        EXIT_BAD_INPUT = 2    ///< the input or arguments are wrong; nothing was written
+    };
+
+    /// Print "treelod: file: element: reason" to stderr and return EXIT_BAD_INPUT.
+    int printError(const Error& error);
+
+    /// A progress callback that draws a bar on a terminal (stderr) and prints one plain
+    /// line per step otherwise. `quiet` gives an empty callback.
+    ProgressCallback makeProgress(bool quiet = false);
+
+    /// Set the exit code a subcommand callback produced (CLI11 callbacks return void).
+    void setExitCode(int code);
+    int exitCode();
+}
