@@ -1,7 +1,126 @@
-// placeholder: being written
+// treelod render INPUT --technique mesh --camera ... --size WxH -o out.png
+// Renders a tree headless through the real plugin (Ogre, default) or through the CPU
+// reference renderer (--renderer cpu). `--technique mesh` is the polygonal reference,
+// supersampled (--supersample N per axis, default 3).
+#include "CliSupport.h"
 #include "Commands.h"
+#include "TreeInput.h"
+
+#include "TreeLod/Image.h"
+#include "TreeLod/ReferenceRenderer.h"
+
+#include <chrono>
+#include <cstdio>
+
+#ifdef TREELOD_WITH_OGRE
+#include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/TechniqueRegistry.h"
+#include "TreeLod/TreeAssetManager.h"
+#endif
 
 namespace TreeLod
 {
-    void addRenderCommand(CLI::App& app) { app.add_subcommand("render", "(not yet implemented)"); }
+    namespace
+    {
+        struct RenderArgs
+        {
+            std::string input;
+            std::string output;
+            std::string technique = "mesh";
+            std::string camera = "orbit:30,10,1.05";
+            std::string size = "512x512";
+            std::string renderer = "ogre";
+            int supersample = 3;
+            std::vector<std::string> leafMaterials;
+            bool verbose = false;
+        };
+
+        bool parseSize(const std::string& text, int& w, int& h)
+        {
+            return std::sscanf(text.c_str(), "%dx%d", &w, &h) == 2 && w > 0 && h > 0 && w <= 16384 && h <= 16384;
+        }
+
+        int runRender(const RenderArgs& args)
+        {
+            int width = 0, height = 0;
+            if (!parseSize(args.size, width, height))
+                return printError(fail("", "--size", "'" + args.size + "' is not WxH with 1..16384"));
+            if (args.supersample < 1 || args.supersample > 8)
+                return printError(fail("", "--supersample", "must be 1..8 samples per axis"));
+            ProgressCallback progress = makeProgress();
+            Result<TreeInput> input = loadTreeInput(args.input, args.leafMaterials, progress);
+            if (!input)
+                return printError(input.error());
+            const TreeModel& model = input->model;
+            CameraSpec camera;
+            std::string cameraError;
+            if (!CameraSpec::parse(args.camera, model.boundsMin, model.boundsMax, camera, cameraError))
+                return printError(fail("", "--camera", cameraError));
+
+            auto start = std::chrono::steady_clock::now();
+            if (args.renderer == "cpu")
+            {
+                if (args.technique != "mesh")
+                    return printError(fail("", "--technique", "the CPU renderer draws the polygonal reference only (mesh)"));
+                ReferenceRenderer renderer(model);
+                RenderOptions options;
+                options.width = width;
+                options.height = height;
+                options.samplesPerPixel = args.supersample * args.supersample;
+                RenderImages images = renderer.render(camera, options);
+                Result<void> written = writePng(args.output, images.colour);
+                if (!written)
+                    return printError(written.error());
+            }
+            else if (args.renderer == "ogre")
+            {
+#ifdef TREELOD_WITH_OGRE
+                try
+                {
+                    OffscreenOptions options;
+                    options.verbose = args.verbose;
+                    OffscreenRenderer renderer(options);
+                    TreeAssetPtr asset = TreeAssetManager::getSingleton().loadFromBytes(
+                        input->name, Ogre::RGN_DEFAULT, input->packageBytes);
+                    Ogre::MovableObject* object = TechniqueRegistry::getSingleton().createInstance(
+                        args.technique, renderer.getSceneManager(), "tree", *asset);
+                    renderer.getSceneManager().getRootSceneNode()->attachObject(object);
+                    RgbaImage image = renderer.render(camera, width, height, args.supersample);
+                    OffscreenRenderer::savePng(image, args.output);
+                }
+                catch (const Ogre::Exception& e)
+                {
+                    return printError(fail(args.input, "ogre", e.getDescription()));
+                }
+#else
+                return printError(fail("", "--renderer", "this build has no Ogre plugin"));
+#endif
+            }
+            else
+                return printError(fail("", "--renderer", "'" + args.renderer + "' is not ogre or cpu"));
+            double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            std::printf("wrote %s (%dx%d, technique %s, renderer %s, %d samples per pixel, %.0f ms)\n",
+                        args.output.c_str(), width, height, args.technique.c_str(), args.renderer.c_str(),
+                        args.supersample * args.supersample, ms);
+            return EXIT_OK;
+        }
+    }
+
+    void addRenderCommand(CLI::App& app)
+    {
+        auto args = std::make_shared<RenderArgs>();
+        CLI::App* cmd = app.add_subcommand("render", "render a tree (.glb, .gltf, .mesh or .treelod) to a PNG, headless");
+        cmd->add_option("input", args->input, "tree file")->required();
+        cmd->add_option("-o,--output", args->output, "PNG to write")->required();
+        cmd->add_option("--technique", args->technique, "LoD technique (mesh = polygonal reference)");
+        cmd->add_option("--camera", args->camera,
+                        "orbit:AZIMUTH,ELEVATION,DISTANCE (degrees; distance 1 = tree fills the view), "
+                        "ortho:AZ,EL,DIST, or PX,PY,PZ,TX,TY,TZ[,FOV]");
+        cmd->add_option("--size", args->size, "WxH pixels");
+        cmd->add_option("--supersample", args->supersample, "samples per pixel per axis (1..8)");
+        cmd->add_option("--renderer", args->renderer, "ogre (through Plugin_TreeLod) or cpu (Embree reference)");
+        cmd->add_option("--leaf-material", args->leafMaterials, "material names that are leaves (glTF/.mesh input)");
+        cmd->add_flag("--verbose", args->verbose, "echo Ogre's log");
+        cmd->callback([args]() { setExitCode(runRender(*args)); });
+    }
 }

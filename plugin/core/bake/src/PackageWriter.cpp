@@ -1,1 +1,343 @@
-// placeholder: being written
+// This work is based on:
+// - Castaño, "Computing Alpha Mipmaps", The Witness blog / NVIDIA Texture Tools, 2010:
+//   rescale each mip level's alpha so the fraction of texels passing the alpha test stays
+//   that of the full-resolution texture.
+#include "TreeLod/PackageWriter.h"
+
+#include "TreeLod/AtomicFile.h"
+#include "TreeLod/ByteWriter.h"
+#include "TreeLod/Crc32.h"
+#include "TreeLod/Image.h"
+#include "TreeLod/Package.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+
+namespace TreeLod
+{
+    namespace
+    {
+        std::uint64_t alignUp(std::uint64_t v) { return (v + PACKAGE_ALIGNMENT - 1) / PACKAGE_ALIGNMENT * PACKAGE_ALIGNMENT; }
+
+        /// A mip level in float: linear RGB (not premultiplied) and alpha, row-major.
+        struct Level
+        {
+            std::uint32_t width = 0, height = 0;
+            std::vector<glm::vec4> texels;
+        };
+
+        /// Source texels and weights (summing to 1) under destination texel `d` when `srcSize`
+        /// texels are box-filtered to `dstSize`: the source interval [d*s/D, (d+1)*s/D).
+        struct Taps
+        {
+            std::array<std::uint32_t, 3> index{};
+            std::array<float, 3> weight{};
+            int count = 0;
+        };
+
+        std::vector<Taps> boxTaps(std::uint32_t srcSize, std::uint32_t dstSize)
+        {
+            std::vector<Taps> taps(dstSize);
+            for (std::uint32_t d = 0; d < dstSize; ++d)
+            {
+                const double a = double(d) * srcSize / dstSize, b = double(d + 1) * srcSize / dstSize;
+                Taps& t = taps[d];
+                for (std::uint32_t s = std::uint32_t(a); s < srcSize && double(s) < b && t.count < 3; ++s)
+                {
+                    const double overlap = std::min(b, double(s + 1)) - std::max(a, double(s));
+                    if (overlap <= 0.0)
+                        continue;
+                    t.index[t.count] = s;
+                    t.weight[t.count] = float(overlap / (b - a));
+                    ++t.count;
+                }
+            }
+            return taps;
+        }
+
+        /// Next smaller level: colour weighted by alpha (averaged plainly where all alpha is 0).
+        Level downsample(const Level& src)
+        {
+            Level dst;
+            dst.width = std::max(1u, src.width / 2);
+            dst.height = std::max(1u, src.height / 2);
+            dst.texels.resize(std::size_t(dst.width) * dst.height);
+            const std::vector<Taps> tx = boxTaps(src.width, dst.width), ty = boxTaps(src.height, dst.height);
+            for (std::uint32_t y = 0; y < dst.height; ++y)
+                for (std::uint32_t x = 0; x < dst.width; ++x)
+                {
+                    glm::vec3 premultiplied(0.0f), plain(0.0f);
+                    float alpha = 0.0f;
+                    for (int j = 0; j < ty[y].count; ++j)
+                        for (int i = 0; i < tx[x].count; ++i)
+                        {
+                            const float w = ty[y].weight[j] * tx[x].weight[i];
+                            const glm::vec4& s = src.texels[std::size_t(ty[y].index[j]) * src.width + tx[x].index[i]];
+                            premultiplied += w * s.a * glm::vec3(s);
+                            plain += w * glm::vec3(s);
+                            alpha += w * s.a;
+                        }
+                    const glm::vec3 colour = alpha > 0.0f ? premultiplied / alpha : plain;
+                    dst.texels[std::size_t(y) * dst.width + x] = glm::vec4(colour, alpha);
+                }
+            return dst;
+        }
+
+        std::uint8_t toByte(float v) { return std::uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
+
+        /// Smallest 8-bit alpha that passes `alpha >= cutoff` in a shader reading a / 255.
+        std::uint32_t cutoffByte(float cutoff)
+        {
+            std::uint32_t k = std::uint32_t(std::ceil(double(cutoff) * 255.0 - 1e-6));
+            return std::clamp(k, 1u, 255u);
+        }
+
+        /// Castaño 2010: choose the alpha threshold t whose coverage in this level is closest
+        /// to `target` texels, then map alpha a -> a * K / t (K = cutoff byte) so that exactly
+        /// the texels with a >= t pass. Ties go to the t nearest K (the smallest change).
+        void preserveCoverage(std::uint8_t* rgba, std::size_t texelCount, double target, std::uint32_t K)
+        {
+            std::array<std::size_t, 257> atLeast{}; // atLeast[t] = texels with alpha >= t
+            for (std::size_t i = 0; i < texelCount; ++i)
+                ++atLeast[rgba[4 * i + 3]];
+            for (int t = 255; t >= 0; --t)
+                atLeast[t] += atLeast[t + 1];
+            std::uint32_t best = K;
+            double bestError = std::abs(double(atLeast[K]) - target);
+            for (std::uint32_t t = 0; t <= 256; ++t)
+            {
+                const double error = std::abs(double(atLeast[t]) - target);
+                const auto distance = [&](std::uint32_t v) { return v > K ? v - K : K - v; };
+                if (error < bestError || (error == bestError && distance(t) < distance(best)))
+                {
+                    best = t;
+                    bestError = error;
+                }
+            }
+            if (best == K)
+                return;
+            for (std::size_t i = 0; i < texelCount; ++i)
+            {
+                const std::uint32_t a = rgba[4 * i + 3];
+                std::uint32_t scaled = best == 0 ? std::max(a, K) : std::uint32_t(std::lround(double(a) * K / best));
+                scaled = a >= best ? std::clamp(scaled, K, 255u) : std::min(scaled, K - 1);
+                rgba[4 * i + 3] = std::uint8_t(scaled);
+            }
+        }
+
+        bool printableTechnique(const std::string& technique)
+        {
+            if (technique.empty() || technique.size() > PACKAGE_MAX_TECHNIQUE_NAME)
+                return false;
+            for (char c : technique)
+                if (std::uint8_t(c) < 0x20 || std::uint8_t(c) >= 0x7f)
+                    return false;
+            return true;
+        }
+    }
+
+    // ---- PackageWriter ------------------------------------------------------------------
+
+    Result<void> PackageWriter::addChunk(const std::string& technique, std::uint32_t level,
+                                         std::uint32_t formatVersion, std::vector<std::uint8_t> bytes)
+    {
+        if (!printableTechnique(technique))
+            return fail("", chunkElement(technique, level),
+                        "technique name must be 1 to 32 printable ASCII characters");
+        mChunks[{technique, level}] = Payload{formatVersion, std::move(bytes)};
+        return {};
+    }
+
+    std::vector<std::uint8_t> PackageWriter::toBytes() const
+    {
+        const std::uint64_t tableOffset = PACKAGE_HEADER_SIZE;
+        const std::uint64_t tableSize = mChunks.size() * PACKAGE_TABLE_ENTRY_SIZE;
+
+        ByteWriter table;
+        std::uint64_t cursor = alignUp(tableOffset + tableSize);
+        std::uint64_t fileSize = tableOffset + tableSize;
+        for (const auto& [key, payload] : mChunks)
+        {
+            char name[PACKAGE_MAX_TECHNIQUE_NAME] = {};
+            std::copy(key.first.begin(), key.first.end(), name);
+            table.bytes(name, sizeof(name));
+            table.u32(key.second);
+            table.u32(payload.formatVersion);
+            table.u64(cursor);
+            table.u64(payload.bytes.size());
+            table.u32(crc32(payload.bytes.data(), payload.bytes.size()));
+            table.u32(0);
+            fileSize = cursor + payload.bytes.size();
+            cursor = alignUp(fileSize);
+        }
+
+        ByteWriter out;
+        out.reserve(fileSize);
+        out.bytes(PACKAGE_MAGIC, 4);
+        out.u32(PACKAGE_VERSION);
+        out.u32(std::uint32_t(mChunks.size()));
+        out.u32(0); // flags
+        out.u64(tableOffset);
+        out.u32(crc32(table.data().data(), table.size()));
+        out.u32(crc32(out.data().data(), out.size()));
+        out.bytes(table.data().data(), table.size());
+        for (const auto& entry : mChunks)
+        {
+            out.align(PACKAGE_ALIGNMENT);
+            out.bytes(entry.second.bytes.data(), entry.second.bytes.size());
+        }
+        return out.take();
+    }
+
+    Result<void> PackageWriter::write(const std::string& path) const { return writeFileAtomic(path, toBytes()); }
+
+    // ---- mip chains ---------------------------------------------------------------------
+
+    GpuTexture buildMipChain(const TextureImage& image, const MipChainOptions& options)
+    {
+        GpuTexture tex;
+        tex.name = image.name;
+        tex.format = GpuTextureFormat::RGBA8;
+        if (image.width <= 0 || image.height <= 0 ||
+            image.rgba.size() != std::size_t(image.width) * std::size_t(image.height) * 4)
+            return tex;
+        tex.width = std::uint32_t(image.width);
+        tex.height = std::uint32_t(image.height);
+        tex.mipCount = fullMipCount(tex.width, tex.height);
+        tex.data.resize(gpuTextureBytes(tex.format, tex.width, tex.height, tex.mipCount));
+        std::copy(image.rgba.begin(), image.rgba.end(), tex.data.begin());
+
+        std::array<float, 256> toLinear;
+        for (int i = 0; i < 256; ++i)
+            toLinear[i] = srgbToLinear(float(i) / 255.0f);
+        Level level;
+        level.width = tex.width;
+        level.height = tex.height;
+        level.texels.resize(std::size_t(tex.width) * tex.height);
+        std::size_t covered = 0;
+        const std::uint32_t K = cutoffByte(options.alphaCutoff);
+        for (std::size_t i = 0; i < level.texels.size(); ++i)
+        {
+            const std::uint8_t* p = &image.rgba[4 * i];
+            level.texels[i] = glm::vec4(toLinear[p[0]], toLinear[p[1]], toLinear[p[2]], float(p[3]) / 255.0f);
+            covered += p[3] >= K ? 1 : 0;
+        }
+        const double coverage = double(covered) / double(level.texels.size());
+        const bool preserve = options.preserveAlphaCoverage && options.alphaCutoff > 0.0f && options.alphaCutoff <= 1.0f;
+
+        for (std::uint32_t mip = 1; mip < tex.mipCount; ++mip)
+        {
+            level = downsample(level);
+            std::uint8_t* out = tex.data.data() + tex.mipOffset(mip);
+            for (std::size_t i = 0; i < level.texels.size(); ++i)
+            {
+                const glm::vec4& t = level.texels[i];
+                out[4 * i + 0] = toByte(linearToSrgb(t.r));
+                out[4 * i + 1] = toByte(linearToSrgb(t.g));
+                out[4 * i + 2] = toByte(linearToSrgb(t.b));
+                out[4 * i + 3] = toByte(t.a);
+            }
+            if (preserve)
+                preserveCoverage(out, level.texels.size(), coverage * double(level.texels.size()), K);
+        }
+        return tex;
+    }
+
+    ReferenceChunk makeReferenceChunk(const TreeModel& model)
+    {
+        ReferenceChunk chunk;
+        chunk.model = model;
+        chunk.model.textures.clear();
+        chunk.textures.reserve(model.textures.size());
+        for (std::size_t t = 0; t < model.textures.size(); ++t)
+        {
+            MipChainOptions options;
+            options.preserveAlphaCoverage = false;
+            for (const Material& m : model.materials)
+                if (m.isLeaf && m.texture == std::int32_t(t))
+                {
+                    options.preserveAlphaCoverage = true;
+                    options.alphaCutoff = m.alphaCutoff;
+                    break;
+                }
+            chunk.textures.push_back(buildMipChain(model.textures[t], options));
+        }
+        return chunk;
+    }
+
+    // ---- meta and bake --------------------------------------------------------------------
+
+    std::uint64_t fnv1a64(const void* data, std::size_t size)
+    {
+        const auto* p = static_cast<const std::uint8_t*>(data);
+        std::uint64_t h = 0xcbf29ce484222325ull;
+        for (std::size_t i = 0; i < size; ++i)
+        {
+            h ^= p[i];
+            h *= 0x100000001b3ull;
+        }
+        return h;
+    }
+
+    std::string PackageMeta::toJson() const
+    {
+        nlohmann::json j;
+        j["generator"] = "treelod";
+        j["source"] = source;
+        j["sourceHash"] = sourceHash;
+        nlohmann::json options = nlohmann::json::parse(optionsJson, nullptr, false);
+        j["options"] = options.is_discarded() ? nlohmann::json(optionsJson) : options;
+        j["techniques"] = techniques;
+        return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+    }
+
+    Result<void> bakeReferencePackage(const TreeModel& model, const std::string& path, const PackageMeta& meta,
+                                      const ProgressCallback& progress)
+    {
+        Result<void> valid = model.validate(path);
+        if (!valid)
+            return fail(path, "model '" + model.name + "', " + valid.error().element, valid.error().reason);
+
+        report(progress, "mip chains", 0.0f);
+        ReferenceChunk chunk = makeReferenceChunk(model);
+        report(progress, "mip chains", 1.0f);
+        if (chunk.textures.size() != model.textures.size())
+            return fail(path, "", "internal error: texture count changed");
+        for (std::size_t t = 0; t < chunk.textures.size(); ++t)
+            if (chunk.textures[t].mipCount == 0)
+                return fail(path, "texture " + std::to_string(t) + " '" + model.textures[t].name + "'",
+                            "empty image cannot be stored");
+
+        report(progress, "encode", 0.0f);
+        PackageWriter writer;
+        PackageMeta withTechniques = meta;
+        if (std::find(withTechniques.techniques.begin(), withTechniques.techniques.end(), REFERENCE_CHUNK) ==
+            withTechniques.techniques.end())
+            withTechniques.techniques.push_back(REFERENCE_CHUNK);
+        const std::string metaText = withTechniques.toJson();
+        Result<void> added =
+            writer.addChunk(REFERENCE_CHUNK, 0, REFERENCE_CHUNK_FORMAT_VERSION, encodeReferenceChunk(chunk));
+        if (added)
+            added = writer.addChunk(META_CHUNK, 0, 1, std::vector<std::uint8_t>(metaText.begin(), metaText.end()));
+        if (!added)
+            return fail(path, added.error().element, added.error().reason);
+        report(progress, "encode", 1.0f);
+
+        report(progress, "write", 0.0f);
+        Result<void> written = writer.write(path);
+        report(progress, "write", 1.0f);
+        return written;
+    }
+
+    Result<void> bakeReferencePackage(const TreeModel& model, const std::string& path,
+                                      const std::string& sourceDescription)
+    {
+        PackageMeta meta;
+        meta.source = sourceDescription;
+        return bakeReferencePackage(model, path, meta);
+    }
+}

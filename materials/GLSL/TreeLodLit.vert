@@ -1,0 +1,20 @@
+#version 330 core
+// Lit tree surfaces (bark and leaves): world-space normal and UV to the fragment stage.
+uniform mat4 worldViewProj;
+uniform mat4 world;
+uniform mat4 normalMatrix;
+uniform vec4 cameraPosition;
+
+in vec4 vertex;
+in vec3 normal;
+in vec2 uv0;
+
+out vec3 vNormal;
+out vec2 vUv;
+
+void main()
+{
+    gl_Position = worldViewProj * vertex;
+    vNormal = mat3(normalMatrix) * normal;
+    vUv = uv0;
+}

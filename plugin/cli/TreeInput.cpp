@@ -1,0 +1,64 @@
+#include "TreeInput.h"
+
+#include "TreeLod/AtomicFile.h"
+#include "TreeLod/GltfImporter.h"
+#include "TreeLod/ModelChunk.h"
+#include "TreeLod/Package.h"
+#include "TreeLod/PackageWriter.h"
+
+#include <filesystem>
+
+namespace TreeLod
+{
+    namespace
+    {
+        std::string lowerExtension(const std::string& path)
+        {
+            std::string ext = std::filesystem::path(path).extension().string();
+            for (char& c : ext)
+                c = char(std::tolower(static_cast<unsigned char>(c)));
+            return ext;
+        }
+    }
+
+    Result<TreeInput> loadTreeInput(const std::string& path, const std::vector<std::string>& leafMaterials,
+                                    const ProgressCallback& progress)
+    {
+        TreeInput input;
+        input.name = std::filesystem::path(path).filename().string();
+        const std::string ext = lowerExtension(path);
+        if (ext == ".treelod")
+        {
+            Result<PackageReader> package = PackageReader::open(path);
+            if (!package)
+                return package.error();
+            Result<std::vector<std::uint8_t>> chunk = package->readChunk(REFERENCE_CHUNK, 0);
+            if (!chunk)
+                return chunk.error();
+            Result<ReferenceChunk> reference = decodeReferenceChunk(chunk.value(), path);
+            if (!reference)
+                return reference.error();
+            input.model = std::move(reference->model);
+            Result<std::vector<std::uint8_t>> bytes = readFile(path);
+            if (!bytes)
+                return bytes.error();
+            input.packageBytes = std::move(bytes.value());
+            return input;
+        }
+        if (ext != ".glb" && ext != ".gltf")
+            return fail(path, "", "unknown tree format '" + ext + "' (expected .glb, .gltf or .treelod)");
+        ImportOptions options;
+        options.leafMaterials = leafMaterials;
+        options.progress = progress;
+        Result<TreeModel> model = importGltf(path, options);
+        if (!model)
+            return model.error();
+        input.model = std::move(model.value());
+        PackageWriter writer;
+        Result<void> added = writer.addChunk(REFERENCE_CHUNK, 0, REFERENCE_CHUNK_FORMAT_VERSION, encodeReferenceChunk(makeReferenceChunk(input.model)));
+        if (!added)
+            return added.error();
+        input.packageBytes = writer.toBytes();
+        return input;
+    }
+}

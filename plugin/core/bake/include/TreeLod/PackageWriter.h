@@ -1,0 +1,98 @@
+// Writing *.treelod packages (format in TreeLod/Package.h), GPU-ready mip chains, and the
+// reference bake: TreeModel -> "reference" + "meta" chunks -> file.
+#pragma once
+
+#include "TreeLod/ModelChunk.h"
+#include "TreeLod/Progress.h"
+#include "TreeLod/Result.h"
+#include "TreeLod/TreeModel.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace TreeLod
+{
+    /// Collects chunks and lays out a package. The output depends only on the chunks added
+    /// (entries sorted by technique then level, payloads in table order, zero padding), never
+    /// on the order of addChunk calls or the time.
+    class PackageWriter
+    {
+    public:
+        /// Add the chunk (technique, level), replacing one added before with the same key.
+        /// Error if `technique` is empty, longer than 32 bytes or not printable ASCII.
+        Result<void> addChunk(const std::string& technique, std::uint32_t level, std::uint32_t formatVersion,
+                              std::vector<std::uint8_t> bytes);
+
+        std::size_t chunkCount() const { return mChunks.size(); }
+
+        /// The whole package.
+        std::vector<std::uint8_t> toBytes() const;
+
+        /// Write the package atomically (temp file beside `path`, then rename): on error
+        /// nothing exists at `path` that was not there before.
+        Result<void> write(const std::string& path) const;
+
+    private:
+        struct Payload
+        {
+            std::uint32_t formatVersion = 1;
+            std::vector<std::uint8_t> bytes;
+        };
+        std::map<std::pair<std::string, std::uint32_t>, Payload> mChunks;
+    };
+
+    /// How buildMipChain filters.
+    struct MipChainOptions
+    {
+        /// Keep the fraction of texels with alpha >= alphaCutoff the same in every level as in
+        /// level 0, for alpha-tested leaves (Castaño, "Computing Alpha Mipmaps", 2010). Without
+        /// it, thin leaf parts fade below the cutoff and distant foliage goes bald.
+        bool preserveAlphaCoverage = true;
+        float alphaCutoff = 0.5f; ///< the material's alpha test threshold, in (0, 1]
+    };
+
+    /// RGBA8 mip chain of `image` down to 1x1 (fullMipCount levels), level 0 an exact copy.
+    /// Each level is a box filter of the one above (2x2 texels for even sizes, area-weighted
+    /// 3 taps along an odd edge, so non-power-of-two sizes work): colour averaged in linear
+    /// light and weighted by alpha (transparent texels lend no colour, so leaf edges do not
+    /// darken), alpha averaged plainly. With preserveAlphaCoverage, each level's alpha is then
+    /// scaled by cutoff / t, where t is the alpha whose coverage is closest to level 0's; the
+    /// coverage then matches level 0 as closely as the level's alpha histogram allows.
+    /// An empty image (0x0) gives a GpuTexture with mipCount 0 and no data.
+    GpuTexture buildMipChain(const TextureImage& image, const MipChainOptions& options = {});
+
+    /// The reference chunk of `model`: the model without its decoded textures plus a mip chain
+    /// per texture, alpha-coverage preserving (with that material's cutoff) for the textures
+    /// that a leaf material uses, plain box filtered for the others.
+    ReferenceChunk makeReferenceChunk(const TreeModel& model);
+
+    /// 64-bit FNV-1a of bytes (the content hash recorded in the meta chunk).
+    std::uint64_t fnv1a64(const void* data, std::size_t size);
+
+    /// What the "meta" chunk records, as one JSON object with sorted keys, e.g.
+    /// {"generator":"treelod 0.1.0","options":{"leafMaterials":["Leaves"]},
+    ///  "source":"oak.glb","sourceHash":"fnv1a64:0123456789abcdef","techniques":["reference"]}
+    struct PackageMeta
+    {
+        std::string source;       ///< input file name without directories (so moving it changes nothing)
+        std::string sourceHash;   ///< e.g. "fnv1a64:" + 16 hex digits of the input file's bytes
+        std::string optionsJson = "{}"; ///< bake options as a JSON object (stored as a string if not JSON)
+        std::vector<std::string> techniques; ///< chunks the bake produced, besides "meta"
+
+        std::string toJson() const;
+    };
+
+    /// Bake the reference chunk of `model` and a meta chunk from `meta`, and write them to
+    /// `path` atomically. Fails (writing nothing) if the model does not validate or the file
+    /// cannot be written.
+    Result<void> bakeReferencePackage(const TreeModel& model, const std::string& path, const PackageMeta& meta,
+                                      const ProgressCallback& progress = {});
+
+    /// Same, with meta.source = sourceDescription and no hash or options.
+    Result<void> bakeReferencePackage(const TreeModel& model, const std::string& path,
+                                      const std::string& sourceDescription);
+}

@@ -1,0 +1,73 @@
+// OffscreenRenderer: a headless Ogre Root that renders into a texture (OGRE-NOTES.md,
+// "Headless"): RenderSystem_GL3Plus under an X server (Xvfb), a hidden 1x1 window owning
+// the context, TreeLod's materials in the resource group "TreeLod", and the TreeLod
+// plugin installed (in-process, or loaded from a .so path for tests of the plugin itself).
+// Used by the CLI, the tests and the benchmarks; not part of Plugin_TreeLod.
+#pragma once
+
+#include "TreeLod/Camera.h"
+
+#include <Ogre.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace TreeLod
+{
+    class TreeLodPlugin;
+
+    struct OffscreenOptions
+    {
+        std::string logFile = "";      ///< "" = no log file (messages dropped unless verbose)
+        bool verbose = false;          ///< also echo Ogre's log to stdout
+        std::string pluginPath = "";   ///< "" = install TreeLodPlugin in-process; else loadPlugin(path)
+        std::string materialsDir = ""; ///< "" = $TREELOD_MATERIALS_DIR or the source tree's materials/
+    };
+
+    /// An RGBA8 picture, rows top to bottom (PNG order).
+    struct RgbaImage
+    {
+        int width = 0;
+        int height = 0;
+        std::vector<std::uint8_t> pixels;
+    };
+
+    class OffscreenRenderer
+    {
+    public:
+        /// Throws Ogre::Exception with the reason when no GL context can be had
+        /// (e.g. no X server: run under xvfb-run).
+        explicit OffscreenRenderer(const OffscreenOptions& options = {});
+        ~OffscreenRenderer();
+
+        Ogre::Root& getRoot() { return *mRoot; }
+        Ogre::SceneManager& getSceneManager() { return *mSceneManager; }
+
+        /// Sun (directional light) and ambient as LightingSpec says; background colour too.
+        void setLighting(const LightingSpec& lighting);
+
+        /// Render the scene from `camera` at width x height, supersampled with
+        /// samplesPerAxis^2 samples per pixel (box filter in linear space, like the CPU
+        /// reference renderer). Returns opaque RGBA8.
+        RgbaImage render(const CameraSpec& camera, int width, int height, int samplesPerAxis = 1);
+
+        /// Save as PNG through Ogre's codec, atomically. Throws on failure.
+        static void savePng(const RgbaImage& image, const std::string& path);
+
+    private:
+        void ensureTarget(int width, int height);
+
+        std::unique_ptr<Ogre::LogManager> mLogManager;
+        std::unique_ptr<Ogre::Root> mRoot;
+        std::unique_ptr<TreeLodPlugin> mPlugin; ///< when installed in-process
+        Ogre::RenderWindow* mWindow = nullptr;
+        Ogre::SceneManager* mSceneManager = nullptr;
+        Ogre::Camera* mCamera = nullptr;
+        Ogre::SceneNode* mCameraNode = nullptr;
+        Ogre::Light* mSun = nullptr;
+        Ogre::TexturePtr mTarget;
+        LightingSpec mLighting;
+    };
+}

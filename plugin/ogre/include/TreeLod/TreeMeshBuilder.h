@@ -1,0 +1,31 @@
+// TreeMeshBuilder: TreeModel -> Ogre::Mesh, the polygonal reference of every comparison.
+//
+// Submeshes: one per bark material, then one per leaf material, each with its own
+// vertex buffer (position float3, normal float3, uv0 float2) and 16-bit indices when
+// its vertices fit, 32-bit otherwise. Bark gets `barkLodLevels` MeshLodGenerator levels
+// (pixel-count strategy, DESIGN.md "LoD thresholds in screen pixels"); leaf submeshes
+// keep every leaf at every level (the technique issues are the foliage LoD).
+#pragma once
+
+#include "TreeLod/TreeModel.h"
+
+#include <OgreMesh.h>
+
+#include <vector>
+
+namespace TreeLod
+{
+    struct MeshBuildOptions
+    {
+        unsigned barkLodLevels = 3;        ///< 0 = no bark LoD
+        float firstLodPixels = 250000.0f;  ///< screen pixels below which level 1 is used
+        float lodPixelRatio = 0.25f;       ///< each next level at this fraction of the previous pixels
+        float lodReduction = 0.5f;         ///< fraction of bark vertices removed per level (cumulative)
+    };
+
+    /// Build mesh `name` in `group`; `materialNames[i]` is the Ogre material for
+    /// model.materials[i]. Throws Ogre::InvalidParametersException on inconsistent input.
+    Ogre::MeshPtr buildTreeMesh(const Ogre::String& name, const Ogre::String& group, const TreeModel& model,
+                                const std::vector<Ogre::String>& materialNames,
+                                const MeshBuildOptions& options = {});
+}

@@ -1,0 +1,195 @@
+#include "TreeLod/OffscreenRenderer.h"
+
+#include "TreeLod/AtomicFile.h"
+#include "TreeLod/TreeLodPlugin.h"
+
+#include <cmath>
+#include <cstdlib>
+
+namespace TreeLod
+{
+    namespace
+    {
+        float toLinear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
+        float toSrgb(float c)
+        {
+            c = c < 0.0f ? 0.0f : (c > 1.0f ? 1.0f : c);
+            return c <= 0.0031308f ? c * 12.92f : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+        }
+
+        std::string envOr(const char* name, const std::string& fallback)
+        {
+            const char* v = std::getenv(name);
+            return v && *v ? std::string(v) : fallback;
+        }
+    }
+
+    OffscreenRenderer::OffscreenRenderer(const OffscreenOptions& options)
+    {
+        // Own LogManager first, else Ogre logs to stdout (OGRE-NOTES.md).
+        mLogManager = std::make_unique<Ogre::LogManager>();
+        mLogManager->createLog(options.logFile, true, options.verbose, options.logFile.empty());
+        mRoot = std::make_unique<Ogre::Root>("", "", "");
+
+        const std::string pluginDir = envOr("OGRE_PLUGIN_DIR_OVERRIDE", TREELOD_OGRE_PLUGIN_DIR);
+        mRoot->loadPlugin(pluginDir + "/RenderSystem_GL3Plus.so");
+        mRoot->loadPlugin(pluginDir + "/Codec_STBI.so");
+        if (options.pluginPath.empty())
+        {
+            mPlugin = std::make_unique<TreeLodPlugin>();
+            mRoot->installPlugin(mPlugin.get());
+        }
+        else
+            mRoot->loadPlugin(options.pluginPath);
+
+        const Ogre::RenderSystemList& systems = mRoot->getAvailableRenderers();
+        if (systems.empty())
+            OGRE_EXCEPT(Ogre::Exception::ERR_RENDERINGAPI_ERROR, "RenderSystem_GL3Plus did not load from " + pluginDir,
+                        "OffscreenRenderer");
+        mRoot->setRenderSystem(systems.front());
+        mRoot->initialise(false);
+        Ogre::NameValuePairList misc;
+        misc["hidden"] = "true";
+        misc["vsync"] = "false";
+        mWindow = mRoot->createRenderWindow("TreeLodOffscreen", 1, 1, false, &misc);
+        mWindow->setAutoUpdated(false);
+
+        const std::string materials = !options.materialsDir.empty()
+                                          ? options.materialsDir
+                                          : envOr("TREELOD_MATERIALS_DIR", TREELOD_DEFAULT_MATERIALS_DIR);
+        Ogre::ResourceGroupManager& rgm = Ogre::ResourceGroupManager::getSingleton();
+        rgm.addResourceLocation(materials, "FileSystem", "TreeLod");
+        rgm.addResourceLocation(materials + "/GLSL", "FileSystem", "TreeLod");
+        rgm.initialiseResourceGroup("TreeLod");
+
+        mSceneManager = mRoot->createSceneManager();
+        mCamera = mSceneManager->createCamera("TreeLodOffscreenCamera");
+        mCameraNode = mSceneManager->getRootSceneNode()->createChildSceneNode();
+        mCameraNode->attachObject(mCamera);
+        mSun = mSceneManager->createLight("TreeLodSun");
+        mSun->setType(Ogre::Light::LT_DIRECTIONAL);
+        mSceneManager->getRootSceneNode()->createChildSceneNode()->attachObject(mSun);
+        setLighting(LightingSpec());
+    }
+
+    OffscreenRenderer::~OffscreenRenderer()
+    {
+        if (mTarget)
+            Ogre::TextureManager::getSingleton().remove(mTarget);
+        mTarget.reset();
+        if (mSceneManager)
+            mRoot->destroySceneManager(mSceneManager);
+        mRoot->shutdown();
+        if (mPlugin)
+            mRoot->uninstallPlugin(mPlugin.get());
+        mRoot.reset();
+        mPlugin.reset();
+        mLogManager.reset();
+    }
+
+    void OffscreenRenderer::setLighting(const LightingSpec& lighting)
+    {
+        mLighting = lighting;
+        const glm::vec3& a = lighting.ambientColour;
+        const glm::vec3& s = lighting.sunColour;
+        mSceneManager->setAmbientLight(Ogre::ColourValue(a.r, a.g, a.b));
+        mSun->setDiffuseColour(Ogre::ColourValue(s.r, s.g, s.b));
+        mSun->setSpecularColour(Ogre::ColourValue::Black);
+        glm::vec3 d = -glm::normalize(lighting.sunDirection); // Ogre: the direction light travels
+        mSun->getParentSceneNode()->setDirection(Ogre::Vector3(d.x, d.y, d.z), Ogre::Node::TS_WORLD);
+    }
+
+    void OffscreenRenderer::ensureTarget(int width, int height)
+    {
+        if (mTarget && int(mTarget->getWidth()) == width && int(mTarget->getHeight()) == height)
+            return;
+        if (mTarget)
+            Ogre::TextureManager::getSingleton().remove(mTarget);
+        mTarget = Ogre::TextureManager::getSingleton().createManual(
+            "TreeLodOffscreenTarget", Ogre::RGN_INTERNAL, Ogre::TEX_TYPE_2D, Ogre::uint(width), Ogre::uint(height),
+            0, Ogre::PF_BYTE_RGBA, Ogre::TU_RENDERTARGET);
+        Ogre::RenderTarget* rt = mTarget->getBuffer()->getRenderTarget();
+        rt->setAutoUpdated(false);
+        Ogre::Viewport* vp = rt->addViewport(mCamera);
+        vp->setOverlaysEnabled(false);
+        vp->setShadowsEnabled(true);
+    }
+
+    RgbaImage OffscreenRenderer::render(const CameraSpec& spec, int width, int height, int samplesPerAxis)
+    {
+        OgreAssert(width > 0 && height > 0 && samplesPerAxis > 0, "render size must be positive");
+        const int s = samplesPerAxis, w = width * s, h = height * s;
+        ensureTarget(w, h);
+
+        mCamera->setNearClipDistance(spec.nearClip);
+        mCamera->setFarClipDistance(spec.farClip);
+        mCamera->setAspectRatio(Ogre::Real(width) / Ogre::Real(height));
+        if (spec.orthographic)
+        {
+            mCamera->setProjectionType(Ogre::PT_ORTHOGRAPHIC);
+            mCamera->setOrthoWindowHeight(spec.orthoHeight);
+        }
+        else
+        {
+            mCamera->setProjectionType(Ogre::PT_PERSPECTIVE);
+            mCamera->setFOVy(Ogre::Degree(spec.fovYDegrees));
+        }
+        mCameraNode->setPosition(spec.position.x, spec.position.y, spec.position.z);
+        mCameraNode->setFixedYawAxis(true, Ogre::Vector3(spec.up.x, spec.up.y, spec.up.z));
+        mCameraNode->lookAt(Ogre::Vector3(spec.target.x, spec.target.y, spec.target.z), Ogre::Node::TS_WORLD);
+
+        Ogre::RenderTarget* rt = mTarget->getBuffer()->getRenderTarget();
+        const glm::vec3& bg = mLighting.background;
+        rt->getViewport(0)->setBackgroundColour(Ogre::ColourValue(bg.r, bg.g, bg.b, 1.0f));
+        mRoot->renderOneFrame(); // frame listeners, controllers
+        rt->update();
+
+        std::vector<std::uint8_t> big(std::size_t(w) * h * 4);
+        Ogre::PixelBox box(Ogre::uint32(w), Ogre::uint32(h), 1, Ogre::PF_BYTE_RGBA, big.data());
+        rt->copyContentsToMemory(Ogre::Box(0, 0, Ogre::uint32(w), Ogre::uint32(h)), box,
+                                 Ogre::RenderTarget::FB_AUTO);
+
+        RgbaImage out;
+        out.width = width;
+        out.height = height;
+        out.pixels.resize(std::size_t(width) * height * 4);
+        const float norm = 1.0f / float(s * s);
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x)
+            {
+                float sum[3] = {0.0f, 0.0f, 0.0f};
+                for (int sy = 0; sy < s; ++sy)
+                    for (int sx = 0; sx < s; ++sx)
+                    {
+                        const std::uint8_t* p = &big[(std::size_t(y * s + sy) * w + (x * s + sx)) * 4];
+                        for (int c = 0; c < 3; ++c)
+                            sum[c] += toLinear(p[c] / 255.0f);
+                    }
+                std::uint8_t* o = &out.pixels[(std::size_t(y) * width + x) * 4];
+                for (int c = 0; c < 3; ++c)
+                    o[c] = std::uint8_t(std::lround(toSrgb(sum[c] * norm) * 255.0f));
+                o[3] = 255;
+            }
+        return out;
+    }
+
+    void OffscreenRenderer::savePng(const RgbaImage& image, const std::string& path)
+    {
+        Result<void> r = writeFileAtomicVia(path, [&](const std::string& temp) -> Result<void> {
+            Ogre::Image img;
+            img.loadDynamicImage(const_cast<std::uint8_t*>(image.pixels.data()), Ogre::uint32(image.width),
+                                 Ogre::uint32(image.height), Ogre::PF_BYTE_RGBA);
+            try
+            {
+                img.save(temp);
+            }
+            catch (const Ogre::Exception& e)
+            {
+                return fail(path, "", e.getDescription());
+            }
+            return {};
+        });
+        if (!r)
+            OGRE_EXCEPT(Ogre::Exception::ERR_CANNOT_WRITE_TO_FILE, r.error().message(), "OffscreenRenderer::savePng");
+    }
+}

@@ -1,0 +1,1 @@
+// placeholder: .mesh import comes with the leaf-extraction move

@@ -1,0 +1,66 @@
+#include "TreeLod/TechniqueRegistry.h"
+
+#include "TreeLod/TreeAsset.h"
+
+#include <OgreEntity.h>
+#include <OgreException.h>
+#include <OgreSceneManager.h>
+
+template <> TreeLod::TechniqueRegistry* Ogre::Singleton<TreeLod::TechniqueRegistry>::msSingleton = nullptr;
+
+namespace TreeLod
+{
+    TechniqueRegistry& TechniqueRegistry::getSingleton() { return *msSingleton; }
+    TechniqueRegistry* TechniqueRegistry::getSingletonPtr() { return msSingleton; }
+
+    TechniqueRegistry::TechniqueRegistry()
+    {
+        // The polygonal reference: every comparison in this project is against it.
+        add({"mesh", "polygonal reference: bark with MeshLodGenerator levels, every leaf", "reference",
+             Ogre::EntityFactory::FACTORY_TYPE_NAME,
+             [](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset, const Ogre::NameValuePairList&) {
+                 return static_cast<Ogre::MovableObject*>(sm.createEntity(name, asset.getReferenceMesh()));
+             }});
+        // Technique issues add their line here.
+    }
+
+    void TechniqueRegistry::add(TechniqueInfo info)
+    {
+        for (TechniqueInfo& t : mTechniques)
+            if (t.name == info.name)
+            {
+                t = std::move(info);
+                return;
+            }
+        mTechniques.push_back(std::move(info));
+    }
+
+    const TechniqueInfo* TechniqueRegistry::find(const Ogre::String& name) const
+    {
+        for (const TechniqueInfo& t : mTechniques)
+            if (t.name == name)
+                return &t;
+        return nullptr;
+    }
+
+    Ogre::String TechniqueRegistry::describe() const
+    {
+        Ogre::String out;
+        for (const TechniqueInfo& t : mTechniques)
+            out += (out.empty() ? "" : ", ") + t.name;
+        return out;
+    }
+
+    Ogre::MovableObject* TechniqueRegistry::createInstance(const Ogre::String& technique,
+                                                           Ogre::SceneManager& sceneManager,
+                                                           const Ogre::String& name, TreeAsset& asset,
+                                                           const Ogre::NameValuePairList& params) const
+    {
+        const TechniqueInfo* info = find(technique);
+        if (!info)
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                        "unknown technique '" + technique + "' (known: " + describe() + ")",
+                        "TechniqueRegistry::createInstance");
+        return info->create(sceneManager, name, asset, params);
+    }
+}

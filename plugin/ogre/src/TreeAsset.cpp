@@ -1,0 +1,185 @@
+#include "TreeLod/TreeAsset.h"
+
+#include "TreeLod/TreeMeshBuilder.h"
+
+#include <OgreException.h>
+#include <OgreImage.h>
+#include <OgreMaterialManager.h>
+#include <OgreMeshManager.h>
+#include <OgrePass.h>
+#include <OgreResourceGroupManager.h>
+#include <OgreTechnique.h>
+#include <OgreTextureManager.h>
+
+namespace TreeLod
+{
+    TreeAsset::TreeAsset(Ogre::ResourceManager* creator, const Ogre::String& name, Ogre::ResourceHandle handle,
+                         const Ogre::String& group, bool isManual, Ogre::ManualResourceLoader* loader)
+        : Ogre::Resource(creator, name, handle, group, isManual, loader)
+    {
+    }
+
+    TreeAsset::~TreeAsset() { unload(); }
+
+    void TreeAsset::setPackageBytes(std::vector<std::uint8_t> bytes) { mManualBytes = std::move(bytes); }
+
+    void TreeAsset::raise(const Error& error) const
+    {
+        OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, error.message(), "TreeAsset '" + mName + "'");
+    }
+
+    void TreeAsset::loadImpl()
+    {
+        std::vector<std::uint8_t> bytes = mManualBytes;
+        if (bytes.empty())
+        {
+            Ogre::DataStreamPtr stream = Ogre::ResourceGroupManager::getSingleton().openResource(mName, mGroup, this);
+            bytes.resize(stream->size());
+            if (!bytes.empty() && stream->read(bytes.data(), bytes.size()) != bytes.size())
+                raise(fail(mName, "", "short read from resource stream"));
+        }
+        Result<PackageReader> package = PackageReader::fromMemory(std::move(bytes), mName);
+        if (!package)
+            raise(package.error());
+        mPackage = std::make_unique<PackageReader>(std::move(package.value()));
+    }
+
+    void TreeAsset::unloadImpl()
+    {
+        if (mReferenceMesh)
+            Ogre::MeshManager::getSingleton().remove(mReferenceMesh);
+        mReferenceMesh.reset();
+        for (const Ogre::String& m : mMaterialNames)
+        {
+            Ogre::MaterialManager::getSingleton().remove(m, mGroup);
+            Ogre::MaterialManager::getSingleton().remove(m + "/Caster", mGroup);
+        }
+        for (const Ogre::String& t : mTextureNames)
+            Ogre::TextureManager::getSingleton().remove(t, mGroup);
+        mMaterialNames.clear();
+        mTextureNames.clear();
+        mReference.reset();
+        mPackage.reset();
+    }
+
+    size_t TreeAsset::calculateSize() const { return mPackage ? size_t(mPackage->fileSize()) : 0; }
+
+    const PackageReader& TreeAsset::getPackage() const
+    {
+        if (!mPackage)
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALID_STATE, "TreeAsset '" + mName + "' is not loaded",
+                        "TreeAsset::getPackage");
+        return *mPackage;
+    }
+
+    bool TreeAsset::hasChunk(const Ogre::String& technique, std::uint32_t level) const
+    {
+        return getPackage().findChunk(technique, level) >= 0;
+    }
+
+    const ReferenceChunk& TreeAsset::getReference()
+    {
+        if (mReference)
+            return *mReference;
+        const PackageReader& package = getPackage();
+        int index = package.findChunk("reference", 0);
+        if (index < 0)
+            raise(fail(mName, "chunk 'reference' level 0", "missing: bake the package with --technique reference"));
+        Result<std::vector<std::uint8_t>> bytes = package.readChunk(std::size_t(index));
+        if (!bytes)
+            raise(bytes.error());
+        Result<ReferenceChunk> chunk = decodeReferenceChunk(bytes.value(), mName);
+        if (!chunk)
+            raise(chunk.error());
+        mReference = std::make_unique<ReferenceChunk>(std::move(chunk.value()));
+        return *mReference;
+    }
+
+    Ogre::AxisAlignedBox TreeAsset::getBounds()
+    {
+        const TreeModel& m = getReference().model;
+        return Ogre::AxisAlignedBox(m.boundsMin.x, m.boundsMin.y, m.boundsMin.z, m.boundsMax.x, m.boundsMax.y,
+                                    m.boundsMax.z);
+    }
+
+    const std::vector<Ogre::String>& TreeAsset::getMaterialNames()
+    {
+        if (mMaterialNames.empty())
+            createMaterials();
+        return mMaterialNames;
+    }
+
+    void TreeAsset::createMaterials()
+    {
+        const ReferenceChunk& ref = getReference();
+        const Ogre::String prefix = "TreeLod/" + mName + "/";
+
+        // GPU-ready textures: RGBA8 with their baked mip chain, uploaded as they are.
+        for (std::size_t t = 0; t < ref.textures.size(); ++t)
+        {
+            const GpuTexture& gpu = ref.textures[t];
+            Ogre::Image image;
+            image.loadDynamicImage(const_cast<Ogre::uchar*>(gpu.data.data()), gpu.width, gpu.height, 1,
+                                   Ogre::PF_BYTE_RGBA, false, 1, gpu.mipCount > 0 ? gpu.mipCount - 1 : 0);
+            const Ogre::String name = prefix + "texture" + std::to_string(t);
+            Ogre::TextureManager::getSingleton().loadImage(name, mGroup, image, Ogre::TEX_TYPE_2D,
+                                                           int(gpu.mipCount > 0 ? gpu.mipCount - 1 : 0));
+            mTextureNames.push_back(name);
+        }
+
+        for (std::size_t i = 0; i < ref.model.materials.size(); ++i)
+        {
+            const Material& src = ref.model.materials[i];
+            const Ogre::String base = src.isLeaf ? "TreeLod/Leaf" : "TreeLod/Bark";
+            Ogre::MaterialPtr parent = Ogre::MaterialManager::getSingleton().getByName(base, Ogre::RGN_DEFAULT);
+            if (!parent)
+                parent = Ogre::MaterialManager::getSingleton().getByName(base);
+            if (!parent)
+                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
+                            "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
+                            "TreeAsset::createMaterials");
+            const Ogre::String name = prefix + std::to_string(i);
+            Ogre::MaterialPtr mat = parent->clone(name, true, mGroup);
+            const Ogre::String texture = src.texture >= 0 ? mTextureNames[std::size_t(src.texture)] : "TreeLodWhite.png";
+            glm::vec3 back = src.backColour == glm::vec3(0.0f) ? glm::vec3(src.baseColour) : src.backColour;
+
+            auto configure = [&](const Ogre::MaterialPtr& m) {
+                m->load();
+                for (Ogre::Technique* tech : m->getTechniques())
+                    for (Ogre::Pass* pass : tech->getPasses())
+                    {
+                        if (pass->getNumTextureUnitStates() > 0)
+                            pass->getTextureUnitState(0)->setTextureName(texture);
+                        if (!pass->hasFragmentProgram())
+                            continue;
+                        Ogre::GpuProgramParametersSharedPtr p = pass->getFragmentProgramParameters();
+                        p->setIgnoreMissingParams(true);
+                        p->setNamedConstant("baseColour", Ogre::ColourValue(src.baseColour.r, src.baseColour.g,
+                                                                          src.baseColour.b, src.baseColour.a));
+                        p->setNamedConstant("backColour", Ogre::ColourValue(back.r, back.g, back.b, 1.0f));
+                        p->setNamedConstant("alphaCutoff", src.alphaCutoff);
+                    }
+            };
+            configure(mat);
+            // The shadow caster alpha-tests the same texture.
+            Ogre::Technique* tech = mat->getTechnique(0);
+            if (Ogre::MaterialPtr caster = tech->getShadowCasterMaterial())
+            {
+                Ogre::MaterialPtr own = caster->clone(name + "/Caster", true, mGroup);
+                configure(own);
+                tech->setShadowCasterMaterial(own);
+            }
+            mMaterialNames.push_back(name);
+        }
+    }
+
+    Ogre::MeshPtr TreeAsset::getReferenceMesh()
+    {
+        if (!mReferenceMesh)
+        {
+            const std::vector<Ogre::String>& materials = getMaterialNames();
+            mReferenceMesh = buildTreeMesh(mName + "/reference", mGroup, getReference().model, materials);
+        }
+        return mReferenceMesh;
+    }
+}

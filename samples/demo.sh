@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# The main job: install what is missing, build, and render the bundled trees headless
+# through the Ogre plugin (and through the CPU reference renderer) into PNGs.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${TREELOD_BUILD_DIR:-$root/build}
+out=${TREELOD_DEMO_OUT:-$root/out/demo}
+"$root/.ci/deps.sh"
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DTREELOD_BUILD_TESTS=OFF -DTREELOD_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build "$build" -j"$(nproc)" --target treelod
+mkdir -p "$out"
+export XDG_CACHE_HOME=${XDG_CACHE_HOME:-$build/cache}
+run() { xvfb-run -a -s "-screen 0 1280x1024x24" "$@"; }
+for tree in "$root"/media/*.glb; do
+  name=$(basename "$tree" .glb)
+  for view in "front:orbit:0,8,1.0" "side:orbit:90,20,1.0"; do
+    label=${view%%:*}; camera=${view#*:}
+    run "$build/bin/treelod" render "$tree" --technique mesh --camera "$camera" --size 512x512 \
+      -o "$out/$name-$label-ogre.png"
+  done
+  "$build/bin/treelod" render "$tree" --renderer cpu --camera "orbit:0,8,1.0" --size 512x512 \
+    -o "$out/$name-front-cpu.png"
+done
+echo
+echo "Rendered the bundled trees into $out:"
+ls -1 "$out"/*.png

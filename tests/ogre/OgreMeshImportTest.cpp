@@ -1,0 +1,1 @@
+// .mesh import tests come with the importer

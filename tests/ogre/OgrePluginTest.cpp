@@ -1,0 +1,161 @@
+// Plugin_TreeLod loaded into a headless Root: install, the TreeAsset resource type,
+// packages found through resource groups, the reference mesh, bad packages.
+#include "OgreTestSupport.h"
+
+#include "TreeLod/PackageWriter.h"
+#include "TreeLod/TechniqueRegistry.h"
+#include "TreeLod/TreeAssetManager.h"
+#include "TreeLod/TreeGenerator.h"
+
+#include <OgreSubMesh.h>
+
+#include <fstream>
+
+namespace TreeLod
+{
+    namespace
+    {
+        /// A generated tree baked into `dir/name` (reference chunk only).
+        std::string bakeGenerated(const std::string& dir, const std::string& name, std::uint32_t leaves)
+        {
+            GeneratorOptions options;
+            options.preset = TreePreset::Birch;
+            options.leafCount = leaves;
+            options.textureSize = 64;
+            Result<TreeModel> model = generateTree(options);
+            EXPECT_TRUE(model.ok()) << (model.ok() ? "" : model.error().message());
+            const std::string path = dir + "/" + name;
+            Result<void> written = bakeReferencePackage(model.value(), path, PackageMeta{});
+            EXPECT_TRUE(written.ok()) << (written.ok() ? "" : written.error().message());
+            return path;
+        }
+
+        Ogre::String packageGroup()
+        {
+            static bool once = [] {
+                Ogre::ResourceGroupManager::getSingleton().addResourceLocation(
+                    OgreEnvironment::outDir() + "/packages", "FileSystem", "TreeLodTestPackages");
+                return true;
+            }();
+            (void)once;
+            return "TreeLodTestPackages";
+        }
+    }
+
+    TEST(OgrePlugin, installsFromSharedLibrary)
+    {
+        // Loading the .so runs dllStartPlugin, which installs the plugin: the resource
+        // manager and the technique registry exist afterwards.
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        bool found = false;
+        for (Ogre::Plugin* p : r.getRoot().getInstalledPlugins())
+            found = found || p->getName() == "TreeLod";
+        EXPECT_TRUE(found);
+        ASSERT_NE(TreeAssetManager::getSingletonPtr(), nullptr);
+        EXPECT_EQ(TreeAssetManager::getSingleton().getResourceType(), "TreeAsset");
+        ASSERT_NE(TechniqueRegistry::getSingletonPtr(), nullptr);
+        EXPECT_NE(TechniqueRegistry::getSingleton().find("mesh"), nullptr);
+    }
+
+    TEST(OgrePlugin, loadsPackageThroughResourceGroupAndBuildsReferenceMesh)
+    {
+        OgreEnvironment::renderer();
+        std::filesystem::create_directories(OgreEnvironment::outDir() + "/packages");
+        bakeGenerated(OgreEnvironment::outDir() + "/packages", "birch-300.treelod", 300);
+        Ogre::ResourceGroupManager::getSingleton().initialiseResourceGroup(packageGroup());
+
+        TreeAssetPtr asset = TreeAssetManager::getSingleton().load("birch-300.treelod", packageGroup());
+        ASSERT_TRUE(asset);
+        EXPECT_TRUE(asset->hasChunk("reference"));
+        Ogre::MeshPtr mesh = asset->getReferenceMesh();
+        ASSERT_TRUE(mesh);
+        const TreeModel& model = asset->getReference().model;
+        EXPECT_EQ(model.leaves.size(), 300u);
+
+        // Bark first (one material), leaves after: every leaf triangle is in the leaf submesh.
+        std::size_t leafIndices = 0, barkIndices = 0;
+        for (Ogre::SubMesh* sub : mesh->getSubMeshes())
+        {
+            bool leaf = sub->getMaterialName().find("TreeLod/birch-300.treelod/") == 0 &&
+                        model.materials[std::stoul(sub->getMaterialName().substr(26))].isLeaf;
+            (leaf ? leafIndices : barkIndices) += sub->indexData->indexCount;
+        }
+        EXPECT_EQ(leafIndices, model.leafIndices.size());
+        EXPECT_EQ(barkIndices, model.barkIndices.size());
+        // MeshLodGenerator levels for the bark, full leaves at each level.
+        EXPECT_GT(mesh->getNumLodLevels(), 1u);
+        for (Ogre::SubMesh* sub : mesh->getSubMeshes())
+        {
+            ASSERT_EQ(sub->mLodFaceList.size(), mesh->getNumLodLevels() - 1u);
+            if (sub->indexData->indexCount == leafIndices)
+                for (Ogre::IndexData* lod : sub->mLodFaceList)
+                    EXPECT_EQ(lod->indexCount, leafIndices);
+        }
+        EXPECT_LT(mesh->getSubMesh(0)->mLodFaceList.back()->indexCount, mesh->getSubMesh(0)->indexData->indexCount);
+    }
+
+    TEST(OgrePlugin, uses32BitIndicesBeyond65535Vertices)
+    {
+        // 20,000 quads = 80,000 leaf vertices in one submesh: 16-bit indices cannot address them.
+        OgreEnvironment::renderer();
+        std::filesystem::create_directories(OgreEnvironment::outDir() + "/packages");
+        bakeGenerated(OgreEnvironment::outDir() + "/packages", "birch-20k.treelod", 20000);
+        Ogre::ResourceGroupManager::getSingleton().initialiseResourceGroup(packageGroup());
+        TreeAssetPtr asset = TreeAssetManager::getSingleton().load("birch-20k.treelod", packageGroup());
+        Ogre::MeshPtr mesh = asset->getReferenceMesh();
+        Ogre::SubMesh* leaves = mesh->getSubMesh(mesh->getNumSubMeshes() - 1);
+        EXPECT_EQ(leaves->vertexData->vertexCount, 80000u);
+        EXPECT_EQ(leaves->indexData->indexBuffer->getType(), Ogre::HardwareIndexBuffer::IT_32BIT);
+        EXPECT_EQ(mesh->getSubMesh(0)->indexData->indexBuffer->getType(), Ogre::HardwareIndexBuffer::IT_16BIT);
+    }
+
+    TEST(OgrePlugin, corruptPackageRaisesErrorNamingResourceAndReason)
+    {
+        OgreEnvironment::renderer();
+        const std::string dir = OgreEnvironment::outDir() + "/packages";
+        std::filesystem::create_directories(dir);
+        std::string good = bakeGenerated(dir, "flip-source.treelod", 100);
+        std::ifstream in(good, std::ios::binary);
+        std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        ASSERT_GT(bytes.size(), 200u);
+        bytes[bytes.size() - 100] ^= 0x40; // inside the reference chunk's payload
+
+        TreeAssetPtr asset = TreeAssetManager::getSingleton().loadFromBytes("flipped.treelod", Ogre::RGN_DEFAULT, bytes);
+        try
+        {
+            asset->getReferenceMesh();
+            FAIL() << "a bit flip in the payload must be detected by the chunk checksum";
+        }
+        catch (const Ogre::Exception& e)
+        {
+            EXPECT_NE(e.getDescription().find("flipped.treelod"), std::string::npos) << e.getDescription();
+            EXPECT_NE(e.getDescription().find("reference"), std::string::npos) << e.getDescription();
+            EXPECT_NE(e.getDescription().find("checksum"), std::string::npos) << e.getDescription();
+        }
+
+        // Truncated: the header and table are checked at load.
+        std::vector<std::uint8_t> cut(bytes.begin(), bytes.begin() + 20);
+        EXPECT_THROW(TreeAssetManager::getSingleton().loadFromBytes("cut.treelod", Ogre::RGN_DEFAULT, cut),
+                     Ogre::Exception);
+    }
+
+    TEST(OgrePlugin, unknownTechniqueNamesTheKnownOnes)
+    {
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        std::filesystem::create_directories(OgreEnvironment::outDir() + "/packages");
+        std::string path = bakeGenerated(OgreEnvironment::outDir() + "/packages", "tech.treelod", 100);
+        std::ifstream in(path, std::ios::binary);
+        std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        TreeAssetPtr asset = TreeAssetManager::getSingleton().loadFromBytes("tech-mem.treelod", Ogre::RGN_DEFAULT, bytes);
+        try
+        {
+            TechniqueRegistry::getSingleton().createInstance("nosuch", r.getSceneManager(), "x", *asset);
+            FAIL();
+        }
+        catch (const Ogre::Exception& e)
+        {
+            EXPECT_NE(e.getDescription().find("nosuch"), std::string::npos);
+            EXPECT_NE(e.getDescription().find("mesh"), std::string::npos);
+        }
+    }
+}
