@@ -11,6 +11,7 @@ uniform vec4 backColour;    // linear
 uniform float alphaCutoff;
 
 in vec3 vNormal;
+in vec3 vToCamera;
 in vec2 vUv;
 
 out vec4 fragColour;
@@ -30,7 +31,9 @@ void main()
 #ifdef LEAF
     if (texel.a < alphaCutoff)
         discard;
-    if (!gl_FrontFacing)
+    // Facing from the normal, not gl_FrontFacing: render-to-texture flips Y and with it
+    // the winding that gl_FrontFacing reports.
+    if (dot(n, vToCamera) < 0.0)
     {
         n = -n;
         tint = backColour.rgb;

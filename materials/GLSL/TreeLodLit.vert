@@ -10,11 +10,13 @@ in vec3 normal;
 in vec2 uv0;
 
 out vec3 vNormal;
+out vec3 vToCamera;
 out vec2 vUv;
 
 void main()
 {
     gl_Position = worldViewProj * vertex;
     vNormal = mat3(normalMatrix) * normal;
+    vToCamera = cameraPosition.xyz - (world * vertex).xyz;
     vUv = uv0;
 }

@@ -1,7 +1,148 @@
-// placeholder: being written
+// treelod bake INPUT.glb -o OUT.treelod [--technique NAME]... [--leaf-material NAME]... [-q]
+// Imports the tree, bakes one chunk set per technique plus the "meta" chunk (source file
+// name, FNV-1a 64 hash of the input file's bytes, options) and writes the package atomically:
+// on any error nothing is written and the exit code is 2.
+#include "CliSupport.h"
 #include "Commands.h"
+
+#include "TreeLod/AtomicFile.h"
+#include "TreeLod/GltfImporter.h"
+#include "TreeLod/Package.h"
+#include "TreeLod/PackageWriter.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
 
 namespace TreeLod
 {
-    void addBakeCommand(CLI::App& app) { app.add_subcommand("bake", "(not yet implemented)"); }
+    namespace
+    {
+        /// Adds a technique's chunks for `model` to the package; `label` names the output in errors.
+        using BakeFunction = Result<void> (*)(PackageWriter& writer, const TreeModel& model, const std::string& label,
+                                              const ProgressCallback& progress);
+
+        struct BakeTechnique
+        {
+            const char* name;
+            const char* description;
+            BakeFunction bake;
+        };
+
+        /// Every technique `treelod bake` knows: a new technique adds one line here.
+        const BakeTechnique BAKE_TECHNIQUES[] = {
+            {REFERENCE_CHUNK, "the polygonal tree with GPU-ready mip-mapped textures", &addReferenceChunk},
+        };
+
+        const BakeTechnique* findTechnique(const std::string& name)
+        {
+            for (const BakeTechnique& t : BAKE_TECHNIQUES)
+                if (name == t.name)
+                    return &t;
+            return nullptr;
+        }
+
+        std::string knownTechniques()
+        {
+            std::string list;
+            for (const BakeTechnique& t : BAKE_TECHNIQUES)
+                list += (list.empty() ? "" : ", ") + std::string(t.name);
+            return list;
+        }
+
+        struct BakeArgs
+        {
+            std::string input;
+            std::string output;
+            std::vector<std::string> techniques;
+            std::vector<std::string> leafMaterials;
+            bool quiet = false;
+        };
+
+        int runBake(const BakeArgs& args)
+        {
+            std::vector<const BakeTechnique*> techniques;
+            for (const std::string& name : args.techniques.empty() ? std::vector<std::string>{REFERENCE_CHUNK}
+                                                                   : args.techniques)
+            {
+                const BakeTechnique* t = findTechnique(name);
+                if (!t)
+                    return printError(fail("", "option --technique",
+                                           "'" + name + "' is not a known technique (known: " + knownTechniques() +
+                                               ")"));
+                if (std::find(techniques.begin(), techniques.end(), t) == techniques.end())
+                    techniques.push_back(t);
+            }
+
+            Result<std::vector<std::uint8_t>> inputBytes = readFile(args.input);
+            if (!inputBytes)
+                return printError(inputBytes.error());
+            char hash[32];
+            std::snprintf(hash, sizeof(hash), "fnv1a64:%016llx",
+                          (unsigned long long)fnv1a64(inputBytes->data(), inputBytes->size()));
+
+            const ProgressCallback progress = makeProgress(args.quiet);
+            ImportOptions options;
+            options.leafMaterials = args.leafMaterials;
+            options.progress = progress;
+            ImportReport importReport;
+            Result<TreeModel> model = importGltf(args.input, options, &importReport);
+            if (!model)
+                return printError(model.error());
+            for (const std::string& w : importReport.warnings)
+                std::fprintf(stderr, "treelod: %s: warning: %s\n", args.input.c_str(), w.c_str());
+
+            PackageWriter writer;
+            PackageMeta meta;
+            meta.source = std::filesystem::path(args.input).filename().string();
+            meta.sourceHash = hash;
+            meta.optionsJson = nlohmann::json{{"leafMaterials", args.leafMaterials}}.dump(
+                -1, ' ', false, nlohmann::json::error_handler_t::replace);
+            for (const BakeTechnique* t : techniques)
+            {
+                Result<void> baked = t->bake(writer, model.value(), args.output, progress);
+                if (!baked)
+                    return printError(baked.error());
+                meta.techniques.push_back(t->name);
+            }
+            Result<void> added = addMetaChunk(writer, meta);
+            if (!added)
+                return printError(added.error());
+
+            report(progress, "write", 0.0f);
+            const std::vector<std::uint8_t> bytes = writer.toBytes();
+            Result<void> written = writeFileAtomic(args.output, bytes);
+            if (!written)
+                return printError(written.error());
+            report(progress, "write", 1.0f);
+
+            std::string list;
+            for (const BakeTechnique* t : techniques)
+                list += (list.empty() ? "" : ", ") + std::string(t->name);
+            std::printf("wrote %s: %zu chunks (%s + meta), %zu bytes; %zu leaves, %zu bark triangles\n",
+                        args.output.c_str(), writer.chunkCount(), list.c_str(), bytes.size(), model->leaves.size(),
+                        model->barkTriangleCount());
+            return EXIT_OK;
+        }
+    }
+
+    void addBakeCommand(CLI::App& app)
+    {
+        auto args = std::make_shared<BakeArgs>();
+        std::string help = "technique to bake (repeatable; default reference). Known:";
+        for (const BakeTechnique& t : BAKE_TECHNIQUES)
+            help += std::string("\n  ") + t.name + ": " + t.description;
+        CLI::App* cmd = app.add_subcommand("bake", "bake a .glb/.gltf tree into a .treelod package");
+        cmd->add_option("input", args->input, ".glb or .gltf file")->required();
+        cmd->add_option("-o,--output", args->output, ".treelod file to write (atomically)")->required();
+        cmd->add_option("--technique", args->techniques, help)->allow_extra_args(false);
+        cmd->add_option("--leaf-material", args->leafMaterials,
+                        "materials with this name are leaves (repeatable; default: alphaMode MASK/BLEND)")
+            ->allow_extra_args(false);
+        cmd->add_flag("-q,--quiet", args->quiet, "no progress display");
+        cmd->callback([args]() { setExitCode(runBake(*args)); });
+    }
 }

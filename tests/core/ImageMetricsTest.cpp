@@ -3,7 +3,9 @@
 #include "TreeLod/ImageMetrics.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -332,6 +334,52 @@ TEST(MultiScaleRmse, MatchesBoxDownsampledRmseOnRandomImages)
     }
 }
 
+TEST(MultiScaleRmse, MatchesRealPixelBlockMeansOnOddSizes)
+{
+    // The documented padding rule, computed directly: band k is the RMSE over the real
+    // pixels after replacing each pixel's difference by the mean over the real pixels of
+    // its aligned 2^k block. Sizes cover odd widths, odd heights and a thin strip.
+    const int sizes[][2] = {{13, 7}, {1, 9}, {6, 5}};
+    for (const auto& size : sizes)
+    {
+        const int w = size[0], h = size[1];
+        const Image a = randomImage(w, h, 11), b = randomImage(w, h, 12);
+        Result<MultiScaleRmseResult> r = multiScaleRmse(a, b);
+        ASSERT_TRUE(r.ok());
+        int levels = 0;
+        while ((1 << levels) < std::max(w, h))
+            ++levels;
+        ASSERT_EQ(r->bands.size(), std::size_t(levels) + 1) << w << "x" << h;
+        for (int k = 0; k <= levels; ++k)
+        {
+            const int s = 1 << k;
+            double sum = 0.0;
+            for (int by = 0; by < h; by += s)
+                for (int bx = 0; bx < w; bx += s)
+                {
+                    glm::dvec3 d(0.0);
+                    int count = 0;
+                    for (int y = by; y < std::min(by + s, h); ++y)
+                        for (int x = bx; x < std::min(bx + s, w); ++x, ++count)
+                            d += glm::dvec3(b.at(x, y)) - glm::dvec3(a.at(x, y));
+                    sum += glm::dot(d, d) / count; // count * |d / count|^2
+                }
+            EXPECT_NEAR(r->bands[std::size_t(k)], std::sqrt(sum / (3.0 * w * h)), 1e-6)
+                << w << "x" << h << " band " << k;
+        }
+    }
+}
+
+TEST(MultiScaleRmse, OnePixelImageHasOneBand)
+{
+    // 1x1 is its own coarsest level: one band, the absolute difference (0.25 in each channel).
+    Result<MultiScaleRmseResult> r = multiScaleRmse(grey(1, 1, {0.5f}), grey(1, 1, {0.75f}));
+    ASSERT_TRUE(r.ok());
+    ASSERT_EQ(r->bands.size(), 1u);
+    EXPECT_NEAR(r->bands[0], 0.25, 1e-7);
+    EXPECT_NEAR(r->combined, 0.25, 1e-7);
+}
+
 TEST(MultiScaleRmse, IsSymmetric)
 {
     // Swapping the images negates every difference; squares are unchanged exactly.
@@ -468,6 +516,22 @@ TEST(Flip, IsSymmetric)
     EXPECT_EQ(ab->max, ba->max);
     EXPECT_EQ(ab->errorMap, ba->errorMap);
     EXPECT_GT(ab->mean, 0.0);
+}
+
+TEST(Flip, ResultDoesNotDependOnThreadCount)
+{
+    // Rows are filtered independently and the mean is summed in row order, so one thread
+    // and all threads must give bit-identical maps and statistics.
+    const Image a = randomImage(40, 70, 6), b = randomImage(40, 70, 7);
+    FlipOptions options;
+    options.keepErrorMap = true;
+    Result<FlipResult> many = flip(a, b, options);
+    tbb::task_arena single(1);
+    Result<FlipResult> one = single.execute([&] { return flip(a, b, options); });
+    ASSERT_TRUE(many.ok() && one.ok());
+    EXPECT_EQ(many->errorMap, one->errorMap);
+    EXPECT_EQ(many->mean, one->mean);
+    EXPECT_EQ(many->weightedMedian, one->weightedMedian);
 }
 
 TEST(Flip, GrowsWithMoreNoise)

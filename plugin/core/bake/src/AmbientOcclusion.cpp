@@ -77,6 +77,9 @@ namespace TreeLod
         float pointVisibility(const EmbreeScene& scene, const AoPoint& point, std::uint64_t index,
                               const AoOptions& options, float epsilon, float maxDistance)
         {
+            const glm::vec3& p = point.position;
+            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+                return 1.0f; // no ray can start there
             PointRng rng(options.seed, index);
             glm::vec3 n = point.normal;
             float len = glm::length(n);

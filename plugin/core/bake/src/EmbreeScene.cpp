@@ -26,6 +26,13 @@ namespace TreeLod
                                          std::to_string(int(err)) + ")");
         }
 
+        /// Embree (Debian builds keep its assertions) accepts ray components up to about 1.8e18.
+        bool rayable(const glm::vec3& v)
+        {
+            constexpr float limit = 1e18f;
+            return std::abs(v.x) <= limit && std::abs(v.y) <= limit && std::abs(v.z) <= limit; // false for NaN
+        }
+
         float wrapUnit(float x)
         {
             if (!std::isfinite(x))
@@ -35,29 +42,56 @@ namespace TreeLod
         }
     }
 
+    namespace
+    {
+        /// The four texels around uv (bilinear footprint) with REPEAT wrapping.
+        struct Footprint
+        {
+            std::size_t i00, i10, i01, i11; ///< texel indices: (x0,y0), (x1,y0), (x0,y1), (x1,y1)
+            float ax, ay;                   ///< weights of x1 and y1
+        };
+
+        Footprint footprint(glm::vec2 uv, int width, int height)
+        {
+            float x = wrapUnit(uv.x) * float(width) - 0.5f;
+            float y = wrapUnit(uv.y) * float(height) - 0.5f;
+            float fx = std::floor(x), fy = std::floor(y);
+            int x0 = int(fx), y0 = int(fy);
+            int x1 = x0 + 1, y1 = y0 + 1;
+            if (x0 < 0)
+                x0 += width;
+            if (y0 < 0)
+                y0 += height;
+            if (x1 >= width)
+                x1 -= width;
+            if (y1 >= height)
+                y1 -= height;
+            std::size_t r0 = std::size_t(y0) * width, r1 = std::size_t(y1) * width;
+            return {r0 + x0, r0 + x1, r1 + x0, r1 + x1, x - fx, y - fy};
+        }
+    }
+
     glm::vec4 LinearTexture::sample(glm::vec2 uv) const
     {
         if (width <= 0 || height <= 0)
             return glm::vec4(1.0f);
-        float x = wrapUnit(uv.x) * float(width) - 0.5f;
-        float y = wrapUnit(uv.y) * float(height) - 0.5f;
-        float fx = std::floor(x), fy = std::floor(y);
-        float ax = x - fx, ay = y - fy;
-        int x0 = int(fx), y0 = int(fy);
-        int x1 = x0 + 1, y1 = y0 + 1;
-        if (x0 < 0)
-            x0 += width;
-        if (y0 < 0)
-            y0 += height;
-        if (x1 >= width)
-            x1 -= width;
-        if (y1 >= height)
-            y1 -= height;
-        const glm::vec4* row0 = &texels[std::size_t(y0) * width];
-        const glm::vec4* row1 = &texels[std::size_t(y1) * width];
-        glm::vec4 top = row0[x0] + (row0[x1] - row0[x0]) * ax;
-        glm::vec4 bottom = row1[x0] + (row1[x1] - row1[x0]) * ax;
-        return top + (bottom - top) * ay;
+        Footprint f = footprint(uv, width, height);
+        glm::vec4 top = texels[f.i00] + (texels[f.i10] - texels[f.i00]) * f.ax;
+        glm::vec4 bottom = texels[f.i01] + (texels[f.i11] - texels[f.i01]) * f.ax;
+        return top + (bottom - top) * f.ay;
+    }
+
+    float LinearTexture::sampleAlpha(glm::vec2 uv) const
+    {
+        if (width <= 0 || height <= 0)
+            return 1.0f;
+        Footprint f = footprint(uv, width, height);
+        constexpr float scale = 1.0f / 255.0f;
+        float a00 = alpha[f.i00] * scale, a10 = alpha[f.i10] * scale;
+        float a01 = alpha[f.i01] * scale, a11 = alpha[f.i11] * scale;
+        float top = a00 + (a10 - a00) * f.ax;
+        float bottom = a01 + (a11 - a01) * f.ax;
+        return top + (bottom - top) * f.ay;
     }
 
     EmbreeScene::EmbreeScene(const TreeModel& model) : mModel(model)
@@ -81,10 +115,12 @@ namespace TreeLod
             dst.width = src.width;
             dst.height = src.height;
             dst.texels.resize(count);
+            dst.alpha.resize(count);
             for (std::size_t p = 0; p < count; ++p)
             {
                 const std::uint8_t* c = &src.rgba[p * 4];
-                dst.texels[p] = glm::vec4(decode[c[0]], decode[c[1]], decode[c[2]], float(c[3]) / 255.0f);
+                dst.texels[p] = glm::vec4(decode[c[0]], decode[c[1]], decode[c[2]], float(c[3]) * (1.0f / 255.0f));
+                dst.alpha[p] = c[3];
             }
         }
 
@@ -137,6 +173,14 @@ namespace TreeLod
                 tri.material = material;
                 tri.faceNormal = faceNormal(model.leafVertices, tri.v);
                 mTriangles[Leaves].push_back(tri);
+                const Material& m = mMaterials[material];
+                AlphaTest test;
+                for (int k = 0; k < 3; ++k)
+                    test.uv[k] = model.leafVertices[tri.v[k]].uv;
+                test.texture = texture(m);
+                test.baseAlpha = m.baseColour.a;
+                test.cutoff = m.alphaCutoff;
+                mAlphaTests.push_back(test);
             }
         }
 
@@ -224,15 +268,10 @@ namespace TreeLod
 
     float EmbreeScene::leafAlpha(std::uint32_t prim, float u, float v) const
     {
-        const Triangle& tri = mTriangles[Leaves][prim];
-        const Material& m = mMaterials[tri.material];
-        float alpha = m.baseColour.a;
-        if (const LinearTexture* tex = texture(m))
-        {
-            const std::vector<Vertex>& vs = mModel.leafVertices;
-            glm::vec2 uv = (1.0f - u - v) * vs[tri.v[0]].uv + u * vs[tri.v[1]].uv + v * vs[tri.v[2]].uv;
-            alpha *= tex->sample(uv).a;
-        }
+        const AlphaTest& test = mAlphaTests[prim];
+        float alpha = test.baseAlpha;
+        if (test.texture)
+            alpha *= test.texture->sampleAlpha((1.0f - u - v) * test.uv[0] + u * test.uv[1] + v * test.uv[2]);
         return alpha;
     }
 
@@ -245,8 +284,7 @@ namespace TreeLod
                 continue;
             std::uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
             float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
-            const Material& m = self->mMaterials[self->mTriangles[Leaves][prim].material];
-            if (self->leafAlpha(prim, u, v) < m.alphaCutoff)
+            if (self->leafAlpha(prim, u, v) < self->mAlphaTests[prim].cutoff)
                 args->valid[i] = 0; // discarded: the ray goes on
         }
     }
@@ -272,6 +310,8 @@ namespace TreeLod
     EmbreeScene::Hit EmbreeScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tnear,
                                             float tfar) const
     {
+        if (!rayable(org) || !rayable(dir) || !(tnear <= tfar))
+            return Hit{};
         QueryContext context;
         rtcInitIntersectContext(&context.base);
         context.cameraRay = true;
@@ -305,6 +345,8 @@ namespace TreeLod
 
     bool EmbreeScene::occluded(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const
     {
+        if (!rayable(org) || !rayable(dir) || !(tnear <= tfar))
+            return false;
         QueryContext context;
         rtcInitIntersectContext(&context.base);
         context.cameraRay = false;

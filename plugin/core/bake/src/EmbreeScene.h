@@ -19,10 +19,13 @@ namespace TreeLod
         int width = 0;
         int height = 0;
         std::vector<glm::vec4> texels; ///< width * height, rows top to bottom
+        std::vector<std::uint8_t> alpha; ///< the alpha channel alone, compact for the alpha test
 
         /// Bilinear lookup of the four nearest texels, REPEAT wrapping, UV (0,0) = top-left
         /// corner; non-finite UVs read as 0.
         glm::vec4 sample(glm::vec2 uv) const;
+        /// The same lookup of the alpha channel only (equal to sample(uv).a up to rounding).
+        float sampleAlpha(glm::vec2 uv) const;
     };
 
     class EmbreeScene
@@ -59,10 +62,12 @@ namespace TreeLod
         EmbreeScene& operator=(const EmbreeScene&) = delete;
 
         /// Closest hit seen by a camera ray: single-sided bark is culled from behind, leaves
-        /// are alpha-tested. `dir` need not be unit; t is in units of |dir|.
+        /// are alpha-tested. `dir` need not be unit; t is in units of |dir|. Rays with
+        /// non-finite or huge (> 1e18) components miss.
         Hit intersect(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const;
 
-        /// Whether anything blocks the segment (bark from both sides, alpha-tested leaves).
+        /// Whether anything blocks the segment (bark from both sides, alpha-tested leaves);
+        /// false for rays intersect() would not trace.
         bool occluded(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const;
 
         const TreeModel& model() const { return mModel; }
@@ -82,6 +87,15 @@ namespace TreeLod
         float leafAlpha(std::uint32_t prim, float u, float v) const;
 
     private:
+        /// What the alpha test of one leaf triangle reads, in one place (the filter is hot).
+        struct AlphaTest
+        {
+            glm::vec2 uv[3];
+            const LinearTexture* texture; ///< nullptr: texture alpha 1
+            float baseAlpha;
+            float cutoff;
+        };
+
         static void leafFilter(const RTCFilterFunctionNArguments* args);
         static void barkCullFilter(const RTCFilterFunctionNArguments* args);
         void addGeometry(Part part, const std::vector<Vertex>& vertices);
@@ -90,6 +104,7 @@ namespace TreeLod
         std::vector<Material> mMaterials;
         std::vector<LinearTexture> mTextures;
         std::vector<Triangle> mTriangles[2];
+        std::vector<AlphaTest> mAlphaTests; ///< per leaf triangle
         std::vector<bool> mSingleSided; ///< per material: culled from behind (bark only)
         float mDiagonal = 0.0f;
         RTCDevice mDevice = nullptr;

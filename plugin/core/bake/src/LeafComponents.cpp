@@ -102,7 +102,7 @@ namespace TreeLod
             }
         }
 
-        LeafExtractionStats extractLeaves(const LeafSoup& soup, float minArea, TreeModel& model,
+        LeafExtractionStats extractLeaves(const LeafSoup& soup, TreeModel& model,
                                           const ProgressCallback& progress)
         {
             LeafExtractionStats stats;
@@ -234,14 +234,19 @@ namespace TreeLod
                 const std::uint32_t* tris = leafTriangles.data() + leafOffsets[l];
                 const std::uint32_t n = leafOffsets[l + 1] - leafOffsets[l];
                 double area = 0.0;
+                glm::dvec3 lo(soup.vertices[idx[3 * tris[0]]].position), hi = lo;
                 for (std::uint32_t k = 0; k < n; ++k)
                 {
-                    const glm::vec3& a = soup.vertices[idx[3 * tris[k]]].position;
-                    const glm::vec3& b = soup.vertices[idx[3 * tris[k] + 1]].position;
-                    const glm::vec3& c = soup.vertices[idx[3 * tris[k] + 2]].position;
-                    area += 0.5 * glm::length(glm::cross(glm::dvec3(b - a), glm::dvec3(c - a)));
+                    const glm::dvec3 a(soup.vertices[idx[3 * tris[k]]].position);
+                    const glm::dvec3 b(soup.vertices[idx[3 * tris[k] + 1]].position);
+                    const glm::dvec3 c(soup.vertices[idx[3 * tris[k] + 2]].position);
+                    area += 0.5 * glm::length(glm::cross(b - a, c - a));
+                    lo = glm::min(lo, glm::min(a, glm::min(b, c)));
+                    hi = glm::max(hi, glm::max(a, glm::max(b, c)));
                 }
-                if (!(area > double(minArea)))
+                const glm::dvec3 extent = hi - lo;
+                const double side = std::max(extent.x, std::max(extent.y, extent.z));
+                if (!(area > kDegenerateAreaRatio * side * side))
                 {
                     ++stats.degenerate;
                     continue;

@@ -32,16 +32,19 @@ namespace TreeLod
 
         struct LeafExtractionStats
         {
-            std::size_t degenerate = 0; ///< leaves of area <= minArea, dropped
+            std::size_t degenerate = 0; ///< leaves of (nearly) zero area, dropped
             std::size_t duplicates = 0; ///< kept leaves that copy an earlier piece exactly
         };
 
         /// Append the soup's leaves to `model` (leafVertices, leafIndices, leaves, each leaf
         /// record updated), ordered by their first triangle in the soup. A leaf's vertices are
         /// those its triangles use, in order of first use; its material is its first
-        /// triangle's. Leaves of area <= `minArea` (m^2) are dropped. Vertices used by no
-        /// triangle are dropped. The soup's indices must be in range.
-        LeafExtractionStats extractLeaves(const LeafSoup& soup, float minArea, TreeModel& model,
+        /// triangle's. A leaf whose area is at most kDegenerateAreaRatio times the square of
+        /// its bounding box's longest side (a point, a line, up to float rounding) is dropped.
+        /// Vertices used by no triangle are dropped. The soup's indices must be in range.
+        LeafExtractionStats extractLeaves(const LeafSoup& soup, TreeModel& model,
                                           const ProgressCallback& progress = {});
+
+        constexpr double kDegenerateAreaRatio = 1e-6;
     }
 }

@@ -62,30 +62,56 @@ namespace TreeLod
         while ((std::uint64_t(1) << levels) < std::max(width, height))
             ++levels;
 
-        // acc[k]: running sum of the current (open) block at level k, k = 1..levels.
+        // acc[k]: running sum of the current (open) block at level k, k = 2..levels.
         std::vector<BlockSum> acc(std::size_t(levels) + 1);
         std::vector<double> squared(std::size_t(levels) + 1, 0.0);
-        const std::uint64_t total = std::uint64_t(1) << (2 * levels);
 
-        // paper 001 §4: one scan of the difference image along the Z curve.
-        std::uint64_t i = 0;
-        while (i < total)
+        auto difference = [&](std::uint32_t x, std::uint32_t y, BlockSum& block) {
+            const std::size_t p = std::size_t(y) * width + x;
+            const glm::vec4& a = reference.pixels[p];
+            const glm::vec4& b = test.pixels[p];
+            const double dr = double(b.r) - a.r, dg = double(b.g) - a.g, db = double(b.b) - a.b;
+            squared[0] += dr * dr + dg * dg + db * db;
+            block.r += dr;
+            block.g += dg;
+            block.b += db;
+            ++block.count;
+        };
+
+        if (levels == 0)
         {
-            const std::uint32_t x = compactBits(i), y = compactBits(i >> 1);
-            std::uint64_t next = i + 1;
+            BlockSum unused;
+            difference(0, 0, unused);
+        }
+
+        // paper 001 §4: one scan of the difference image along the Z curve. The scan steps
+        // over 2x2 quads (level-1 blocks, Z-ordered inside) so that band 0 and band 1
+        // are done in the same step; coarser blocks close as their runs of quads end.
+        const std::uint64_t quads = levels > 0 ? std::uint64_t(1) << (2 * (levels - 1)) : 0;
+        std::uint64_t j = 0;
+        while (j < quads)
+        {
+            const std::uint32_t x = 2 * compactBits(j), y = 2 * compactBits(j >> 1);
+            std::uint64_t next = j + 1;
             if (x < width && y < height)
             {
-                const std::size_t p = std::size_t(y) * width + x;
-                const glm::vec4& a = reference.pixels[p];
-                const glm::vec4& b = test.pixels[p];
-                const double dr = double(b.r) - a.r, dg = double(b.g) - a.g, db = double(b.b) - a.b;
-                squared[0] += dr * dr + dg * dg + db * db;
-                if (levels > 0)
+                BlockSum quad;
+                difference(x, y, quad);
+                const bool right = x + 1 < width, below = y + 1 < height;
+                if (right)
+                    difference(x + 1, y, quad);
+                if (below)
+                    difference(x, y + 1, quad);
+                if (right && below)
+                    difference(x + 1, y + 1, quad);
+                squared[1] += (quad.r * quad.r + quad.g * quad.g + quad.b * quad.b) / double(quad.count);
+                if (levels > 1)
                 {
-                    acc[1].r += dr;
-                    acc[1].g += dg;
-                    acc[1].b += db;
-                    ++acc[1].count;
+                    BlockSum& parent = acc[2];
+                    parent.r += quad.r;
+                    parent.g += quad.g;
+                    parent.b += quad.b;
+                    parent.count += quad.count;
                 }
             }
             else
@@ -93,19 +119,19 @@ namespace TreeLod
                 // The aligned block starting here lies wholly outside the image (its
                 // origin does), so jump over the largest such block at once.
                 int k = 0;
-                while (k < levels && (i & ((std::uint64_t(1) << (2 * (k + 1))) - 1)) == 0)
+                while (k + 1 < levels && (j & ((std::uint64_t(1) << (2 * (k + 1))) - 1)) == 0)
                     ++k;
-                next = i + (std::uint64_t(1) << (2 * k));
+                next = j + (std::uint64_t(1) << (2 * k));
             }
 
-            // Close every block that ends at next - 1: its mean is one coarse pixel.
-            for (int k = 1; k <= levels && (next & ((std::uint64_t(1) << (2 * k)) - 1)) == 0; ++k)
+            // Close every block of level >= 2 whose run of quads ends at next - 1; its
+            // mean is one coarse pixel: add count * |mean|^2 = |sum|^2 / count.
+            for (int k = 2; k <= levels && (next & ((std::uint64_t(1) << (2 * (k - 1))) - 1)) == 0; ++k)
             {
                 BlockSum& s = acc[std::size_t(k)];
                 if (s.count > 0)
                 {
-                    const double n = double(s.count);
-                    squared[std::size_t(k)] += (s.r * s.r + s.g * s.g + s.b * s.b) / n; // n * |sum / n|^2
+                    squared[std::size_t(k)] += (s.r * s.r + s.g * s.g + s.b * s.b) / double(s.count);
                     if (k < levels)
                     {
                         BlockSum& parent = acc[std::size_t(k) + 1];
@@ -117,7 +143,7 @@ namespace TreeLod
                 }
                 s = BlockSum();
             }
-            i = next;
+            j = next;
         }
 
         MultiScaleRmseResult result;

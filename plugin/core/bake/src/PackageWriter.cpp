@@ -295,37 +295,46 @@ namespace TreeLod
         return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
     }
 
+    Result<void> addReferenceChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
+                                   const ProgressCallback& progress)
+    {
+        Result<void> valid = model.validate(label);
+        if (!valid)
+            return fail(label, "model '" + model.name + "', " + valid.error().element, valid.error().reason);
+        for (std::size_t t = 0; t < model.textures.size(); ++t)
+            if (model.textures[t].width <= 0 || model.textures[t].height <= 0)
+                return fail(label, "texture " + std::to_string(t) + " '" + model.textures[t].name + "'",
+                            "empty image cannot be stored");
+
+        report(progress, "mip chains", 0.0f);
+        const ReferenceChunk chunk = makeReferenceChunk(model);
+        report(progress, "mip chains", 1.0f);
+        report(progress, "encode", 0.0f);
+        Result<void> added = writer.addChunk(REFERENCE_CHUNK, 0, REFERENCE_CHUNK_FORMAT_VERSION, encodeReferenceChunk(chunk));
+        report(progress, "encode", 1.0f);
+        return added;
+    }
+
+    Result<void> addMetaChunk(PackageWriter& writer, const PackageMeta& meta)
+    {
+        const std::string text = meta.toJson();
+        return writer.addChunk(META_CHUNK, 0, 1, std::vector<std::uint8_t>(text.begin(), text.end()));
+    }
+
     Result<void> bakeReferencePackage(const TreeModel& model, const std::string& path, const PackageMeta& meta,
                                       const ProgressCallback& progress)
     {
-        Result<void> valid = model.validate(path);
-        if (!valid)
-            return fail(path, "model '" + model.name + "', " + valid.error().element, valid.error().reason);
-
-        report(progress, "mip chains", 0.0f);
-        ReferenceChunk chunk = makeReferenceChunk(model);
-        report(progress, "mip chains", 1.0f);
-        if (chunk.textures.size() != model.textures.size())
-            return fail(path, "", "internal error: texture count changed");
-        for (std::size_t t = 0; t < chunk.textures.size(); ++t)
-            if (chunk.textures[t].mipCount == 0)
-                return fail(path, "texture " + std::to_string(t) + " '" + model.textures[t].name + "'",
-                            "empty image cannot be stored");
-
-        report(progress, "encode", 0.0f);
         PackageWriter writer;
+        Result<void> added = addReferenceChunk(writer, model, path, progress);
+        if (!added)
+            return added;
         PackageMeta withTechniques = meta;
         if (std::find(withTechniques.techniques.begin(), withTechniques.techniques.end(), REFERENCE_CHUNK) ==
             withTechniques.techniques.end())
             withTechniques.techniques.push_back(REFERENCE_CHUNK);
-        const std::string metaText = withTechniques.toJson();
-        Result<void> added =
-            writer.addChunk(REFERENCE_CHUNK, 0, REFERENCE_CHUNK_FORMAT_VERSION, encodeReferenceChunk(chunk));
-        if (added)
-            added = writer.addChunk(META_CHUNK, 0, 1, std::vector<std::uint8_t>(metaText.begin(), metaText.end()));
+        added = addMetaChunk(writer, withTechniques);
         if (!added)
             return fail(path, added.error().element, added.error().reason);
-        report(progress, "encode", 1.0f);
 
         report(progress, "write", 0.0f);
         Result<void> written = writer.write(path);

@@ -153,7 +153,7 @@ namespace TreeLod
             std::array<LevelParams, 3> level;
             // leaves
             float leafAreaFactor = 1.0f; ///< total quad area = factor * height^2
-            float leafSpread = 0.03f;    ///< invisible twig length, fraction of the height
+            float leafSpread = 0.03f;    ///< reach of leaves around their stem, fraction of the height
             float leafStart = 0.2f;      ///< leaves on this outer fraction of a stem onwards
             float leafDownAngle = 50.0f, leafDownAngleV = 20.0f;
             float leafBend = 0.4f;       ///< + turns leaf axes up, - lets them hang
@@ -183,12 +183,12 @@ namespace TreeLod
                 t.taper = 1.0f;
                 t.sides = 12;
                 LevelParams& b = p.level[1];
-                b.length = 0.62f;
+                b.length = 0.7f;
                 b.lengthV = 0.1f;
                 b.curveRes = 6;
                 b.curve = -45.0f;
                 b.curveV = 70.0f;
-                b.downAngle = 62.0f;
+                b.downAngle = 66.0f;
                 b.downAngleV = -25.0f;
                 b.rotate = 137.5f;
                 b.rotateV = 20.0f;
@@ -211,8 +211,8 @@ namespace TreeLod
                 c.taper = 1.0f;
                 c.attractionUp = 0.3f;
                 c.sides = 5;
-                p.leafAreaFactor = 1.3f;
-                p.leafSpread = 0.035f;
+                p.leafAreaFactor = 4.0f;
+                p.leafSpread = 0.08f;
                 p.leafStart = 0.15f;
                 p.leafDownAngle = 55.0f;
                 p.leafDownAngleV = 25.0f;
@@ -228,8 +228,8 @@ namespace TreeLod
                 p.height = 16.0f;
                 p.leaves = 10000;
                 p.shape = Conical;
-                p.baseSize = 0.1f;
-                p.ratio = 0.02f;
+                p.baseSize = 0.14f;
+                p.ratio = 0.016f;
                 p.ratioPower = 1.2f;
                 p.flare = 0.4f;
                 LevelParams& t = p.level[0];
@@ -241,14 +241,14 @@ namespace TreeLod
                 b.length = 0.3f;
                 b.lengthV = 0.04f;
                 b.curveRes = 5;
-                b.curve = 25.0f;
-                b.curveBack = -35.0f;
+                b.curve = 15.0f;
+                b.curveBack = -30.0f;
                 b.curveV = 20.0f;
-                b.downAngle = 78.0f;
-                b.downAngleV = -22.0f;
+                b.downAngle = 70.0f;
+                b.downAngleV = -20.0f;
                 b.rotate = 137.5f;
                 b.rotateV = 12.0f;
-                b.branches = 64;
+                b.branches = 80;
                 b.taper = 1.0f;
                 b.sides = 6;
                 LevelParams& c = p.level[2];
@@ -265,8 +265,8 @@ namespace TreeLod
                 c.start = 0.08f;
                 c.taper = 1.0f;
                 c.sides = 4;
-                p.leafAreaFactor = 0.9f;
-                p.leafSpread = 0.006f;
+                p.leafAreaFactor = 3.0f;
+                p.leafSpread = 0.03f;
                 p.leafStart = 0.05f;
                 p.leafDownAngle = 25.0f;
                 p.leafDownAngleV = 15.0f;
@@ -320,8 +320,8 @@ namespace TreeLod
                 c.taper = 1.0f;
                 c.attractionUp = -0.7f;
                 c.sides = 4;
-                p.leafAreaFactor = 0.55f;
-                p.leafSpread = 0.012f;
+                p.leafAreaFactor = 1.0f;
+                p.leafSpread = 0.04f;
                 p.leafStart = 0.2f;
                 p.leafDownAngle = 40.0f;
                 p.leafDownAngleV = 20.0f;
@@ -378,8 +378,8 @@ namespace TreeLod
                 c.taper = 1.0f;
                 c.attractionUp = 0.2f;
                 c.sides = 3;
-                p.leafAreaFactor = 1.6f;
-                p.leafSpread = 0.05f;
+                p.leafAreaFactor = 3.0f;
+                p.leafSpread = 0.1f;
                 p.leafStart = 0.1f;
                 p.leafDownAngle = 50.0f;
                 p.leafDownAngleV = 25.0f;
@@ -731,7 +731,10 @@ namespace TreeLod
             const float leafArea = p.leafAreaFactor * height * height / float(leafCount);
             const float leafLength = std::sqrt(leafArea / aspect);
             const float halfWidth = 0.5f * aspect * leafLength;
-            const float spread = p.leafSpread * height;
+            // Leaves fill a tube of radius `reach` around their stem whatever their size:
+            // the invisible twig is as long as the leaf leaves room for (at least a quarter).
+            const float reach = p.leafSpread * height;
+            const float spread = std::max(reach - leafLength, 0.25f * reach);
             const glm::vec3 up(0.0f, 1.0f, 0.0f);
 
             model.leafVertices.reserve(std::size_t(leafCount) * 4);

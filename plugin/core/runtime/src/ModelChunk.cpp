@@ -4,7 +4,9 @@
 #include "TreeLod/ByteWriter.h"
 #include "TreeLod/Package.h"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace TreeLod
 {
@@ -325,12 +327,25 @@ namespace TreeLod
         }
         if (!r.ok())
             return r.error();
-        // Leaves own their index ranges, so together they cover at most every index once;
-        // this also bounds the work TreeModel::validate does per index.
+        // Leaves own their index ranges (TreeModel.h), so the ranges are disjoint; this also
+        // bounds the work TreeModel::validate does to one pass over the indices.
         if (leafIndexTotal > m.leafIndices.size())
             return fail(label, chunkName + ", leaves",
                         "leaf index ranges overlap (they cover " + std::to_string(leafIndexTotal) +
                             " indices, the model has " + std::to_string(m.leafIndices.size()) + ")");
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges; // (firstIndex, leaf)
+        ranges.reserve(leafCount);
+        for (std::uint32_t i = 0; i < leafCount; ++i)
+            if (m.leaves[i].indexCount > 0)
+                ranges.emplace_back(m.leaves[i].firstIndex, i);
+        std::sort(ranges.begin(), ranges.end());
+        for (std::size_t k = 1; k < ranges.size(); ++k)
+        {
+            const Leaf& previous = m.leaves[ranges[k - 1].second];
+            if (std::uint64_t(previous.firstIndex) + previous.indexCount > ranges[k].first)
+                return fail(label, chunkName + ", leaf " + std::to_string(ranges[k].second),
+                            "index range overlaps that of leaf " + std::to_string(ranges[k - 1].second));
+        }
 
         r.setElement(chunkName + ", skeleton");
         const std::uint32_t nodeCount = r.count(NODE_BYTES, ALIGN);

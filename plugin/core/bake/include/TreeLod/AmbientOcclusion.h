@@ -34,7 +34,7 @@ namespace TreeLod
     struct AoOptions
     {
         int raysPerPoint = 64;  ///< >= 1; leaves split them between both hemispheres
-        float maxDistance = 0.0f; ///< metres a ray may travel; 0 = 0.5 * bounding-box diagonal
+        float maxDistance = 0.0f; ///< metres a ray may travel; <= 0: 0.5 * bounding-box diagonal
         std::uint32_t seed = 1;
     };
 
@@ -55,7 +55,7 @@ namespace TreeLod
 
     /// AO at every bark vertex (around its normal; vertices whose normal is zero or not finite
     /// use the mean face normal of their triangles) and every leaf vertex (two-sided). Vertices
-    /// used by no triangle get 1. Calls `progress` ("ambient occlusion", 0..1) from the calling
+    /// used by no triangle and non-finite positions get 1. Calls `progress` ("ambient occlusion", 0..1) from the calling
     /// thread. Precondition: model.validate() succeeds (out-of-range indices are skipped).
     AmbientOcclusion computeAmbientOcclusion(const TreeModel& model, const AoOptions& options = {},
                                              const ProgressCallback& progress = {});

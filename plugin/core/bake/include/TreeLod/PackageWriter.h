@@ -86,6 +86,14 @@ namespace TreeLod
         std::string toJson() const;
     };
 
+    /// Validate `model` and add its reference chunk (makeReferenceChunk, encodeReferenceChunk)
+    /// to `writer`. `label` names the output in errors ("model 'oak', leaf 3: ...").
+    Result<void> addReferenceChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
+                                   const ProgressCallback& progress = {});
+
+    /// Add the "meta" chunk (level 0, format 1): meta.toJson() as UTF-8 text.
+    Result<void> addMetaChunk(PackageWriter& writer, const PackageMeta& meta);
+
     /// Bake the reference chunk of `model` and a meta chunk from `meta`, and write them to
     /// `path` atomically. Fails (writing nothing) if the model does not validate or the file
     /// cannot be written.

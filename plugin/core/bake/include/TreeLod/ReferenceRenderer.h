@@ -31,7 +31,8 @@
 //   ao     = barycentric interpolation of RenderOptions::ambientOcclusion's vertex values,
 //            1 without it.
 //   colour = albedo * (ambientColour * ao + sunColour * max(0, dot(n, sunDirection))),
-//            clamped to [0, 1] per sample (as a UNORM render target does).
+//            sunDirection normalised, colour clamped to [0, 1] per sample (as a UNORM render
+//            target does).
 // A sample that hits nothing has the colour srgbToLinear(background) (opaque background), or
 // is transparent with RenderOptions::transparentBackground.
 //
@@ -92,7 +93,8 @@ namespace TreeLod
     public:
         /// Builds the Embree scene (bark + leaves) and linear copies of the textures.
         /// `model` must outlive the renderer and not change meanwhile. Triangles with
-        /// out-of-range indices are skipped; degenerate and NaN triangles are never hit.
+        /// out-of-range indices are skipped; degenerate triangles and triangles with non-finite
+        /// or huge (> 1.8e18) coordinates are never hit.
         /// Throws std::runtime_error if Embree cannot be initialised.
         explicit ReferenceRenderer(const TreeModel& model);
         ~ReferenceRenderer();
