@@ -153,7 +153,9 @@ namespace
         auto limit = threadLimit();
         const TreeModel& model = tree30k();
         ReferenceRenderer renderer(model);
-        CameraSpec camera = CameraSpec::framing(model.boundsMin, model.boundsMax, 30.0f, 10.0f);
+        // Framed by the bounding sphere at range(2) percent of the distance that just fits it.
+        CameraSpec camera =
+            CameraSpec::framing(model.boundsMin, model.boundsMax, 30.0f, 10.0f, float(state.range(2)) / 100.0f);
         RenderOptions options;
         options.width = options.height = int(state.range(0));
         options.samplesPerPixel = int(state.range(1));
@@ -170,7 +172,8 @@ namespace
         state.counters["coverage"] = coverage / (double(options.width) * options.height);
         state.counters["rays/s"] = benchmark::Counter(rays * state.iterations(), benchmark::Counter::kIsRate);
     }
-    BENCHMARK(BM_RendererFrame30k)->Args({512, 4})->Args({512, 1})->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+    // Args: size, samples per pixel, camera distance in percent.
+    BENCHMARK(BM_RendererFrame30k)->Args({512, 4, 100})->Args({512, 4, 60})->Args({512, 1, 100})->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
     void BM_RendererAmbientOcclusion30k(benchmark::State& state)
     {

@@ -29,7 +29,7 @@ void main()
     vec3 n = normalize(vNormal);
     vec3 tint = baseColour.rgb;
 #ifdef LEAF
-    if (texel.a < alphaCutoff)
+    if (baseColour.a * texel.a < alphaCutoff)
         discard;
     // Facing from the normal, not gl_FrontFacing: render-to-texture flips Y and with it
     // the winding that gl_FrontFacing reports.

@@ -77,6 +77,12 @@ namespace TreeLod
                     techniques.push_back(t);
             }
 
+            // Fail before the import, not after it, when the output cannot be written.
+            const std::filesystem::path outDir = std::filesystem::path(args.output).parent_path();
+            std::error_code ec;
+            if (!outDir.empty() && !std::filesystem::is_directory(outDir, ec))
+                return printError(fail(args.output, "", "directory '" + outDir.string() + "' does not exist"));
+
             Result<std::vector<std::uint8_t>> inputBytes = readFile(args.input);
             if (!inputBytes)
                 return printError(inputBytes.error());

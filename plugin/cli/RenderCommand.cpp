@@ -14,6 +14,7 @@
 
 #ifdef TREELOD_WITH_OGRE
 #include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/OgreMeshImporter.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 #endif
@@ -47,19 +48,20 @@ namespace TreeLod
                 return printError(fail("", "--size", "'" + args.size + "' is not WxH with 1..16384"));
             if (args.supersample < 1 || args.supersample > 8)
                 return printError(fail("", "--supersample", "must be 1..8 samples per axis"));
+            if (args.renderer != "cpu" && args.renderer != "ogre")
+                return printError(fail("", "--renderer", "'" + args.renderer + "' is not ogre or cpu"));
             ProgressCallback progress = makeProgress();
-            Result<TreeInput> input = loadTreeInput(args.input, args.leafMaterials, progress);
-            if (!input)
-                return printError(input.error());
-            const TreeModel& model = input->model;
-            CameraSpec camera;
-            std::string cameraError;
-            if (!CameraSpec::parse(args.camera, model.boundsMin, model.boundsMax, camera, cameraError))
-                return printError(fail("", "--camera", cameraError));
-
             auto start = std::chrono::steady_clock::now();
             if (args.renderer == "cpu")
             {
+                Result<TreeInput> input = loadTreeInput(args.input, args.leafMaterials, progress);
+                if (!input)
+                    return printError(input.error());
+                const TreeModel& model = input->model;
+                CameraSpec camera;
+                std::string cameraError;
+                if (!CameraSpec::parse(args.camera, model.boundsMin, model.boundsMax, camera, cameraError))
+                    return printError(fail("", "--camera", cameraError));
                 if (args.technique != "mesh")
                     return printError(fail("", "--technique", "the CPU renderer draws the polygonal reference only (mesh)"));
                 ReferenceRenderer renderer(model);
@@ -72,7 +74,7 @@ namespace TreeLod
                 if (!written)
                     return printError(written.error());
             }
-            else if (args.renderer == "ogre")
+            else
             {
 #ifdef TREELOD_WITH_OGRE
                 try
@@ -80,11 +82,21 @@ namespace TreeLod
                     OffscreenOptions options;
                     options.verbose = args.verbose;
                     OffscreenRenderer renderer(options);
+                    OgreMeshImportOptions meshOptions;
+                    meshOptions.leafMaterials = args.leafMaterials;
+                    Result<TreeInput> input = loadTreeInput(args.input, args.leafMaterials, progress,
+                                                            [&](const std::string& path) { return importOgreMesh(path, meshOptions); });
+                    if (!input)
+                        return printError(input.error());
+                    CameraSpec camera;
+                    std::string cameraError;
+                    if (!CameraSpec::parse(args.camera, input->model.boundsMin, input->model.boundsMax, camera, cameraError))
+                        return printError(fail("", "--camera", cameraError));
                     TreeAssetPtr asset = TreeAssetManager::getSingleton().loadFromBytes(
                         input->name, Ogre::RGN_DEFAULT, input->packageBytes);
                     Ogre::MovableObject* object = TechniqueRegistry::getSingleton().createInstance(
                         args.technique, renderer.getSceneManager(), "tree", *asset);
-                    renderer.getSceneManager().getRootSceneNode()->attachObject(object);
+                    renderer.getContentNode().attachObject(object);
                     RgbaImage image = renderer.render(camera, width, height, args.supersample);
                     OffscreenRenderer::savePng(image, args.output);
                 }
@@ -96,8 +108,6 @@ namespace TreeLod
                 return printError(fail("", "--renderer", "this build has no Ogre plugin"));
 #endif
             }
-            else
-                return printError(fail("", "--renderer", "'" + args.renderer + "' is not ogre or cpu"));
             double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
             std::printf("wrote %s (%dx%d, technique %s, renderer %s, %d samples per pixel, %.0f ms)\n",
                         args.output.c_str(), width, height, args.technique.c_str(), args.renderer.c_str(),

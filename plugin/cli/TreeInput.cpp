@@ -22,7 +22,7 @@ namespace TreeLod
     }
 
     Result<TreeInput> loadTreeInput(const std::string& path, const std::vector<std::string>& leafMaterials,
-                                    const ProgressCallback& progress)
+                                    const ProgressCallback& progress, const MeshImporter& meshImporter)
     {
         TreeInput input;
         input.name = std::filesystem::path(path).filename().string();
@@ -45,12 +45,14 @@ namespace TreeLod
             input.packageBytes = std::move(bytes.value());
             return input;
         }
-        if (ext != ".glb" && ext != ".gltf")
-            return fail(path, "", "unknown tree format '" + ext + "' (expected .glb, .gltf or .treelod)");
+        if (ext != ".glb" && ext != ".gltf" && ext != ".mesh")
+            return fail(path, "", "unknown tree format '" + ext + "' (expected .glb, .gltf, .mesh or .treelod)");
+        if (ext == ".mesh" && !meshImporter)
+            return fail(path, "", ".mesh input needs Ogre: use the Ogre renderer");
         ImportOptions options;
         options.leafMaterials = leafMaterials;
         options.progress = progress;
-        Result<TreeModel> model = importGltf(path, options);
+        Result<TreeModel> model = ext == ".mesh" ? meshImporter(path) : importGltf(path, options);
         if (!model)
             return model.error();
         input.model = std::move(model.value());

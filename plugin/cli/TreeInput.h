@@ -7,6 +7,7 @@
 #include "TreeLod/TreeModel.h"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -19,8 +20,11 @@ namespace TreeLod
         std::vector<std::uint8_t> packageBytes;
     };
 
-    /// .glb / .gltf (glTF importer) or .treelod (package reader). .mesh files need Ogre and
-    /// are read by the Ogre .mesh importer when the build has the plugin.
+    /// Reads an Ogre .mesh (needs a running Root, so the caller supplies it).
+    using MeshImporter = std::function<Result<TreeModel>(const std::string& path)>;
+
+    /// .glb / .gltf (glTF importer), .treelod (package reader), or .mesh through `meshImporter`
+    /// (an error naming the file when it is empty).
     Result<TreeInput> loadTreeInput(const std::string& path, const std::vector<std::string>& leafMaterials,
-                                    const ProgressCallback& progress);
+                                    const ProgressCallback& progress, const MeshImporter& meshImporter = {});
 }

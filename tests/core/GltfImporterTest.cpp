@@ -879,3 +879,15 @@ TEST(GltfImporter, GeneratedTreeRoundTripsThroughGlb)
     EXPECT_EQ(report.droppedDegenerateLeaves, 0u);
     EXPECT_EQ(report.duplicateLeaves, 0u);
 }
+
+TEST(GltfImporter, TruncatedPngIsAnErrorNamingTheImage)
+{
+    std::vector<std::uint8_t> png = makeRgbaPng(2, 1, kTwoPixels);
+    png.resize(png.size() - 20); // cut inside IDAT: IEND is gone
+    GltfBuilder b;
+    addTexturedLeaves(b, b.addImageEmbedded(png));
+    auto model = importBuilt(b);
+    ASSERT_FALSE(model);
+    EXPECT_EQ(model.error().element, "image 0 ''");
+    EXPECT_TRUE(contains(model.error().reason, "truncated PNG")) << model.error().reason;
+}

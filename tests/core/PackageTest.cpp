@@ -726,6 +726,35 @@ TEST(PackageWriter, AtomicWriteLeavesNoFileWhenTheDirectoryIsMissing)
     EXPECT_FALSE(std::filesystem::exists(target));
 }
 
+TEST(PackageWriter, RefusesWhatTheReferenceChunkCannotHold)
+{
+    // The decoder caps names at MODEL_CHUNK_MAX_STRING bytes and texture edges at
+    // GPU_TEXTURE_MAX_SIZE; the baker refuses such models instead of writing a package that
+    // would not load. A long but legal name round-trips.
+    const std::string path = outDir() + "/refused.treelod";
+    std::filesystem::remove(path);
+    TreeModel longName = makeTree();
+    longName.name.assign(MODEL_CHUNK_MAX_STRING + 1, 'n');
+    Result<void> r = bakeReferencePackage(longName, path, "x");
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().element, "model");
+
+    TreeModel wide = makeTree();
+    wide.textures[0].width = int(GPU_TEXTURE_MAX_SIZE) + 1;
+    wide.textures[0].height = 1;
+    wide.textures[0].rgba.assign(std::size_t(wide.textures[0].width) * 4, 255);
+    r = bakeReferencePackage(wide, path, "x");
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().element, "texture 0 'bark.png'");
+    EXPECT_FALSE(std::filesystem::exists(path));
+
+    TreeModel legal = makeTree();
+    legal.name.assign(MODEL_CHUNK_MAX_STRING, 'n');
+    Result<ReferenceChunk> decoded = decodeFrom(packageOf(legal));
+    ASSERT_TRUE(decoded) << decoded.error().message();
+    EXPECT_EQ(decoded->model.name, legal.name);
+}
+
 TEST(PackageWriter, RejectsTechniqueNamesTheTableCannotHold)
 {
     PackageWriter w;

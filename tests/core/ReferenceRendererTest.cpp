@@ -390,6 +390,26 @@ TEST(ReferenceRenderer, LeafSeenFromBehindUsesBackColourAndFlippedNormal)
     EXPECT_EQ(front.normal[20 * 40 + 20], glm::vec3(0.0f, 0.0f, 1.0f));
 }
 
+TEST(ReferenceRenderer, LeafSideComesFromItsShadingNormalNotItsWinding)
+{
+    // Winding faces +Z but the vertex normals say -Z. Seen from +Z, the normal turns away from
+    // the camera, so (as in the GLSL) this is the back: n = (0,0,1) and the back colour is used.
+    // With the sun at (0,0,1): linear = backColour * (0.2 + sun) = (0.24, 0.42, 0.045).
+    TreeModel m;
+    m.materials.push_back(leafMaterial({0.9f, 0.8f, 0.7f}, {0.2f, 0.6f, 0.1f}, -1));
+    addLeafQuad(m, {-1.0f, -1.0f, 0.0f}, {2.0f, 0.0f, 0.0f}, {0.0f, 2.0f, 0.0f}, 0);
+    for (Vertex& v : m.leafVertices)
+        v.normal = {0.0f, 0.0f, -1.0f};
+    RenderOptions o = smallOptions();
+    o.lighting.sunDirection = {0.0f, 0.0f, 1.0f};
+    RenderImages img = ReferenceRenderer(m).render(frontOrtho(5.0f), o);
+    glm::vec4 c = img.colour.at(20, 20);
+    EXPECT_NEAR(c.r, srgb(0.24f), 1e-4f);
+    EXPECT_NEAR(c.g, srgb(0.42f), 1e-4f);
+    EXPECT_NEAR(c.b, srgb(0.045f), 1e-4f);
+    EXPECT_EQ(img.normal[20 * 40 + 20], glm::vec3(0.0f, 0.0f, 1.0f));
+}
+
 TEST(ReferenceRenderer, SingleSidedBarkIsCulledFromBehind)
 {
     // As the GPU culls back faces: single-sided bark vanishes from behind, double-sided bark

@@ -1,5 +1,6 @@
 // treelod generate: the procedural generator, its textures and the .glb writer.
 #include "TreeLod/GltfExporter.h"
+#include "TreeLod/GltfImporter.h"
 #include "TreeLod/LeafTexture.h"
 #include "TreeLod/TreeGenerator.h"
 
@@ -73,7 +74,8 @@ TEST(TreeGenerator, leafCountDoesNotChangeBranches)
     EXPECT_TRUE(sameVertices(a.barkVertices, b.barkVertices));
 }
 
-// Leaves are distributed by largest remainder, which sums to the request exactly.
+// Leaves are distributed by rounding cumulative weights, which ends exactly at the request
+// (1237 is not a round number, so no stem count divides it evenly).
 TEST(TreeGenerator, hitsRequestedLeafCountExactly)
 {
     for (std::uint32_t count : {100u, 1000u, 1237u})
@@ -155,8 +157,19 @@ TEST(TreeGenerator, everyPresetValidates)
         for (const SkeletonNode& n : model.skeleton)
             stemTop = std::max(stemTop, n.position.y);
         EXPECT_NEAR(stemTop, presetDefaultHeight(p), 1e-3f * presetDefaultHeight(p));
-        EXPECT_GE(model.boundsMin.y, -0.01f * presetDefaultHeight(p)); // stands on the ground
     }
+}
+
+// Nothing of a tree goes into the ground, not even with the fewest (largest) leaves, whose
+// hanging ones the generator lifts onto it.
+TEST(TreeGenerator, standsOnTheGround)
+{
+    for (TreePreset p : kPresets)
+        for (std::uint32_t seed : {1u, 2u, 3u})
+        {
+            TreeModel model = generate(p, seed, 100, 16);
+            EXPECT_GE(model.boundsMin.y, -1e-4f) << presetName(p) << " seed " << seed;
+        }
 }
 
 // --height scales the whole tree: the stems' top is exactly the request.
@@ -340,4 +353,41 @@ TEST(GltfExporter, writesLargeLeafMeshWith32BitIndices)
     EXPECT_NE(json.find("treelodSkeleton"), std::string::npos);
     EXPECT_NE(json.find("treelodBackColour"), std::string::npos);
     EXPECT_NE(json.find("\"MASK\""), std::string::npos);
+}
+
+// Round trip through the importer: what the exporter writes (geometry, skeleton extras,
+// back colour extras, PNG textures) is what the importer reads. Positions, UVs, the
+// skeleton and texels are stored exactly; normals may be renormalised (float rounding).
+TEST(GltfExporter, roundTripsThroughImporter)
+{
+    TreeModel model = generate(TreePreset::Birch, 2, 400, 32);
+    const std::filesystem::path path = testOut("generator-roundtrip.glb");
+    ASSERT_TRUE(writeGlb(model, path.string()).ok());
+    Result<TreeModel> back = importGltf(path.string());
+    ASSERT_TRUE(back.ok()) << back.error().message();
+    ASSERT_EQ(back->leaves.size(), model.leaves.size());
+    ASSERT_EQ(back->leafVertices.size(), model.leafVertices.size());
+    EXPECT_EQ(back->barkTriangleCount(), model.barkTriangleCount());
+    for (std::size_t i = 0; i < model.leafVertices.size(); ++i)
+    {
+        ASSERT_EQ(back->leafVertices[i].position, model.leafVertices[i].position) << "leaf vertex " << i;
+        ASSERT_EQ(back->leafVertices[i].uv, model.leafVertices[i].uv) << "leaf vertex " << i;
+        ASSERT_NEAR(glm::length(back->leafVertices[i].normal - model.leafVertices[i].normal), 0.0f, 1e-5f);
+    }
+    ASSERT_EQ(back->skeleton.size(), model.skeleton.size());
+    for (std::size_t i = 0; i < model.skeleton.size(); ++i)
+    {
+        EXPECT_EQ(back->skeleton[i].position, model.skeleton[i].position);
+        EXPECT_EQ(back->skeleton[i].radius, model.skeleton[i].radius);
+        EXPECT_EQ(back->skeleton[i].parent, model.skeleton[i].parent);
+    }
+    std::size_t leafMaterial = back->materials.size();
+    for (std::size_t m = 0; m < back->materials.size(); ++m)
+        if (back->materials[m].isLeaf)
+            leafMaterial = m;
+    ASSERT_LT(leafMaterial, back->materials.size());
+    EXPECT_EQ(back->materials[leafMaterial].backColour, model.materials[1].backColour);
+    EXPECT_TRUE(back->materials[leafMaterial].doubleSided);
+    ASSERT_GE(back->materials[leafMaterial].texture, 0);
+    EXPECT_EQ(back->textures[std::size_t(back->materials[leafMaterial].texture)].rgba, model.textures[1].rgba);
 }

@@ -7,6 +7,7 @@
 #include "TreeLod/TreeAssetManager.h"
 #include "TreeLod/TreeGenerator.h"
 
+#include <OgrePlugin.h>
 #include <OgreSubMesh.h>
 
 #include <fstream>
@@ -88,8 +89,10 @@ namespace TreeLod
         {
             ASSERT_EQ(sub->mLodFaceList.size(), mesh->getNumLodLevels() - 1u);
             if (sub->indexData->indexCount == leafIndices)
+            {
                 for (Ogre::IndexData* lod : sub->mLodFaceList)
                     EXPECT_EQ(lod->indexCount, leafIndices);
+            }
         }
         EXPECT_LT(mesh->getSubMesh(0)->mLodFaceList.back()->indexCount, mesh->getSubMesh(0)->indexData->indexCount);
     }

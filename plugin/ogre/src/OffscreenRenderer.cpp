@@ -26,6 +26,12 @@ namespace TreeLod
 
     OffscreenRenderer::OffscreenRenderer(const OffscreenOptions& options)
     {
+        // Debian's OGRE is GLX only; fail before Ogre half-starts (its teardown then crashes).
+        const char* display = std::getenv("DISPLAY");
+        if (!display || !*display)
+            OGRE_EXCEPT(Ogre::Exception::ERR_RENDERINGAPI_ERROR,
+                        "no X display (DISPLAY is not set): run under xvfb-run -a -s \"-screen 0 1280x1024x24\"",
+                        "OffscreenRenderer");
         // Own LogManager first, else Ogre logs to stdout (OGRE-NOTES.md).
         mLogManager = std::make_unique<Ogre::LogManager>();
         mLogManager->createLog(options.logFile, true, options.verbose, options.logFile.empty());
@@ -69,7 +75,23 @@ namespace TreeLod
         mSun = mSceneManager->createLight("TreeLodSun");
         mSun->setType(Ogre::Light::LT_DIRECTIONAL);
         mSceneManager->getRootSceneNode()->createChildSceneNode()->attachObject(mSun);
+        mContentNode = mSceneManager->getRootSceneNode()->createChildSceneNode("TreeLodContent");
         setLighting(LightingSpec());
+    }
+
+    void OffscreenRenderer::clearContent()
+    {
+        std::vector<Ogre::SceneNode*> stack{mContentNode};
+        while (!stack.empty())
+        {
+            Ogre::SceneNode* node = stack.back();
+            stack.pop_back();
+            while (node->numAttachedObjects() > 0)
+                mSceneManager->destroyMovableObject(node->detachObject((unsigned short)0));
+            for (Ogre::Node* child : node->getChildren())
+                stack.push_back(static_cast<Ogre::SceneNode*>(child));
+        }
+        mContentNode->removeAndDestroyAllChildren();
     }
 
     OffscreenRenderer::~OffscreenRenderer()

@@ -6,6 +6,7 @@
 #include <OgreDataStream.h>
 #include <OgreImage.h>
 #include <OgreMaterialManager.h>
+#include <OgreMesh.h>
 #include <OgreMeshManager.h>
 #include <OgreMeshSerializer.h>
 #include <OgreSubMesh.h>
@@ -119,11 +120,12 @@ namespace TreeLod
             {
                 Ogre::Image image;
                 image.load(textureName, Ogre::ResourceGroupManager::AUTODETECT_RESOURCE_GROUP_NAME);
-                image.convert(Ogre::PF_BYTE_RGBA);
                 out.name = textureName;
                 out.width = int(image.getWidth());
                 out.height = int(image.getHeight());
-                out.rgba.assign(image.getData(), image.getData() + size_t(out.width) * out.height * 4);
+                out.rgba.resize(size_t(out.width) * out.height * 4);
+                Ogre::PixelBox dst(image.getWidth(), image.getHeight(), 1, Ogre::PF_BYTE_RGBA, out.rgba.data());
+                Ogre::PixelUtil::bulkPixelConversion(image.getPixelBox(), dst);
                 return true;
             }
             catch (const Ogre::Exception&)
@@ -131,6 +133,19 @@ namespace TreeLod
                 return false;
             }
         }
+    }
+
+    namespace
+    {
+        /// Records submesh material names as the file has them: SubMesh keeps only the
+        /// names of materials Ogre knows, and a tree's scripts are often not loaded.
+        struct MaterialNameRecorder : Ogre::MeshSerializerListener
+        {
+            std::vector<std::string> names;
+            void processMaterialName(Ogre::Mesh*, Ogre::String* name) override { names.push_back(*name); }
+            void processSkeletonName(Ogre::Mesh*, Ogre::String*) override {}
+            void processMeshCompleted(Ogre::Mesh*) override {}
+        };
     }
 
     Result<TreeModel> importOgreMesh(const std::string& path, const OgreMeshImportOptions& options)
@@ -150,10 +165,13 @@ namespace TreeLod
             Ogre::MeshPtr mesh;
             ~Remover() { Ogre::MeshManager::getSingleton().remove(mesh); }
         } remover{mesh};
+        MaterialNameRecorder recorder;
         try
         {
             Ogre::DataStreamPtr stream(new Ogre::MemoryDataStream(bytes->data(), bytes->size(), false, true));
-            Ogre::MeshSerializer().importMesh(stream, mesh.get());
+            Ogre::MeshSerializer serializer;
+            serializer.setListener(&recorder);
+            serializer.importMesh(stream, mesh.get());
         }
         catch (const Ogre::Exception& e)
         {
@@ -163,11 +181,12 @@ namespace TreeLod
         TreeModel model;
         model.name = std::filesystem::path(path).stem().string();
         std::map<std::string, std::uint32_t> materialIndex;
-        LeafSoup soup;
+        detail::LeafSoup soup;
         for (unsigned short s = 0; s < mesh->getNumSubMeshes(); ++s)
         {
             Ogre::SubMesh* sub = mesh->getSubMesh(s);
-            const std::string element = "submesh " + std::to_string(s) + " '" + sub->getMaterialName() + "'";
+            const std::string matName = s < recorder.names.size() ? recorder.names[s] : sub->getMaterialName();
+            const std::string element = "submesh " + std::to_string(s) + " '" + matName + "'";
             const Ogre::VertexData* vd = sub->useSharedVertices ? mesh->sharedVertexData : sub->vertexData;
             if (!vd)
                 return fail(path, element, "no vertex data");
@@ -184,7 +203,6 @@ namespace TreeLod
             if (!tris)
                 return tris.error();
 
-            const std::string& matName = sub->getMaterialName();
             auto found = materialIndex.find(matName);
             if (found == materialIndex.end())
             {
@@ -230,7 +248,7 @@ namespace TreeLod
         }
         if (model.barkIndices.empty() && soup.indices.empty())
             return fail(path, "mesh", "no triangles");
-        extractLeaves(soup, 0.0f, model);
+        detail::extractLeaves(soup, model);
         model.updateBounds();
         Result<void> valid = model.validate(path);
         if (!valid)

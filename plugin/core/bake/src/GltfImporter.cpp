@@ -5,7 +5,7 @@
 // OpenImageIO decodes the images that materials use (PNG, JPEG; palette PNGs keep tRNS alpha).
 #include "TreeLod/GltfImporter.h"
 
-#include "LeafComponents.h"
+#include "TreeLod/LeafExtraction.h"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
@@ -239,6 +239,18 @@ namespace TreeLod
             }
         }
 
+        /// double -> float without undefined behaviour: out-of-range values become +-inf.
+        float narrow(double d)
+        {
+            if (d > double(std::numeric_limits<float>::max()))
+                return std::numeric_limits<float>::infinity();
+            if (d < -double(std::numeric_limits<float>::max()))
+                return -std::numeric_limits<float>::infinity();
+            return float(d);
+        }
+
+        glm::vec3 narrow(const glm::dvec3& v) { return glm::vec3(narrow(v.x), narrow(v.y), narrow(v.z)); }
+
         float readComponent(const std::uint8_t* p, int componentType, bool normalized)
         {
             switch (componentType)
@@ -284,7 +296,7 @@ namespace TreeLod
             {
                 double v;
                 std::memcpy(&v, p, 8);
-                return float(v);
+                return narrow(v);
             }
             default: return 0.0f;
             }
@@ -330,6 +342,35 @@ namespace TreeLod
 
         // ---- images ------------------------------------------------------------------------
 
+        std::uint32_t readU32BE(const std::uint8_t* p)
+        {
+            return std::uint32_t(p[0]) << 24 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[2]) << 8 | std::uint32_t(p[3]);
+        }
+
+        /// Walk the PNG chunks (after the signature) up to IEND. OpenImageIO 2.4 leaks a string
+        /// when libpng runs out of data (its read callback longjmps), so a PNG that ends early
+        /// is refused here, with a clearer message.
+        Result<void> checkPngChunks(const std::uint8_t* data, std::size_t size, const std::string& file,
+                                    const std::string& where)
+        {
+            std::size_t pos = 8;
+            for (int index = 0;; ++index)
+            {
+                if (size - pos < 12)
+                    return fail(file, where, "truncated PNG: chunk " + std::to_string(index) + " header at byte " +
+                                                 std::to_string(pos) + " runs past the end (" + std::to_string(size) +
+                                                 " bytes)");
+                const std::uint32_t length = readU32BE(data + pos);
+                const std::string type(reinterpret_cast<const char*>(data + pos + 4), 4);
+                if (length > 0x7fffffffu || length > size - pos - 12)
+                    return fail(file, where, "truncated PNG: chunk " + std::to_string(index) + " of " +
+                                                 std::to_string(length) + " bytes runs past the end");
+                pos += 12 + std::size_t(length);
+                if (type == "IEND")
+                    return {};
+            }
+        }
+
         /// Decode PNG or JPEG bytes to RGBA8 (straight alpha; grey and RGB get alpha 255).
         Result<TextureImage> decodeImage(const std::uint8_t* data, std::size_t size, const std::string& file,
                                          const std::string& where)
@@ -337,7 +378,11 @@ namespace TreeLod
             static const std::uint8_t pngSignature[8] = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
             const char* format = nullptr;
             if (size >= 8 && std::memcmp(data, pngSignature, 8) == 0)
+            {
                 format = "png";
+                if (auto r = checkPngChunks(data, size, file, where); !r)
+                    return r.error();
+            }
             else if (size >= 3 && data[0] == 0xFF && data[1] == 0xD8 && data[2] == 0xFF)
                 format = "jpeg";
             else
@@ -468,9 +513,9 @@ namespace TreeLod
                 return fail(mFile, "leaves", "no triangles left: all " + std::to_string(stats.degenerate) +
                                                  " leaves have zero area");
             if (stats.degenerate > 0)
-                warn("dropped " + std::to_string(stats.degenerate) + " leaves of zero area");
+                warn("leaves of zero area dropped: " + std::to_string(stats.degenerate));
             if (stats.duplicates > 0)
-                warn(std::to_string(stats.duplicates) + " leaves are exact copies of earlier leaves (kept)");
+                warn("leaves that exactly copy an earlier leaf (kept): " + std::to_string(stats.duplicates));
 
             mModel.updateBounds();
             glm::vec3 extent = mModel.boundsMax - mModel.boundsMin;
@@ -498,13 +543,13 @@ namespace TreeLod
                 m.name = src.name;
                 const std::vector<double>& f = src.pbrMetallicRoughness.baseColorFactor;
                 if (f.size() == 4)
-                    m.baseColour = glm::vec4(float(f[0]), float(f[1]), float(f[2]), float(f[3]));
+                    m.baseColour = glm::vec4(narrow(f[0]), narrow(f[1]), narrow(f[2]), narrow(f[3]));
                 else
                     warn(where + ": baseColorFactor has " + std::to_string(f.size()) + " values, not 4; using white");
                 if (!std::isfinite(m.baseColour.x) || !std::isfinite(m.baseColour.y) || !std::isfinite(m.baseColour.z) ||
                     !std::isfinite(m.baseColour.w))
                     return fail(mFile, where, "baseColorFactor is not finite");
-                m.alphaCutoff = std::isfinite(src.alphaCutoff) ? float(src.alphaCutoff) : 0.5f;
+                m.alphaCutoff = std::isfinite(narrow(src.alphaCutoff)) ? narrow(src.alphaCutoff) : 0.5f;
                 m.doubleSided = src.doubleSided;
                 if (mOptions.leafMaterials.empty())
                     m.isLeaf = src.alphaMode == "MASK" || src.alphaMode == "BLEND";
@@ -517,10 +562,10 @@ namespace TreeLod
                     const tinygltf::Value& c = src.extras.Get("treelodBackColour");
                     bool ok = c.IsArray() && c.ArrayLen() == 3;
                     for (int k = 0; ok && k < 3; ++k)
-                        ok = c.Get(k).IsNumber() && std::isfinite(c.Get(k).GetNumberAsDouble());
+                        ok = c.Get(k).IsNumber() && std::isfinite(narrow(c.Get(k).GetNumberAsDouble()));
                     if (ok)
-                        m.backColour = glm::vec3(float(c.Get(0).GetNumberAsDouble()), float(c.Get(1).GetNumberAsDouble()),
-                                                 float(c.Get(2).GetNumberAsDouble()));
+                        m.backColour = glm::vec3(narrow(c.Get(0).GetNumberAsDouble()), narrow(c.Get(1).GetNumberAsDouble()),
+                                                 narrow(c.Get(2).GetNumberAsDouble()));
                     else
                         warn(where + ": extras treelodBackColour is not 3 numbers; ignored");
                 }
@@ -862,7 +907,7 @@ namespace TreeLod
                 readVec(*positions, i, &p.x);
                 if (!finite3(p))
                     return fail(mFile, positionWhere, "vertex " + std::to_string(i) + " position is not finite " + vecText(p));
-                glm::vec3 q = glm::vec3(world * glm::dvec4(p, 1.0));
+                glm::vec3 q = narrow(glm::dvec3(world * glm::dvec4(p, 1.0)));
                 if (!finite3(q))
                     return fail(mFile, positionWhere, "vertex " + std::to_string(i) +
                                                           " position is not finite after the transform of node " +
@@ -1026,7 +1071,6 @@ namespace TreeLod
             targetVertices.insert(targetVertices.end(), vertices.begin(), vertices.end());
             std::vector<std::uint32_t>& targetIndices = isLeaf ? mLeafSoup.indices : mModel.barkIndices;
             std::vector<std::uint32_t>& targetMaterial = isLeaf ? mLeafSoup.triangleMaterial : mModel.barkTriangleMaterial;
-            targetIndices.reserve(targetIndices.size() + triangles.size());
             for (std::uint32_t v : triangles)
                 targetIndices.push_back(std::uint32_t(base + v));
             targetMaterial.insert(targetMaterial.end(), triangles.size() / 3, material);
@@ -1072,10 +1116,12 @@ namespace TreeLod
                     parent.GetNumberAsDouble() < -1.0 || parent.GetNumberAsDouble() >= double(i))
                     return fail(mFile, nodeWhere, "parent must be -1 or the index of an earlier node");
                 SkeletonNode sn;
-                sn.position = glm::vec3(world * glm::dvec4(p[0], p[1], p[2], 1.0));
+                sn.position = narrow(glm::dvec3(world * glm::dvec4(p[0], p[1], p[2], 1.0)));
                 if (!finite3(sn.position))
                     return fail(mFile, nodeWhere, "position is not finite after the node transform");
-                sn.radius = float(r.GetNumberAsDouble() * radiusScale);
+                sn.radius = narrow(r.GetNumberAsDouble() * radiusScale);
+                if (!std::isfinite(sn.radius))
+                    return fail(mFile, nodeWhere, "radius is not finite after the node transform");
                 const int pi = int(parent.GetNumberAsDouble());
                 sn.parent = pi < 0 ? -1 : offset + pi;
                 mModel.skeleton.push_back(sn);

@@ -113,27 +113,16 @@ namespace TreeLod
             {
                 // Ovate, widest at a third, drawn-out tip, double-serrate margin.
                 const float envelope = std::pow(std::sin(kPi * std::pow(s, 0.62f)), 0.85f);
-                const float teeth = 1.0f - 0.07f * fract(s * 16.0f) - 0.04f * fract(s * 32.0f);
+                const float teeth = 1.0f - 0.045f * fract(s * 16.0f) - 0.025f * fract(s * 32.0f);
                 return maxHalf * envelope * teeth;
             }
             case TreePreset::Shrub:
             default:
-                return maxHalf * std::pow(std::sin(kPi * std::pow(s, 0.85f)), 0.7f);
+                return maxHalf * std::pow(std::sin(kPi * std::pow(s, 0.8f)), 0.8f);
             }
         }
 
         constexpr float kPetiole = 0.1f; ///< petiole length, fraction of the leaf
-
-        /// Inside test for broad leaves: blade or petiole.
-        bool insideBroadLeaf(TreePreset preset, float X, float Y, float aspect)
-        {
-            if (Y < 0.0f || Y > 0.985f)
-                return false;
-            if (Y < kPetiole + 0.02f && std::abs(X) < 0.012f)
-                return true;
-            const float s = (Y - kPetiole) / (0.985f - kPetiole);
-            return std::abs(X) < bladeHalfWidth(preset, s, X < 0.0f, aspect);
-        }
 
         /// Conifer spray: a twig up the middle with needles on both sides, angled forward.
         struct Needle
@@ -146,15 +135,18 @@ namespace TreeLod
             std::vector<Needle> needles;
             const float reach = 0.5f * aspect * 0.92f;
             int i = 0;
-            for (float y = 0.04f; y < 0.93f; y += 0.02f, ++i)
+            for (float y = 0.04f; y < 0.9f; y += 0.02f, ++i)
             {
-                const float length = reach * (1.0f - 0.35f * y) / std::sin(radians(62.0f));
                 for (int side = -1; side <= 1; side += 2)
                 {
-                    const float angle = radians(60.0f + 12.0f * hash2(i, side, 7)); // from the twig
-                    const glm::vec2 a(0.0f, y + 0.01f * float(side));
+                    // Forward-angled needles that reach at most `reach` sideways and stay
+                    // below the top edge; shorter towards the tip of the spray.
+                    const float angle = radians(52.0f + 14.0f * hash2(i, side, 7)); // from the twig
                     const glm::vec2 dir(float(side) * std::sin(angle), std::cos(angle));
-                    needles.push_back({a, a + dir * length * (0.85f + 0.15f * hash2(i, side, 9))});
+                    float length = reach * (1.0f - 0.4f * y) * (0.85f + 0.15f * hash2(i, side, 9)) / dir.x * float(side);
+                    length = std::min(length, (0.97f - y) / dir.y);
+                    const glm::vec2 a(0.0f, y + 0.01f * float(side));
+                    needles.push_back({a, a + dir * length});
                 }
             }
             // A tuft at the tip.
@@ -213,57 +205,97 @@ namespace TreeLod
         size = std::max(size, 4);
         const float aspect = leafAspect(preset);
         const LeafStyle style = leafStyle(preset);
+        const bool spray = preset == TreePreset::Conifer;
         const int ss = size <= 1024 ? 4 : 2; // supersampling per axis for the alpha edge
-        const std::vector<Needle> needles = preset == TreePreset::Conifer ? sprayNeedles(aspect) : std::vector<Needle>();
+        const std::vector<Needle> needles = spray ? sprayNeedles(aspect) : std::vector<Needle>();
         const float needleHalf = 0.011f;
+        const float texel = 1.0f / float(size);
 
-        // Leaf coordinates of a point in the texture: u across, v down.
-        auto toLeaf = [&](float u, float v) { return glm::vec2((u - 0.5f) * aspect, 1.0f - v); };
-
+        // Leaf coordinates: X = (u - 0.5) * aspect across, Y = 1 - v from the petiole end.
         std::vector<glm::vec3> colour(std::size_t(size) * size);
         std::vector<float> alpha(std::size_t(size) * size);
+        std::vector<Needle> rowNeedles;
+        std::vector<glm::vec2> halfWidths(std::size_t(ss) + 1); // per sub-row (+ centre): left, right
         for (int py = 0; py < size; ++py)
+        {
+            const float yCentre = 1.0f - (float(py) + 0.5f) * texel;
+            // What a row needs, once per row: the needles that can reach it, or the
+            // blade's half-widths on both sides at each sub-row and at the centre.
+            if (spray)
+            {
+                rowNeedles.clear();
+                for (const Needle& n : needles)
+                    if (yCentre + texel + needleHalf >= std::min(n.a.y, n.b.y) - 0.02f &&
+                        yCentre - texel - needleHalf <= std::max(n.a.y, n.b.y) + 0.02f)
+                        rowNeedles.push_back(n);
+            }
+            else
+                for (int sy = 0; sy <= ss; ++sy)
+                {
+                    const float y = sy < ss ? 1.0f - (float(py) + (float(sy) + 0.5f) / float(ss)) * texel : yCentre;
+                    float left = 0.0f, right = 0.0f;
+                    if (y >= 0.0f && y <= 0.985f)
+                    {
+                        if (y < kPetiole + 0.02f)
+                            left = right = 0.012f;
+                        const float s = (y - kPetiole) / (0.985f - kPetiole);
+                        left = std::max(left, bladeHalfWidth(preset, s, true, aspect));
+                        right = std::max(right, bladeHalfWidth(preset, s, false, aspect));
+                    }
+                    halfWidths[std::size_t(sy)] = {left, right};
+                }
+
             for (int px = 0; px < size; ++px)
             {
-                // Coverage.
+                const glm::vec2 c(((float(px) + 0.5f) * texel - 0.5f) * aspect, yCentre);
+                float centreAlong = 0.0f, centreDistance = 0.0f;
+                bool centreTwig = false;
+                if (spray)
+                    centreDistance = sprayDistance(rowNeedles, c, centreAlong, centreTwig);
+                // The spray's distance changes at most ~1 per unit, so texels whose centre is
+                // farther than a texel diagonal from the edge are wholly in or out.
+                const float margin = 0.8f * texel * std::max(1.0f, aspect);
                 int inside = 0;
-                for (int sy = 0; sy < ss; ++sy)
-                    for (int sx = 0; sx < ss; ++sx)
-                    {
-                        const glm::vec2 q = toLeaf((float(px) + (float(sx) + 0.5f) / float(ss)) / float(size),
-                                                   (float(py) + (float(sy) + 0.5f) / float(ss)) / float(size));
-                        if (preset == TreePreset::Conifer)
+                if (spray && centreDistance < needleHalf - margin)
+                    inside = ss * ss;
+                else if (!spray || centreDistance <= needleHalf + margin)
+                {
+                    for (int sy = 0; sy < ss; ++sy)
+                        for (int sx = 0; sx < ss; ++sx)
                         {
-                            float along;
-                            bool twig;
-                            inside += sprayDistance(needles, q, along, twig) < needleHalf ? 1 : 0;
+                            const float x = ((float(px) + (float(sx) + 0.5f) / float(ss)) * texel - 0.5f) * aspect;
+                            if (spray)
+                            {
+                                const float y = 1.0f - (float(py) + (float(sy) + 0.5f) / float(ss)) * texel;
+                                float along;
+                                bool twig;
+                                inside += sprayDistance(rowNeedles, {x, y}, along, twig) < needleHalf ? 1 : 0;
+                            }
+                            else
+                            {
+                                const glm::vec2 hw = halfWidths[std::size_t(sy)];
+                                inside += std::abs(x) < (x < 0.0f ? hw.x : hw.y) ? 1 : 0;
+                            }
                         }
-                        else
-                            inside += insideBroadLeaf(preset, q.x, q.y, aspect) ? 1 : 0;
-                    }
+                }
                 const std::size_t i = std::size_t(py) * size + px;
                 alpha[i] = float(inside) / float(ss * ss);
 
                 // Colour at the texel centre.
-                const glm::vec2 c = toLeaf((float(px) + 0.5f) / float(size), (float(py) + 0.5f) / float(size));
                 const float noise = tileNoise(c.x * 40.0f, c.y * 40.0f, 1 << 20, 1 << 20, 3) - 0.5f;
                 glm::vec3 col;
-                if (preset == TreePreset::Conifer)
-                {
-                    float along;
-                    bool twig;
-                    sprayDistance(needles, c, along, twig);
-                    col = twig ? style.petioleColour
-                               : glm::mix(style.baseColour, style.tipColour, 0.3f + 0.5f * along + 0.2f * c.y);
-                }
+                if (spray)
+                    col = centreTwig ? style.petioleColour
+                                     : glm::mix(style.baseColour, style.tipColour,
+                                                0.3f + 0.5f * centreAlong + 0.2f * c.y);
                 else if (c.y < kPetiole)
                     col = style.petioleColour;
                 else
                 {
                     const float s = (c.y - kPetiole) / (0.985f - kPetiole);
                     col = glm::mix(style.baseColour, style.tipColour, smoothstep(0.0f, 1.0f, s));
-                    const float half = std::max(1e-3f, bladeHalfWidth(preset, s, c.x < 0.0f, aspect));
-                    const float edge = std::abs(c.x) / half;
+                    const glm::vec2 hw = halfWidths[std::size_t(ss)];
+                    const float edge = std::abs(c.x) / std::max(1e-3f, c.x < 0.0f ? hw.x : hw.y);
                     col *= 1.0f - 0.12f * smoothstep(0.6f, 1.0f, edge); // darker rim
                     // Midrib, tapering to the tip.
                     const float midrib = 1.0f - smoothstep(0.0f, 0.008f + 0.006f * (1.0f - s), std::abs(c.x));
@@ -276,12 +308,14 @@ namespace TreeLod
                 }
                 colour[i] = glm::clamp(col * (1.0f + 0.16f * noise), glm::vec3(0.0f), glm::vec3(1.0f));
             }
+        }
 
-        // Bleed colour into empty texels (a few rings by neighbour averaging, then the
-        // mean leaf colour), so filtering never mixes in an unrelated colour.
-        std::vector<char> known(alpha.size());
+        // Bleed colour into empty texels: 16 rings outwards, each texel the mean of its
+        // already coloured 8-neighbours; beyond that the mean leaf colour. Only the
+        // frontier is visited, so the cost is proportional to the texels coloured.
         glm::vec3 mean(0.0f);
         double weight = 0.0;
+        std::vector<char> known(alpha.size());
         for (std::size_t i = 0; i < alpha.size(); ++i)
         {
             known[i] = alpha[i] > 0.0f;
@@ -289,43 +323,59 @@ namespace TreeLod
             weight += alpha[i];
         }
         mean = weight > 0.0 ? mean / float(weight) : style.baseColour;
-        std::vector<glm::vec3> next = colour;
-        std::vector<char> nextKnown = known;
-        for (int pass = 0; pass < 16; ++pass)
-        {
-            bool changed = false;
-            for (int py = 0; py < size; ++py)
-                for (int px = 0; px < size; ++px)
+        auto forNeighbours = [size](std::size_t i, auto&& visit) {
+            const int px = int(i % std::size_t(size)), py = int(i / std::size_t(size));
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx)
                 {
-                    const std::size_t i = std::size_t(py) * size + px;
-                    if (known[i])
-                        continue;
-                    glm::vec3 sum(0.0f);
-                    int n = 0;
-                    for (int dy = -1; dy <= 1; ++dy)
-                        for (int dx = -1; dx <= 1; ++dx)
-                        {
-                            const int x = px + dx, y = py + dy;
-                            if (x < 0 || y < 0 || x >= size || y >= size)
-                                continue;
-                            const std::size_t j = std::size_t(y) * size + x;
-                            if (known[j])
-                            {
-                                sum += colour[j];
-                                ++n;
-                            }
-                        }
-                    if (n > 0)
-                    {
-                        next[i] = sum / float(n);
-                        nextKnown[i] = 1;
-                        changed = true;
-                    }
+                    const int x = px + dx, y = py + dy;
+                    if ((dx != 0 || dy != 0) && x >= 0 && y >= 0 && x < size && y < size)
+                        visit(std::size_t(y) * std::size_t(size) + std::size_t(x));
                 }
-            colour = next;
-            known = nextKnown;
-            if (!changed)
-                break;
+        };
+        std::vector<char> queued(alpha.size(), 0);
+        std::vector<std::size_t> frontier, next;
+        for (std::size_t i = 0; i < alpha.size(); ++i)
+            if (!known[i])
+                forNeighbours(i, [&](std::size_t j) {
+                    if (known[j] && !queued[i])
+                    {
+                        queued[i] = 1;
+                        frontier.push_back(i);
+                    }
+                });
+        std::vector<glm::vec3> filled;
+        for (int ring = 0; ring < 16 && !frontier.empty(); ++ring)
+        {
+            filled.assign(frontier.size(), glm::vec3(0.0f));
+            for (std::size_t k = 0; k < frontier.size(); ++k)
+            {
+                glm::vec3 sum(0.0f);
+                int n = 0;
+                forNeighbours(frontier[k], [&](std::size_t j) {
+                    if (known[j])
+                    {
+                        sum += colour[j];
+                        ++n;
+                    }
+                });
+                filled[k] = sum / float(std::max(n, 1));
+            }
+            next.clear();
+            for (std::size_t k = 0; k < frontier.size(); ++k)
+            {
+                colour[frontier[k]] = filled[k];
+                known[frontier[k]] = 1;
+            }
+            for (std::size_t i : frontier)
+                forNeighbours(i, [&](std::size_t j) {
+                    if (!known[j] && !queued[j])
+                    {
+                        queued[j] = 1;
+                        next.push_back(j);
+                    }
+                });
+            frontier.swap(next);
         }
 
         TextureImage image;
@@ -386,14 +436,14 @@ namespace TreeLod
                     col = rgb(222, 220, 212) * (0.9f + 0.15f * n);
                     const int cx = int(u * 6.0f), cy = int(v * 28.0f);
                     const float fy = v * 28.0f - float(cy), fx = u * 6.0f - float(cx);
-                    const float length = 0.3f + 0.6f * hash2(cx, cy, 41);
+                    const float length = 0.25f + 0.5f * hash2(cx, cy, 41);
                     const float startX = hash2(cx, cy, 43) * (1.0f - length);
                     const bool dash = hash2(cx, cy, 47) < 0.55f && std::abs(fy - 0.5f) < 0.09f &&
                                       fx > startX && fx < startX + length;
                     if (dash)
                         col = rgb(40, 34, 32);
-                    const float patch = tileFbm(u, v, 3, 5, 3, 53);
-                    col = glm::mix(col, rgb(60, 55, 50), smoothstep(0.68f, 0.74f, patch));
+                    const float patch = tileFbm(u, v, 4, 12, 3, 53);
+                    col = glm::mix(col, rgb(60, 55, 50), smoothstep(0.7f, 0.74f, patch));
                     break;
                 }
                 case TreePreset::Shrub:

@@ -301,10 +301,27 @@ namespace TreeLod
         Result<void> valid = model.validate(label);
         if (!valid)
             return fail(label, "model '" + model.name + "', " + valid.error().element, valid.error().reason);
+        // What decodeReferenceChunk would refuse is refused here, before anything is written.
+        const auto tooLong = [](const std::string& s) { return s.size() > MODEL_CHUNK_MAX_STRING; };
+        const std::string tooLongReason = "name longer than " + std::to_string(MODEL_CHUNK_MAX_STRING) + " bytes";
+        if (tooLong(model.name))
+            return fail(label, "model", tooLongReason);
+        for (std::size_t m = 0; m < model.materials.size(); ++m)
+            if (tooLong(model.materials[m].name))
+                return fail(label, "material " + std::to_string(m), tooLongReason);
         for (std::size_t t = 0; t < model.textures.size(); ++t)
-            if (model.textures[t].width <= 0 || model.textures[t].height <= 0)
-                return fail(label, "texture " + std::to_string(t) + " '" + model.textures[t].name + "'",
-                            "empty image cannot be stored");
+        {
+            const TextureImage& image = model.textures[t];
+            const std::string element = "texture " + std::to_string(t) + " '" + image.name + "'";
+            if (tooLong(image.name))
+                return fail(label, "texture " + std::to_string(t), tooLongReason);
+            if (image.width <= 0 || image.height <= 0)
+                return fail(label, element, "empty image cannot be stored");
+            if (image.width > int(GPU_TEXTURE_MAX_SIZE) || image.height > int(GPU_TEXTURE_MAX_SIZE))
+                return fail(label, element,
+                            std::to_string(image.width) + "x" + std::to_string(image.height) +
+                                " is larger than the " + std::to_string(GPU_TEXTURE_MAX_SIZE) + " texels a GPU texture may have");
+        }
 
         report(progress, "mip chains", 0.0f);
         const ReferenceChunk chunk = makeReferenceChunk(model);

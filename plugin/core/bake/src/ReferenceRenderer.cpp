@@ -56,7 +56,7 @@ namespace TreeLod
             const Vertex& b = scene.vertex(hit.part, tri.v[1]);
             const Vertex& c = scene.vertex(hit.part, tri.v[2]);
             float w0 = 1.0f - hit.u - hit.v, w1 = hit.u, w2 = hit.v;
-            bool back = glm::dot(tri.faceNormal, dir) > 0.0f;
+            glm::vec3 point = org + dir * hit.t;
 
             glm::vec3 n = w0 * a.normal + w1 * b.normal + w2 * c.normal;
             float len = glm::length(n);
@@ -65,10 +65,12 @@ namespace TreeLod
             else if (tri.faceNormal != glm::vec3(0.0f))
                 n = tri.faceNormal;
             else
-            {
                 n = -glm::normalize(dir); // never hit in practice: degenerate triangles are skipped
-                back = false;
-            }
+            // The side seen. Leaves: from the shading normal and the vector to the camera
+            // position, as the GLSL does. Bark: from the winding (only double-sided bark is
+            // ever hit from behind, the rest is culled).
+            bool back = hit.part == EmbreeScene::Leaves ? glm::dot(n, f.eye - point) < 0.0f
+                                                        : glm::dot(tri.faceNormal, dir) > 0.0f;
             if (back)
                 n = -n;
 
@@ -95,7 +97,7 @@ namespace TreeLod
             Sample s;
             s.hit = true;
             s.colour = glm::clamp(colour, glm::vec3(0.0f), glm::vec3(1.0f));
-            s.depth = glm::dot(org + dir * hit.t - f.eye, f.forward);
+            s.depth = glm::dot(point - f.eye, f.forward);
             s.normal = n;
             return s;
         }

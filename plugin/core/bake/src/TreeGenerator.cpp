@@ -9,10 +9,10 @@
 // flare, attraction up, leaves on the last stem level weighted by ShapeRatio(4, ...).
 // Deviations: no stem splits (SegSplits) and no pruning envelope; several trunks from the
 // ground (shrub) instead of BaseSplits; attraction up is a simpler rotation towards (or away
-// from) +Y by a fraction of the declination; the leaf count is exact (largest-remainder
-// distribution over the leaf-bearing stems) and leaves are placed around those stems on
-// invisible twigs instead of on a further stem level; the tree is scaled so that the top of
-// its stems is exactly the requested height.
+// from) +Y by a fraction of the declination, per level; the leaf count is exact (rounded
+// cumulative weights over the leaf-bearing stems) and leaves are placed around those stems
+// on invisible twigs instead of on a further stem level; the tree is scaled so that the top
+// of its stems is exactly the requested height.
 #include "TreeLod/TreeGenerator.h"
 
 #include "TreeLod/LeafTexture.h"
@@ -264,7 +264,7 @@ namespace TreeLod
                 c.branches = 12;
                 c.start = 0.08f;
                 c.taper = 1.0f;
-                c.sides = 4;
+                c.sides = 3;
                 p.leafAreaFactor = 3.0f;
                 p.leafSpread = 0.03f;
                 p.leafStart = 0.05f;
@@ -518,6 +518,8 @@ namespace TreeLod
                     glm::vec3 out(frame.z.x, 0.0f, frame.z.z);
                     if (glm::length(out) > 1e-6f)
                         base = glm::normalize(out) * (p.trunkBaseSpread * height * std::sqrt(rnd.unit()));
+                    // Lift a leaning stem so that its tilted base ring stays above ground.
+                    base.y = trunk.radius * flareAt(p.flare, 0.0f) * std::sin(lean);
                 }
                 growStem(trunk, base, frame, tp, p.flare, rnd);
                 stems.push_back(std::move(trunk));
@@ -680,28 +682,27 @@ namespace TreeLod
             model.barkTriangleMaterial.assign(model.barkIndices.size() / 3, 0u);
         }
 
-        /// Split `total` leaves over stems in proportion to `weights` (largest remainder;
-        /// ties go to the lower index), so the sum is exact.
+        /// Split `total` leaves over stems in proportion to `weights` by rounding the
+        /// cumulative sums (systematic sampling): the counts add up to `total` exactly, and
+        /// when there are fewer leaves than stems they spread evenly over the stem order
+        /// (which runs up the tree) instead of piling onto the heaviest stems.
         std::vector<std::uint32_t> distribute(std::uint32_t total, const std::vector<double>& weights)
         {
             double sum = 0.0;
             for (double w : weights)
                 sum += w;
             std::vector<std::uint32_t> counts(weights.size(), 0);
-            std::vector<std::pair<double, std::size_t>> remainders;
+            double cumulative = 0.0;
             std::uint64_t given = 0;
             for (std::size_t i = 0; i < weights.size(); ++i)
             {
-                const double ideal = sum > 0.0 ? double(total) * weights[i] / sum : double(total) / double(weights.size());
-                counts[i] = std::uint32_t(std::floor(ideal));
-                given += counts[i];
-                remainders.emplace_back(ideal - std::floor(ideal), i);
+                cumulative += sum > 0.0 ? weights[i] : 1.0;
+                const double fraction = i + 1 == weights.size() ? 1.0
+                                        : cumulative / (sum > 0.0 ? sum : double(weights.size()));
+                const std::uint64_t upTo = std::min<std::uint64_t>(total, std::uint64_t(std::floor(double(total) * fraction + 0.5)));
+                counts[i] = std::uint32_t(upTo - std::min(upTo, given));
+                given = std::max(given, upTo);
             }
-            std::sort(remainders.begin(), remainders.end(), [](const auto& a, const auto& b) {
-                return a.first != b.first ? a.first > b.first : a.second < b.second;
-            });
-            for (std::size_t k = 0; given < total; ++k, ++given)
-                ++counts[remainders[k % remainders.size()].second];
             return counts;
         }
 
@@ -727,9 +728,10 @@ namespace TreeLod
             }
             const std::vector<std::uint32_t> counts = distribute(leafCount, weights);
 
-            // Leaf size rule (see TreeGenerator.h): total quad area = k * height^2.
+            // Leaf size rule (see TreeGenerator.h): total quad area = k * height^2, each
+            // leaf at most a tenth of the height long (only binds near 100 leaves).
             const float leafArea = p.leafAreaFactor * height * height / float(leafCount);
-            const float leafLength = std::sqrt(leafArea / aspect);
+            const float leafLength = std::min(std::sqrt(leafArea / aspect), 0.1f * height);
             const float halfWidth = 0.5f * aspect * leafLength;
             // Leaves fill a tube of radius `reach` around their stem whatever their size:
             // the invisible twig is as long as the leaf leaves room for (at least a quarter).
@@ -776,7 +778,15 @@ namespace TreeLod
 
                     const float sizeJitter = 1.0f + rnd.spread(0.15f);
                     const glm::vec3 w = across * (halfWidth * sizeJitter);
-                    const glm::vec3 tip = basePos + axis * (leafLength * sizeJitter);
+                    glm::vec3 base = basePos;
+                    glm::vec3 tip = basePos + axis * (leafLength * sizeJitter);
+                    // Leaves hanging into the ground are lifted onto it.
+                    const float lowest = std::min({base.y - std::abs(w.y), tip.y - std::abs(w.y)});
+                    if (lowest < 0.0f)
+                    {
+                        base.y -= lowest;
+                        tip.y -= lowest;
+                    }
 
                     Leaf leaf;
                     leaf.firstVertex = std::uint32_t(model.leafVertices.size());
@@ -786,8 +796,8 @@ namespace TreeLod
                     leaf.material = 1;
                     // Petiole at the bottom of the texture (v = 1), tip at the top (v = 0);
                     // (across, axis, face) is right-handed, so the triangles face `face`.
-                    model.leafVertices.push_back({basePos - w, face, {0.0f, 1.0f}});
-                    model.leafVertices.push_back({basePos + w, face, {1.0f, 1.0f}});
+                    model.leafVertices.push_back({base - w, face, {0.0f, 1.0f}});
+                    model.leafVertices.push_back({base + w, face, {1.0f, 1.0f}});
                     model.leafVertices.push_back({tip + w, face, {1.0f, 0.0f}});
                     model.leafVertices.push_back({tip - w, face, {0.0f, 0.0f}});
                     const std::uint32_t v0 = leaf.firstVertex;

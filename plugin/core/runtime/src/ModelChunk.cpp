@@ -209,7 +209,7 @@ namespace TreeLod
         ReferenceChunk chunk;
         TreeModel& m = chunk.model;
 
-        m.name = r.string();
+        m.name = r.string(MODEL_CHUNK_MAX_STRING);
 
         // ---- materials ----
         r.setElement(chunkName + ", materials");
@@ -221,7 +221,7 @@ namespace TreeLod
         {
             Material& mat = m.materials[i];
             r.setElement(chunkName + ", material " + std::to_string(i));
-            mat.name = r.string();
+            mat.name = r.string(MODEL_CHUNK_MAX_STRING);
             r.setElement(chunkName + ", material " + std::to_string(i) + " '" + mat.name + "'");
             mat.baseColour = r.vec4();
             mat.backColour = r.vec3();
@@ -252,7 +252,7 @@ namespace TreeLod
         {
             GpuTexture& tex = chunk.textures[i];
             r.setElement(chunkName + ", texture " + std::to_string(i));
-            tex.name = r.string();
+            tex.name = r.string(MODEL_CHUNK_MAX_STRING);
             r.setElement(chunkName + ", texture " + std::to_string(i) + " '" + tex.name + "'");
             const std::uint32_t format = r.u32();
             tex.width = r.u32();

@@ -45,6 +45,11 @@ namespace TreeLod
         Ogre::Root& getRoot() { return *mRoot; }
         Ogre::SceneManager& getSceneManager() { return *mSceneManager; }
 
+        /// Parent node for what is drawn (the camera and sun live elsewhere).
+        Ogre::SceneNode& getContentNode() { return *mContentNode; }
+        /// Destroy every object under the content node and its child nodes.
+        void clearContent();
+
         /// Sun (directional light) and ambient as LightingSpec says; background colour too.
         void setLighting(const LightingSpec& lighting);
 
@@ -67,6 +72,7 @@ namespace TreeLod
         Ogre::Camera* mCamera = nullptr;
         Ogre::SceneNode* mCameraNode = nullptr;
         Ogre::Light* mSun = nullptr;
+        Ogre::SceneNode* mContentNode = nullptr;
         Ogre::TexturePtr mTarget;
         LightingSpec mLighting;
     };

@@ -12,20 +12,35 @@
 //   glTF image), alphaMode, alphaCutoff, doubleSided, and the back colour of leaves from the
 //   material's extras {"treelodBackColour": [r, g, b]} (linear).
 // - Images: .glb bufferViews, data URIs, and files relative to the .gltf; PNG (palette + tRNS
-//   alpha kept) and JPEG.
+//   alpha kept) and JPEG, decoded with OpenImageIO. A missing external image that a material
+//   uses is an Error naming the image and the path.
 // - The bark skeleton from a mesh's extras {"treelodSkeleton": {"positions": [x,y,z,...],
 //   "radii": [...], "parents": [...]}} (parents before children; -1 = root), transformed by
 //   the node that instances the mesh. Several instances append with offset parents.
 //
 // Leaves (TreeModel header): triangles whose material is a leaf material. A leaf is one
 // connected component of leaf triangles, two triangles being connected when they share a
-// vertex index or a vertex position (after the node transform, welded when equal within
-// 1e-6 of the model's size, so crossed quads that share their middle edge are one leaf).
-// Leaves are ordered by their first triangle in file order (scene traversal order, then
-// primitive, then triangle). Every other triangle is bark.
+// vertex index or a vertex position (bitwise-equal floats after the node transform; -0 = +0),
+// so single quads, multi-triangle leaves and crossed quads whose halves share their middle
+// edge's positions are one leaf each; quads that only intersect are two. Leaves are ordered
+// by their first triangle in file order (scene traversal, depth first, children in order;
+// then primitive; then triangle). Triangles that repeat a vertex index are dropped (they
+// have no area and would only glue neighbours). Every other triangle is bark.
+// - Zero-area leaves (area <= 1e-6 x the square of their bounding box's longest side: a
+//   point or a line, up to float rounding) are dropped and counted.
+// - A leaf written twice (an index-connected piece whose corner positions repeat an earlier
+//   piece exactly) stays a leaf of its own, not welded to the original, and is counted.
 //
-// Errors name the file, the element ("mesh 1 'Leaves' primitive 0 accessor 3", "image 2
-// 'bark.png'", "node 4", "glb header") and the reason. Nothing is partially returned.
+// Not supported (an Error names the element): sparse accessors, accessors without a
+// bufferView, required extensions other than KHR_mesh_quantization, images that are not
+// PNG or JPEG or larger than 16384 per side / 64 Mpixel, JSON nested deeper than 128.
+// Ignored: skins, morph targets, cameras, lights, KHR_texture_transform, samplers.
+//
+// Errors name the file, the element ("mesh 1 'Leaves' primitive 0 accessor 3 (indices)",
+// "image 2 'bark'", "node 4", "glb header") and the reason. Nothing is partially returned.
+// Bad geometry is an Error (index out of range, NaN/Inf position, accessor overrunning its
+// buffer view), as is a file without any triangle; a bare trunk or leaves without bark are
+// valid trees. A model more than 1 km across imports with a warning (units are metres).
 #pragma once
 
 #include "TreeLod/Progress.h"

@@ -3,8 +3,9 @@
 // Leaf: RGBA8, straight alpha, rows top to bottom (glTF/PNG convention), sRGB colour.
 // The leaf stands upright in the image: petiole at the bottom edge (v = 1), tip at the top
 // (v = 0), centred in u. Alpha is the leaf silhouette with an anti-aliased edge (4x4
-// supersampled coverage); colour is bled into the transparent texels so that mipmaps and
-// bilinear filtering don't darken the edge. Shapes: oak lobed, birch ovate serrated,
+// supersampled coverage, 2x2 above 1024 texels); colour is bled into the transparent
+// texels (16 texels out, then the mean leaf colour) so that mipmaps and bilinear filtering
+// don't darken the edge. Shapes: oak lobed, birch ovate serrated,
 // conifer a needle spray on a twig, shrub small ovate; colour has a base-to-tip gradient,
 // a midrib, side veins and faint noise.
 //

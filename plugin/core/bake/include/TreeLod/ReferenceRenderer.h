@@ -17,17 +17,22 @@
 //     of the four nearest texels of the full-resolution texture (texel centres at
 //     ((i + 0.5) / w, (j + 0.5) / h), UV (0, 0) = top-left texel corner as in glTF, REPEAT
 //     wrapping), no mip-mapping. Without a texture textureAlpha = 1.
-//   - The back side of a triangle is where its geometric normal cross(p1 - p0, p2 - p0)
-//     (counter-clockwise front, as OpenGL) faces away from the camera.
+//   - Bark's back side (for culling and for double-sided bark's shading) is where its
+//     geometric normal cross(p1 - p0, p2 - p0) (counter-clockwise front, as OpenGL) faces
+//     away from the camera.
 //
 // Shading (the LightingSpec contract, all in linear space):
+//   n0     = barycentric interpolation of the vertex normals, normalised (the unit geometric
+//            normal where that is zero or not finite).
+//   side   = leaves: back where dot(n0, cameraPosition - hitPoint) < 0 (the shading normal
+//            turned away from the camera position; like the GLSL, which cannot trust
+//            gl_FrontFacing under render-to-texture); bark: back where the winding faces away
+//            (only double-sided bark is seen from there).
+//   n      = n0 on the front, -n0 on the back, so a leaf's n always faces the camera.
 //   albedo = baseColour.rgb * srgbToLinear(texture.rgb(uv))    (same bilinear lookup as alpha;
 //            texture = white without one). On the back side of a leaf whose material has a
 //            nonzero backColour, backColour replaces baseColour.rgb:
 //            albedo = backColour * srgbToLinear(texture.rgb(uv)).
-//   n      = barycentric interpolation of the vertex normals, normalised (the unit geometric
-//            normal where that is zero or not finite), negated on the back side
-//            (GLSL: gl_FrontFacing ? n : -n).
 //   ao     = barycentric interpolation of RenderOptions::ambientOcclusion's vertex values,
 //            1 without it.
 //   colour = albedo * (ambientColour * ao + sunColour * max(0, dot(n, sunDirection))),
@@ -81,8 +86,9 @@ namespace TreeLod
         std::vector<float> depth;  ///< metres along the camera's view axis (view-space -z) from
                                    ///< the camera position; +inf where alpha = 0
         std::vector<glm::vec3> normal; ///< world-space unit shading normal n (see above); it faces
-                                       ///< the camera except where interpolated bark normals turn
-                                       ///< away near silhouettes; 0 where alpha = 0
+                                       ///< the camera (always for leaves; for bark except where
+                                       ///< interpolated normals turn away near silhouettes);
+                                       ///< 0 where alpha = 0
         int width = 0;
         int height = 0;
     };

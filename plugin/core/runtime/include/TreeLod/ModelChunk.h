@@ -2,7 +2,7 @@
 // TreeModel field, with its textures stored GPU-ready (whole mip chains).
 //
 // Layout, formatVersion 1 (REFERENCE_CHUNK_FORMAT_VERSION), little-endian. "string" is a
-// u32 byte length + UTF-8 bytes (at most 4096); "align16" is zero bytes up to the next
+// u32 byte length + UTF-8 bytes (at most MODEL_CHUNK_MAX_STRING); "align16" is zero bytes up to the next
 // multiple of 16 from the chunk start, so that bulk arrays and texel data are 16-byte
 // aligned in the file (chunks start 16-aligned) and can be handed to the GPU as they are.
 //
@@ -37,6 +37,9 @@
 namespace TreeLod
 {
     constexpr std::uint32_t REFERENCE_CHUNK_FORMAT_VERSION = 1;
+
+    /// Longest name (model, material, texture) a reference chunk may hold, in bytes.
+    constexpr std::uint32_t MODEL_CHUNK_MAX_STRING = 65535;
 
     /// Largest texture edge a chunk may hold (the GL 3.3 guaranteed minimum of GPUs we target).
     constexpr std::uint32_t GPU_TEXTURE_MAX_SIZE = 16384;

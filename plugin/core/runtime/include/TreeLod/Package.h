@@ -86,6 +86,9 @@ namespace TreeLod
     class PackageReader
     {
     public:
+        /// An empty reader: no chunks, no label (a placeholder until open() / fromMemory()).
+        PackageReader() = default;
+
         /// Read the header and chunk table of the file at `path`; payloads stay on disk
         /// until readChunk(). Checks magic, version, header and table checksums, and that
         /// every chunk lies inside the file. Errors name `path`.
@@ -120,7 +123,6 @@ namespace TreeLod
         std::uint32_t version() const { return mVersion; }
 
     private:
-        PackageReader() = default;
         /// Reads `size` bytes at `offset` of the package; the element names the part in errors.
         using RangeReader = std::function<Result<std::vector<std::uint8_t>>(
             std::uint64_t offset, std::uint64_t size, const std::string& element)>;

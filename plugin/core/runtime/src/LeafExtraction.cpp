@@ -1,4 +1,4 @@
-#include "LeafComponents.h"
+#include "TreeLod/LeafExtraction.h"
 
 #include <algorithm>
 #include <cstring>

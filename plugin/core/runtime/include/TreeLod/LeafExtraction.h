@@ -1,4 +1,4 @@
-// LeafComponents (private to TreeLodBake): split a soup of leaf triangles into leaves.
+// LeafExtraction: split a soup of leaf triangles into leaves (shared by the glTF and .mesh importers).
 //
 // A leaf is one connected component of the soup's triangles, two triangles being connected
 // when they share a vertex index or a vertex position (bitwise-equal floats, -0 == +0).
