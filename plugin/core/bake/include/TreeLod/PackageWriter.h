@@ -28,6 +28,10 @@ namespace TreeLod
                               std::vector<std::uint8_t> bytes);
 
         std::size_t chunkCount() const { return mChunks.size(); }
+        bool hasChunk(const std::string& technique, std::uint32_t level) const
+        {
+            return mChunks.count({technique, level}) != 0;
+        }
 
         /// The whole package.
         std::vector<std::uint8_t> toBytes() const;

@@ -1,0 +1,64 @@
+// FoliageLodBaker: builds LoDF's multiresolution foliage (paper 004 §3, §3.1) from a tree.
+//
+// 1. Independent groups (§3.1): the leaves of each leaf material are split into spatially
+//    compact clusters of at most `clusterSize` leaves (recursive median split of the leaf
+//    centres along the longest axis). A collapse never crosses clusters, and the sequence
+//    runs until each cluster is one leaf, so the coarsest level has one leaf per cluster.
+// 2. Leaf collapse (§3, after the Foliage Simplification Algorithm [15]): inside a cluster the
+//    cheapest pair of active leaves is collapsed, greedily, until one leaf is left. Cost of
+//    collapsing a and b (metres: the error of replacing two leaves by one):
+//        cost = (|c_a - c_b| + s * (1 - |n_a . n_b|) + s * uvPenalty) * sqrt((A_a + A_b) / A_mean)
+//    c centre, n normal, A the area the leaf stands for (sum of the original leaves it
+//    replaces), s = sqrt(A_a + A_b) its size, uvPenalty 1 when the two leaves show different
+//    parts of the texture (else 0), A_mean the mean original leaf area. Distance keeps the
+//    crown's shape, orientation keeps its shading, the area factor makes leaves grow evenly.
+// 3. The new leaf (eq. 3, no new vertices): each leaf has four corner vertices, one per corner
+//    of its texture rectangle; the new leaf takes every corner from a or from b (16 choices)
+//    and the choice kept is the one closest to covering the area A_a + A_b, centred on the
+//    pair, without folding. So the crown's covered area is kept as leaves disappear, and the
+//    whole leaf image stays mapped on the new quad.
+// 4. Order (Fig. 8): Changed_group lists the collapses by cost band (`costBands` equal-count
+//    bands of each collapse's running-maximum cost in its cluster), and inside a band cluster
+//    by cluster (clusters in a fixed pseudo-random order, so no region of the crown simplifies
+//    first). Deviation from a pure global cost order, stated in README: with it, any 1 % change
+//    touches nearly every cluster and §4's partial upload saves nothing; with bands, a run of
+//    consecutive changes touches few clusters, at the price of reordering collapses whose
+//    costs lie in the same band.
+// Deterministic: the same model and options give the same data, whatever the thread count.
+#pragma once
+
+#include "TreeLod/FoliageLodData.h"
+#include "TreeLod/Progress.h"
+#include "TreeLod/Result.h"
+#include "TreeLod/TreeModel.h"
+
+#include <cstdint>
+#include <string>
+
+namespace TreeLod
+{
+    class PackageWriter;
+
+    struct FoliageLodOptions
+    {
+        std::uint32_t clusterSize = 64; ///< leaves per independent cluster (1 .. 4096)
+        std::uint32_t costBands = 8;    ///< bands of Changed_group (1 = pure cost order .. 64)
+    };
+
+    /// Build F^r for `model` (validated first). Errors name `label`. A tree without leaves
+    /// gives empty data (no clusters).
+    Result<FoliageLodData> buildFoliageLod(const TreeModel& model, const FoliageLodOptions& options = {},
+                                           const std::string& label = "", const ProgressCallback& progress = {});
+
+    /// The polygonal foliage of `model` with `leafCount` leaves: the leaves of that LoDF state
+    /// as a TreeModel (same bark, vertices, materials), for the CPU renderer and for
+    /// discrete-level baselines.
+    TreeModel foliageLodModel(const TreeModel& model, const FoliageLodData& data, std::uint32_t leafCount);
+
+    /// Add the "lodf" chunk of `model` to `writer`, and its "reference" chunk (whose vertices
+    /// it indexes) unless the writer has it.
+    Result<void> addFoliageLodChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
+                                    const ProgressCallback& progress = {});
+    Result<void> addFoliageLodChunk(PackageWriter& writer, const TreeModel& model, const FoliageLodOptions& options,
+                                    const std::string& label, const ProgressCallback& progress = {});
+}

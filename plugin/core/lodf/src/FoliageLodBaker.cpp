@@ -1,0 +1,470 @@
+#include "TreeLod/FoliageLodBaker.h"
+
+#include "TreeLod/FoliageLodState.h"
+#include "TreeLod/Package.h"
+#include "TreeLod/PackageWriter.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace TreeLod
+{
+    namespace
+    {
+        /// A leaf while collapsing: original or created, by its four corner vertices.
+        struct Node
+        {
+            std::array<std::uint32_t, 4> corner{}; ///< vertices at texture corners (0,0) (1,0) (1,1) (0,1)
+            glm::vec3 centre{0.0f};
+            glm::vec3 normal{0.0f, 1.0f, 0.0f};
+            float area = 0.0f;       ///< area it stands for: the sum over the original leaves it replaces
+            glm::vec2 uvMin{0.0f}, uvMax{0.0f};
+        };
+
+        struct Collapse
+        {
+            std::uint32_t a = 0, b = 0; ///< cluster-local node ids (originals 0..n-1, created n..)
+            float cost = 0.0f;          ///< running maximum in the cluster (monotone)
+        };
+
+        struct ClusterBuild
+        {
+            std::uint32_t material = 0;
+            std::vector<std::uint32_t> leaves; ///< model leaf indices, the cluster's originals
+            std::vector<Node> nodes;           ///< originals then created
+            std::vector<Collapse> collapses;
+        };
+
+        float quadArea(const TreeModel& m, const std::array<std::uint32_t, 4>& q)
+        {
+            const glm::vec3& p0 = m.leafVertices[q[0]].position;
+            const glm::vec3& p1 = m.leafVertices[q[1]].position;
+            const glm::vec3& p2 = m.leafVertices[q[2]].position;
+            const glm::vec3& p3 = m.leafVertices[q[3]].position;
+            return 0.5f * glm::length(glm::cross(p2 - p0, p3 - p1));
+        }
+
+        /// The four vertices of leaf `i` nearest its texture rectangle's corners (or, for a leaf
+        /// without a UV extent, nearest the corners of its extent in its own plane).
+        Node originalNode(const TreeModel& m, std::size_t i)
+        {
+            const Leaf& leaf = m.leaves[i];
+            Node node;
+            node.centre = leaf.centre;
+            node.normal = leaf.normal;
+            node.uvMin = leaf.uvMin;
+            node.uvMax = leaf.uvMax;
+            const glm::vec2 uvExtent = leaf.uvMax - leaf.uvMin;
+            const bool useUv = uvExtent.x > 1e-6f && uvExtent.y > 1e-6f;
+            glm::vec3 axisU(1.0f, 0.0f, 0.0f);
+            if (!useUv)
+            {
+                axisU = glm::cross(leaf.normal, std::abs(leaf.normal.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0));
+                axisU = glm::normalize(axisU);
+            }
+            const glm::vec3 axisV = glm::cross(leaf.normal, axisU);
+            std::vector<glm::vec2> t(leaf.vertexCount);
+            glm::vec2 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+            for (std::uint32_t k = 0; k < leaf.vertexCount; ++k)
+            {
+                const Vertex& v = m.leafVertices[leaf.firstVertex + k];
+                t[k] = useUv ? v.uv : glm::vec2(glm::dot(v.position, axisU), glm::dot(v.position, axisV));
+                lo = glm::min(lo, t[k]);
+                hi = glm::max(hi, t[k]);
+            }
+            const glm::vec2 extent = glm::max(hi - lo, glm::vec2(1e-12f));
+            static const glm::vec2 CORNERS[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+            for (int r = 0; r < 4; ++r)
+            {
+                float best = std::numeric_limits<float>::max();
+                for (std::uint32_t k = 0; k < leaf.vertexCount; ++k)
+                {
+                    glm::vec2 d = (t[k] - lo) / extent - CORNERS[r];
+                    float e = glm::dot(d, d);
+                    if (e < best)
+                    {
+                        best = e;
+                        node.corner[r] = leaf.firstVertex + k;
+                    }
+                }
+            }
+            float q = quadArea(m, node.corner);
+            node.area = q > 1e-12f ? q : leaf.area;
+            return node;
+        }
+
+        bool sameImage(const Node& a, const Node& b)
+        {
+            return glm::length(a.uvMin - b.uvMin) + glm::length(a.uvMax - b.uvMax) < 1e-4f;
+        }
+
+        float collapseCost(const Node& a, const Node& b, float meanArea)
+        {
+            const float area = a.area + b.area;
+            const float size = std::sqrt(area);
+            const float orient = 1.0f - std::abs(glm::dot(a.normal, b.normal));
+            const float uv = sameImage(a, b) ? 0.0f : 1.0f;
+            return (glm::length(a.centre - b.centre) + size * (orient + uv)) * std::sqrt(area / meanArea);
+        }
+
+        /// eq. 1 and 3: the leaf that replaces a and b, on four of their vertices.
+        Node collapseLeaves(const TreeModel& m, const Node& a, const Node& b)
+        {
+            const float target = a.area + b.area;
+            const glm::vec3 centre = (a.centre * a.area + b.centre * b.area) / std::max(target, 1e-30f);
+            float bestScore = std::numeric_limits<float>::max();
+            Node out;
+            for (int mask = 0; mask < 16; ++mask)
+            {
+                std::array<std::uint32_t, 4> q;
+                for (int r = 0; r < 4; ++r)
+                    q[r] = (mask >> r) & 1 ? b.corner[r] : a.corner[r];
+                const glm::vec3 p0 = m.leafVertices[q[0]].position, p1 = m.leafVertices[q[1]].position;
+                const glm::vec3 p2 = m.leafVertices[q[2]].position, p3 = m.leafVertices[q[3]].position;
+                const glm::vec3 n1 = glm::cross(p1 - p0, p2 - p0), n2 = glm::cross(p2 - p0, p3 - p0);
+                const bool folded = glm::dot(n1, n2) <= 0.0f;
+                const float area = quadArea(m, q);
+                const float score = std::abs(area - target) / std::max(target, 1e-30f) +
+                                    glm::length(0.25f * (p0 + p1 + p2 + p3) - centre) / std::sqrt(std::max(target, 1e-30f)) +
+                                    (folded ? 4.0f : 0.0f);
+                if (score < bestScore)
+                {
+                    bestScore = score;
+                    out.corner = q;
+                }
+            }
+            const glm::vec3 p0 = m.leafVertices[out.corner[0]].position, p1 = m.leafVertices[out.corner[1]].position;
+            const glm::vec3 p2 = m.leafVertices[out.corner[2]].position, p3 = m.leafVertices[out.corner[3]].position;
+            out.centre = 0.25f * (p0 + p1 + p2 + p3);
+            glm::vec3 n = glm::cross(p2 - p0, p3 - p1);
+            glm::vec3 mean = a.normal * a.area + (glm::dot(a.normal, b.normal) < 0.0f ? -b.normal : b.normal) * b.area;
+            if (glm::length(n) > 1e-12f)
+                out.normal = glm::normalize(glm::dot(n, mean) < 0.0f ? -n : n);
+            else
+                out.normal = glm::length(mean) > 1e-12f ? glm::normalize(mean) : a.normal;
+            out.area = target;
+            out.uvMin = sameImage(a, b) ? a.uvMin : glm::min(a.uvMin, b.uvMin);
+            out.uvMax = sameImage(a, b) ? a.uvMax : glm::max(a.uvMax, b.uvMax);
+            return out;
+        }
+
+        /// §3 / FSA: collapse the cheapest pair until one leaf is left. Row minima make it
+        /// O(n^2) per cluster in practice.
+        void simplifyCluster(const TreeModel& m, ClusterBuild& cluster, float meanArea)
+        {
+            const std::uint32_t n = std::uint32_t(cluster.leaves.size());
+            for (std::uint32_t i = 0; i < n; ++i)
+                cluster.nodes.push_back(originalNode(m, cluster.leaves[i]));
+            if (n < 2)
+                return;
+            // slot -> node id; a collapse puts its new leaf in the slot of `a` and frees `b`'s.
+            std::vector<std::uint32_t> slotNode(n);
+            std::iota(slotNode.begin(), slotNode.end(), 0u);
+            std::vector<char> alive(n, 1);
+            std::vector<float> cost(std::size_t(n) * n, 0.0f);
+            auto at = [&](std::uint32_t i, std::uint32_t j) -> float& { return cost[std::size_t(i) * n + j]; };
+            for (std::uint32_t i = 0; i < n; ++i)
+                for (std::uint32_t j = i + 1; j < n; ++j)
+                    at(i, j) = at(j, i) = collapseCost(cluster.nodes[i], cluster.nodes[j], meanArea);
+            std::vector<std::uint32_t> best(n);
+            auto refreshRow = [&](std::uint32_t i) {
+                float v = std::numeric_limits<float>::max();
+                std::uint32_t b = i;
+                for (std::uint32_t j = 0; j < n; ++j)
+                    if (j != i && alive[j] && at(i, j) < v)
+                    {
+                        v = at(i, j);
+                        b = j;
+                    }
+                best[i] = b;
+            };
+            for (std::uint32_t i = 0; i < n; ++i)
+                refreshRow(i);
+            float running = 0.0f;
+            for (std::uint32_t step = 1; step < n; ++step)
+            {
+                std::uint32_t bi = n, bj = n;
+                float bv = std::numeric_limits<float>::max();
+                for (std::uint32_t i = 0; i < n; ++i)
+                    if (alive[i] && best[i] != i && at(i, best[i]) < bv)
+                    {
+                        bv = at(i, best[i]);
+                        bi = i;
+                        bj = best[i];
+                    }
+                if (bi > bj)
+                    std::swap(bi, bj);
+                const std::uint32_t na = slotNode[bi], nb = slotNode[bj];
+                cluster.nodes.push_back(collapseLeaves(m, cluster.nodes[na], cluster.nodes[nb]));
+                running = std::max(running, bv);
+                cluster.collapses.push_back({na, nb, running});
+                slotNode[bi] = std::uint32_t(cluster.nodes.size() - 1);
+                alive[bj] = 0;
+                const Node& created = cluster.nodes.back();
+                for (std::uint32_t k = 0; k < n; ++k)
+                    if (alive[k] && k != bi)
+                        at(bi, k) = at(k, bi) = collapseCost(created, cluster.nodes[slotNode[k]], meanArea);
+                refreshRow(bi);
+                for (std::uint32_t k = 0; k < n; ++k)
+                {
+                    if (!alive[k] || k == bi)
+                        continue;
+                    if (best[k] == bi || best[k] == bj)
+                        refreshRow(k);
+                    else if (at(k, bi) < at(k, best[k]))
+                        best[k] = bi;
+                }
+            }
+        }
+
+        /// §3.1: spatially compact clusters of at most `size` leaves (median splits).
+        void splitClusters(const TreeModel& m, std::vector<std::uint32_t> leaves, std::uint32_t size,
+                           std::uint32_t material, std::vector<ClusterBuild>& out)
+        {
+            if (leaves.size() <= size)
+            {
+                ClusterBuild c;
+                c.material = material;
+                c.leaves = std::move(leaves);
+                out.push_back(std::move(c));
+                return;
+            }
+            glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+            for (std::uint32_t i : leaves)
+            {
+                lo = glm::min(lo, m.leaves[i].centre);
+                hi = glm::max(hi, m.leaves[i].centre);
+            }
+            const glm::vec3 e = hi - lo;
+            const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+            // Split at a multiple of `size` near the middle so clusters stay full.
+            const std::size_t blocks = (leaves.size() + size - 1) / size;
+            const std::size_t half = (blocks / 2) * size;
+            std::nth_element(leaves.begin(), leaves.begin() + std::ptrdiff_t(half), leaves.end(),
+                             [&](std::uint32_t a, std::uint32_t b) {
+                                 float ca = m.leaves[a].centre[axis], cb = m.leaves[b].centre[axis];
+                                 return ca < cb || (ca == cb && a < b);
+                             });
+            std::vector<std::uint32_t> right(leaves.begin() + std::ptrdiff_t(half), leaves.end());
+            leaves.resize(half);
+            splitClusters(m, std::move(leaves), size, material, out);
+            splitClusters(m, std::move(right), size, material, out);
+        }
+
+        std::uint64_t mix64(std::uint64_t x)
+        {
+            x += 0x9e3779b97f4a7c15ull;
+            x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+            x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+            return x ^ (x >> 31);
+        }
+    }
+
+    Result<FoliageLodData> buildFoliageLod(const TreeModel& model, const FoliageLodOptions& options,
+                                           const std::string& label, const ProgressCallback& progress)
+    {
+        if (options.clusterSize < 1 || options.clusterSize > 4096)
+            return fail(label, "lodf option clusterSize", std::to_string(options.clusterSize) + " is not in 1..4096");
+        if (options.costBands < 1 || options.costBands > 64)
+            return fail(label, "lodf option costBands", std::to_string(options.costBands) + " is not in 1..64");
+        Result<void> valid = model.validate(label);
+        if (!valid)
+            return valid.error();
+        const std::uint32_t L = std::uint32_t(model.leaves.size());
+        FoliageLodData data;
+        data.originalLeafCount = L;
+        data.leafVertexCount = std::uint32_t(model.leafVertices.size());
+        if (L == 0)
+            return data;
+
+        // §3.1: independent groups, per material, then in spatial order.
+        std::vector<std::vector<std::uint32_t>> byMaterial(model.materials.size());
+        for (std::uint32_t i = 0; i < L; ++i)
+            byMaterial[model.leaves[i].material].push_back(i);
+        std::vector<ClusterBuild> clusters;
+        for (std::uint32_t mat = 0; mat < byMaterial.size(); ++mat)
+            if (!byMaterial[mat].empty())
+                splitClusters(model, std::move(byMaterial[mat]), options.clusterSize, mat, clusters);
+
+        double areaSum = 0.0;
+        for (const Leaf& leaf : model.leaves)
+            areaSum += leaf.area;
+        const float meanArea = float(std::max(areaSum / L, 1e-20));
+
+        // §3 / FSA, cluster by cluster in parallel (each cluster's result depends on it alone).
+        std::atomic<std::size_t> done{0};
+        const std::size_t batch = 256;
+        for (std::size_t first = 0; first < clusters.size(); first += batch)
+        {
+            const std::size_t last = std::min(clusters.size(), first + batch);
+            tbb::parallel_for(first, last, [&](std::size_t c) { simplifyCluster(model, clusters[c], meanArea); });
+            done = last;
+            report(progress, "lodf collapse", float(done) / float(clusters.size()));
+        }
+
+        // Fig. 8: Changed_group by cost band, then cluster (pseudo-random order), then step.
+        struct Order
+        {
+            std::uint32_t band, rank, cluster, step;
+        };
+        std::vector<float> costs;
+        for (const ClusterBuild& c : clusters)
+            for (const Collapse& k : c.collapses)
+                costs.push_back(k.cost);
+        std::sort(costs.begin(), costs.end());
+        std::vector<float> bandEnd; // upper bounds of bands 0..B-2
+        for (std::uint32_t b = 1; b < options.costBands && !costs.empty(); ++b)
+            bandEnd.push_back(costs[std::min(costs.size() - 1, costs.size() * b / options.costBands)]);
+        std::vector<Order> order;
+        order.reserve(costs.size());
+        for (std::uint32_t c = 0; c < clusters.size(); ++c)
+            for (std::uint32_t s = 0; s < clusters[c].collapses.size(); ++s)
+            {
+                const float cost = clusters[c].collapses[s].cost;
+                const auto band = std::uint32_t(std::upper_bound(bandEnd.begin(), bandEnd.end(), cost) - bandEnd.begin());
+                order.push_back({band, std::uint32_t(mix64(c) >> 32), c, s});
+            }
+        std::sort(order.begin(), order.end(), [](const Order& x, const Order& y) {
+            return std::tie(x.band, x.rank, x.cluster, x.step) < std::tie(y.band, y.rank, y.cluster, y.step);
+        });
+        // Global numbers of created leaves: L + position in Changed_group (Fig. 6 numbering).
+        std::vector<std::vector<std::uint32_t>> createdNumber(clusters.size());
+        for (std::uint32_t c = 0; c < clusters.size(); ++c)
+            createdNumber[c].resize(clusters[c].collapses.size());
+        data.changedGroup.reserve(order.size());
+        for (std::uint32_t i = 0; i < order.size(); ++i)
+        {
+            data.changedGroup.push_back(order[i].cluster);
+            createdNumber[order[i].cluster][order[i].step] = L + i;
+        }
+
+        // §3.2, Fig. 7: each cluster's array in removal order, root last.
+        for (std::uint32_t c = 0; c < clusters.size(); ++c)
+        {
+            const ClusterBuild& b = clusters[c];
+            const std::uint32_t n = std::uint32_t(b.leaves.size());
+            FoliageLodCluster k;
+            k.material = b.material;
+            k.firstEntry = std::uint32_t(data.entries.size());
+            k.entryCount = 2 * n - 1;
+            k.originalLeaves = n;
+            k.firstSlot = data.slotCount();
+            auto addEntry = [&](std::uint32_t node) {
+                FoliageLodEntry e;
+                e.firstIndex = std::uint32_t(data.indices.size());
+                if (node < n)
+                {
+                    const Leaf& leaf = model.leaves[b.leaves[node]];
+                    e.leaf = b.leaves[node];
+                    e.created = 0;
+                    data.indices.insert(data.indices.end(), model.leafIndices.begin() + leaf.firstIndex,
+                                        model.leafIndices.begin() + leaf.firstIndex + leaf.indexCount);
+                    e.indexCount = leaf.indexCount;
+                    k.slotCount += leaf.indexCount;
+                }
+                else
+                {
+                    const std::uint32_t step = node - n; // 0-based collapse that created it
+                    e.leaf = createdNumber[c][step];
+                    e.created = step + 1;
+                    const auto& q = b.nodes[node].corner;
+                    data.indices.insert(data.indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+                    e.indexCount = 6;
+                }
+                data.entries.push_back(e);
+            };
+            for (const Collapse& col : b.collapses)
+            {
+                addEntry(col.a);
+                addEntry(col.b);
+            }
+            addEntry(n == 1 ? 0 : std::uint32_t(b.nodes.size() - 1));
+            data.clusters.push_back(k);
+        }
+        Result<void> ok = data.validate(label);
+        if (!ok)
+            return ok.error();
+        return data;
+    }
+
+    TreeModel foliageLodModel(const TreeModel& model, const FoliageLodData& data, std::uint32_t leafCount)
+    {
+        TreeModel out = model;
+        out.leafVertices.clear();
+        out.leafIndices.clear();
+        out.leaves.clear();
+        const FoliageLodState state = FoliageLodState::fromScratch(data, leafCount);
+        std::vector<std::uint32_t> remap(model.leafVertices.size(), ~0u);
+        for (std::uint32_t c = 0; c < data.clusters.size(); ++c)
+        {
+            std::vector<std::uint32_t> region(data.clusters[c].slotCount);
+            const std::uint32_t used = region.empty() ? 0 : state.writeCluster(c, region.data());
+            // Split the region back into leaves: one leaf per active entry, in order.
+            std::vector<std::uint32_t> sizes;
+            const FoliageLodCluster& k = data.clusters[c];
+            const FoliageLodState::ClusterState& s = state.cluster(c);
+            for (std::uint32_t p = s.initGroup, left = s.activeLeaves; p < k.entryCount && left > 0; ++p)
+            {
+                const FoliageLodEntry& e = data.entries[k.firstEntry + p];
+                if (e.created <= s.initGroup / 2)
+                {
+                    sizes.push_back(e.indexCount);
+                    --left;
+                }
+            }
+            std::uint32_t at = 0;
+            for (std::uint32_t size : sizes)
+            {
+                Leaf leaf;
+                leaf.material = k.material;
+                leaf.firstVertex = std::uint32_t(out.leafVertices.size());
+                leaf.firstIndex = std::uint32_t(out.leafIndices.size());
+                for (std::uint32_t i = at; i < at + size; ++i)
+                {
+                    const std::uint32_t v = region[i];
+                    if (remap[v] == ~0u || remap[v] < leaf.firstVertex)
+                    {
+                        remap[v] = std::uint32_t(out.leafVertices.size());
+                        out.leafVertices.push_back(model.leafVertices[v]);
+                    }
+                    out.leafIndices.push_back(remap[v]);
+                }
+                leaf.vertexCount = std::uint32_t(out.leafVertices.size()) - leaf.firstVertex;
+                leaf.indexCount = size;
+                at += size;
+                out.leaves.push_back(leaf);
+                out.updateLeafRecord(out.leaves.size() - 1);
+            }
+            (void)used;
+        }
+        out.updateBounds();
+        return out;
+    }
+
+    Result<void> addFoliageLodChunk(PackageWriter& writer, const TreeModel& model, const FoliageLodOptions& options,
+                                    const std::string& label, const ProgressCallback& progress)
+    {
+        if (!writer.hasChunk(REFERENCE_CHUNK, 0))
+        {
+            Result<void> added = addReferenceChunk(writer, model, label, progress);
+            if (!added)
+                return added;
+        }
+        Result<FoliageLodData> data = buildFoliageLod(model, options, label, progress);
+        if (!data)
+            return data.error();
+        return writer.addChunk(FOLIAGE_LOD_CHUNK, 0, FOLIAGE_LOD_CHUNK_FORMAT_VERSION, encodeFoliageLodChunk(*data));
+    }
+
+    Result<void> addFoliageLodChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
+                                    const ProgressCallback& progress)
+    {
+        return addFoliageLodChunk(writer, model, FoliageLodOptions{}, label, progress);
+    }
+}

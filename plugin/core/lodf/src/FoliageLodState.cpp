@@ -1,0 +1,132 @@
+#include "TreeLod/FoliageLodState.h"
+
+#include <algorithm>
+
+namespace TreeLod
+{
+    namespace
+    {
+        /// Visit the active leaves of cluster `k` in state `s`: entries at positions >= Init_group
+        /// created by a step the cluster has applied (FoliageLodData.h, deviation from Fig. 7).
+        template <typename Visit>
+        void forEachActive(const FoliageLodData& data, const FoliageLodCluster& k,
+                           const FoliageLodState::ClusterState& s, Visit&& visit)
+        {
+            const std::uint32_t applied = s.initGroup / 2;
+            std::uint32_t left = s.activeLeaves;
+            for (std::uint32_t p = s.initGroup; p < k.entryCount && left > 0; ++p)
+            {
+                const FoliageLodEntry& e = data.entries[k.firstEntry + p];
+                if (e.created <= applied)
+                {
+                    visit(e);
+                    --left;
+                }
+            }
+        }
+
+        std::uint32_t usedSlots(const FoliageLodData& data, const FoliageLodCluster& k,
+                                const FoliageLodState::ClusterState& s)
+        {
+            std::uint32_t used = 0;
+            forEachActive(data, k, s, [&](const FoliageLodEntry& e) { used += e.indexCount; });
+            return used;
+        }
+    }
+
+    FoliageLodState::FoliageLodState(const FoliageLodData& data) : mData(&data), mClusters(data.clusters.size())
+    {
+        for (std::size_t c = 0; c < mClusters.size(); ++c)
+        {
+            mClusters[c].activeLeaves = data.clusters[c].originalLeaves;
+            mClusters[c].usedSlots = data.clusters[c].slotCount;
+        }
+        mChanged.reserve(mClusters.size());
+    }
+
+    std::uint32_t FoliageLodState::setLeafCount(std::uint32_t target)
+    {
+        mChanged.clear();
+        const std::uint32_t lo = mData->minLeafCount(), hi = mData->maxLeafCount();
+        target = std::clamp(target, lo, hi);
+        const std::uint32_t position = mData->originalLeafCount - target; // collapses to apply
+        const std::vector<std::uint32_t>& changedGroup = mData->changedGroup;
+
+        // §3.3: walk Changed_group from init_position, counting changes per cluster.
+        auto note = [&](std::uint32_t c, std::int32_t change) {
+            if (mClusters[c].changesNumber == 0)
+                mChanged.push_back(c);
+            mClusters[c].changesNumber += change;
+        };
+        if (position > mPosition)
+            for (std::uint32_t i = mPosition; i < position; ++i)
+                note(changedGroup[i], +1); // leaf collapse
+        else
+            for (std::uint32_t i = position; i < mPosition; ++i)
+                note(changedGroup[i], -1); // leaf split
+        mPosition = position;
+
+        // eqs. 10-13 on the clusters that changed; then Changes_number back to 0.
+        for (std::uint32_t c : mChanged)
+        {
+            ClusterState& s = mClusters[c];
+            s.initGroup = std::uint32_t(std::int64_t(s.initGroup) + 2 * std::int64_t(s.changesNumber));
+            s.activeLeaves = std::uint32_t(std::int64_t(s.activeLeaves) - s.changesNumber);
+            s.changesNumber = 0;
+            s.usedSlots = usedSlots(*mData, mData->clusters[c], s);
+        }
+        return std::uint32_t(mChanged.size());
+    }
+
+    template <typename Index> std::uint32_t FoliageLodState::writeCluster(std::uint32_t c, Index* out) const
+    {
+        const FoliageLodCluster& k = mData->clusters[c];
+        std::uint32_t n = 0;
+        forEachActive(*mData, k, mClusters[c], [&](const FoliageLodEntry& e) {
+            const std::uint32_t* src = mData->indices.data() + e.firstIndex;
+            for (std::uint32_t i = 0; i < e.indexCount; ++i)
+                out[n + i] = Index(src[i]);
+            n += e.indexCount;
+        });
+        // Degenerate triangles (one repeated vertex) fill the rest of the region.
+        const Index pad = n > 0 ? out[n - 1] : Index(0);
+        std::fill(out + n, out + k.slotCount, pad);
+        return n;
+    }
+
+    template std::uint32_t FoliageLodState::writeCluster<std::uint16_t>(std::uint32_t, std::uint16_t*) const;
+    template std::uint32_t FoliageLodState::writeCluster<std::uint32_t>(std::uint32_t, std::uint32_t*) const;
+
+    void FoliageLodState::activeLeaves(std::uint32_t c, std::vector<std::uint32_t>& out) const
+    {
+        forEachActive(*mData, mData->clusters[c], mClusters[c], [&](const FoliageLodEntry& e) { out.push_back(e.leaf); });
+    }
+
+    std::vector<std::uint32_t> FoliageLodState::activeLeaves() const
+    {
+        std::vector<std::uint32_t> out;
+        out.reserve(leafCount());
+        for (std::uint32_t c = 0; c < mClusters.size(); ++c)
+            activeLeaves(c, out);
+        return out;
+    }
+
+    FoliageLodState FoliageLodState::fromScratch(const FoliageLodData& data, std::uint32_t leafCount)
+    {
+        FoliageLodState state(data);
+        leafCount = std::clamp(leafCount, data.minLeafCount(), data.maxLeafCount());
+        const std::uint32_t position = data.originalLeafCount - leafCount;
+        std::vector<std::uint32_t> applied(data.clusters.size(), 0);
+        for (std::uint32_t i = 0; i < position; ++i)
+            ++applied[data.changedGroup[i]];
+        for (std::size_t c = 0; c < applied.size(); ++c)
+        {
+            ClusterState& s = state.mClusters[c];
+            s.initGroup = 2 * applied[c];
+            s.activeLeaves = data.clusters[c].originalLeaves - applied[c];
+            s.usedSlots = usedSlots(data, data.clusters[c], s);
+        }
+        state.mPosition = position;
+        return state;
+    }
+}
