@@ -5,7 +5,7 @@ uniform sampler2D diffuseMap;
 uniform float alphaCutoff;
 #endif
 
-in float vDepth;
+in vec2 vClipZW;
 in vec2 vUv;
 
 out vec4 fragColour;
@@ -16,5 +16,8 @@ void main()
     if (texture(diffuseMap, vUv).a < alphaCutoff)
         discard;
 #endif
-    fragColour = vec4(vDepth, vDepth, vDepth, 1.0);
+    // Depth as the shadow camera's window depth, 0..1 (shadow textures clear to 1); the
+    // receiver computes the same from texture_viewproj_matrix.
+    float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5;
+    fragColour = vec4(depth, depth, depth, 1.0);
 }

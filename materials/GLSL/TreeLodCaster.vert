@@ -1,17 +1,16 @@
 #version 330 core
-// Shadow caster: depth normalised to 0..1 by the scene depth range.
+// Shadow caster: passes clip-space z and w on; the fragment stage writes depth in 0..1.
 uniform mat4 worldViewProj;
-uniform vec4 depthRange; // near, far, far - near, 1 / (far - near)
 
 in vec4 vertex;
 in vec2 uv0;
 
-out float vDepth;
+out vec2 vClipZW;
 out vec2 vUv;
 
 void main()
 {
     gl_Position = worldViewProj * vertex;
-    vDepth = (gl_Position.z - depthRange.x) * depthRange.w;
+    vClipZW = gl_Position.zw;
     vUv = uv0;
 }

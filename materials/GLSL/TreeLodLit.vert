@@ -1,5 +1,6 @@
 #version 330 core
-// Lit tree surfaces (bark and leaves): world-space normal and UV to the fragment stage.
+// Lit tree surfaces (bark and leaves): world-space normal and UV to the fragment stage;
+// SHADOW_RECEIVER: also the position in the sun's shadow texture.
 uniform mat4 worldViewProj;
 uniform mat4 world;
 uniform mat4 normalMatrix;
@@ -12,6 +13,10 @@ in vec2 uv0;
 out vec3 vNormal;
 out vec3 vToCamera;
 out vec2 vUv;
+#ifdef SHADOW_RECEIVER
+uniform mat4 texViewProj; // the sun's shadow camera, clip space to texture space
+out vec4 vShadowPos;
+#endif
 
 void main()
 {
@@ -19,4 +24,7 @@ void main()
     vNormal = mat3(normalMatrix) * normal;
     vToCamera = cameraPosition.xyz - (world * vertex).xyz;
     vUv = uv0;
+#ifdef SHADOW_RECEIVER
+    vShadowPos = texViewProj * (world * vertex);
+#endif
 }

@@ -2,6 +2,7 @@
 // Imports the tree, bakes one chunk set per technique plus the "meta" chunk (source file
 // name, FNV-1a 64 hash of the input file's bytes, options) and writes the package atomically:
 // on any error nothing is written and the exit code is 2.
+#include "BakeTechniques.h"
 #include "CliSupport.h"
 #include "Commands.h"
 
@@ -21,38 +22,6 @@ namespace TreeLod
 {
     namespace
     {
-        /// Adds a technique's chunks for `model` to the package; `label` names the output in errors.
-        using BakeFunction = Result<void> (*)(PackageWriter& writer, const TreeModel& model, const std::string& label,
-                                              const ProgressCallback& progress);
-
-        struct BakeTechnique
-        {
-            const char* name;
-            const char* description;
-            BakeFunction bake;
-        };
-
-        /// Every technique `treelod bake` knows: a new technique adds one line here.
-        const BakeTechnique BAKE_TECHNIQUES[] = {
-            {REFERENCE_CHUNK, "the polygonal tree with GPU-ready mip-mapped textures", &addReferenceChunk},
-        };
-
-        const BakeTechnique* findTechnique(const std::string& name)
-        {
-            for (const BakeTechnique& t : BAKE_TECHNIQUES)
-                if (name == t.name)
-                    return &t;
-            return nullptr;
-        }
-
-        std::string knownTechniques()
-        {
-            std::string list;
-            for (const BakeTechnique& t : BAKE_TECHNIQUES)
-                list += (list.empty() ? "" : ", ") + std::string(t.name);
-            return list;
-        }
-
         struct BakeArgs
         {
             std::string input;
@@ -68,10 +37,10 @@ namespace TreeLod
             for (const std::string& name : args.techniques.empty() ? std::vector<std::string>{REFERENCE_CHUNK}
                                                                    : args.techniques)
             {
-                const BakeTechnique* t = findTechnique(name);
+                const BakeTechnique* t = findBakeTechnique(name);
                 if (!t)
                     return printError(fail("", "option --technique",
-                                           "'" + name + "' is not a known technique (known: " + knownTechniques() +
+                                           "'" + name + "' is not a known technique (known: " + knownBakeTechniques() +
                                                ")"));
                 if (std::find(techniques.begin(), techniques.end(), t) == techniques.end())
                     techniques.push_back(t);
@@ -139,7 +108,7 @@ namespace TreeLod
     {
         auto args = std::make_shared<BakeArgs>();
         std::string help = "technique to bake (repeatable; default reference). Known:";
-        for (const BakeTechnique& t : BAKE_TECHNIQUES)
+        for (const BakeTechnique& t : bakeTechniques())
             help += std::string("\n  ") + t.name + ": " + t.description;
         CLI::App* cmd = app.add_subcommand("bake", "bake a .glb/.gltf tree into a .treelod package");
         cmd->add_option("input", args->input, ".glb or .gltf file")->required();

@@ -32,6 +32,10 @@ namespace TreeLod
             std::string size = "512x512";
             std::string renderer = "ogre";
             int supersample = 3;
+            std::uint32_t leaves = 0;
+            float pixelsPerLeaf = 0.0f;
+            float lodBias = 1.0f;
+            bool shadows = false;
             std::vector<std::string> leafMaterials;
             bool verbose = false;
         };
@@ -48,6 +52,8 @@ namespace TreeLod
                 return printError(fail("", "--size", "'" + args.size + "' is not WxH with 1..16384"));
             if (args.supersample < 1 || args.supersample > 8)
                 return printError(fail("", "--supersample", "must be 1..8 samples per axis"));
+            if (!(args.lodBias > 0.0f))
+                return printError(fail("", "--lod-bias", "must be a positive number"));
             if (args.renderer != "cpu" && args.renderer != "ogre")
                 return printError(fail("", "--renderer", "'" + args.renderer + "' is not ogre or cpu"));
             ProgressCallback progress = makeProgress();
@@ -84,8 +90,13 @@ namespace TreeLod
                     OffscreenRenderer renderer(options);
                     OgreMeshImportOptions meshOptions;
                     meshOptions.leafMaterials = args.leafMaterials;
+                    const TechniqueInfo* technique = TechniqueRegistry::getSingleton().find(args.technique);
+                    if (!technique)
+                        return printError(fail("", "--technique", "'" + args.technique + "' is not a known technique (known: " +
+                                                                      TechniqueRegistry::getSingleton().describe() + ")"));
                     Result<TreeInput> input = loadTreeInput(args.input, args.leafMaterials, progress,
-                                                            [&](const std::string& path) { return importOgreMesh(path, meshOptions); });
+                                                            [&](const std::string& path) { return importOgreMesh(path, meshOptions); },
+                                                            {technique->chunkTechnique});
                     if (!input)
                         return printError(input.error());
                     CameraSpec camera;
@@ -94,8 +105,15 @@ namespace TreeLod
                         return printError(fail("", "--camera", cameraError));
                     TreeAssetPtr asset = TreeAssetManager::getSingleton().loadFromBytes(
                         input->name, Ogre::RGN_DEFAULT, input->packageBytes);
+                    Ogre::NameValuePairList params;
+                    if (args.leaves > 0)
+                        params["leaves"] = std::to_string(args.leaves);
+                    if (args.pixelsPerLeaf > 0.0f)
+                        params["pixelsPerLeaf"] = std::to_string(args.pixelsPerLeaf);
+                    renderer.setShadows(args.shadows);
+                    renderer.setLodBias(args.lodBias);
                     Ogre::MovableObject* object = TechniqueRegistry::getSingleton().createInstance(
-                        args.technique, renderer.getSceneManager(), "tree", *asset);
+                        args.technique, renderer.getSceneManager(), "tree", *asset, params);
                     renderer.getContentNode().attachObject(object);
                     RgbaImage image = renderer.render(camera, width, height, args.supersample);
                     OffscreenRenderer::savePng(image, args.output);
@@ -122,7 +140,12 @@ namespace TreeLod
         CLI::App* cmd = app.add_subcommand("render", "render a tree (.glb, .gltf, .mesh or .treelod) to a PNG, headless");
         cmd->add_option("input", args->input, "tree file")->required();
         cmd->add_option("-o,--output", args->output, "PNG to write")->required();
-        cmd->add_option("--technique", args->technique, "LoD technique (mesh = polygonal reference)");
+        cmd->add_option("--technique", args->technique,
+                        "LoD technique: mesh (polygonal reference), lodf (paper 004); a .glb is baked in memory");
+        cmd->add_option("--leaves", args->leaves, "lodf: draw exactly this many leaves (default: from screen size)");
+        cmd->add_option("--pixels-per-leaf", args->pixelsPerLeaf, "lodf: projected pixels per leaf (default 4)");
+        cmd->add_option("--lod-bias", args->lodBias, "camera LoD bias (> 1 = more detail)");
+        cmd->add_flag("--shadows", args->shadows, "texture shadows from the sun (LiSPSM, 2048^2 float depth)");
         cmd->add_option("--camera", args->camera,
                         "orbit:AZIMUTH,ELEVATION,DISTANCE (degrees; distance 1 = tree fills the view), "
                         "ortho:AZ,EL,DIST, or PX,PY,PZ,TX,TY,TZ[,FOV]");

@@ -1,5 +1,7 @@
 #include "TreeInput.h"
 
+#include "BakeTechniques.h"
+
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/GltfImporter.h"
 #include "TreeLod/ModelChunk.h"
@@ -22,7 +24,8 @@ namespace TreeLod
     }
 
     Result<TreeInput> loadTreeInput(const std::string& path, const std::vector<std::string>& leafMaterials,
-                                    const ProgressCallback& progress, const MeshImporter& meshImporter)
+                                    const ProgressCallback& progress, const MeshImporter& meshImporter,
+                                    const std::vector<std::string>& chunks)
     {
         TreeInput input;
         input.name = std::filesystem::path(path).filename().string();
@@ -39,6 +42,10 @@ namespace TreeLod
             if (!reference)
                 return reference.error();
             input.model = std::move(reference->model);
+            for (const std::string& chunk : chunks)
+                if (package->findChunk(chunk, 0) < 0)
+                    return fail(path, chunkElement(chunk, 0),
+                                "missing: bake the package with --technique " + chunk);
             Result<std::vector<std::uint8_t>> bytes = readFile(path);
             if (!bytes)
                 return bytes.error();
@@ -57,9 +64,15 @@ namespace TreeLod
             return model.error();
         input.model = std::move(model.value());
         PackageWriter writer;
-        Result<void> added = writer.addChunk(REFERENCE_CHUNK, 0, REFERENCE_CHUNK_FORMAT_VERSION, encodeReferenceChunk(makeReferenceChunk(input.model)));
-        if (!added)
-            return added.error();
+        for (const std::string& chunk : chunks)
+        {
+            const BakeTechnique* technique = findBakeTechnique(chunk);
+            if (!technique)
+                return fail(path, "", "no baker for chunk '" + chunk + "' (known: " + knownBakeTechniques() + ")");
+            Result<void> added = technique->bake(writer, input.model, input.name, progress);
+            if (!added)
+                return added.error();
+        }
         input.packageBytes = writer.toBytes();
         return input;
     }

@@ -1,6 +1,6 @@
 // TreeInput: one tree file loaded for a command: the model and, for the Ogre path, the
 // package bytes the plugin loads (a .treelod as it is; other inputs baked in memory
-// with the reference chunk only).
+// with the chunks asked for, the reference by default).
 #pragma once
 
 #include "TreeLod/Progress.h"
@@ -24,7 +24,9 @@ namespace TreeLod
     using MeshImporter = std::function<Result<TreeModel>(const std::string& path)>;
 
     /// .glb / .gltf (glTF importer), .treelod (package reader), or .mesh through `meshImporter`
-    /// (an error naming the file when it is empty).
+    /// (an error naming the file when it is empty). Non-package inputs are baked in memory
+    /// with `chunks` (names of BakeTechniques.h); a package must already hold them.
     Result<TreeInput> loadTreeInput(const std::string& path, const std::vector<std::string>& leafMaterials,
-                                    const ProgressCallback& progress, const MeshImporter& meshImporter = {});
+                                    const ProgressCallback& progress, const MeshImporter& meshImporter = {},
+                                    const std::vector<std::string>& chunks = {"reference"});
 }

@@ -3,6 +3,10 @@
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/TreeLodPlugin.h"
 
+#include <OgreShadowCameraSetupFocused.h>
+
+#include <chrono>
+#include <filesystem>
 #include <cmath>
 #include <cstdlib>
 
@@ -67,6 +71,13 @@ namespace TreeLod
         rgm.addResourceLocation(materials, "FileSystem", "TreeLod");
         rgm.addResourceLocation(materials + "/GLSL", "FileSystem", "TreeLod");
         rgm.initialiseResourceGroup("TreeLod");
+        // Texture shadows need OGRE's ShadowVolume programs (the shadow setup loads them).
+        const std::string shadowVolume = envOr("TREELOD_OGRE_MEDIA_DIR", TREELOD_OGRE_MEDIA_DIR) + std::string("/ShadowVolume");
+        if (std::filesystem::is_directory(shadowVolume))
+        {
+            rgm.addResourceLocation(shadowVolume, "FileSystem", Ogre::RGN_INTERNAL);
+            rgm.initialiseResourceGroup(Ogre::RGN_INTERNAL);
+        }
 
         mSceneManager = mRoot->createSceneManager();
         mCamera = mSceneManager->createCamera("TreeLodOffscreenCamera");
@@ -137,12 +148,19 @@ namespace TreeLod
         vp->setShadowsEnabled(true);
     }
 
-    RgbaImage OffscreenRenderer::render(const CameraSpec& spec, int width, int height, int samplesPerAxis)
+    void OffscreenRenderer::placeCamera(const CameraSpec& spec, int width, int height, int samplesPerAxis)
     {
-        OgreAssert(width > 0 && height > 0 && samplesPerAxis > 0, "render size must be positive");
-        const int s = samplesPerAxis, w = width * s, h = height * s;
-        ensureTarget(w, h);
-
+        if (mSceneManager->isShadowTechniqueTextureBased())
+        {
+            // The directional shadow camera sits this far from what it focuses on; the
+            // default (10 km) would squeeze a tree's depths into the bias.
+            mContentNode->_update(true, false);
+            const Ogre::AxisAlignedBox& box = mContentNode->_getWorldAABB();
+            const Ogre::Real radius = box.isFinite() ? 0.5f * box.getSize().length() : 10.0f;
+            mSceneManager->setShadowDirectionalLightExtrusionDistance(2.0f * radius + 1.0f);
+            mSceneManager->setShadowFarDistance(4.0f * radius + 2.0f);
+        }
+        mCamera->setLodBias(mLodBias / float(samplesPerAxis * samplesPerAxis));
         mCamera->setNearClipDistance(spec.nearClip);
         mCamera->setFarClipDistance(spec.farClip);
         mCamera->setAspectRatio(Ogre::Real(width) / Ogre::Real(height));
@@ -159,6 +177,51 @@ namespace TreeLod
         mCameraNode->setPosition(spec.position.x, spec.position.y, spec.position.z);
         mCameraNode->setFixedYawAxis(true, Ogre::Vector3(spec.up.x, spec.up.y, spec.up.z));
         mCameraNode->lookAt(Ogre::Vector3(spec.target.x, spec.target.y, spec.target.z), Ogre::Node::TS_WORLD);
+    }
+
+    void OffscreenRenderer::setShadows(bool enabled, unsigned textureSize)
+    {
+        if (!enabled)
+        {
+            mSceneManager->setShadowTechnique(Ogre::SHADOWTYPE_NONE);
+            return;
+        }
+        mSceneManager->setShadowTechnique(Ogre::SHADOWTYPE_TEXTURE_ADDITIVE_INTEGRATED);
+        mSceneManager->setShadowTextureCount(1);
+        mSceneManager->setShadowTextureSettings(textureSize, 1, Ogre::PF_FLOAT32_R);
+        mSceneManager->setShadowTextureSelfShadow(true);
+        mSceneManager->setShadowCameraSetup(Ogre::ShadowCameraSetupPtr(new Ogre::FocusedShadowCameraSetup()));
+        mSun->setCastShadows(true);
+    }
+
+    std::vector<double> OffscreenRenderer::timeFrames(const CameraSpec& spec, int width, int height, int frames)
+    {
+        ensureTarget(width, height);
+        placeCamera(spec, width, height, 1);
+        Ogre::RenderTarget* rt = mTarget->getBuffer()->getRenderTarget();
+        const glm::vec3& bg = mLighting.background;
+        rt->getViewport(0)->setBackgroundColour(Ogre::ColourValue(bg.r, bg.g, bg.b, 1.0f));
+        std::uint8_t pixel[4];
+        Ogre::PixelBox one(1, 1, 1, Ogre::PF_BYTE_RGBA, pixel);
+        std::vector<double> ms;
+        for (int f = -1; f < frames; ++f)
+        {
+            const auto start = std::chrono::steady_clock::now();
+            mRoot->renderOneFrame();
+            rt->update();
+            rt->copyContentsToMemory(Ogre::Box(0, 0, 1, 1), one, Ogre::RenderTarget::FB_AUTO);
+            if (f >= 0)
+                ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        }
+        return ms;
+    }
+
+    RgbaImage OffscreenRenderer::render(const CameraSpec& spec, int width, int height, int samplesPerAxis)
+    {
+        OgreAssert(width > 0 && height > 0 && samplesPerAxis > 0, "render size must be positive");
+        const int s = samplesPerAxis, w = width * s, h = height * s;
+        ensureTarget(w, h);
+        placeCamera(spec, width, height, s);
 
         Ogre::RenderTarget* rt = mTarget->getBuffer()->getRenderTarget();
         const glm::vec3& bg = mLighting.background;

@@ -1,5 +1,6 @@
 #include "TreeLod/TechniqueRegistry.h"
 
+#include "TreeLod/FoliageLodTree.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreEntity.h>
@@ -20,6 +21,15 @@ namespace TreeLod
              Ogre::EntityFactory::FACTORY_TYPE_NAME,
              [](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset, const Ogre::NameValuePairList&) {
                  return static_cast<Ogre::MovableObject*>(sm.createEntity(name, asset.getReferenceMesh()));
+             }});
+        // paper 004: continuous foliage LoD by leaf collapse.
+        add({"lodf", "LoDF: every leaf geometric, leaf count continuous with screen size (paper 004)",
+             FOLIAGE_LOD_CHUNK, FoliageLodTreeFactory::FACTORY_TYPE_NAME,
+             [](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset, const Ogre::NameValuePairList& params) {
+                 Ogre::NameValuePairList all = params;
+                 all["asset"] = asset.getName();
+                 all["group"] = asset.getGroup();
+                 return sm.createMovableObject(name, FoliageLodTreeFactory::FACTORY_TYPE_NAME, &all);
              }});
         // Technique issues add their line here.
     }

@@ -46,14 +46,21 @@ namespace TreeLod
 
     void TreeAsset::unloadImpl()
     {
-        if (mReferenceMesh)
-            Ogre::MeshManager::getSingleton().remove(mReferenceMesh);
-        mReferenceMesh.reset();
-        for (const Ogre::String& m : mMaterialNames)
+        for (Ogre::MeshPtr* mesh : {&mReferenceMesh, &mBarkMesh})
         {
-            Ogre::MaterialManager::getSingleton().remove(m, mGroup);
-            Ogre::MaterialManager::getSingleton().remove(m + "/Caster", mGroup);
+            if (*mesh)
+                Ogre::MeshManager::getSingleton().remove(*mesh);
+            mesh->reset();
         }
+        mLeafVertexData.reset();
+        mFoliageLod.reset();
+        for (const std::vector<Ogre::String>* names : {&mMaterialNames, &mShadowedMaterialNames})
+            for (const Ogre::String& m : *names)
+            {
+                Ogre::MaterialManager::getSingleton().remove(m, mGroup);
+                Ogre::MaterialManager::getSingleton().remove(m + "/Caster", mGroup);
+            }
+        mShadowedMaterialNames.clear();
         for (const Ogre::String& t : mTextureNames)
             Ogre::TextureManager::getSingleton().remove(t, mGroup);
         mMaterialNames.clear();
@@ -105,11 +112,18 @@ namespace TreeLod
     const std::vector<Ogre::String>& TreeAsset::getMaterialNames()
     {
         if (mMaterialNames.empty())
-            createMaterials();
+            mMaterialNames = createMaterials("");
         return mMaterialNames;
     }
 
-    void TreeAsset::createMaterials()
+    const std::vector<Ogre::String>& TreeAsset::getShadowedMaterialNames()
+    {
+        if (mShadowedMaterialNames.empty())
+            mShadowedMaterialNames = createMaterials("Shadowed");
+        return mShadowedMaterialNames;
+    }
+
+    void TreeAsset::createTextures()
     {
         const ReferenceChunk& ref = getReference();
         const Ogre::String prefix = "TreeLod/" + mName + "/";
@@ -126,11 +140,19 @@ namespace TreeLod
                                                            int(gpu.mipCount > 0 ? gpu.mipCount - 1 : 0));
             mTextureNames.push_back(name);
         }
+    }
 
+    std::vector<Ogre::String> TreeAsset::createMaterials(const Ogre::String& variant)
+    {
+        const ReferenceChunk& ref = getReference();
+        if (mTextureNames.size() != ref.textures.size())
+            createTextures();
+        const Ogre::String prefix = "TreeLod/" + mName + "/";
+        std::vector<Ogre::String> names;
         for (std::size_t i = 0; i < ref.model.materials.size(); ++i)
         {
             const Material& src = ref.model.materials[i];
-            const Ogre::String base = src.isLeaf ? "TreeLod/Leaf" : "TreeLod/Bark";
+            const Ogre::String base = (src.isLeaf ? "TreeLod/Leaf" : "TreeLod/Bark") + variant;
             Ogre::MaterialPtr parent = Ogre::MaterialManager::getSingleton().getByName(base, Ogre::RGN_DEFAULT);
             if (!parent)
                 parent = Ogre::MaterialManager::getSingleton().getByName(base);
@@ -138,7 +160,7 @@ namespace TreeLod
                 OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
                             "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
                             "TreeAsset::createMaterials");
-            const Ogre::String name = prefix + std::to_string(i);
+            const Ogre::String name = prefix + std::to_string(i) + (variant.empty() ? "" : "/" + variant);
             Ogre::MaterialPtr mat = parent->clone(name, true, mGroup);
             const Ogre::String texture = src.texture >= 0 ? mTextureNames[std::size_t(src.texture)] : "TreeLodWhite.png";
             glm::vec3 back = src.backColour == glm::vec3(0.0f) ? glm::vec3(src.baseColour) : src.backColour;
@@ -169,8 +191,57 @@ namespace TreeLod
                 configure(own);
                 tech->setShadowCasterMaterial(own);
             }
-            mMaterialNames.push_back(name);
+            names.push_back(name);
         }
+        return names;
+    }
+
+    Ogre::MeshPtr TreeAsset::getBarkMesh()
+    {
+        if (!mBarkMesh)
+        {
+            TreeModel bark = getReference().model;
+            bark.leafVertices.clear();
+            bark.leafIndices.clear();
+            bark.leaves.clear();
+            mBarkMesh = buildTreeMesh(mName + "/bark", mGroup, bark, getMaterialNames());
+        }
+        return mBarkMesh;
+    }
+
+    const FoliageLodData& TreeAsset::getFoliageLod()
+    {
+        if (mFoliageLod)
+            return *mFoliageLod;
+        const PackageReader& package = getPackage();
+        int index = package.findChunk(FOLIAGE_LOD_CHUNK, 0);
+        if (index < 0)
+            raise(fail(mName, chunkElement(FOLIAGE_LOD_CHUNK, 0), "missing: bake the package with --technique lodf"));
+        Result<std::vector<std::uint8_t>> bytes = package.readChunk(std::size_t(index));
+        if (!bytes)
+            raise(bytes.error());
+        Result<FoliageLodData> data = decodeFoliageLodChunk(bytes.value(), mName);
+        if (!data)
+            raise(data.error());
+        const TreeModel& model = getReference().model;
+        if (data->leafVertexCount != model.leafVertices.size() || data->originalLeafCount != model.leaves.size())
+            raise(fail(mName, chunkElement(FOLIAGE_LOD_CHUNK, 0),
+                       "made for " + std::to_string(data->originalLeafCount) + " leaves / " +
+                           std::to_string(data->leafVertexCount) + " vertices, the reference has " +
+                           std::to_string(model.leaves.size()) + " / " + std::to_string(model.leafVertices.size())));
+        for (const FoliageLodCluster& c : data->clusters)
+            if (c.material >= model.materials.size() || !model.materials[c.material].isLeaf)
+                raise(fail(mName, chunkElement(FOLIAGE_LOD_CHUNK, 0),
+                           "cluster material " + std::to_string(c.material) + " is not a leaf material"));
+        mFoliageLod = std::make_unique<FoliageLodData>(std::move(data.value()));
+        return *mFoliageLod;
+    }
+
+    Ogre::VertexData* TreeAsset::getLeafVertexData()
+    {
+        if (!mLeafVertexData)
+            mLeafVertexData.reset(makeTreeVertexData(getReference().model.leafVertices));
+        return mLeafVertexData.get();
     }
 
     Ogre::MeshPtr TreeAsset::getReferenceMesh()

@@ -1,10 +1,12 @@
 #include "TreeLod/TreeLodPlugin.h"
 
+#include "TreeLod/FoliageLodTree.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 
 #include <MeshLodGenerator/OgreMeshLodGenerator.h>
 #include <OgreLogManager.h>
+#include <OgreRoot.h>
 
 namespace TreeLod
 {
@@ -21,6 +23,9 @@ namespace TreeLod
     {
         mTechniques = std::make_unique<TechniqueRegistry>();
         mAssetManager = std::make_unique<TreeAssetManager>();
+        // One MovableObject factory per technique (DESIGN.md, "Factories").
+        mFoliageLodFactory = std::make_unique<FoliageLodTreeFactory>();
+        Ogre::Root::getSingleton().addMovableObjectFactory(mFoliageLodFactory.get());
         Ogre::LogManager::getSingleton().logMessage("TreeLod: installed (techniques: " +
                                                     mTechniques->describe() + ")");
     }
@@ -39,6 +44,9 @@ namespace TreeLod
 
     void TreeLodPlugin::uninstall()
     {
+        if (mFoliageLodFactory)
+            Ogre::Root::getSingleton().removeMovableObjectFactory(mFoliageLodFactory.get());
+        mFoliageLodFactory.reset();
         delete mLodGenerator;
         mLodGenerator = nullptr;
         mAssetManager.reset();

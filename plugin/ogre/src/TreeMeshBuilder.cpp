@@ -12,25 +12,25 @@
 
 namespace TreeLod
 {
+    Ogre::VertexData* makeTreeVertexData(const std::vector<Vertex>& vertices)
+    {
+        auto* data = new Ogre::VertexData();
+        data->vertexCount = vertices.size();
+        Ogre::VertexDeclaration* decl = data->vertexDeclaration;
+        size_t offset = 0;
+        offset += decl->addElement(0, offset, Ogre::VET_FLOAT3, Ogre::VES_POSITION).getSize();
+        offset += decl->addElement(0, offset, Ogre::VET_FLOAT3, Ogre::VES_NORMAL).getSize();
+        decl->addElement(0, offset, Ogre::VET_FLOAT2, Ogre::VES_TEXTURE_COORDINATES, 0);
+        static_assert(sizeof(Vertex) == 8 * sizeof(float), "Vertex must be tightly packed");
+        Ogre::HardwareVertexBufferSharedPtr buffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
+            sizeof(Vertex), vertices.size(), Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+        buffer->writeData(0, buffer->getSizeInBytes(), vertices.data(), true);
+        data->vertexBufferBinding->setBinding(0, buffer);
+        return data;
+    }
+
     namespace
     {
-        Ogre::VertexData* makeVertexData(const std::vector<Vertex>& vertices)
-        {
-            auto* data = new Ogre::VertexData();
-            data->vertexCount = vertices.size();
-            Ogre::VertexDeclaration* decl = data->vertexDeclaration;
-            size_t offset = 0;
-            offset += decl->addElement(0, offset, Ogre::VET_FLOAT3, Ogre::VES_POSITION).getSize();
-            offset += decl->addElement(0, offset, Ogre::VET_FLOAT3, Ogre::VES_NORMAL).getSize();
-            decl->addElement(0, offset, Ogre::VET_FLOAT2, Ogre::VES_TEXTURE_COORDINATES, 0);
-            static_assert(sizeof(Vertex) == 8 * sizeof(float), "Vertex must be tightly packed");
-            Ogre::HardwareVertexBufferSharedPtr buffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
-                sizeof(Vertex), vertices.size(), Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
-            buffer->writeData(0, buffer->getSizeInBytes(), vertices.data(), true);
-            data->vertexBufferBinding->setBinding(0, buffer);
-            return data;
-        }
-
         void fillIndexData(Ogre::IndexData* data, const std::vector<std::uint32_t>& indices, size_t vertexCount)
         {
             const bool wide = vertexCount > 65535;
@@ -60,7 +60,7 @@ namespace TreeLod
         {
             Ogre::SubMesh* sub = mesh.createSubMesh();
             sub->useSharedVertices = false;
-            sub->vertexData = makeVertexData(part.vertices);
+            sub->vertexData = makeTreeVertexData(part.vertices);
             fillIndexData(sub->indexData, part.indices, part.vertices.size());
             sub->setMaterialName(materialNames[part.material], mesh.getGroup());
         }

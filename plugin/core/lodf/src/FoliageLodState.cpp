@@ -1,6 +1,7 @@
 #include "TreeLod/FoliageLodState.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace TreeLod
 {
@@ -109,6 +110,20 @@ namespace TreeLod
         for (std::uint32_t c = 0; c < mClusters.size(); ++c)
             activeLeaves(c, out);
         return out;
+    }
+
+    std::uint32_t FoliageLodState::quantise(const FoliageLodData& data, std::uint32_t count, std::uint32_t levels)
+    {
+        const std::uint32_t lo = data.minLeafCount(), hi = data.maxLeafCount();
+        count = std::clamp(count, lo, hi);
+        if (levels <= 1 || lo == hi)
+            return count;
+        const double ratio = std::pow(double(hi) / double(std::max(lo, 1u)), 1.0 / double(levels - 1));
+        double level = double(std::max(lo, 1u));
+        for (std::uint32_t i = 0; i + 1 < levels; ++i, level *= ratio)
+            if (double(count) <= std::ceil(level))
+                return std::min(hi, std::uint32_t(std::ceil(level)));
+        return hi;
     }
 
     FoliageLodState FoliageLodState::fromScratch(const FoliageLodData& data, std::uint32_t leafCount)

@@ -53,16 +53,32 @@ namespace TreeLod
         /// Sun (directional light) and ambient as LightingSpec says; background colour too.
         void setLighting(const LightingSpec& lighting);
 
+        /// Texture shadows from the sun: integrated additive technique, one float depth map of
+        /// `textureSize`^2 with the focused camera setup: an orthographic shadow camera, so the
+        /// stored depth is linear (OGRE-NOTES.md "Shadows"). Objects
+        /// choose receiving materials themselves (FoliageLodTree does).
+        void setShadows(bool enabled, unsigned textureSize = 2048);
+
+        /// Camera LoD bias (> 1 = more detail). render() divides it by the supersampling
+        /// factor's pixel count, so pixel-count LoD sees the output image's size.
+        void setLodBias(float bias) { mLodBias = bias; }
+
         /// Render the scene from `camera` at width x height, supersampled with
         /// samplesPerAxis^2 samples per pixel (box filter in linear space, like the CPU
         /// reference renderer). Returns opaque RGBA8.
         RgbaImage render(const CameraSpec& camera, int width, int height, int samplesPerAxis = 1);
+
+        /// Milliseconds of each of `frames` frames from `camera` at width x height (one sample
+        /// per pixel), each ended by reading one pixel back so the GPU has finished it; after
+        /// one untimed warm-up frame. For benchmarks.
+        std::vector<double> timeFrames(const CameraSpec& camera, int width, int height, int frames);
 
         /// Save as PNG through Ogre's codec, atomically. Throws on failure.
         static void savePng(const RgbaImage& image, const std::string& path);
 
     private:
         void ensureTarget(int width, int height);
+        void placeCamera(const CameraSpec& camera, int width, int height, int samplesPerAxis);
 
         std::unique_ptr<Ogre::LogManager> mLogManager;
         std::unique_ptr<Ogre::Root> mRoot;
@@ -75,5 +91,6 @@ namespace TreeLod
         Ogre::SceneNode* mContentNode = nullptr;
         Ogre::TexturePtr mTarget;
         LightingSpec mLighting;
+        float mLodBias = 1.0f;
     };
 }

@@ -7,6 +7,7 @@
 // names the resource, the chunk and the reason.
 #pragma once
 
+#include "TreeLod/FoliageLodData.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
 
@@ -39,11 +40,25 @@ namespace TreeLod
         /// and textures (built on first call). See TreeMeshBuilder.
         Ogre::MeshPtr getReferenceMesh();
 
+        /// The bark alone as an Ogre mesh "<asset>/bark" with its MeshLodGenerator levels
+        /// (techniques that draw their own foliage use it). Built on first call.
+        Ogre::MeshPtr getBarkMesh();
+
+        /// The LoDF foliage of chunk "lodf" (decoded on first call; its indices address the
+        /// reference chunk's leaf vertices, checked here).
+        const FoliageLodData& getFoliageLod();
+        /// The reference chunk's leaf vertices on the GPU, once for every instance.
+        Ogre::VertexData* getLeafVertexData();
+
         /// Local bounds of the tree in metres (from the reference chunk).
         Ogre::AxisAlignedBox getBounds();
 
         /// Names of the materials made for model material i ("TreeLod/<asset>/<i>").
         const std::vector<Ogre::String>& getMaterialNames();
+        /// The same materials receiving texture shadows ("TreeLod/<asset>/<i>/Shadowed", clones
+        /// of TreeLod/BarkShadowed and TreeLod/LeafShadowed): for scenes with an integrated
+        /// texture shadow technique.
+        const std::vector<Ogre::String>& getShadowedMaterialNames();
 
     protected:
         void loadImpl() override;
@@ -51,13 +66,19 @@ namespace TreeLod
         size_t calculateSize() const override;
 
     private:
-        void createMaterials();
+        void createTextures();
+        /// Clones of TreeLod/Bark<variant> and TreeLod/Leaf<variant>, one per model material.
+        std::vector<Ogre::String> createMaterials(const Ogre::String& variant);
         [[noreturn]] void raise(const Error& error) const;
 
         std::vector<std::uint8_t> mManualBytes;
         std::unique_ptr<PackageReader> mPackage;
         std::unique_ptr<ReferenceChunk> mReference;
         Ogre::MeshPtr mReferenceMesh;
+        Ogre::MeshPtr mBarkMesh;
+        std::unique_ptr<FoliageLodData> mFoliageLod;
+        std::unique_ptr<Ogre::VertexData> mLeafVertexData;
+        std::vector<Ogre::String> mShadowedMaterialNames;
         std::vector<Ogre::String> mMaterialNames;
         std::vector<Ogre::String> mTextureNames;
     };

@@ -17,6 +17,7 @@ namespace Ogre
 
 namespace TreeLod
 {
+    class FoliageLodTreeFactory;
     class TreeAssetManager;
     class TechniqueRegistry;
 
@@ -35,6 +36,7 @@ namespace TreeLod
     private:
         std::unique_ptr<TreeAssetManager> mAssetManager;
         std::unique_ptr<TechniqueRegistry> mTechniques;
+        std::unique_ptr<FoliageLodTreeFactory> mFoliageLodFactory;
         Ogre::MeshLodGenerator* mLodGenerator = nullptr; ///< owned only when we created it
     };
 }

@@ -23,6 +23,10 @@ namespace TreeLod
         float lodReduction = 0.5f;         ///< fraction of bark vertices removed per level (cumulative)
     };
 
+    /// Vertex data over `vertices` as they are (position float3, normal float3, uv0 float2;
+    /// one static buffer): the layout of every TreeLod submesh.
+    Ogre::VertexData* makeTreeVertexData(const std::vector<Vertex>& vertices);
+
     /// Build mesh `name` in `group`; `materialNames[i]` is the Ogre material for
     /// model.materials[i]. Throws Ogre::InvalidParametersException on inconsistent input.
     Ogre::MeshPtr buildTreeMesh(const Ogre::String& name, const Ogre::String& group, const TreeModel& model,

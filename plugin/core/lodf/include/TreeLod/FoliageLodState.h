@@ -55,6 +55,11 @@ namespace TreeLod
         void activeLeaves(std::uint32_t c, std::vector<std::uint32_t>& out) const;
         std::vector<std::uint32_t> activeLeaves() const;
 
+        /// Snap `count` to one of `levels` leaf counts spaced geometrically from minLeafCount to
+        /// maxLeafCount (the next one up, never fewer leaves than asked). For instances that
+        /// share index buffers (a Forest's distant trees); levels <= 1 returns count unchanged.
+        static std::uint32_t quantise(const FoliageLodData& data, std::uint32_t count, std::uint32_t levels);
+
         /// The state reached from F_0 by applying the first `collapses` of Changed_group in
         /// one go: what setLeafCount must agree with after any sequence of moves.
         static FoliageLodState fromScratch(const FoliageLodData& data, std::uint32_t leafCount);

@@ -1,0 +1,285 @@
+#include "TreeLod/FoliageLodTree.h"
+
+#include "TreeLod/TreeAssetManager.h"
+
+#include <OgreCamera.h>
+#include <OgreException.h>
+#include <OgreHardwareBufferManager.h>
+#include <OgreMaterialManager.h>
+#include <OgreNode.h>
+#include <OgrePixelCountLodStrategy.h>
+#include <OgreRenderQueue.h>
+#include <OgreSceneManager.h>
+#include <OgreStringConverter.h>
+#include <OgreSubMesh.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace TreeLod
+{
+    /// One draw of a FoliageLodTree: a leaf material's regions, or a bark submesh.
+    class FoliageLodTree::Part : public Ogre::Renderable
+    {
+    public:
+        Part(FoliageLodTree& parent, Ogre::VertexData* vertexData, const Ogre::String& material,
+             const Ogre::String& shadowedMaterial)
+            : mParent(parent), mVertexData(vertexData)
+        {
+            const Ogre::String& group = parent.mAsset->getGroup();
+            mMaterial = Ogre::MaterialManager::getSingleton().getByName(material, group);
+            if (!shadowedMaterial.empty())
+                mShadowedMaterial = Ogre::MaterialManager::getSingleton().getByName(shadowedMaterial, group);
+            for (Ogre::MaterialPtr* m : {&mMaterial, &mShadowedMaterial})
+                if (*m)
+                    (*m)->load();
+            if (!mMaterial)
+                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND, "material '" + material + "' not found",
+                            "FoliageLodTree");
+        }
+
+        Ogre::IndexData mIndexData;           ///< leaf parts: start and count in the instance's buffer
+        std::vector<Ogre::IndexData*> mLevels; ///< bark parts: index data per mesh LoD level
+
+        const Ogre::MaterialPtr& getMaterial() const override
+        {
+            return mShadowedMaterial && mParent.useShadowedMaterials() ? mShadowedMaterial : mMaterial;
+        }
+        void getRenderOperation(Ogre::RenderOperation& op) override
+        {
+            op.operationType = Ogre::RenderOperation::OT_TRIANGLE_LIST;
+            op.useIndexes = true;
+            op.vertexData = mVertexData;
+            op.indexData = mLevels.empty() ? &mIndexData
+                                           : mLevels[std::min<std::size_t>(mParent.mBarkLodIndex, mLevels.size() - 1)];
+        }
+        void getWorldTransforms(Ogre::Matrix4* xform) const override { *xform = mParent._getParentNodeFullTransform(); }
+        Ogre::Real getSquaredViewDepth(const Ogre::Camera* camera) const override
+        {
+            return mParent.getParentNode() ? mParent.getParentNode()->getSquaredViewDepth(camera) : 0.0f;
+        }
+        const Ogre::LightList& getLights() const override { return mParent.queryLights(); }
+        bool getCastsShadows() const override { return mParent.getCastShadows(); }
+
+    private:
+        FoliageLodTree& mParent;
+        Ogre::VertexData* mVertexData;
+        Ogre::MaterialPtr mMaterial;
+        Ogre::MaterialPtr mShadowedMaterial;
+    };
+
+    const Ogre::String FoliageLodTreeFactory::FACTORY_TYPE_NAME = "FoliageLodTree";
+
+    FoliageLodTree::FoliageLodTree(const Ogre::String& name, const TreeAssetPtr& asset, const Options& options)
+        : Ogre::MovableObject(name), mAsset(asset), mData(&asset->getFoliageLod()), mState(*mData), mOptions(options)
+    {
+        mBounds = mAsset->getBounds();
+        mRadius = 0.5f * mBounds.getSize().length();
+        const std::vector<Ogre::String>& materials = mAsset->getMaterialNames();
+        const std::vector<Ogre::String>& shadowed = mAsset->getShadowedMaterialNames();
+
+        if (!mData->clusters.empty())
+        {
+            Ogre::VertexData* vertices = mAsset->getLeafVertexData();
+            const bool wide = vertices->vertexCount > 65535;
+            mIndexBuffer = Ogre::HardwareBufferManager::getSingleton().createIndexBuffer(
+                wide ? Ogre::HardwareIndexBuffer::IT_32BIT : Ogre::HardwareIndexBuffer::IT_16BIT, mData->slotCount(),
+                Ogre::HardwareBuffer::HBU_DYNAMIC_WRITE_ONLY);
+            // One part per run of clusters with the same material (clusters are sorted by it).
+            for (std::size_t c = 0; c < mData->clusters.size();)
+            {
+                const std::uint32_t material = mData->clusters[c].material;
+                std::size_t end = c;
+                while (end < mData->clusters.size() && mData->clusters[end].material == material)
+                    ++end;
+                auto part = std::make_unique<Part>(*this, vertices, materials[material], shadowed[material]);
+                part->mIndexData.indexBuffer = mIndexBuffer;
+                part->mIndexData.indexStart = mData->clusters[c].firstSlot;
+                part->mIndexData.indexCount =
+                    mData->clusters[end - 1].firstSlot + mData->clusters[end - 1].slotCount - mData->clusters[c].firstSlot;
+                mLeafParts.push_back(std::move(part));
+                c = end;
+            }
+            writeAllClusters();
+        }
+
+        if (!mAsset->getReference().model.barkIndices.empty())
+        {
+            mBarkMesh = mAsset->getBarkMesh();
+            for (Ogre::SubMesh* sub : mBarkMesh->getSubMeshes())
+            {
+                const auto it = std::find(materials.begin(), materials.end(), sub->getMaterialName());
+                const Ogre::String receiver = it == materials.end() ? "" : shadowed[std::size_t(it - materials.begin())];
+                auto part = std::make_unique<Part>(*this, sub->vertexData, sub->getMaterialName(), receiver);
+                part->mLevels.push_back(sub->indexData);
+                for (Ogre::IndexData* level : sub->mLodFaceList)
+                    part->mLevels.push_back(level);
+                mBarkParts.push_back(std::move(part));
+            }
+        }
+        mStats.leafCount = mState.leafCount();
+    }
+
+    FoliageLodTree::~FoliageLodTree() = default;
+
+    const Ogre::String& FoliageLodTree::getMovableType() const { return FoliageLodTreeFactory::FACTORY_TYPE_NAME; }
+
+    void FoliageLodTree::writeAllClusters()
+    {
+        const std::size_t indexSize = mIndexBuffer->getIndexSize();
+        std::vector<std::uint8_t> all(std::size_t(mData->slotCount()) * indexSize);
+        for (std::uint32_t c = 0; c < mData->clusters.size(); ++c)
+        {
+            void* at = all.data() + std::size_t(mData->clusters[c].firstSlot) * indexSize;
+            if (indexSize == 4)
+                mState.writeCluster(c, static_cast<std::uint32_t*>(at));
+            else
+                mState.writeCluster(c, static_cast<std::uint16_t*>(at));
+        }
+        mIndexBuffer->writeData(0, all.size(), all.data(), true);
+    }
+
+    std::uint32_t FoliageLodTree::updateLeafCount(std::uint32_t count)
+    {
+        if (mOptions.quantiseLevels > 1)
+            count = FoliageLodState::quantise(*mData, count, mOptions.quantiseLevels);
+        const std::uint32_t target = std::clamp(count, mData->minLeafCount(), mData->maxLeafCount());
+        if (!mIndexBuffer || target == mState.leafCount())
+            return 0;
+        // §3.3: update the state; §4: send only the changed clusters' regions.
+        mState.setLeafCount(target);
+        std::vector<std::uint32_t> changed = mState.changedClusters();
+        std::sort(changed.begin(), changed.end());
+        const std::size_t indexSize = mIndexBuffer->getIndexSize();
+        mStats.clustersWritten = std::uint32_t(changed.size());
+        mStats.bytesUploaded = 0;
+        mStats.writeCalls = 0;
+        for (std::size_t i = 0; i < changed.size();)
+        {
+            // Merge runs of adjacent regions into one write.
+            std::size_t end = i + 1;
+            while (end < changed.size() && changed[end] == changed[end - 1] + 1)
+                ++end;
+            const FoliageLodCluster& first = mData->clusters[changed[i]];
+            const FoliageLodCluster& last = mData->clusters[changed[end - 1]];
+            const std::size_t slots = last.firstSlot + last.slotCount - first.firstSlot;
+            mScratch.resize(slots * indexSize);
+            for (std::size_t k = i; k < end; ++k)
+            {
+                void* at = mScratch.data() + (mData->clusters[changed[k]].firstSlot - first.firstSlot) * indexSize;
+                if (indexSize == 4)
+                    mState.writeCluster(changed[k], static_cast<std::uint32_t*>(at));
+                else
+                    mState.writeCluster(changed[k], static_cast<std::uint16_t*>(at));
+            }
+            mIndexBuffer->writeData(first.firstSlot * indexSize, mScratch.size(), mScratch.data(), false);
+            mStats.bytesUploaded += mScratch.size();
+            ++mStats.writeCalls;
+            i = end;
+        }
+        mStats.totalBytesUploaded += mStats.bytesUploaded;
+        mStats.leafCount = mState.leafCount();
+        ++mStats.changes;
+        return mStats.clustersWritten;
+    }
+
+    std::uint32_t FoliageLodTree::leafCountForPixels(Ogre::Real pixels, Ogre::Real bias) const
+    {
+        const double leaves = std::max(0.0, double(pixels) * double(bias) / double(mOptions.pixelsPerLeaf));
+        return std::uint32_t(std::clamp(std::ceil(leaves), double(mData->minLeafCount()), double(mData->maxLeafCount())));
+    }
+
+    void FoliageLodTree::setFixedLeafCount(std::uint32_t count)
+    {
+        mOptions.fixedLeafCount = count;
+        if (count > 0)
+            updateLeafCount(count);
+    }
+
+    void FoliageLodTree::setPixelsPerLeaf(float pixelsPerLeaf)
+    {
+        if (!(pixelsPerLeaf > 0.0f) || !std::isfinite(pixelsPerLeaf))
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                        "pixelsPerLeaf must be a positive number, got " + std::to_string(pixelsPerLeaf),
+                        "FoliageLodTree '" + mName + "'");
+        mOptions.pixelsPerLeaf = pixelsPerLeaf;
+    }
+
+    void FoliageLodTree::setQuantiseLevels(std::uint32_t levels) { mOptions.quantiseLevels = levels; }
+
+    void FoliageLodTree::_notifyCurrentCamera(Ogre::Camera* camera)
+    {
+        Ogre::MovableObject::_notifyCurrentCamera(camera);
+        if (!mParentNode)
+            return;
+        const Ogre::Camera* lodCamera = camera->getLodCamera();
+        const Ogre::Real pixels = Ogre::AbsolutePixelCountLodStrategy::getSingleton().getValue(this, camera);
+        if (mBarkMesh)
+            mBarkLodIndex = mBarkMesh->getLodIndex(mBarkMesh->getLodStrategy()->getValue(this, camera));
+        // The LoD camera (the viewer's camera for shadow cameras) and its bias drive the count.
+        updateLeafCount(mOptions.fixedLeafCount > 0 ? mOptions.fixedLeafCount
+                                                    : leafCountForPixels(pixels, lodCamera->getLodBias()));
+    }
+
+    bool FoliageLodTree::useShadowedMaterials()
+    {
+        return mManager && mManager->isShadowTechniqueTextureBased() &&
+               mManager->isShadowTechniqueIntegrated();
+    }
+
+    void FoliageLodTree::_updateRenderQueue(Ogre::RenderQueue* queue)
+    {
+        for (auto* parts : {&mBarkParts, &mLeafParts})
+            for (const std::unique_ptr<Part>& part : *parts)
+                queue->addRenderable(part.get(), mRenderQueueID, mRenderQueuePriority);
+    }
+
+    void FoliageLodTree::visitRenderables(Ogre::Renderable::Visitor* visitor, bool)
+    {
+        for (auto* parts : {&mBarkParts, &mLeafParts})
+            for (const std::unique_ptr<Part>& part : *parts)
+                visitor->visit(part.get(), 0, false);
+    }
+
+    FoliageLodTree::Options FoliageLodTreeFactory::parseOptions(const Ogre::NameValuePairList* params)
+    {
+        FoliageLodTree::Options options;
+        if (!params)
+            return options;
+        auto number = [&](const char* key, double lo, double hi, double& out) {
+            auto it = params->find(key);
+            if (it == params->end())
+                return false;
+            char* end = nullptr;
+            out = std::strtod(it->second.c_str(), &end);
+            if (it->second.empty() || *end != '\0' || !(out >= lo && out <= hi))
+                OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                            Ogre::String("parameter '") + key + "': '" + it->second + "' is not a number in [" +
+                                std::to_string(lo) + ", " + std::to_string(hi) + "]",
+                            "FoliageLodTreeFactory");
+            return true;
+        };
+        double v = 0.0;
+        if (number("leaves", 0.0, 4294967295.0, v))
+            options.fixedLeafCount = std::uint32_t(v);
+        if (number("pixelsPerLeaf", 1e-6, 1e9, v))
+            options.pixelsPerLeaf = float(v);
+        if (number("quantise", 0.0, 1024.0, v))
+            options.quantiseLevels = std::uint32_t(v);
+        return options;
+    }
+
+    Ogre::MovableObject* FoliageLodTreeFactory::createInstanceImpl(const Ogre::String& name,
+                                                                  const Ogre::NameValuePairList* params)
+    {
+        auto asset = params ? params->find("asset") : Ogre::NameValuePairList::const_iterator();
+        if (!params || asset == params->end())
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, "FoliageLodTree '" + name + "': parameter 'asset' is required",
+                        "FoliageLodTreeFactory::createInstanceImpl");
+        auto group = params->find("group");
+        TreeAssetPtr tree = TreeAssetManager::getSingleton().load(
+            asset->second, group == params->end() ? Ogre::ResourceGroupManager::AUTODETECT_RESOURCE_GROUP_NAME
+                                                  : group->second);
+        return new FoliageLodTree(name, tree, parseOptions(params));
+    }
+}
