@@ -1,9 +1,6 @@
 // Golden-image tests of the polygonal reference rendered through Plugin_TreeLod.
 //
-// compare | update: by default each render is compared with tests/golden/NAME.png by FLIP
-// (mean below the bound stated per test); with TREELOD_GOLDEN=update the goldens are
-// rewritten instead (then open them and look before committing). On a failure the
-// render and the FLIP heat map are left in build/test-out/ogre/ for inspection.
+// Golden comparison: compareWithGolden in OgreTestSupport.h.
 #include "OgreTestSupport.h"
 
 #include "TreeLod/GltfImporter.h"
@@ -14,31 +11,11 @@
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 
-#include <cstdlib>
 
 namespace TreeLod
 {
     namespace
     {
-        Image toImage(const RgbaImage& rgba)
-        {
-            Image image(rgba.width, rgba.height);
-            for (std::size_t i = 0; i < image.pixels.size(); ++i)
-                image.pixels[i] = glm::vec4(rgba.pixels[4 * i], rgba.pixels[4 * i + 1], rgba.pixels[4 * i + 2],
-                                            rgba.pixels[4 * i + 3]) / 255.0f;
-            return image;
-        }
-
-        /// Fraction of pixels that differ from the background colour: a black, empty or
-        /// background-only picture cannot pass a golden test.
-        double treeCoverage(const Image& image, const glm::vec3& background)
-        {
-            std::size_t covered = 0;
-            for (const glm::vec4& p : image.pixels)
-                covered += glm::length(glm::vec3(p) - background) > 0.02f;
-            return double(covered) / double(image.pixels.size());
-        }
-
         struct Rendered
         {
             TreeModel model;
@@ -74,28 +51,6 @@ namespace TreeLod
             return out;
         }
 
-        void compareWithGolden(const Image& actual, const std::string& name, double bound)
-        {
-            const std::string golden = OgreEnvironment::sourcePath("tests/golden/" + name + ".png");
-            const std::string actualPath = OgreEnvironment::outDir() + "/" + name + ".png";
-            ASSERT_TRUE(writePng(actualPath, actual).ok());
-            const char* mode = std::getenv("TREELOD_GOLDEN");
-            if (mode && std::string(mode) == "update")
-            {
-                ASSERT_TRUE(writePng(golden, actual).ok());
-                GTEST_SKIP() << "golden updated: " << golden << " (open it and look before committing)";
-            }
-            Result<Image> expected = readImage(golden);
-            ASSERT_TRUE(expected.ok()) << expected.error().message()
-                                       << " (run with TREELOD_GOLDEN=update to create it)";
-            FlipOptions options;
-            options.keepErrorMap = true;
-            Result<FlipResult> flipped = flip(expected.value(), actual, options);
-            ASSERT_TRUE(flipped.ok()) << flipped.error().message();
-            if (flipped->mean >= bound)
-                writePng(OgreEnvironment::outDir() + "/" + name + ".flip.png", flipHeatmap(flipped.value()));
-            EXPECT_LT(flipped->mean, bound) << name << ": see " << actualPath;
-        }
     }
 
     // Bound 0.02 mean FLIP: llvmpipe versions may round a few edge texels differently; a

@@ -100,6 +100,8 @@ namespace TreeLod
                 mLeafParts.push_back(std::move(part));
                 c = end;
             }
+            if (mOptions.fixedLeafCount > 0)
+                mState.setLeafCount(mOptions.fixedLeafCount);
             writeAllClusters();
         }
 

@@ -10,6 +10,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 
@@ -120,6 +121,7 @@ namespace TreeLod
             const glm::vec3 centre = (a.centre * a.area + b.centre * b.area) / std::max(target, 1e-30f);
             float bestScore = std::numeric_limits<float>::max();
             Node out;
+            out.corner = a.corner; // kept if every score is NaN (extreme coordinates)
             for (int mask = 0; mask < 16; ++mask)
             {
                 std::array<std::uint32_t, 4> q;
@@ -198,6 +200,14 @@ namespace TreeLod
                         bi = i;
                         bj = best[i];
                     }
+                if (bi == n)
+                {
+                    // Every cost NaN or infinite (finite but extreme coordinates): collapse the
+                    // first two live leaves, the structure stays valid.
+                    bi = std::uint32_t(std::find(alive.begin(), alive.end(), 1) - alive.begin());
+                    bj = std::uint32_t(std::find(alive.begin() + bi + 1, alive.end(), 1) - alive.begin());
+                    bv = std::numeric_limits<float>::max();
+                }
                 if (bi > bj)
                     std::swap(bi, bj);
                 const std::uint32_t na = slotNode[bi], nb = slotNode[bj];
@@ -271,8 +281,8 @@ namespace TreeLod
     {
         if (options.clusterSize < 1 || options.clusterSize > 4096)
             return fail(label, "lodf option clusterSize", std::to_string(options.clusterSize) + " is not in 1..4096");
-        if (options.costBands < 1 || options.costBands > 64)
-            return fail(label, "lodf option costBands", std::to_string(options.costBands) + " is not in 1..64");
+        if (options.costBands > 64)
+            return fail(label, "lodf option costBands", std::to_string(options.costBands) + " is not in 0..64");
         Result<void> valid = model.validate(label);
         if (!valid)
             return valid.error();
@@ -328,7 +338,14 @@ namespace TreeLod
             {
                 const float cost = clusters[c].collapses[s].cost;
                 const auto band = std::uint32_t(std::upper_bound(bandEnd.begin(), bandEnd.end(), cost) - bandEnd.begin());
-                order.push_back({band, std::uint32_t(mix64(c) >> 32), c, s});
+                // costBands 0: the paper's pure cost order (rank = the cost's bits, monotone for
+                // non-negative floats); else the band's clusters in a fixed pseudo-random order.
+                std::uint32_t costBits;
+                std::memcpy(&costBits, &cost, 4);
+                if (options.costBands == 0)
+                    order.push_back({0, std::isfinite(cost) ? costBits : 0x7f800000u, c, s});
+                else
+                    order.push_back({band, std::uint32_t(mix64(c) >> 32), c, s});
             }
         std::sort(order.begin(), order.end(), [](const Order& x, const Order& y) {
             return std::tie(x.band, x.rank, x.cluster, x.step) < std::tie(y.band, y.rank, y.cluster, y.step);

@@ -76,6 +76,23 @@ namespace TreeLod
             if (originals != k.originalLeaves)
                 return fail(label, element, std::to_string(originals) + " original leaves, header says " +
                                                 std::to_string(k.originalLeaves));
+            // Replay the steps: no state may need more index slots than the region has.
+            std::vector<std::uint32_t> createdAt(k.originalLeaves, 0);
+            for (std::uint32_t p = 0; p < k.entryCount; ++p)
+                createdAt[entries[k.firstEntry + p].created] = p;
+            std::uint64_t used = 0;
+            for (std::uint32_t p = 0; p < k.entryCount; ++p)
+                if (entries[k.firstEntry + p].created == 0)
+                    used += entries[k.firstEntry + p].indexCount;
+            for (std::uint32_t step = 1; step < k.originalLeaves; ++step)
+            {
+                used -= entries[k.firstEntry + 2 * step - 2].indexCount + entries[k.firstEntry + 2 * step - 1].indexCount;
+                used += entries[k.firstEntry + createdAt[step]].indexCount;
+                if (used > originalSlots)
+                    return fail(label, element, "after step " + std::to_string(step) + " its leaves need " +
+                                                    std::to_string(used) + " index slots, the region has " +
+                                                    std::to_string(originalSlots));
+            }
             if (k.slotCount != originalSlots)
                 return fail(label, element, "index region of " + std::to_string(k.slotCount) +
                                                 " slots, its original leaves have " + std::to_string(originalSlots));

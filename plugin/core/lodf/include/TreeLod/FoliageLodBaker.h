@@ -42,7 +42,9 @@ namespace TreeLod
     struct FoliageLodOptions
     {
         std::uint32_t clusterSize = 64; ///< leaves per independent cluster (1 .. 4096)
-        std::uint32_t costBands = 8;    ///< bands of Changed_group (1 = pure cost order .. 64)
+        /// Bands of Changed_group (1..64); 0 = the paper's pure global cost order (every
+        /// change then touches most clusters). 1 = cluster by cluster.
+        std::uint32_t costBands = 4;
     };
 
     /// Build F^r for `model` (validated first). Errors name `label`. A tree without leaves

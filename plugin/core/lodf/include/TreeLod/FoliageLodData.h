@@ -92,6 +92,7 @@ namespace TreeLod
     };
 
     std::vector<std::uint8_t> encodeFoliageLodChunk(const FoliageLodData& data);
-    /// Parse and validate(); errors name `label` and "chunk 'lodf' level 0".
+    /// Parse and validate(); errors name `label` and the element ("chunk 'lodf' level 0" for
+    /// layout errors, "lodf cluster 3", "lodf index 17", ... for content).
     Result<FoliageLodData> decodeFoliageLodChunk(const std::vector<std::uint8_t>& bytes, const std::string& label);
 }

@@ -57,7 +57,7 @@ namespace TreeLod
 
         /// Snap `count` to one of `levels` leaf counts spaced geometrically from minLeafCount to
         /// maxLeafCount (the next one up, never fewer leaves than asked). For instances that
-        /// share index buffers (a Forest's distant trees); levels <= 1 returns count unchanged.
+        /// share index buffers (a Forest's distant trees); levels <= 1 only clamps `count`.
         static std::uint32_t quantise(const FoliageLodData& data, std::uint32_t count, std::uint32_t levels);
 
         /// The state reached from F_0 by applying the first `collapses` of Changed_group in

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# treelod bake/render --technique lodf end to end (run by ctest under xvfb-run):
+# bake a package, see the chunk in `info`, render it at two distances and a fixed leaf
+# count, and check that bad input exits 2 and writes nothing.
+set -euo pipefail
+treelod=$1; src=$2; out=$3
+rm -rf "$out"; mkdir -p "$out"
+"$treelod" bake "$src/media/oak.glb" --technique lodf -q -o "$out/oak.treelod"
+"$treelod" info "$out/oak.treelod" --json > "$out/info.json"
+grep -q '"lodf"' "$out/info.json" || { echo "no lodf chunk in info"; exit 1; }
+grep -q '"reference"' "$out/info.json" || { echo "no reference chunk in info"; exit 1; }
+"$treelod" render "$out/oak.treelod" --technique lodf --camera orbit:30,10,1 --size 128x128 -o "$out/near.png"
+"$treelod" render "$out/oak.treelod" --technique lodf --camera orbit:30,10,6 --size 128x128 -o "$out/far.png"
+"$treelod" render "$src/media/conifer.glb" --technique lodf --leaves 200 --size 128x128 -o "$out/conifer200.png"
+for f in near far conifer200; do [ -s "$out/$f.png" ] || { echo "$f.png missing"; exit 1; }; done
+
+# A package without the lodf chunk: exit 2, a message naming the chunk, no output.
+"$treelod" bake "$src/media/birch.glb" -q -o "$out/birch-ref.treelod"
+set +e
+"$treelod" render "$out/birch-ref.treelod" --technique lodf -o "$out/bad.png" 2> "$out/bad.txt"; code=$?
+set -e
+[ "$code" = 2 ] || { echo "expected exit 2, got $code"; exit 1; }
+grep -q "lodf" "$out/bad.txt" || { echo "error does not name the chunk:"; cat "$out/bad.txt"; exit 1; }
+[ ! -e "$out/bad.png" ] || { echo "bad.png written"; exit 1; }
+set +e
+"$treelod" bake "$src/media/birch.glb" --technique nosuch -o "$out/bad.treelod" 2> "$out/bad2.txt"; code=$?
+set -e
+[ "$code" = 2 ] && [ ! -e "$out/bad.treelod" ] || { echo "unknown technique not refused"; exit 1; }
+echo "lodf CLI ok"
