@@ -83,6 +83,10 @@ namespace TreeLod
                     return printError(baked.error());
                 meta.techniques.push_back(t->name);
             }
+            // Techniques that index the reference chunk add it themselves: list it too.
+            if (writer.hasChunk(REFERENCE_CHUNK, 0) &&
+                std::find(meta.techniques.begin(), meta.techniques.end(), REFERENCE_CHUNK) == meta.techniques.end())
+                meta.techniques.insert(meta.techniques.begin(), REFERENCE_CHUNK);
             Result<void> added = addMetaChunk(writer, meta);
             if (!added)
                 return printError(added.error());
@@ -95,8 +99,8 @@ namespace TreeLod
             report(progress, "write", 1.0f);
 
             std::string list;
-            for (const BakeTechnique* t : techniques)
-                list += (list.empty() ? "" : ", ") + std::string(t->name);
+            for (const std::string& t : meta.techniques)
+                list += (list.empty() ? "" : ", ") + t;
             std::printf("wrote %s: %zu chunks (%s + meta), %zu bytes; %zu leaves, %zu bark triangles\n",
                         args.output.c_str(), writer.chunkCount(), list.c_str(), bytes.size(), model->leaves.size(),
                         model->barkTriangleCount());
