@@ -84,18 +84,24 @@ namespace TreeLod
         return getPackage().findChunk(technique, level) >= 0;
     }
 
+    std::vector<std::uint8_t> TreeAsset::readChunk(const char* technique) const
+    {
+        const PackageReader& package = getPackage();
+        int index = package.findChunk(technique, 0);
+        if (index < 0)
+            raise(fail(mName, chunkElement(technique, 0),
+                       std::string("missing: bake the package with --technique ") + technique));
+        Result<std::vector<std::uint8_t>> bytes = package.readChunk(std::size_t(index));
+        if (!bytes)
+            raise(bytes.error());
+        return std::move(bytes.value());
+    }
+
     const ReferenceChunk& TreeAsset::getReference()
     {
         if (mReference)
             return *mReference;
-        const PackageReader& package = getPackage();
-        int index = package.findChunk("reference", 0);
-        if (index < 0)
-            raise(fail(mName, "chunk 'reference' level 0", "missing: bake the package with --technique reference"));
-        Result<std::vector<std::uint8_t>> bytes = package.readChunk(std::size_t(index));
-        if (!bytes)
-            raise(bytes.error());
-        Result<ReferenceChunk> chunk = decodeReferenceChunk(bytes.value(), mName);
+        Result<ReferenceChunk> chunk = decodeReferenceChunk(readChunk(REFERENCE_CHUNK), mName);
         if (!chunk)
             raise(chunk.error());
         mReference = std::make_unique<ReferenceChunk>(std::move(chunk.value()));
@@ -213,14 +219,7 @@ namespace TreeLod
     {
         if (mFoliageLod)
             return *mFoliageLod;
-        const PackageReader& package = getPackage();
-        int index = package.findChunk(FOLIAGE_LOD_CHUNK, 0);
-        if (index < 0)
-            raise(fail(mName, chunkElement(FOLIAGE_LOD_CHUNK, 0), "missing: bake the package with --technique lodf"));
-        Result<std::vector<std::uint8_t>> bytes = package.readChunk(std::size_t(index));
-        if (!bytes)
-            raise(bytes.error());
-        Result<FoliageLodData> data = decodeFoliageLodChunk(bytes.value(), mName);
+        Result<FoliageLodData> data = decodeFoliageLodChunk(readChunk(FOLIAGE_LOD_CHUNK), mName);
         if (!data)
             raise(data.error());
         const TreeModel& model = getReference().model;

@@ -70,6 +70,8 @@ namespace TreeLod
         /// Clones of TreeLod/Bark<variant> and TreeLod/Leaf<variant>, one per model material.
         std::vector<Ogre::String> createMaterials(const Ogre::String& variant);
         [[noreturn]] void raise(const Error& error) const;
+        /// Level 0 of chunk `technique`, CRC-checked; throws naming what is missing or broken.
+        std::vector<std::uint8_t> readChunk(const char* technique) const;
 
         std::vector<std::uint8_t> mManualBytes;
         std::unique_ptr<PackageReader> mPackage;
