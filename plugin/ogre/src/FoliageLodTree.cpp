@@ -74,7 +74,9 @@ namespace TreeLod
         : Ogre::MovableObject(name), mAsset(asset), mData(&asset->getFoliageLod()), mState(*mData), mOptions(options)
     {
         mBounds = mAsset->getBounds();
-        mRadius = 0.5f * mBounds.getSize().length();
+        // Ogre's convention (Mesh::_setBounds): a sphere about the object's origin holding the
+        // box, so culling and pixel-count LoD see the same radius as an Entity of this tree.
+        mRadius = Ogre::Math::boundingRadiusFromAABB(mBounds);
         const std::vector<Ogre::String>& materials = mAsset->getMaterialNames();
         const std::vector<Ogre::String>& shadowed = mAsset->getShadowedMaterialNames();
 

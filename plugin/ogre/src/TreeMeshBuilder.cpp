@@ -133,7 +133,6 @@ namespace TreeLod
         Ogre::AxisAlignedBox box(model.boundsMin.x, model.boundsMin.y, model.boundsMin.z, model.boundsMax.x,
                                  model.boundsMax.y, model.boundsMax.z);
         mesh->_setBounds(box);
-        mesh->_setBoundingSphereRadius(0.5f * box.getSize().length());
 
         // paper 000 §6 (Hoppe's progressive meshes for the trunk): MeshLodGenerator on the
         // bark alone, before the leaf submeshes exist.
