@@ -86,7 +86,7 @@ namespace TreeLod
             const bool wide = vertices->vertexCount > 65535;
             mIndexBuffer = Ogre::HardwareBufferManager::getSingleton().createIndexBuffer(
                 wide ? Ogre::HardwareIndexBuffer::IT_32BIT : Ogre::HardwareIndexBuffer::IT_16BIT, mData->slotCount(),
-                Ogre::HardwareBuffer::HBU_DYNAMIC_WRITE_ONLY);
+                Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
             // One part per run of clusters with the same material (clusters are sorted by it).
             for (std::size_t c = 0; c < mData->clusters.size();)
             {

@@ -54,6 +54,7 @@ namespace TreeLod
         }
         mLeafVertexData.reset();
         mFoliageLod.reset();
+        mLeafVertexOrder.clear();
         for (const std::vector<Ogre::String>* names : {&mMaterialNames, &mShadowedMaterialNames})
             for (const Ogre::String& m : *names)
             {
@@ -232,6 +233,19 @@ namespace TreeLod
             if (c.material >= model.materials.size() || !model.materials[c.material].isLeaf)
                 raise(fail(mName, chunkElement(FOLIAGE_LOD_CHUNK, 0),
                            "cluster material " + std::to_string(c.material) + " is not a leaf material"));
+        // Vertices in the order the clusters first use them, so that a draw's indices address
+        // nearby vertices (GPU vertex caches; llvmpipe ran 20 % slower in the reference's order).
+        std::vector<std::uint32_t> order(model.leafVertices.size(), ~0u);
+        std::uint32_t next = 0;
+        for (std::uint32_t& index : data->indices)
+        {
+            if (order[index] == ~0u)
+                order[index] = next++;
+            index = order[index];
+        }
+        mLeafVertexOrder.assign(model.leafVertices.size(), 0);
+        for (std::uint32_t v = 0; v < order.size(); ++v)
+            mLeafVertexOrder[order[v] == ~0u ? next++ : order[v]] = v;
         mFoliageLod = std::make_unique<FoliageLodData>(std::move(data.value()));
         return *mFoliageLod;
     }
@@ -239,7 +253,14 @@ namespace TreeLod
     Ogre::VertexData* TreeAsset::getLeafVertexData()
     {
         if (!mLeafVertexData)
-            mLeafVertexData.reset(makeTreeVertexData(getReference().model.leafVertices));
+        {
+            const std::vector<Vertex>& vertices = getReference().model.leafVertices;
+            getFoliageLod(); // the order its indices were renumbered to
+            std::vector<Vertex> ordered(vertices.size());
+            for (std::size_t i = 0; i < ordered.size(); ++i)
+                ordered[i] = vertices[mLeafVertexOrder[i]];
+            mLeafVertexData.reset(makeTreeVertexData(ordered));
+        }
         return mLeafVertexData.get();
     }
 

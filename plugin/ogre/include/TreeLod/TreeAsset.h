@@ -44,10 +44,11 @@ namespace TreeLod
         /// (techniques that draw their own foliage use it). Built on first call.
         Ogre::MeshPtr getBarkMesh();
 
-        /// The LoDF foliage of chunk "lodf" (decoded on first call; its indices address the
-        /// reference chunk's leaf vertices, checked here).
+        /// The LoDF foliage of chunk "lodf" (decoded on first call, checked against the
+        /// reference). Its indices are renumbered to address getLeafVertexData().
         const FoliageLodData& getFoliageLod();
-        /// The reference chunk's leaf vertices on the GPU, once for every instance.
+        /// The reference chunk's leaf vertices on the GPU, once for every instance, in the
+        /// order the LoDF clusters first use them.
         Ogre::VertexData* getLeafVertexData();
 
         /// Local bounds of the tree in metres (from the reference chunk).
@@ -80,6 +81,7 @@ namespace TreeLod
         Ogre::MeshPtr mBarkMesh;
         std::unique_ptr<FoliageLodData> mFoliageLod;
         std::unique_ptr<Ogre::VertexData> mLeafVertexData;
+        std::vector<std::uint32_t> mLeafVertexOrder; ///< GPU vertex i = reference leaf vertex mLeafVertexOrder[i]
         std::vector<Ogre::String> mShadowedMaterialNames;
         std::vector<Ogre::String> mMaterialNames;
         std::vector<Ogre::String> mTextureNames;
