@@ -6,6 +6,7 @@
 #include "CliSupport.h"
 #include "Commands.h"
 
+#include "TreeLod/FoliageLodData.h"
 #include "TreeLod/GltfImporter.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
@@ -109,6 +110,7 @@ namespace TreeLod
             json chunks = json::array();
             std::vector<bool> crcOk(reader.chunks().size(), false);
             std::optional<ReferenceChunk> reference;
+            std::optional<FoliageLodData> foliageLod;
             json meta;
             for (std::size_t i = 0; i < reader.chunks().size(); ++i)
             {
@@ -150,6 +152,14 @@ namespace TreeLod
                     else if (!firstError)
                         firstError = decoded.error();
                 }
+                else if (c.technique == FOLIAGE_LOD_CHUNK && c.level == 0)
+                {
+                    Result<FoliageLodData> decoded = decodeFoliageLodChunk(bytes.value(), reader.label());
+                    if (decoded)
+                        foliageLod = std::move(decoded.value());
+                    else if (!firstError)
+                        firstError = decoded.error();
+                }
             }
 
             std::vector<TextureRow> textures;
@@ -169,6 +179,15 @@ namespace TreeLod
                     j["meta"] = meta;
                 if (reference)
                     j["model"] = modelJson(reference->model, textures); // same key as for glTF input
+                if (foliageLod)
+                    j["lodf"] = {{"leaves", foliageLod->maxLeafCount()},
+                                 {"coarsestLeaves", foliageLod->minLeafCount()},
+                                 {"clusters", foliageLod->clusters.size()},
+                                 {"storedLeaves", foliageLod->entries.size()},
+                                 {"collapses", foliageLod->changedGroup.size()},
+                                 {"paperWords", foliageLod->paperWords()},
+                                 {"eq9Words", foliageLod->paperEq9Words()},
+                                 {"bytes", foliageLod->byteSize()}};
                 if (firstError)
                     j["error"] = firstError->message();
                 std::printf("%s\n", j.dump(2, ' ', false, json::error_handler_t::replace).c_str());
@@ -195,6 +214,13 @@ namespace TreeLod
                 }
                 if (reference)
                     printModel(reference->model, textures);
+                if (foliageLod)
+                    std::printf("lodf: %u leaves down to %u (%zu clusters), %zu stored leaves (2L - clusters), "
+                                "%llu words as paper 004 counts them (eq. 9: %llu), %llu bytes\n",
+                                foliageLod->maxLeafCount(), foliageLod->minLeafCount(), foliageLod->clusters.size(),
+                                foliageLod->entries.size(), (unsigned long long)foliageLod->paperWords(),
+                                (unsigned long long)foliageLod->paperEq9Words(),
+                                (unsigned long long)foliageLod->byteSize());
             }
             if (firstError)
                 return printError(*firstError);

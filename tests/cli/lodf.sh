@@ -9,6 +9,7 @@ rm -rf "$out"; mkdir -p "$out"
 "$treelod" info "$out/oak.treelod" --json > "$out/info.json"
 grep -q '"lodf"' "$out/info.json" || { echo "no lodf chunk in info"; exit 1; }
 grep -q '"reference"' "$out/info.json" || { echo "no reference chunk in info"; exit 1; }
+grep -q '"eq9Words"' "$out/info.json" || { echo "no lodf storage summary in info"; exit 1; }
 "$treelod" render "$out/oak.treelod" --technique lodf --camera orbit:30,10,1 --size 128x128 -o "$out/near.png"
 "$treelod" render "$out/oak.treelod" --technique lodf --camera orbit:30,10,6 --size 128x128 -o "$out/far.png"
 "$treelod" render "$src/media/conifer.glb" --technique lodf --leaves 200 --size 128x128 -o "$out/conifer200.png"
