@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The main job: install what is missing, build, and render the bundled trees headless
-# through the Ogre plugin (and through the CPU reference renderer) into PNGs.
+# through the Ogre plugin (the polygonal reference and LoDF) and through the CPU reference
+# renderer into PNGs.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${TREELOD_BUILD_DIR:-$root/build}
@@ -20,6 +21,12 @@ for tree in "$root"/media/*.glb; do
   done
   "$build/bin/treelod" render "$tree" --renderer cpu --camera "orbit:0,8,1.0" --size 512x512 \
     -o "$out/$name-front-cpu.png"
+  # LoDF (paper 004): the full tree close up, and a quarter of the leaves with shadows.
+  run "$build/bin/treelod" render "$tree" --technique lodf --camera "orbit:0,8,1.0" --size 512x512 \
+    -o "$out/$name-front-lodf.png"
+  leaves=$("$build/bin/treelod" info "$tree" --json | sed -n 's/.*"leaves": \([0-9]*\).*/\1/p' | head -n 1)
+  run "$build/bin/treelod" render "$tree" --technique lodf --leaves $((leaves / 4)) --shadows \
+    --camera "orbit:0,8,1.0" --size 512x512 -o "$out/$name-front-lodf-quarter-shadows.png"
 done
 echo
 echo "Rendered the bundled trees into $out:"

@@ -1,11 +1,13 @@
-// libFuzzer target: PackageReader::fromMemory on arbitrary bytes, then every chunk read and
-// every "reference" chunk decoded. Must never crash, read out of bounds or allocate more
+// libFuzzer target: PackageReader::fromMemory on arbitrary bytes, then every chunk read,
+// every "reference" chunk decoded, and every "lodf" chunk decoded and walked through its
+// levels as FoliageLodTree does (writeCluster must stay inside each cluster's region). Must never crash, read out of bounds or allocate more
 // than a small multiple of the input (Package.h, "Hostile input").
 //
 // Seeds: tests/fuzz/corpus/package/ (small valid packages). The chunk CRCs stop most
 // mutations at readChunk; the input's last byte may ask the fuzzer to skip those checks by
 // resealing the checksums, so the decoders behind them are fuzzed too.
 #include "TreeLod/Crc32.h"
+#include "TreeLod/FoliageLodState.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
 
@@ -80,6 +82,25 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                     for (std::uint32_t level = 0; level < t.mipCount; ++level)
                         if (t.mipOffset(level) + t.mipBytes(level) > t.data.size())
                             __builtin_trap();
+            }
+        }
+        else if (reader->chunks()[i].technique == TreeLod::FOLIAGE_LOD_CHUNK)
+        {
+            TreeLod::Result<TreeLod::FoliageLodData> decoded = TreeLod::decodeFoliageLodChunk(chunk.value(), "fuzz");
+            if (!decoded)
+                continue;
+            TreeLod::FoliageLodState state(decoded.value());
+            const std::uint32_t lo = decoded->minLeafCount(), hi = decoded->maxLeafCount();
+            for (std::uint32_t target : {lo, (lo + hi) / 2, hi + 1, 0u})
+            {
+                state.setLeafCount(target);
+                for (std::uint32_t c : state.changedClusters())
+                {
+                    // A region of exactly slotCount: ASan reports any write past it.
+                    std::vector<std::uint32_t> region(decoded->clusters[c].slotCount);
+                    if (!region.empty() && state.writeCluster(c, region.data()) > region.size())
+                        __builtin_trap();
+                }
             }
         }
     }
