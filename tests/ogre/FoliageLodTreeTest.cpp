@@ -268,10 +268,20 @@ namespace TreeLod
         const LodfTree& oak = bundledOak();
         OffscreenRenderer& r = OgreEnvironment::renderer();
         const CameraSpec view = camera(oak.model, "orbit:30,10,1.0");
-        place(oak.asset);
+        FoliageLodTree* tree = place(oak.asset);
         const Image plain = toImage(r.render(view, 192, 192, 2));
         r.setShadows(true, 1024);
         const Image shadowed = toImage(r.render(view, 192, 192, 2));
+        // The shadow camera sees the viewer's level (its LoD camera is the viewer's): a second
+        // frame from the same view changes nothing, so no re-upload per shadow pass.
+        const std::uint32_t changes = tree->getUpdateStats().changes;
+        r.render(camera(oak.model, "orbit:30,10,4"), 192, 192, 2);
+        const std::uint32_t farCount = tree->getLeafCount();
+        const std::uint32_t farChanges = tree->getUpdateStats().changes;
+        r.render(camera(oak.model, "orbit:30,10,4"), 192, 192, 2);
+        EXPECT_EQ(tree->getUpdateStats().changes, farChanges);
+        EXPECT_EQ(tree->getLeafCount(), farCount);
+        EXPECT_LE(farChanges, changes + 1);
         r.setShadows(false);
         // Self-shadowing darkens the crown's inside; the background is untouched.
         const double drop = meanLuminance(plain) - meanLuminance(shadowed);
