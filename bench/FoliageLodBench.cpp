@@ -98,20 +98,9 @@ namespace
         std::uint32_t* out = packed.data();
         for (std::uint32_t c = 0; c < d.clusters.size(); ++c)
         {
-            // The active leaves of a cluster (FoliageLodData.h): entries from initGroup on whose
-            // creating step has been applied, activeLeaves of them.
-            const FoliageLodCluster& k = d.clusters[c];
-            const FoliageLodState::ClusterState& s = state.cluster(c);
-            const std::uint32_t applied = s.initGroup / 2;
-            std::uint32_t left = s.activeLeaves;
-            for (std::uint32_t p = s.initGroup; p < k.entryCount && left > 0; ++p)
-            {
-                const FoliageLodEntry& e = d.entries[k.firstEntry + p];
-                if (e.created > applied)
-                    continue;
+            state.forEachActive(c, [&](const FoliageLodEntry& e) {
                 out = std::copy_n(d.indices.data() + e.firstIndex, e.indexCount, out);
-                --left;
-            }
+            });
         }
         benchmark::DoNotOptimize(packed.data());
         benchmark::ClobberMemory();

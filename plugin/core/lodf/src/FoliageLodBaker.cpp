@@ -419,32 +419,14 @@ namespace TreeLod
         const FoliageLodState state = FoliageLodState::fromScratch(data, leafCount);
         std::vector<std::uint32_t> remap(model.leafVertices.size(), ~0u);
         for (std::uint32_t c = 0; c < data.clusters.size(); ++c)
-        {
-            std::vector<std::uint32_t> region(data.clusters[c].slotCount);
-            const std::uint32_t used = region.empty() ? 0 : state.writeCluster(c, region.data());
-            // Split the region back into leaves: one leaf per active entry, in order.
-            std::vector<std::uint32_t> sizes;
-            const FoliageLodCluster& k = data.clusters[c];
-            const FoliageLodState::ClusterState& s = state.cluster(c);
-            for (std::uint32_t p = s.initGroup, left = s.activeLeaves; p < k.entryCount && left > 0; ++p)
-            {
-                const FoliageLodEntry& e = data.entries[k.firstEntry + p];
-                if (e.created <= s.initGroup / 2)
-                {
-                    sizes.push_back(e.indexCount);
-                    --left;
-                }
-            }
-            std::uint32_t at = 0;
-            for (std::uint32_t size : sizes)
-            {
+            state.forEachActive(c, [&](const FoliageLodEntry& e) {
                 Leaf leaf;
-                leaf.material = k.material;
+                leaf.material = data.clusters[c].material;
                 leaf.firstVertex = std::uint32_t(out.leafVertices.size());
                 leaf.firstIndex = std::uint32_t(out.leafIndices.size());
-                for (std::uint32_t i = at; i < at + size; ++i)
+                for (std::uint32_t i = e.firstIndex; i < e.firstIndex + e.indexCount; ++i)
                 {
-                    const std::uint32_t v = region[i];
+                    const std::uint32_t v = data.indices[i];
                     if (remap[v] == ~0u || remap[v] < leaf.firstVertex)
                     {
                         remap[v] = std::uint32_t(out.leafVertices.size());
@@ -453,13 +435,10 @@ namespace TreeLod
                     out.leafIndices.push_back(remap[v]);
                 }
                 leaf.vertexCount = std::uint32_t(out.leafVertices.size()) - leaf.firstVertex;
-                leaf.indexCount = size;
-                at += size;
+                leaf.indexCount = e.indexCount;
                 out.leaves.push_back(leaf);
                 out.updateLeafRecord(out.leaves.size() - 1);
-            }
-            (void)used;
-        }
+            });
         out.updateBounds();
         return out;
     }

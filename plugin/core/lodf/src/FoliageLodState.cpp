@@ -7,30 +7,11 @@ namespace TreeLod
 {
     namespace
     {
-        /// Visit the active leaves of cluster `k` in state `s`: entries at positions >= Init_group
-        /// created by a step the cluster has applied (FoliageLodData.h, deviation from Fig. 7).
-        template <typename Visit>
-        void forEachActive(const FoliageLodData& data, const FoliageLodCluster& k,
-                           const FoliageLodState::ClusterState& s, Visit&& visit)
-        {
-            const std::uint32_t applied = s.initGroup / 2;
-            std::uint32_t left = s.activeLeaves;
-            for (std::uint32_t p = s.initGroup; p < k.entryCount && left > 0; ++p)
-            {
-                const FoliageLodEntry& e = data.entries[k.firstEntry + p];
-                if (e.created <= applied)
-                {
-                    visit(e);
-                    --left;
-                }
-            }
-        }
-
-        std::uint32_t usedSlots(const FoliageLodData& data, const FoliageLodCluster& k,
-                                const FoliageLodState::ClusterState& s)
+        /// Index slots the active leaves of cluster `c` take.
+        std::uint32_t usedSlots(const FoliageLodState& state, std::uint32_t c)
         {
             std::uint32_t used = 0;
-            forEachActive(data, k, s, [&](const FoliageLodEntry& e) { used += e.indexCount; });
+            state.forEachActive(c, [&](const FoliageLodEntry& e) { used += e.indexCount; });
             return used;
         }
     }
@@ -74,7 +55,7 @@ namespace TreeLod
             s.initGroup = std::uint32_t(std::int64_t(s.initGroup) + 2 * std::int64_t(s.changesNumber));
             s.activeLeaves = std::uint32_t(std::int64_t(s.activeLeaves) - s.changesNumber);
             s.changesNumber = 0;
-            s.usedSlots = usedSlots(*mData, mData->clusters[c], s);
+            s.usedSlots = usedSlots(*this, c);
         }
         return std::uint32_t(mChanged.size());
     }
@@ -83,7 +64,7 @@ namespace TreeLod
     {
         const FoliageLodCluster& k = mData->clusters[c];
         std::uint32_t n = 0;
-        forEachActive(*mData, k, mClusters[c], [&](const FoliageLodEntry& e) {
+        forEachActive(c, [&](const FoliageLodEntry& e) {
             const std::uint32_t* src = mData->indices.data() + e.firstIndex;
             for (std::uint32_t i = 0; i < e.indexCount; ++i)
                 out[n + i] = Index(src[i]);
@@ -100,7 +81,7 @@ namespace TreeLod
 
     void FoliageLodState::activeLeaves(std::uint32_t c, std::vector<std::uint32_t>& out) const
     {
-        forEachActive(*mData, mData->clusters[c], mClusters[c], [&](const FoliageLodEntry& e) { out.push_back(e.leaf); });
+        forEachActive(c, [&](const FoliageLodEntry& e) { out.push_back(e.leaf); });
     }
 
     std::vector<std::uint32_t> FoliageLodState::activeLeaves() const
@@ -139,7 +120,7 @@ namespace TreeLod
             ClusterState& s = state.mClusters[c];
             s.initGroup = 2 * applied[c];
             s.activeLeaves = data.clusters[c].originalLeaves - applied[c];
-            s.usedSlots = usedSlots(data, data.clusters[c], s);
+            s.usedSlots = usedSlots(state, std::uint32_t(c));
         }
         state.mPosition = position;
         return state;

@@ -51,6 +51,26 @@ namespace TreeLod
         /// Returns the indices of active leaves written before the degenerate padding.
         template <typename Index> std::uint32_t writeCluster(std::uint32_t c, Index* out) const;
 
+        /// Call visit(const FoliageLodEntry&) for each active leaf of cluster `c`, in array order:
+        /// the entries at positions >= Init_group created by a step the cluster has applied
+        /// (FoliageLodData.h, the deviation from Fig. 7).
+        template <typename Visit> void forEachActive(std::uint32_t c, Visit&& visit) const
+        {
+            const FoliageLodCluster& k = mData->clusters[c];
+            const ClusterState& s = mClusters[c];
+            const std::uint32_t applied = s.initGroup / 2;
+            std::uint32_t left = s.activeLeaves;
+            for (std::uint32_t p = s.initGroup; p < k.entryCount && left > 0; ++p)
+            {
+                const FoliageLodEntry& e = mData->entries[k.firstEntry + p];
+                if (e.created <= applied)
+                {
+                    visit(e);
+                    --left;
+                }
+            }
+        }
+
         /// Numbers of the active leaves of cluster `c` (or of all clusters), in array order.
         void activeLeaves(std::uint32_t c, std::vector<std::uint32_t>& out) const;
         std::vector<std::uint32_t> activeLeaves() const;
