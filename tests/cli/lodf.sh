@@ -13,7 +13,12 @@ grep -q '"eq9Words"' "$out/info.json" || { echo "no lodf storage summary in info
 "$treelod" render "$out/oak.treelod" --technique lodf --camera orbit:30,10,1 --size 128x128 -o "$out/near.png"
 "$treelod" render "$out/oak.treelod" --technique lodf --camera orbit:30,10,6 --size 128x128 -o "$out/far.png"
 "$treelod" render "$src/media/conifer.glb" --technique lodf --leaves 200 --size 128x128 -o "$out/conifer200.png"
-for f in near far conifer200; do [ -s "$out/$f.png" ] || { echo "$f.png missing"; exit 1; }; done
+# A 100k-leaf generated tree (32-bit index ranges), baked and rendered from the package.
+"$treelod" generate --preset oak --seed 3 --leaves 100000 --texture-size 64 -o "$out/oak100k.glb" > /dev/null
+"$treelod" bake "$out/oak100k.glb" --technique lodf -q -o "$out/oak100k.treelod"
+"$treelod" render "$out/oak100k.treelod" --technique lodf --camera orbit:30,10,2 --size 128x128 \
+  --supersample 1 -o "$out/oak100k.png"
+for f in near far conifer200 oak100k; do [ -s "$out/$f.png" ] || { echo "$f.png missing"; exit 1; }; done
 
 # A package without the lodf chunk: exit 2, a message naming the chunk, no output.
 "$treelod" bake "$src/media/birch.glb" -q -o "$out/birch-ref.treelod"
