@@ -3,6 +3,8 @@
 #ifdef ALPHA_TEST
 uniform sampler2D diffuseMap;
 uniform float alphaCutoff;
+uniform float alphaMaxLod;
+#include "TreeLodLeafAlpha.glsl"
 #endif
 
 in vec2 vClipZW;
@@ -13,7 +15,7 @@ out vec4 fragColour;
 void main()
 {
 #ifdef ALPHA_TEST
-    if (texture(diffuseMap, vUv).a < alphaCutoff)
+    if (leafAlpha(diffuseMap, vUv, alphaMaxLod) < alphaCutoff)
         discard;
 #endif
     // Depth as the shadow camera's window depth, 0..1 (shadow textures clear to 1); the

@@ -10,6 +10,7 @@ uniform vec4 ambientColour;
 uniform vec4 baseColour;    // linear
 uniform vec4 backColour;    // linear
 uniform float alphaCutoff;
+uniform float alphaMaxLod;  // coarsest mip level the alpha test reads (see leafAlpha)
 
 in vec3 vNormal;
 in vec3 vToCamera;
@@ -48,9 +49,14 @@ vec3 toSrgb(vec3 c)
     return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
 }
 
+#include "TreeLodLeafAlpha.glsl"
+
 void main()
 {
     vec4 texel = texture(diffuseMap, vUv);
+#ifdef LEAF
+    texel.a = leafAlpha(diffuseMap, vUv, alphaMaxLod);
+#endif
     vec3 n = normalize(vNormal);
     vec3 tint = baseColour.rgb;
 #ifdef LEAF
