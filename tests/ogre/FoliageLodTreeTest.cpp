@@ -340,4 +340,38 @@ namespace TreeLod
         ASSERT_TRUE(error.ok());
         EXPECT_LT(error->mean, 0.15);
     }
+
+    TEST(FoliageLodTree, quantisedInstancesShareLevelsAndUploadNothing)
+    {
+        // A Forest's distant instances: quantise=8 snaps to 8 levels whose index buffers the
+        // asset builds once; instances switch by pointing at them.
+        const LodfTree& oak = bundledOak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const CameraSpec view = camera(oak.model, "orbit:30,10,1.0");
+        FoliageLodTree* a = place(oak.asset, {{"quantise", "8"}, {"leaves", "500"}});
+        Ogre::MovableObject* second = TechniqueRegistry::getSingleton().createInstance(
+            "lodf", r.getSceneManager(), "quantised-b", *oak.asset, {{"quantise", "8"}, {"leaves", "3000"}});
+        auto* b = static_cast<FoliageLodTree*>(second);
+        EXPECT_TRUE(a->isQuantised());
+        EXPECT_GE(a->getLeafCount(), 500u); // snapped up, never fewer leaves than asked
+        EXPECT_EQ(b->getLeafCount(), 3000u);
+        const std::size_t levels = oak.asset->getFoliageLodLevelCount();
+        b->setFixedLeafCount(a->getLeafCount()); // to a level that exists: nothing is built or sent
+        EXPECT_EQ(b->getLeafCount(), a->getLeafCount());
+        EXPECT_EQ(oak.asset->getFoliageLodLevelCount(), levels);
+        EXPECT_EQ(b->getUpdateStats().bytesUploaded, 0u);
+        EXPECT_GT(oak.asset->getFoliageLodLevelBytes(), 0u);
+        r.getSceneManager().destroyMovableObject(second);
+
+        // A shared level draws exactly what a continuous instance draws at that count.
+        const std::uint32_t count = a->getLeafCount();
+        const Image quantised = toImage(r.render(view, 128, 128, 1));
+        place(oak.asset, {{"leaves", std::to_string(count)}});
+        const Image continuous = toImage(r.render(view, 128, 128, 1));
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < quantised.pixels.size(); ++i)
+            differ += quantised.pixels[i] != continuous.pixels[i];
+        EXPECT_EQ(differ, 0u);
+        EXPECT_GT(treeCoverage(quantised, LightingSpec().background), 0.05);
+    }
 }

@@ -84,9 +84,10 @@ namespace TreeLod
         {
             Ogre::VertexData* vertices = mAsset->getLeafVertexData();
             const bool wide = vertices->vertexCount > 65535;
-            mIndexBuffer = Ogre::HardwareBufferManager::getSingleton().createIndexBuffer(
-                wide ? Ogre::HardwareIndexBuffer::IT_32BIT : Ogre::HardwareIndexBuffer::IT_16BIT, mData->slotCount(),
-                Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+            if (!isQuantised())
+                mIndexBuffer = Ogre::HardwareBufferManager::getSingleton().createIndexBuffer(
+                    wide ? Ogre::HardwareIndexBuffer::IT_32BIT : Ogre::HardwareIndexBuffer::IT_16BIT,
+                    mData->slotCount(), Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
             // One part per run of clusters with the same material (clusters are sorted by it).
             for (std::size_t c = 0; c < mData->clusters.size();)
             {
@@ -104,7 +105,13 @@ namespace TreeLod
             }
             if (mOptions.fixedLeafCount > 0)
                 mState.setLeafCount(mOptions.fixedLeafCount);
-            writeAllClusters();
+            if (isQuantised())
+            {
+                mState.setLeafCount(FoliageLodState::quantise(*mData, mState.leafCount(), mOptions.quantiseLevels));
+                useSharedLevel();
+            }
+            else
+                writeAllClusters();
         }
 
         if (!mAsset->getReference().model.barkIndices.empty())
@@ -143,13 +150,36 @@ namespace TreeLod
         mIndexBuffer->writeData(0, all.size(), all.data(), true);
     }
 
+    void FoliageLodTree::useSharedLevel()
+    {
+        const FoliageLodLevel& level = mAsset->getFoliageLodLevel(mState.leafCount());
+        for (std::size_t i = 0; i < mLeafParts.size(); ++i)
+        {
+            mLeafParts[i]->mIndexData.indexBuffer = level.buffer;
+            mLeafParts[i]->mIndexData.indexStart = level.ranges[i].first;
+            mLeafParts[i]->mIndexData.indexCount = level.ranges[i].second;
+        }
+    }
+
     std::uint32_t FoliageLodTree::updateLeafCount(std::uint32_t count)
     {
-        if (mOptions.quantiseLevels > 1)
+        if (isQuantised())
             count = FoliageLodState::quantise(*mData, count, mOptions.quantiseLevels);
         const std::uint32_t target = std::clamp(count, mData->minLeafCount(), mData->maxLeafCount());
-        if (!mIndexBuffer || target == mState.leafCount())
+        if (mLeafParts.empty() || target == mState.leafCount())
             return 0;
+        if (isQuantised())
+        {
+            // A shared level: point the parts at it, upload nothing.
+            mState.setLeafCount(target);
+            useSharedLevel();
+            mStats.clustersWritten = 0;
+            mStats.bytesUploaded = 0;
+            mStats.writeCalls = 0;
+            mStats.leafCount = target;
+            ++mStats.changes;
+            return 0;
+        }
         // §3.3: update the state; §4: send only the changed clusters' regions.
         mState.setLeafCount(target);
         std::vector<std::uint32_t> changed = mState.changedClusters();
@@ -209,7 +239,6 @@ namespace TreeLod
         mOptions.pixelsPerLeaf = pixelsPerLeaf;
     }
 
-    void FoliageLodTree::setQuantiseLevels(std::uint32_t levels) { mOptions.quantiseLevels = levels; }
 
     void FoliageLodTree::_notifyCurrentCamera(Ogre::Camera* camera)
     {

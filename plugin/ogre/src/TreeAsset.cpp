@@ -1,8 +1,10 @@
 #include "TreeLod/TreeAsset.h"
 
+#include "TreeLod/FoliageLodState.h"
 #include "TreeLod/TreeMeshBuilder.h"
 
 #include <OgreException.h>
+#include <OgreHardwareBufferManager.h>
 #include <OgreImage.h>
 #include <OgreMaterialManager.h>
 #include <OgreMeshManager.h>
@@ -10,6 +12,8 @@
 #include <OgreResourceGroupManager.h>
 #include <OgreTechnique.h>
 #include <OgreTextureManager.h>
+
+#include <algorithm>
 
 namespace TreeLod
 {
@@ -52,6 +56,7 @@ namespace TreeLod
                 Ogre::MeshManager::getSingleton().remove(*mesh);
             mesh->reset();
         }
+        mFoliageLodLevels.clear();
         mLeafVertexData.reset();
         mFoliageLod.reset();
         mLeafVertexOrder.clear();
@@ -262,6 +267,48 @@ namespace TreeLod
             mLeafVertexData.reset(makeTreeVertexData(ordered));
         }
         return mLeafVertexData.get();
+    }
+
+    const FoliageLodLevel& TreeAsset::getFoliageLodLevel(std::uint32_t leafCount)
+    {
+        const FoliageLodData& data = getFoliageLod();
+        leafCount = std::clamp(leafCount, data.minLeafCount(), data.maxLeafCount());
+        auto found = mFoliageLodLevels.find(leafCount);
+        if (found != mFoliageLodLevels.end())
+            return found->second;
+        const FoliageLodState state = FoliageLodState::fromScratch(data, leafCount);
+        FoliageLodLevel level;
+        std::vector<std::uint32_t> indices;
+        for (std::uint32_t c = 0; c < data.clusters.size(); ++c)
+        {
+            if (c == 0 || data.clusters[c].material != data.clusters[c - 1].material)
+                level.ranges.emplace_back(indices.size(), 0);
+            state.forEachActive(c, [&](const FoliageLodEntry& e) {
+                indices.insert(indices.end(), data.indices.begin() + e.firstIndex,
+                               data.indices.begin() + e.firstIndex + e.indexCount);
+            });
+            level.ranges.back().second = indices.size() - level.ranges.back().first;
+        }
+        const bool wide = data.leafVertexCount > 65535;
+        level.buffer = Ogre::HardwareBufferManager::getSingleton().createIndexBuffer(
+            wide ? Ogre::HardwareIndexBuffer::IT_32BIT : Ogre::HardwareIndexBuffer::IT_16BIT,
+            std::max<std::size_t>(indices.size(), 1), Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+        if (wide)
+            level.buffer->writeData(0, indices.size() * 4, indices.data(), true);
+        else
+        {
+            std::vector<std::uint16_t> narrow(indices.begin(), indices.end());
+            level.buffer->writeData(0, narrow.size() * 2, narrow.data(), true);
+        }
+        return mFoliageLodLevels.emplace(leafCount, std::move(level)).first->second;
+    }
+
+    std::uint64_t TreeAsset::getFoliageLodLevelBytes() const
+    {
+        std::uint64_t bytes = 0;
+        for (const auto& level : mFoliageLodLevels)
+            bytes += level.second.buffer->getSizeInBytes();
+        return bytes;
     }
 
     Ogre::MeshPtr TreeAsset::getReferenceMesh()

@@ -19,6 +19,9 @@
 // Parameters (createMovableObject params, or the registry): asset (required with the
 // factory), group, leaves (a fixed leaf count instead of the curve), pixelsPerLeaf (default 4),
 // quantise (N: snap to N geometric levels, see FoliageLodState::quantise; 0 = continuous).
+// A quantised instance owns no index buffer: it draws the asset's shared level
+// (TreeAsset::getFoliageLodLevel), so changing level uploads nothing and instances at one
+// level draw identical geometry (what a Forest instances).
 #pragma once
 
 #include "TreeLod/FoliageLodState.h"
@@ -61,7 +64,8 @@ namespace TreeLod
         /// Draw exactly `count` leaves (clamped), or 0 to follow the LoD strategy again.
         void setFixedLeafCount(std::uint32_t count);
         void setPixelsPerLeaf(float pixelsPerLeaf);
-        void setQuantiseLevels(std::uint32_t levels);
+        /// Quantised instances draw shared levels (set at creation by the `quantise` parameter).
+        bool isQuantised() const { return mOptions.quantiseLevels > 1; }
         /// Leaves the curve gives for `pixels` (projected bounding-sphere area) and `bias`.
         std::uint32_t leafCountForPixels(Ogre::Real pixels, Ogre::Real bias = 1.0f) const;
 
@@ -88,6 +92,7 @@ namespace TreeLod
 
     private:
         void writeAllClusters();
+        void useSharedLevel();
         bool useShadowedMaterials();
 
         TreeAssetPtr mAsset;

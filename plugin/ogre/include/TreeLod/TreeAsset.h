@@ -11,14 +11,26 @@
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
 
+#include <OgreHardwareIndexBuffer.h>
 #include <OgreMesh.h>
 #include <OgreResource.h>
 
+#include <map>
 #include <memory>
 #include <vector>
 
 namespace TreeLod
 {
+    /// One LoDF level shared by every quantised FoliageLodTree of an asset: the active leaves'
+    /// indices packed (no padding), one range per run of same-material clusters, in the order
+    /// of FoliageLodTree's leaf parts. Built once, never rewritten: instances switch between
+    /// levels by pointing at another one, so they upload nothing and can be instanced.
+    struct FoliageLodLevel
+    {
+        Ogre::HardwareIndexBufferSharedPtr buffer;
+        std::vector<std::pair<std::size_t, std::size_t>> ranges; ///< (start, count) per leaf part
+    };
+
     class TreeAsset : public Ogre::Resource
     {
     public:
@@ -50,6 +62,11 @@ namespace TreeLod
         /// The reference chunk's leaf vertices on the GPU, once for every instance, in the
         /// order the LoDF clusters first use them.
         Ogre::VertexData* getLeafVertexData();
+        /// The shared LoDF level with `leafCount` leaves (clamped), built on first use.
+        const FoliageLodLevel& getFoliageLodLevel(std::uint32_t leafCount);
+        /// Shared levels built so far, and the bytes they take on the GPU.
+        std::size_t getFoliageLodLevelCount() const { return mFoliageLodLevels.size(); }
+        std::uint64_t getFoliageLodLevelBytes() const;
 
         /// Local bounds of the tree in metres (from the reference chunk).
         Ogre::AxisAlignedBox getBounds();
@@ -81,7 +98,8 @@ namespace TreeLod
         Ogre::MeshPtr mBarkMesh;
         std::unique_ptr<FoliageLodData> mFoliageLod;
         std::unique_ptr<Ogre::VertexData> mLeafVertexData;
-        std::vector<std::uint32_t> mLeafVertexOrder; ///< GPU vertex i = reference leaf vertex mLeafVertexOrder[i]
+        std::vector<std::uint32_t> mLeafVertexOrder;
+        std::map<std::uint32_t, FoliageLodLevel> mFoliageLodLevels; ///< GPU vertex i = reference leaf vertex mLeafVertexOrder[i]
         std::vector<Ogre::String> mShadowedMaterialNames;
         std::vector<Ogre::String> mMaterialNames;
         std::vector<Ogre::String> mTextureNames;
