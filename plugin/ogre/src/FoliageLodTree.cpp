@@ -248,7 +248,12 @@ namespace TreeLod
         const Ogre::Camera* lodCamera = camera->getLodCamera();
         const Ogre::Real pixels = Ogre::AbsolutePixelCountLodStrategy::getSingleton().getValue(this, camera);
         if (mBarkMesh)
-            mBarkLodIndex = mBarkMesh->getLodIndex(mBarkMesh->getLodStrategy()->getValue(this, camera));
+        {
+            const Ogre::LodStrategy* strategy = mBarkMesh->getLodStrategy();
+            mBarkLodIndex = mBarkMesh->getLodIndex(
+                strategy == Ogre::AbsolutePixelCountLodStrategy::getSingletonPtr() ? pixels
+                                                                                  : strategy->getValue(this, camera));
+        }
         // The LoD camera (the viewer's camera for shadow cameras) and its bias drive the count.
         updateLeafCount(mOptions.fixedLeafCount > 0 ? mOptions.fixedLeafCount
                                                     : leafCountForPixels(pixels, lodCamera->getLodBias()));
