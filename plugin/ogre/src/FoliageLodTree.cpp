@@ -140,14 +140,16 @@ namespace TreeLod
         const std::size_t indexSize = mIndexBuffer->getIndexSize();
         std::vector<std::uint8_t> all(std::size_t(mData->slotCount()) * indexSize);
         for (std::uint32_t c = 0; c < mData->clusters.size(); ++c)
-        {
-            void* at = all.data() + std::size_t(mData->clusters[c].firstSlot) * indexSize;
-            if (indexSize == 4)
-                mState.writeCluster(c, static_cast<std::uint32_t*>(at));
-            else
-                mState.writeCluster(c, static_cast<std::uint16_t*>(at));
-        }
+            writeRegion(c, all.data() + std::size_t(mData->clusters[c].firstSlot) * indexSize);
         mIndexBuffer->writeData(0, all.size(), all.data(), true);
+    }
+
+    void FoliageLodTree::writeRegion(std::uint32_t cluster, std::uint8_t* at) const
+    {
+        if (mIndexBuffer->getType() == Ogre::HardwareIndexBuffer::IT_32BIT)
+            mState.writeCluster(cluster, reinterpret_cast<std::uint32_t*>(at));
+        else
+            mState.writeCluster(cluster, reinterpret_cast<std::uint16_t*>(at));
     }
 
     void FoliageLodTree::useSharedLevel()
@@ -182,7 +184,8 @@ namespace TreeLod
         }
         // §3.3: update the state; §4: send only the changed clusters' regions.
         mState.setLeafCount(target);
-        std::vector<std::uint32_t> changed = mState.changedClusters();
+        std::vector<std::uint32_t>& changed = mChanged; // reused: no allocation per change
+        changed.assign(mState.changedClusters().begin(), mState.changedClusters().end());
         std::sort(changed.begin(), changed.end());
         const std::size_t indexSize = mIndexBuffer->getIndexSize();
         mStats.clustersWritten = std::uint32_t(changed.size());
@@ -199,13 +202,8 @@ namespace TreeLod
             const std::size_t slots = last.firstSlot + last.slotCount - first.firstSlot;
             mScratch.resize(slots * indexSize);
             for (std::size_t k = i; k < end; ++k)
-            {
-                void* at = mScratch.data() + (mData->clusters[changed[k]].firstSlot - first.firstSlot) * indexSize;
-                if (indexSize == 4)
-                    mState.writeCluster(changed[k], static_cast<std::uint32_t*>(at));
-                else
-                    mState.writeCluster(changed[k], static_cast<std::uint16_t*>(at));
-            }
+                writeRegion(changed[k],
+                            mScratch.data() + (mData->clusters[changed[k]].firstSlot - first.firstSlot) * indexSize);
             mIndexBuffer->writeData(first.firstSlot * indexSize, mScratch.size(), mScratch.data(), false);
             mStats.bytesUploaded += mScratch.size();
             ++mStats.writeCalls;

@@ -92,6 +92,8 @@ namespace TreeLod
 
     private:
         void writeAllClusters();
+        /// Cluster `cluster`'s region as the index buffer's index type, at `at`.
+        void writeRegion(std::uint32_t cluster, std::uint8_t* at) const;
         void useSharedLevel();
         bool useShadowedMaterials();
 
@@ -100,7 +102,8 @@ namespace TreeLod
         FoliageLodState mState;
         Options mOptions;
         Ogre::HardwareIndexBufferSharedPtr mIndexBuffer;
-        std::vector<std::uint8_t> mScratch; ///< one region as written
+        std::vector<std::uint8_t> mScratch; ///< the regions of one write
+        std::vector<std::uint32_t> mChanged; ///< changed clusters, sorted
         std::vector<std::unique_ptr<Part>> mLeafParts;
         std::vector<std::unique_ptr<Part>> mBarkParts;
         Ogre::MeshPtr mBarkMesh;
