@@ -145,7 +145,7 @@ namespace TreeLod
         cmd->add_option("--leaves", args->leaves, "lodf: draw exactly this many leaves (default: from screen size)");
         cmd->add_option("--pixels-per-leaf", args->pixelsPerLeaf, "lodf: projected pixels per leaf (default 4)");
         cmd->add_option("--lod-bias", args->lodBias, "camera LoD bias (> 1 = more detail)");
-        cmd->add_flag("--shadows", args->shadows, "texture shadows from the sun (LiSPSM, 2048^2 float depth)");
+        cmd->add_flag("--shadows", args->shadows, "texture shadows from the sun (focused shadow camera, 2048^2 float depth)");
         cmd->add_option("--camera", args->camera,
                         "orbit:AZIMUTH,ELEVATION,DISTANCE (degrees; distance 1 = tree fills the view), "
                         "ortho:AZ,EL,DIST, or PX,PY,PZ,TX,TY,TZ[,FOV]");

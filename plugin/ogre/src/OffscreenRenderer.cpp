@@ -6,9 +6,9 @@
 #include <OgreShadowCameraSetupFocused.h>
 
 #include <chrono>
-#include <filesystem>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 
 namespace TreeLod
 {
