@@ -39,6 +39,8 @@
 #include "TreeLod/TreeAssetManager.h"
 #include "TreeLod/TreeGenerator.h"
 
+#include "StudySupport.h"
+
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -81,156 +83,10 @@ namespace TreeLod
             std::string out = "out/lodf-study";
         };
 
-        /// Every failure of the study: printed as one line, exit 2.
-        struct StudyError : std::runtime_error
-        {
-            using std::runtime_error::runtime_error;
-        };
-
-        constexpr float FOV_Y_DEGREES = 45.0f;
-        constexpr double PI = 3.14159265358979323846;
-
-        std::string format(const char* fmt, ...)
-        {
-            va_list args, copy;
-            va_start(args, fmt);
-            va_copy(copy, args);
-            const int n = std::vsnprintf(nullptr, 0, fmt, copy);
-            va_end(copy);
-            std::string out(std::size_t(std::max(n, 0)) + 1, '\0');
-            std::vsnprintf(out.data(), out.size(), fmt, args);
-            va_end(args);
-            out.resize(std::size_t(std::max(n, 0)));
-            return out;
-        }
+        constexpr float FOV_Y_DEGREES = STUDY_FOV_Y_DEGREES;
+        constexpr double PI = STUDY_PI;
 
         void progressLine(const std::string& line) { std::fprintf(stderr, "lodf-study: %s\n", line.c_str()); }
-
-        double secondsSince(std::chrono::steady_clock::time_point start)
-        {
-            return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        }
-
-        // The same conversion as toImage in tests/ogre/OgreTestSupport.h, which is test-only (it
-        // pulls in gtest); OffscreenRenderer.h must not depend on TreeLodBake's Image.
-        Image toImage(const RgbaImage& rgba)
-        {
-            Image image(rgba.width, rgba.height);
-            for (std::size_t i = 0; i < image.pixels.size(); ++i)
-                image.pixels[i] = glm::vec4(rgba.pixels[4 * i], rgba.pixels[4 * i + 1], rgba.pixels[4 * i + 2],
-                                            rgba.pixels[4 * i + 3]) / 255.0f;
-            return image;
-        }
-
-        double flipMean(const Image& a, const Image& b)
-        {
-            Result<FlipResult> r = flip(a, b);
-            if (!r)
-                throw StudyError("FLIP: " + r.error().message());
-            return r->mean;
-        }
-
-        double median(std::vector<double> v)
-        {
-            if (v.empty())
-                return 0.0;
-            std::sort(v.begin(), v.end());
-            const std::size_t n = v.size();
-            return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-        }
-
-        /// Pixels that differ from the background (as tests/ogre treeCoverage counts them).
-        struct Extent
-        {
-            int minX = std::numeric_limits<int>::max(), minY = std::numeric_limits<int>::max();
-            int maxX = -1, maxY = -1;
-            bool any() const { return maxX >= 0; }
-            int heightPx() const { return any() ? maxY - minY + 1 : 0; }
-        };
-
-        Extent treeExtent(const Image& image)
-        {
-            const glm::vec3 background = LightingSpec().background;
-            Extent e;
-            for (int y = 0; y < image.height; ++y)
-                for (int x = 0; x < image.width; ++x)
-                    if (glm::length(glm::vec3(image.at(x, y)) - background) > 0.02f)
-                    {
-                        e.minX = std::min(e.minX, x);
-                        e.maxX = std::max(e.maxX, x);
-                        e.minY = std::min(e.minY, y);
-                        e.maxY = std::max(e.maxY, y);
-                    }
-            return e;
-        }
-
-        Extent unite(Extent a, const Extent& b)
-        {
-            a.minX = std::min(a.minX, b.minX);
-            a.minY = std::min(a.minY, b.minY);
-            a.maxX = std::max(a.maxX, b.maxX);
-            a.maxY = std::max(a.maxY, b.maxY);
-            return a;
-        }
-
-        struct Crop
-        {
-            int x = 0, y = 0, side = 0;
-        };
-
-        /// A square around the tree with a margin, inside the image (the whole image if none).
-        Crop cropAround(const Extent& e, int width, int height)
-        {
-            const int full = std::min(width, height);
-            if (!e.any())
-                return {0, 0, full};
-            const int side = std::clamp(int(std::ceil(1.15 * std::max(e.maxX - e.minX + 1, e.maxY - e.minY + 1))) + 4,
-                                        8, full);
-            const int cx = (e.minX + e.maxX + 1) / 2, cy = (e.minY + e.maxY + 1) / 2;
-            return {std::clamp(cx - side / 2, 0, width - side), std::clamp(cy - side / 2, 0, height - side), side};
-        }
-
-        /// Nearest-neighbour magnification of `crop` of `image` to size x size.
-        Image magnify(const Image& image, const Crop& crop, int size)
-        {
-            Image out(size, size);
-            for (int y = 0; y < size; ++y)
-                for (int x = 0; x < size; ++x)
-                    out.at(x, y) = image.at(crop.x + x * crop.side / size, crop.y + y * crop.side / size);
-            return out;
-        }
-
-        /// Rows of equally sized panels with a grey gap between them.
-        Image composePanels(const std::vector<std::vector<const Image*>>& rows)
-        {
-            const int gap = 4;
-            const int w = rows[0][0]->width, h = rows[0][0]->height;
-            std::size_t columns = 0;
-            for (const auto& row : rows)
-                columns = std::max(columns, row.size());
-            Image out(int(columns) * w + (int(columns) - 1) * gap, int(rows.size()) * h + (int(rows.size()) - 1) * gap,
-                      glm::vec4(0.25f, 0.25f, 0.25f, 1.0f));
-            for (std::size_t r = 0; r < rows.size(); ++r)
-                for (std::size_t c = 0; c < rows[r].size(); ++c)
-                    for (int y = 0; y < h; ++y)
-                        for (int x = 0; x < w; ++x)
-                            out.at(int(c) * (w + gap) + x, int(r) * (h + gap) + y) = rows[r][c]->at(x, y);
-            return out;
-        }
-
-        void writeText(const std::string& path, const std::string& text)
-        {
-            Result<void> r = writeFileAtomic(path, std::vector<std::uint8_t>(text.begin(), text.end()));
-            if (!r)
-                throw StudyError(r.error().message());
-        }
-
-        void writeImage(const std::string& path, const Image& image)
-        {
-            Result<void> r = writePng(path, image);
-            if (!r)
-                throw StudyError(r.error().message());
-        }
 
         // ---- the tree and its three objects ------------------------------------------------
 
@@ -366,25 +222,9 @@ namespace TreeLod
             return camera;
         }
 
-        /// Distance at which the tree (its bounds' height) is about `px` pixels tall in a
-        /// `size`-pixel-high view (small-angle; the measured height is reported beside it).
         double distanceForHeight(const StudyTree& tree, double px, int size)
         {
-            const double height = tree.model.boundsMax.y - tree.model.boundsMin.y;
-            return height * size / (2.0 * px * std::tan(0.5 * FOV_Y_DEGREES * PI / 180.0));
-        }
-
-        /// The CPU ray-traced reference at size x size, quantised to 8 bits like the GPU frames
-        /// (FLIP's power law turns float-vs-8-bit rounding of a flat sky into ~0.03 mean error).
-        Image traceReference(const ReferenceRenderer& cpu, const CameraSpec& camera, int size, int supersample)
-        {
-            RenderOptions options;
-            options.width = options.height = size;
-            options.samplesPerPixel = supersample * supersample;
-            Image traced = cpu.render(camera, options).colour;
-            for (glm::vec4& p : traced.pixels)
-                p = glm::round(glm::clamp(p, 0.0f, 1.0f) * 255.0f) / 255.0f;
-            return traced;
+            return TreeLod::distanceForHeight(tree.model.boundsMax.y - tree.model.boundsMin.y, px, size);
         }
 
         // ---- 1. continuity ------------------------------------------------------------------

@@ -21,14 +21,26 @@ namespace TreeLod
         constexpr std::uint32_t MATERIAL_LEAF = 1u;
         constexpr std::uint32_t MATERIAL_DOUBLE_SIDED = 2u;
 
-        std::uint32_t bytesPerTexel(GpuTextureFormat format)
+        /// Bytes per texel (RGBA8) or per 4x4 block (DXT); 0 for an unknown format.
+        std::uint32_t bytesPerUnit(GpuTextureFormat format)
         {
             switch (format)
             {
             case GpuTextureFormat::RGBA8:
                 return 4;
+            case GpuTextureFormat::DXT1:
+                return 8;
+            case GpuTextureFormat::DXT5:
+                return 16;
             }
             return 0;
+        }
+
+        std::uint64_t levelBytes(GpuTextureFormat format, std::uint64_t w, std::uint64_t h)
+        {
+            if (isBlockCompressed(format))
+                return ((w + 3) / 4) * ((h + 3) / 4) * bytesPerUnit(format);
+            return w * h * bytesPerUnit(format);
         }
 
         bool finite(float v) { return std::isfinite(v); }
@@ -120,7 +132,7 @@ namespace TreeLod
         for (std::uint32_t level = 0; level < mipCount && level < 32; ++level)
         {
             std::uint64_t w = width >> level ? width >> level : 1, h = height >> level ? height >> level : 1;
-            total += w * h * bytesPerTexel(format);
+            total += levelBytes(format, w, h);
         }
         return total;
     }
@@ -132,7 +144,60 @@ namespace TreeLod
 
     std::uint64_t GpuTexture::mipBytes(std::uint32_t level) const
     {
-        return std::uint64_t(mipWidth(level)) * mipHeight(level) * bytesPerTexel(format);
+        return levelBytes(format, mipWidth(level), mipHeight(level));
+    }
+
+    bool isBlockCompressed(GpuTextureFormat format)
+    {
+        return format == GpuTextureFormat::DXT1 || format == GpuTextureFormat::DXT5;
+    }
+
+    void writeGpuTexture(ByteWriter& w, const GpuTexture& tex)
+    {
+        w.string(tex.name);
+        w.u32(std::uint32_t(tex.format));
+        w.u32(tex.width);
+        w.u32(tex.height);
+        w.u32(tex.mipCount);
+        w.u64(tex.data.size());
+        w.align(ALIGN);
+        w.bytes(tex.data.data(), tex.data.size());
+    }
+
+    bool readGpuTexture(ByteReader& r, const std::string& element, GpuTexture& tex)
+    {
+        r.setElement(element);
+        tex.name = r.string(MODEL_CHUNK_MAX_STRING);
+        r.setElement(element + " '" + tex.name + "'");
+        const std::uint32_t format = r.u32();
+        tex.width = r.u32();
+        tex.height = r.u32();
+        tex.mipCount = r.u32();
+        const std::uint64_t dataBytes = r.u64();
+        if (!r.ok())
+            return false;
+        tex.format = GpuTextureFormat(format);
+        if (bytesPerUnit(tex.format) == 0)
+            r.failHere("unknown format " + std::to_string(format));
+        else if (tex.width < 1 || tex.height < 1 || tex.width > GPU_TEXTURE_MAX_SIZE ||
+                 tex.height > GPU_TEXTURE_MAX_SIZE)
+            r.failHere("size " + std::to_string(tex.width) + "x" + std::to_string(tex.height) + " outside 1.." +
+                       std::to_string(GPU_TEXTURE_MAX_SIZE));
+        else if (tex.mipCount < 1 || tex.mipCount > fullMipCount(tex.width, tex.height))
+            r.failHere(std::to_string(tex.mipCount) + " mip levels, a " + std::to_string(tex.width) + "x" +
+                       std::to_string(tex.height) + " texture has 1.." +
+                       std::to_string(fullMipCount(tex.width, tex.height)));
+        else if (dataBytes != gpuTextureBytes(tex.format, tex.width, tex.height, tex.mipCount))
+            r.failHere(std::to_string(dataBytes) + " bytes of texel data, expected " +
+                       std::to_string(gpuTextureBytes(tex.format, tex.width, tex.height, tex.mipCount)));
+        if (!r.ok())
+            return false;
+        r.align(ALIGN);
+        const std::uint8_t* texels = r.take(std::size_t(dataBytes));
+        if (!texels)
+            return false;
+        tex.data.assign(texels, texels + dataBytes);
+        return true;
     }
 
     std::vector<std::uint8_t> encodeReferenceChunk(const ReferenceChunk& chunk)
@@ -154,16 +219,7 @@ namespace TreeLod
 
         w.u32(std::uint32_t(chunk.textures.size()));
         for (const GpuTexture& tex : chunk.textures)
-        {
-            w.string(tex.name);
-            w.u32(std::uint32_t(tex.format));
-            w.u32(tex.width);
-            w.u32(tex.height);
-            w.u32(tex.mipCount);
-            w.u64(tex.data.size());
-            w.align(ALIGN);
-            w.bytes(tex.data.data(), tex.data.size());
-        }
+            writeGpuTexture(w, tex);
 
         writeVertices(w, m.barkVertices);
         writeU32s(w, m.barkIndices);
@@ -250,38 +306,14 @@ namespace TreeLod
         chunk.textures.resize(textureCount);
         for (std::uint32_t i = 0; i < textureCount; ++i)
         {
-            GpuTexture& tex = chunk.textures[i];
-            r.setElement(chunkName + ", texture " + std::to_string(i));
-            tex.name = r.string(MODEL_CHUNK_MAX_STRING);
-            r.setElement(chunkName + ", texture " + std::to_string(i) + " '" + tex.name + "'");
-            const std::uint32_t format = r.u32();
-            tex.width = r.u32();
-            tex.height = r.u32();
-            tex.mipCount = r.u32();
-            const std::uint64_t dataBytes = r.u64();
-            if (!r.ok())
+            if (!readGpuTexture(r, chunkName + ", texture " + std::to_string(i), chunk.textures[i]))
                 return r.error();
-            tex.format = GpuTextureFormat(format);
-            if (bytesPerTexel(tex.format) == 0)
-                r.failHere("unknown format " + std::to_string(format));
-            else if (tex.width < 1 || tex.height < 1 || tex.width > GPU_TEXTURE_MAX_SIZE ||
-                     tex.height > GPU_TEXTURE_MAX_SIZE)
-                r.failHere("size " + std::to_string(tex.width) + "x" + std::to_string(tex.height) + " outside 1.." +
-                           std::to_string(GPU_TEXTURE_MAX_SIZE));
-            else if (tex.mipCount < 1 || tex.mipCount > fullMipCount(tex.width, tex.height))
-                r.failHere(std::to_string(tex.mipCount) + " mip levels, a " + std::to_string(tex.width) + "x" +
-                           std::to_string(tex.height) + " texture has 1.." +
-                           std::to_string(fullMipCount(tex.width, tex.height)));
-            else if (dataBytes != gpuTextureBytes(tex.format, tex.width, tex.height, tex.mipCount))
-                r.failHere(std::to_string(dataBytes) + " bytes of texel data, expected " +
-                           std::to_string(gpuTextureBytes(tex.format, tex.width, tex.height, tex.mipCount)));
-            if (!r.ok())
+            if (chunk.textures[i].format != GpuTextureFormat::RGBA8)
+            {
+                r.failHere("format " + std::to_string(std::uint32_t(chunk.textures[i].format)) +
+                           ": reference textures are RGBA8");
                 return r.error();
-            r.align(ALIGN);
-            const std::uint8_t* texels = r.take(std::size_t(dataBytes));
-            if (!texels)
-                return r.error();
-            tex.data.assign(texels, texels + dataBytes);
+            }
         }
         for (std::uint32_t i = 0; i < materialCount; ++i)
             if (m.materials[i].texture >= std::int32_t(textureCount))

@@ -46,9 +46,13 @@ namespace TreeLod
 
     enum class GpuTextureFormat : std::uint32_t
     {
-        RGBA8 = 1 ///< 4 bytes per texel, R G B A; colour sRGB-encoded, alpha straight (linear)
-        // later: DXT1, DXT5
+        RGBA8 = 1, ///< 4 bytes per texel, R G B A; colour sRGB-encoded, alpha straight (linear)
+        DXT1 = 2,  ///< BC1, 8 bytes per 4x4 block (levels under 4 texels still take one block)
+        DXT5 = 3   ///< BC3, 16 bytes per 4x4 block
     };
+
+    /// True for the 4x4 block formats.
+    bool isBlockCompressed(GpuTextureFormat format);
 
     /// A texture as the GPU takes it: every mip level, largest first.
     struct GpuTexture
@@ -84,6 +88,15 @@ namespace TreeLod
         /// GPU-ready textures, same indices as model.materials[i].texture.
         std::vector<GpuTexture> textures;
     };
+
+    class ByteWriter;
+    class ByteReader;
+    /// A GpuTexture in the layout above (string name, u32 format, width, height, mipCount,
+    /// u64 dataBytes, align16, data); every chunk that stores textures uses these two.
+    void writeGpuTexture(ByteWriter& writer, const GpuTexture& texture);
+    /// Reads and checks format, size, mip count and byte count; false with the reader's error
+    /// set (element `element`, then "<element> '<name>'").
+    bool readGpuTexture(ByteReader& reader, const std::string& element, GpuTexture& texture);
 
     /// Serialise `chunk` in the layout above. Deterministic: equal chunks give equal bytes.
     /// Does not check consistency; decodeReferenceChunk does.
