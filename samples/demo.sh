@@ -2,6 +2,8 @@
 # The main job: install what is missing, build, and render the bundled trees headless
 # through the Ogre plugin (the polygonal reference and LoDF) and through the CPU reference
 # renderer into PNGs.
+# Also billboard clouds with multi-layered indirect texturing (paper 000) close up and far,
+# and the classic billboard cloud at the same memory.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${TREELOD_BUILD_DIR:-$root/build}
@@ -27,6 +29,15 @@ for tree in "$root"/media/*.glb; do
   leaves=$("$build/bin/treelod" info "$tree" --json | sed -n 's/.*"leaves": \([0-9]*\).*/\1/p' | head -n 1)
   run "$build/bin/treelod" render "$tree" --technique lodf --leaves $((leaves / 4)) --shadows \
     --camera "orbit:0,8,1.0" --size 512x512 -o "$out/$name-front-lodf-quarter-shadows.png"
+  # Billboard clouds (paper 000): bake both clouds once, render close up, far, and the classic one.
+  "$build/bin/treelod" bake "$tree" --technique billboard-cloud --technique classic-billboard-cloud -q \
+    -o "$out/$name.treelod"
+  run "$build/bin/treelod" render "$out/$name.treelod" --technique billboard-cloud --camera "orbit:0,8,1.0" \
+    --size 512x512 -o "$out/$name-front-billboard-cloud.png"
+  run "$build/bin/treelod" render "$out/$name.treelod" --technique billboard-cloud --camera "orbit:0,8,6.0" \
+    --size 512x512 -o "$out/$name-far-billboard-cloud.png"
+  run "$build/bin/treelod" render "$out/$name.treelod" --technique classic-billboard-cloud \
+    --camera "orbit:0,8,1.0" --size 512x512 -o "$out/$name-front-classic-billboard-cloud.png"
 done
 echo
 echo "Rendered the bundled trees into $out:"

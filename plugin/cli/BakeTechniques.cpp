@@ -1,5 +1,6 @@
 #include "BakeTechniques.h"
 
+#include "TreeLod/BillboardCloudBaker.h"
 #include "TreeLod/FoliageLodBaker.h"
 #include "TreeLod/FoliageLodData.h"
 #include "TreeLod/Package.h"
@@ -12,6 +13,11 @@ namespace TreeLod
             {REFERENCE_CHUNK, "the polygonal tree with GPU-ready mip-mapped textures", &addReferenceChunk},
             {FOLIAGE_LOD_CHUNK, "LoDF continuous foliage by leaf collapse, paper 004 (adds reference)",
              static_cast<BakeFunction>(&addFoliageLodChunk)},
+            {BILLBOARD_CLOUD_CHUNK, "billboard cloud, multi-layered indirect texturing, paper 000 (adds reference)",
+             &addBillboardCloudChunk},
+            {CLASSIC_BILLBOARD_CLOUD_CHUNK,
+             "classic billboard cloud at equal memory, paper 000 Fig. 13 (adds reference)",
+             &addClassicBillboardCloudChunk},
         };
         return techniques;
     }

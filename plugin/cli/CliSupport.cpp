@@ -23,8 +23,13 @@ namespace TreeLod
 
     ProgressCallback makeProgress(bool quiet)
     {
+        // Steps named "warning: ..." are messages, printed whole even with -q.
+        auto isWarning = [](const std::string& step) { return step.rfind("warning: ", 0) == 0; };
         if (quiet)
-            return {};
+            return [isWarning](const std::string& step, float) {
+                if (isWarning(step))
+                    std::fprintf(stderr, "%s\n", step.c_str());
+            };
         struct State
         {
             std::string step;
@@ -32,7 +37,12 @@ namespace TreeLod
         };
         auto state = std::make_shared<State>();
         const bool tty = isatty(fileno(stderr));
-        return [state, tty](const std::string& step, float fraction) {
+        return [state, tty, isWarning](const std::string& step, float fraction) {
+            if (isWarning(step))
+            {
+                std::fprintf(stderr, "%s%s\n", tty && state->shown >= 0 && state->shown < 100 ? "\n" : "", step.c_str());
+                return;
+            }
             int percent = int(fraction * 100.0f + 0.5f);
             percent = percent < 0 ? 0 : (percent > 100 ? 100 : percent);
             if (tty)

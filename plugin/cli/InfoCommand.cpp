@@ -6,6 +6,7 @@
 #include "CliSupport.h"
 #include "Commands.h"
 
+#include "TreeLod/BillboardCloudData.h"
 #include "TreeLod/FoliageLodData.h"
 #include "TreeLod/GltfImporter.h"
 #include "TreeLod/ModelChunk.h"
@@ -111,6 +112,7 @@ namespace TreeLod
             std::vector<bool> crcOk(reader.chunks().size(), false);
             std::optional<ReferenceChunk> reference;
             std::optional<FoliageLodData> foliageLod;
+            std::vector<BillboardCloudData> clouds; ///< billboard-cloud, classic-billboard-cloud
             json meta;
             for (std::size_t i = 0; i < reader.chunks().size(); ++i)
             {
@@ -160,6 +162,15 @@ namespace TreeLod
                     else if (!firstError)
                         firstError = decoded.error();
                 }
+                else if ((c.technique == BILLBOARD_CLOUD_CHUNK || c.technique == CLASSIC_BILLBOARD_CLOUD_CHUNK) &&
+                         c.level == 0)
+                {
+                    Result<BillboardCloudData> decoded = decodeBillboardCloudChunk(bytes.value(), reader.label());
+                    if (decoded)
+                        clouds.push_back(std::move(decoded.value()));
+                    else if (!firstError)
+                        firstError = decoded.error();
+                }
             }
 
             std::vector<TextureRow> textures;
@@ -188,6 +199,23 @@ namespace TreeLod
                                  {"paperWords", foliageLod->paperWords()},
                                  {"eq9Words", foliageLod->paperEq9Words()},
                                  {"bytes", foliageLod->byteSize()}};
+                for (const BillboardCloudData& cloud : clouds)
+                {
+                    json levels = json::array();
+                    for (const BillboardCloudLevel& level : cloud.levels)
+                        levels.push_back({{"billboards", level.billboardCount},
+                                          {"layered", level.layered},
+                                          {"cellSize", level.cellSize},
+                                          {"lowResTexelSize", level.lowResTexelSize}});
+                    j[cloud.classic ? CLASSIC_BILLBOARD_CLOUD_CHUNK : BILLBOARD_CLOUD_CHUNK] = {
+                        {"levels", levels},
+                        {"listEntries", cloud.entries.size()},
+                        {"hashAtlas", {cloud.hashAtlasWidth, cloud.hashAtlasHeight}},
+                        {"listsAtlas", {cloud.listsAtlasWidth, cloud.listsAtlasHeight}},
+                        {"leavesTexture", {cloud.leavesColour.width, cloud.leavesColour.height}},
+                        {"lowResTexture", {cloud.lowRes.width, cloud.lowRes.height}},
+                        {"gpuBytes", cloud.gpuBytes()}};
+                }
                 if (firstError)
                     j["error"] = firstError->message();
                 std::printf("%s\n", j.dump(2, ' ', false, json::error_handler_t::replace).c_str());
@@ -221,6 +249,20 @@ namespace TreeLod
                                 foliageLod->entries.size(), (unsigned long long)foliageLod->paperWords(),
                                 (unsigned long long)foliageLod->paperEq9Words(),
                                 (unsigned long long)foliageLod->byteSize());
+                for (const BillboardCloudData& cloud : clouds)
+                {
+                    std::string counts;
+                    for (const BillboardCloudLevel& level : cloud.levels)
+                        counts += (counts.empty() ? "" : " / ") + std::to_string(level.billboardCount) +
+                                  (level.layered ? "" : " (low-res)");
+                    std::printf("%s: %s billboards, %zu list entries, hash atlas %ux%u, lists atlas %ux%u, leaves "
+                                "texture %ux%u, low-res texture %ux%u, %llu bytes on the GPU\n",
+                                cloud.classic ? CLASSIC_BILLBOARD_CLOUD_CHUNK : BILLBOARD_CLOUD_CHUNK, counts.c_str(),
+                                cloud.entries.size(), cloud.hashAtlasWidth, cloud.hashAtlasHeight,
+                                cloud.listsAtlasWidth, cloud.listsAtlasHeight, cloud.leavesColour.width,
+                                cloud.leavesColour.height, cloud.lowRes.width, cloud.lowRes.height,
+                                (unsigned long long)cloud.gpuBytes());
+                }
             }
             if (firstError)
                 return printError(*firstError);

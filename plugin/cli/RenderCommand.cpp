@@ -36,6 +36,8 @@ namespace TreeLod
             float pixelsPerLeaf = 0.0f;
             float lodBias = 1.0f;
             bool shadows = false;
+            int level = -1;
+            float listFactor = -1.0f;
             std::vector<std::string> leafMaterials;
             bool verbose = false;
         };
@@ -110,6 +112,10 @@ namespace TreeLod
                         params["leaves"] = std::to_string(args.leaves);
                     if (args.pixelsPerLeaf > 0.0f)
                         params["pixelsPerLeaf"] = std::to_string(args.pixelsPerLeaf);
+                    if (args.level >= 0)
+                        params["level"] = std::to_string(args.level);
+                    if (args.listFactor >= 0.0f)
+                        params["listFactor"] = std::to_string(args.listFactor);
                     renderer.setShadows(args.shadows);
                     renderer.setLodBias(args.lodBias);
                     Ogre::MovableObject* object = TechniqueRegistry::getSingleton().createInstance(
@@ -141,9 +147,15 @@ namespace TreeLod
         cmd->add_option("input", args->input, "tree file")->required();
         cmd->add_option("-o,--output", args->output, "PNG to write")->required();
         cmd->add_option("--technique", args->technique,
-                        "LoD technique: mesh (polygonal reference), lodf (paper 004); a .glb is baked in memory");
+                        "LoD technique: mesh (polygonal reference), lodf (paper 004), billboard-cloud (paper 000), "
+                        "classic-billboard-cloud; a .glb is baked in memory");
         cmd->add_option("--leaves", args->leaves, "lodf: draw exactly this many leaves (default: from screen size)");
         cmd->add_option("--pixels-per-leaf", args->pixelsPerLeaf, "lodf: projected pixels per leaf (default 4)");
+        cmd->add_option("--level", args->level, "billboard clouds: draw this cloud (0 finest .. 2 low-res only) "
+                                               "instead of the LoD strategy's");
+        cmd->add_option("--list-factor", args->listFactor,
+                        "billboard-cloud: shader LoD, list entries walked per pixel of projected hash-cell diagonal "
+                        "(0 = low-res texture only; default from the package)");
         cmd->add_option("--lod-bias", args->lodBias, "camera LoD bias (> 1 = more detail)");
         cmd->add_flag("--shadows", args->shadows, "texture shadows from the sun (focused shadow camera, 2048^2 float depth)");
         cmd->add_option("--camera", args->camera,

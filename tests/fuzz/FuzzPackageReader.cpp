@@ -1,11 +1,14 @@
 // libFuzzer target: PackageReader::fromMemory on arbitrary bytes, then every chunk read,
-// every "reference" chunk decoded, and every "lodf" chunk decoded and walked through its
-// levels as FoliageLodTree does (writeCluster must stay inside each cluster's region). Must never crash, read out of bounds or allocate more
-// than a small multiple of the input (Package.h, "Hostile input").
+// every "reference" chunk decoded, every "lodf" chunk decoded and walked through its
+// levels as FoliageLodTree does (writeCluster must stay inside each cluster's region), and
+// every "billboard-cloud" / "classic-billboard-cloud" chunk decoded and sampled as the
+// shader addresses it (BillboardCloudSampler). Must never crash, read out of bounds or
+// allocate more than a small multiple of the input (Package.h, "Hostile input").
 //
 // Seeds: tests/fuzz/corpus/package/ (small valid packages). The chunk CRCs stop most
 // mutations at readChunk; the input's last byte may ask the fuzzer to skip those checks by
 // resealing the checksums, so the decoders behind them are fuzzed too.
+#include "TreeLod/BillboardCloudData.h"
 #include "TreeLod/Crc32.h"
 #include "TreeLod/FoliageLodState.h"
 #include "TreeLod/ModelChunk.h"
@@ -83,6 +86,25 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                         if (t.mipOffset(level) + t.mipBytes(level) > t.data.size())
                             __builtin_trap();
             }
+        }
+        else if (reader->chunks()[i].technique == TreeLod::BILLBOARD_CLOUD_CHUNK ||
+                 reader->chunks()[i].technique == TreeLod::CLASSIC_BILLBOARD_CLOUD_CHUNK)
+        {
+            TreeLod::Result<TreeLod::BillboardCloudData> decoded =
+                TreeLod::decodeBillboardCloudChunk(chunk.value(), "fuzz");
+            if (!decoded)
+                continue;
+            // What the shader does per fragment: hash fetch, list walk from either end; every
+            // entry and tile it reads must exist.
+            const TreeLod::BillboardCloudSampler sampler(decoded.value());
+            const std::uint32_t billboards = std::uint32_t(decoded->billboards.size());
+            for (std::uint32_t b = 0; b < billboards && b < 64; ++b)
+                for (float uv : {0.0f, 0.37f, 0.5f, 1.0f})
+                    for (bool front : {true, false})
+                        for (const TreeLod::BillboardCloudSampler::Fragment& f : sampler.walk(b, uv, 1.0f - uv, front))
+                            if (f.entry >= decoded->entries.size() || f.tile >= decoded->tileCount())
+                                __builtin_trap();
+            sampler.walk(billboards, 0.5f, 0.5f, true); // out of range: no fragments, no crash
         }
         else if (reader->chunks()[i].technique == TreeLod::FOLIAGE_LOD_CHUNK)
         {

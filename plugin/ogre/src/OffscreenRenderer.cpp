@@ -4,7 +4,9 @@
 #include "TreeLod/TreeLodPlugin.h"
 
 #include <OgreShadowCameraSetupFocused.h>
+#include <OgreShadowCameraSetupLiSPSM.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -158,7 +160,10 @@ namespace TreeLod
             const Ogre::AxisAlignedBox& box = mContentNode->_getWorldAABB();
             const Ogre::Real radius = box.isFinite() ? 0.5f * box.getSize().length() : 10.0f;
             mSceneManager->setShadowDirectionalLightExtrusionDistance(2.0f * radius + 1.0f);
-            mSceneManager->setShadowFarDistance(4.0f * radius + 2.0f);
+            // Shadows reach past the far side of the content however far the camera stands.
+            const Ogre::Vector3 eye(spec.position.x, spec.position.y, spec.position.z);
+            const Ogre::Real reach = box.isFinite() ? eye.distance(box.getCenter()) + 2.0f * radius : 0.0f;
+            mSceneManager->setShadowFarDistance(std::max(4.0f * radius + 2.0f, reach));
         }
         mCamera->setLodBias(mLodBias / float(samplesPerAxis * samplesPerAxis));
         mCamera->setNearClipDistance(spec.nearClip);
@@ -179,7 +184,7 @@ namespace TreeLod
         mCameraNode->lookAt(Ogre::Vector3(spec.target.x, spec.target.y, spec.target.z), Ogre::Node::TS_WORLD);
     }
 
-    void OffscreenRenderer::setShadows(bool enabled, unsigned textureSize)
+    void OffscreenRenderer::setShadows(bool enabled, unsigned textureSize, ShadowCamera camera)
     {
         if (!enabled)
         {
@@ -190,7 +195,10 @@ namespace TreeLod
         mSceneManager->setShadowTextureCount(1);
         mSceneManager->setShadowTextureSettings(textureSize, 1, Ogre::PF_FLOAT32_R);
         mSceneManager->setShadowTextureSelfShadow(true);
-        mSceneManager->setShadowCameraSetup(Ogre::ShadowCameraSetupPtr(new Ogre::FocusedShadowCameraSetup()));
+        if (camera == ShadowCamera::LiSPSM)
+            mSceneManager->setShadowCameraSetup(Ogre::ShadowCameraSetupPtr(new Ogre::LiSPSMShadowCameraSetup()));
+        else
+            mSceneManager->setShadowCameraSetup(Ogre::ShadowCameraSetupPtr(new Ogre::FocusedShadowCameraSetup()));
         mSun->setCastShadows(true);
     }
 

@@ -1,5 +1,6 @@
 #include "TreeLod/TechniqueRegistry.h"
 
+#include "TreeLod/BillboardCloudTree.h"
 #include "TreeLod/FoliageLodTree.h"
 #include "TreeLod/TreeAsset.h"
 
@@ -31,6 +32,21 @@ namespace TreeLod
                  all["group"] = asset.getGroup();
                  return sm.createMovableObject(name, FoliageLodTreeFactory::FACTORY_TYPE_NAME, &all);
              }});
+        // paper 000: billboard clouds with multi-layered indirect texturing, and the classic cloud.
+        for (const bool classic : {false, true})
+            add({classic ? CLASSIC_BILLBOARD_CLOUD_CHUNK : BILLBOARD_CLOUD_CHUNK,
+                 classic ? "classic billboard cloud: one RGBA texture per billboard, the baseline of paper 000 Fig. 13"
+                         : "billboard clouds with multi-layered indirect texturing and shader LoD (paper 000)",
+                 classic ? CLASSIC_BILLBOARD_CLOUD_CHUNK : BILLBOARD_CLOUD_CHUNK,
+                 BillboardCloudTreeFactory::FACTORY_TYPE_NAME,
+                 [classic](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset,
+                           const Ogre::NameValuePairList& params) {
+                     Ogre::NameValuePairList all = params;
+                     all["asset"] = asset.getName();
+                     all["group"] = asset.getGroup();
+                     all["classic"] = classic ? "true" : "false";
+                     return sm.createMovableObject(name, BillboardCloudTreeFactory::FACTORY_TYPE_NAME, &all);
+                 }});
         // Technique issues add their line here.
     }
 

@@ -4,6 +4,7 @@
 #include "TreeLod/TreeMeshBuilder.h"
 
 #include <OgreException.h>
+#include <OgreGpuProgramParams.h>
 #include <OgreHardwareBufferManager.h>
 #include <OgreImage.h>
 #include <OgreMaterialManager.h>
@@ -14,6 +15,10 @@
 #include <OgreTextureManager.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <map>
 
 namespace TreeLod
 {
@@ -55,6 +60,34 @@ namespace TreeLod
             if (*mesh)
                 Ogre::MeshManager::getSingleton().remove(*mesh);
             mesh->reset();
+        }
+        for (Ogre::MeshPtr& mesh : mBarkAoMeshes)
+        {
+            if (mesh)
+                Ogre::MeshManager::getSingleton().remove(mesh);
+            mesh.reset();
+        }
+        for (std::unique_ptr<BillboardCloudGpu>& gpu : mBillboardCloudGpus)
+        {
+            if (!gpu)
+                continue;
+            for (const Ogre::String& m : gpu->materials)
+                Ogre::MaterialManager::getSingleton().remove(m, mGroup);
+            for (const Ogre::String& t : gpu->textures)
+                Ogre::TextureManager::getSingleton().remove(t, mGroup);
+            gpu.reset();
+        }
+        for (std::unique_ptr<BillboardCloudData>& data : mBillboardClouds)
+            data.reset();
+        for (std::vector<Ogre::String>& names : mBarkAoMaterialNames)
+        {
+            for (const Ogre::String& m : names)
+                if (m.find("/BarkAo") != Ogre::String::npos) // leaf entries are the plain materials
+                {
+                    Ogre::MaterialManager::getSingleton().remove(m, mGroup);
+                    Ogre::MaterialManager::getSingleton().remove(m + "/Caster", mGroup);
+                }
+            names.clear();
         }
         mFoliageLodLevels.clear();
         mLeafVertexData.reset();
@@ -124,14 +157,14 @@ namespace TreeLod
     const std::vector<Ogre::String>& TreeAsset::getMaterialNames()
     {
         if (mMaterialNames.empty())
-            mMaterialNames = createMaterials("");
+            mMaterialNames = createMaterials("TreeLod/Bark", "TreeLod/Leaf", "");
         return mMaterialNames;
     }
 
     const std::vector<Ogre::String>& TreeAsset::getShadowedMaterialNames()
     {
         if (mShadowedMaterialNames.empty())
-            mShadowedMaterialNames = createMaterials("Shadowed");
+            mShadowedMaterialNames = createMaterials("TreeLod/BarkShadowed", "TreeLod/LeafShadowed", "/Shadowed");
         return mShadowedMaterialNames;
     }
 
@@ -154,7 +187,8 @@ namespace TreeLod
         }
     }
 
-    std::vector<Ogre::String> TreeAsset::createMaterials(const Ogre::String& variant)
+    std::vector<Ogre::String> TreeAsset::createMaterials(const Ogre::String& barkBase, const Ogre::String& leafBase,
+                                                         const Ogre::String& suffix)
     {
         const ReferenceChunk& ref = getReference();
         if (mTextureNames.size() != ref.textures.size())
@@ -164,7 +198,12 @@ namespace TreeLod
         for (std::size_t i = 0; i < ref.model.materials.size(); ++i)
         {
             const Material& src = ref.model.materials[i];
-            const Ogre::String base = (src.isLeaf ? "TreeLod/Leaf" : "TreeLod/Bark") + variant;
+            if (src.isLeaf && leafBase.empty())
+            {
+                names.push_back(getMaterialNames()[i]);
+                continue;
+            }
+            const Ogre::String base = src.isLeaf ? leafBase : barkBase;
             Ogre::MaterialPtr parent = Ogre::MaterialManager::getSingleton().getByName(base, Ogre::RGN_DEFAULT);
             if (!parent)
                 parent = Ogre::MaterialManager::getSingleton().getByName(base);
@@ -172,7 +211,7 @@ namespace TreeLod
                 OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
                             "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
                             "TreeAsset::createMaterials");
-            const Ogre::String name = prefix + std::to_string(i) + (variant.empty() ? "" : "/" + variant);
+            const Ogre::String name = prefix + std::to_string(i) + suffix;
             Ogre::MaterialPtr mat = parent->clone(name, true, mGroup);
             const Ogre::String texture = src.texture >= 0 ? mTextureNames[std::size_t(src.texture)] : "TreeLodWhite.png";
             glm::vec3 back = src.backColour == glm::vec3(0.0f) ? glm::vec3(src.baseColour) : src.backColour;
@@ -208,17 +247,303 @@ namespace TreeLod
         return names;
     }
 
+    Ogre::MeshPtr TreeAsset::buildBarkMesh(const Ogre::String& name, const std::vector<Ogre::String>& materials,
+                                           const std::vector<std::uint8_t>& barkAo)
+    {
+        TreeModel bark = getReference().model;
+        bark.leafVertices.clear();
+        bark.leafIndices.clear();
+        bark.leaves.clear();
+        MeshBuildOptions options;
+        options.barkVertexAo = barkAo;
+        return buildTreeMesh(name, mGroup, bark, materials, options);
+    }
+
     Ogre::MeshPtr TreeAsset::getBarkMesh()
     {
         if (!mBarkMesh)
-        {
-            TreeModel bark = getReference().model;
-            bark.leafVertices.clear();
-            bark.leafIndices.clear();
-            bark.leaves.clear();
-            mBarkMesh = buildTreeMesh(mName + "/bark", mGroup, bark, getMaterialNames());
-        }
+            mBarkMesh = buildBarkMesh(mName + "/bark", getMaterialNames(), {});
         return mBarkMesh;
+    }
+
+    const std::vector<Ogre::String>& TreeAsset::getBarkAoMaterialNames(bool shadowed)
+    {
+        std::vector<Ogre::String>& names = mBarkAoMaterialNames[shadowed ? 1 : 0];
+        if (names.empty())
+            names = shadowed ? createMaterials("TreeLod/BarkAoShadowed", "", "/BarkAoShadowed")
+                             : createMaterials("TreeLod/BarkAo", "", "/BarkAo");
+        return names;
+    }
+
+    Ogre::MeshPtr TreeAsset::getBarkAoMesh(bool classic)
+    {
+        Ogre::MeshPtr& mesh = mBarkAoMeshes[classic ? 1 : 0];
+        if (!mesh)
+        {
+            const BillboardCloudData& data = getBillboardCloud(classic);
+            const char* chunk = classic ? CLASSIC_BILLBOARD_CLOUD_CHUNK : BILLBOARD_CLOUD_CHUNK;
+            mesh = buildBarkMesh(mName + "/bark-ao/" + chunk, getBarkAoMaterialNames(false), data.barkAo);
+        }
+        return mesh;
+    }
+
+    // ---- billboard clouds (paper 000) ----------------------------------------------------------
+
+    Ogre::Real billboardCloudPixelCount(float entries, float cellSize, float radius, float listFactor)
+    {
+        // entries = listFactor * sqrt(2) * cellSize * r_px / radius  =>  r_px; value = 4 pi r_px^2.
+        if (!(cellSize > 0.0f) || !(listFactor > 0.0f))
+            return std::numeric_limits<Ogre::Real>::max();
+        const double rPx = double(entries) * double(radius) / (std::sqrt(2.0) * double(listFactor) * double(cellSize));
+        return Ogre::Real(4.0 * Ogre::Math::PI * rPx * rPx);
+    }
+
+    const BillboardCloudData& TreeAsset::getBillboardCloud(bool classic)
+    {
+        std::unique_ptr<BillboardCloudData>& slot = mBillboardClouds[classic ? 1 : 0];
+        if (slot)
+            return *slot;
+        const char* chunk = classic ? CLASSIC_BILLBOARD_CLOUD_CHUNK : BILLBOARD_CLOUD_CHUNK;
+        Result<BillboardCloudData> data = decodeBillboardCloudChunk(readChunk(chunk), mName);
+        if (!data)
+            raise(data.error());
+        const TreeModel& model = getReference().model;
+        if (data->barkAo.size() != model.barkVertices.size())
+            raise(fail(mName, chunkElement(chunk, 0),
+                       "bark AO for " + std::to_string(data->barkAo.size()) + " vertices, the reference bark has " +
+                           std::to_string(model.barkVertices.size())));
+        if (data->classic != classic)
+            raise(fail(mName, chunkElement(chunk, 0), classic ? "not a classic cloud" : "a classic cloud"));
+        for (const BillboardLeafMaterial& m : data->leafMaterials)
+            if (m.material >= model.materials.size())
+                raise(fail(mName, chunkElement(chunk, 0),
+                           "leaf material " + std::to_string(m.material) + " is not a material of the reference"));
+        slot = std::make_unique<BillboardCloudData>(std::move(data.value()));
+        return *slot;
+    }
+
+    namespace
+    {
+        Ogre::PixelFormat ogreFormat(GpuTextureFormat format)
+        {
+            switch (format)
+            {
+            case GpuTextureFormat::DXT1:
+                return Ogre::PF_DXT1;
+            case GpuTextureFormat::DXT5:
+                return Ogre::PF_DXT5;
+            default:
+                return Ogre::PF_BYTE_RGBA;
+            }
+        }
+
+        /// Upload `bytes` (level 0 then its mips, tightly packed) as texture `name`.
+        void uploadTexture(const Ogre::String& name, const Ogre::String& group, const std::uint8_t* bytes,
+                           std::uint32_t width, std::uint32_t height, Ogre::PixelFormat format, std::uint32_t mips)
+        {
+            Ogre::Image image;
+            image.loadDynamicImage(const_cast<Ogre::uchar*>(bytes), width, height, 1, format, false, 1,
+                                   mips > 0 ? mips - 1 : 0);
+            Ogre::TextureManager::getSingleton().loadImage(name, group, image, Ogre::TEX_TYPE_2D,
+                                                           int(mips > 0 ? mips - 1 : 0));
+        }
+    }
+
+    const BillboardCloudGpu& TreeAsset::getBillboardCloudGpu(bool classic)
+    {
+        std::unique_ptr<BillboardCloudGpu>& slot = mBillboardCloudGpus[classic ? 1 : 0];
+        if (slot)
+            return *slot;
+        const BillboardCloudData& data = getBillboardCloud(classic);
+        const Ogre::String prefix =
+            "TreeLod/" + mName + "/" + (classic ? CLASSIC_BILLBOARD_CLOUD_CHUNK : BILLBOARD_CLOUD_CHUNK) + "/";
+        auto gpu = std::make_unique<BillboardCloudGpu>();
+        gpu->listFactor = data.listFactor;
+        gpu->bounds = getBounds();
+        gpu->bounds.merge(Ogre::AxisAlignedBox(data.boundsMin.x, data.boundsMin.y, data.boundsMin.z, data.boundsMax.x,
+                                               data.boundsMax.y, data.boundsMax.z));
+        for (const Billboard& b : data.billboards)
+            for (const glm::vec3& c : {b.origin, b.origin + b.axisU, b.origin + b.axisV, b.origin + b.axisU + b.axisV})
+                gpu->bounds.merge(Ogre::Vector3(c.x, c.y, c.z));
+        gpu->radius = Ogre::Math::boundingRadiusFromAABB(gpu->bounds);
+
+        // §6 atlases: integer texel fetches only (no mips; filtering unused). The Lists and AO
+        // atlases are padded with zero texels past the last entry.
+        auto atlas = [&](const char* suffix, const std::uint8_t* bytes, std::size_t byteCount, std::uint32_t width,
+                         std::uint32_t height, Ogre::PixelFormat format) {
+            const std::size_t texel = Ogre::PixelUtil::getNumElemBytes(format);
+            if (width == 0 || height == 0)
+                width = height = 1;
+            std::vector<std::uint8_t> padded(std::size_t(width) * height * texel, 0);
+            std::memcpy(padded.data(), bytes, std::min(byteCount, padded.size()));
+            const Ogre::String name = prefix + suffix;
+            uploadTexture(name, mGroup, padded.data(), width, height, format, 1);
+            gpu->textures.push_back(name);
+        };
+        atlas("hash", data.hashAtlas.data(), data.hashAtlas.size(), data.hashAtlasWidth, data.hashAtlasHeight,
+              Ogre::PF_BYTE_RGBA);
+        static_assert(sizeof(BillboardListEntry) == 8, "a list entry is four u16 words");
+        atlas("lists", reinterpret_cast<const std::uint8_t*>(data.entries.data()), data.entries.size() * 8,
+              data.listsAtlasWidth, data.listsAtlasHeight, Ogre::PF_SHORT_RGBA);
+        atlas("ao", data.entryAo.data(), data.entryAo.size(), data.listsAtlasWidth, data.listsAtlasHeight,
+              Ogre::PF_BYTE_RGBA);
+        // Leaves Texture and low-res texture: every mip level as baked (DXT or RGBA8).
+        for (const std::pair<const char*, const GpuTexture*>& t :
+             {std::make_pair("leaves-colour", &data.leavesColour), std::make_pair("leaves-normal", &data.leavesNormal),
+              std::make_pair("low-res", &data.lowRes)})
+        {
+            const Ogre::String name = prefix + t.first;
+            uploadTexture(name, mGroup, t.second->data.data(), t.second->width, t.second->height,
+                          ogreFormat(t.second->format), t.second->mipCount);
+            gpu->textures.push_back(name);
+        }
+
+        // §6: the quads of every level in one vertex buffer, a range of the index buffer per level.
+        if (!data.billboards.empty())
+        {
+            constexpr std::size_t floatsPerVertex = 3 + 3 + 3 + 2 + 4 + 4;
+            const float lowResW = float(data.lowRes.width), lowResH = float(data.lowRes.height);
+            std::vector<float> vertices;
+            vertices.reserve(data.billboards.size() * 4 * floatsPerVertex);
+            for (const Billboard& b : data.billboards)
+            {
+                const glm::vec3 tangent = glm::normalize(b.axisU);
+                for (const glm::vec2 c : {glm::vec2(0, 0), glm::vec2(1, 0), glm::vec2(1, 1), glm::vec2(0, 1)})
+                {
+                    const glm::vec3 p = b.origin + c.x * b.axisU + c.y * b.axisV;
+                    const float v[floatsPerVertex] = {
+                        p.x, p.y, p.z, b.normal.x, b.normal.y, b.normal.z, tangent.x, tangent.y, tangent.z, c.x, c.y,
+                        float(b.hashX), float(b.hashY), float(b.hashWidth), float(b.hashHeight),
+                        float(b.lowResX) / lowResW, float(b.lowResY) / lowResH,
+                        float(b.lowResX + b.lowResWidth) / lowResW, float(b.lowResY + b.lowResHeight) / lowResH};
+                    vertices.insert(vertices.end(), v, v + floatsPerVertex);
+                }
+            }
+            gpu->vertexData = std::make_unique<Ogre::VertexData>();
+            Ogre::VertexData& vd = *gpu->vertexData;
+            vd.vertexCount = data.billboards.size() * 4;
+            Ogre::VertexDeclaration* decl = vd.vertexDeclaration;
+            std::size_t offset = 0;
+            offset += decl->addElement(0, offset, Ogre::VET_FLOAT3, Ogre::VES_POSITION).getSize();
+            offset += decl->addElement(0, offset, Ogre::VET_FLOAT3, Ogre::VES_NORMAL).getSize();
+            offset += decl->addElement(0, offset, Ogre::VET_FLOAT3, Ogre::VES_TANGENT).getSize();
+            offset += decl->addElement(0, offset, Ogre::VET_FLOAT2, Ogre::VES_TEXTURE_COORDINATES, 0).getSize();
+            offset += decl->addElement(0, offset, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 1).getSize();
+            decl->addElement(0, offset, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 2);
+            Ogre::HardwareVertexBufferSharedPtr buffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
+                floatsPerVertex * sizeof(float), vd.vertexCount, Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+            buffer->writeData(0, buffer->getSizeInBytes(), vertices.data(), true);
+            vd.vertexBufferBinding->setBinding(0, buffer);
+
+            std::vector<std::uint32_t> indices;
+            indices.reserve(data.billboards.size() * 6);
+            for (std::uint32_t b = 0; b < data.billboards.size(); ++b)
+                for (std::uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u})
+                    indices.push_back(4 * b + k);
+            const bool wide = vd.vertexCount > 65535;
+            gpu->indexBuffer = Ogre::HardwareBufferManager::getSingleton().createIndexBuffer(
+                wide ? Ogre::HardwareIndexBuffer::IT_32BIT : Ogre::HardwareIndexBuffer::IT_16BIT, indices.size(),
+                Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+            if (wide)
+                gpu->indexBuffer->writeData(0, indices.size() * 4, indices.data(), true);
+            else
+            {
+                std::vector<std::uint16_t> narrow(indices.begin(), indices.end());
+                gpu->indexBuffer->writeData(0, narrow.size() * 2, narrow.data(), true);
+            }
+        }
+        for (const BillboardCloudLevel& l : data.levels)
+        {
+            BillboardCloudGpu::Level level;
+            level.indexStart = std::size_t(l.firstBillboard) * 6;
+            level.indexCount = std::size_t(l.billboardCount) * 6;
+            level.layered = l.layered;
+            level.cellSize = l.cellSize;
+            if (l.layered)
+                level.lowResPixelCount =
+                    billboardCloudPixelCount(1.0f, l.cellSize, float(gpu->radius), data.listFactor);
+            gpu->levels.push_back(level);
+        }
+        createBillboardCloudMaterials(*gpu, data, prefix);
+        slot = std::move(gpu);
+        return *slot;
+    }
+
+    void TreeAsset::createBillboardCloudMaterials(BillboardCloudGpu& gpu, const BillboardCloudData& data,
+                                                  const Ogre::String& prefix)
+    {
+        const std::pair<const char*, Ogre::String> units[] = {
+            {"HashAtlas", prefix + "hash"},           {"ListsAtlas", prefix + "lists"},
+            {"AoAtlas", prefix + "ao"},               {"LeavesColour", prefix + "leaves-colour"},
+            {"LeavesNormal", prefix + "leaves-normal"}, {"LowRes", prefix + "low-res"}};
+        const int tileSize = int(std::max<std::uint32_t>(data.tileSize, 1));
+        const int columns = int(std::max<std::uint32_t>(data.tileColumns, 1));
+        const int rows = std::max(1, int(data.leavesColour.height) / tileSize);
+        float cutoffs[4] = {0.5f, 0.5f, 0.5f, 0.5f};
+        for (std::size_t m = 0; m < data.leafMaterials.size() && m < 4; ++m)
+            cutoffs[m] = data.leafMaterials[m].alphaCutoff;
+
+        auto configure = [&](const Ogre::MaterialPtr& material) {
+            material->load();
+            for (Ogre::Technique* tech : material->getTechniques())
+                for (Ogre::Pass* pass : tech->getPasses())
+                {
+                    for (const auto& unit : units)
+                        if (Ogre::TextureUnitState* state = pass->getTextureUnitState(unit.first))
+                            state->setTextureName(unit.second);
+                    if (!pass->hasFragmentProgram())
+                        continue;
+                    Ogre::GpuProgramParametersSharedPtr p = pass->getFragmentProgramParameters();
+                    p->setIgnoreMissingParams(true);
+                    p->setNamedConstant("listsAtlasWidth", int(std::max<std::uint32_t>(data.listsAtlasWidth, 1)));
+                    p->setNamedConstant("tileSize", float(tileSize));
+                    p->setNamedConstant("tileColumns", columns);
+                    p->setNamedConstant("tileRows", rows);
+                    p->setNamedConstant("orientationCount", int(std::max<std::uint32_t>(data.orientationCount(), 1)));
+                    p->setNamedConstant("leavesMaxLod", float(data.leavesMaxLod));
+                    p->setNamedConstant("alphaCutoffs", Ogre::Vector4(cutoffs[0], cutoffs[1], cutoffs[2], cutoffs[3]));
+                }
+        };
+        auto clone = [&](const Ogre::String& base, const Ogre::String& name) {
+            Ogre::MaterialPtr parent = Ogre::MaterialManager::getSingleton().getByName(base, Ogre::RGN_DEFAULT);
+            if (!parent)
+                parent = Ogre::MaterialManager::getSingleton().getByName(base);
+            if (!parent)
+                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
+                            "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
+                            "TreeAsset::createBillboardCloudMaterials");
+            Ogre::MaterialPtr material = parent->clone(name, true, mGroup);
+            configure(material);
+            gpu.materials.push_back(name);
+            return material;
+        };
+        // The shadow casters of each technique (§5.2: layers close up, low-res far away).
+        std::map<Ogre::String, Ogre::MaterialPtr> casters;
+        auto withCasters = [&](const Ogre::MaterialPtr& material) {
+            for (Ogre::Technique* tech : material->getTechniques())
+                if (Ogre::MaterialPtr caster = tech->getShadowCasterMaterial())
+                {
+                    Ogre::MaterialPtr& own = casters[caster->getName()];
+                    if (!own)
+                        own = clone(caster->getName(), prefix + caster->getName().substr(8)); // drop "TreeLod/"
+                    tech->setShadowCasterMaterial(own);
+                }
+        };
+        for (std::size_t l = 0; l < gpu.levels.size(); ++l)
+        {
+            BillboardCloudGpu::Level& level = gpu.levels[l];
+            const Ogre::String base = level.layered ? "TreeLod/BillboardCloud" : "TreeLod/BillboardCloudLowRes";
+            level.material = prefix + std::to_string(l);
+            level.shadowedMaterial = level.material + "/Shadowed";
+            for (const Ogre::String& name : {level.material, level.shadowedMaterial})
+            {
+                Ogre::MaterialPtr material = clone(name == level.material ? base : base + "Shadowed", name);
+                // §5.1: far away the layered material switches to the low-res technique.
+                if (level.layered)
+                    material->setLodLevels({level.lowResPixelCount});
+                withCasters(material);
+            }
+        }
     }
 
     const FoliageLodData& TreeAsset::getFoliageLod()

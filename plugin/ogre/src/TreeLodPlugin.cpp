@@ -1,5 +1,6 @@
 #include "TreeLod/TreeLodPlugin.h"
 
+#include "TreeLod/BillboardCloudTree.h"
 #include "TreeLod/FoliageLodTree.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
@@ -26,6 +27,8 @@ namespace TreeLod
         // One MovableObject factory per technique (DESIGN.md, "Factories").
         mFoliageLodFactory = std::make_unique<FoliageLodTreeFactory>();
         Ogre::Root::getSingleton().addMovableObjectFactory(mFoliageLodFactory.get());
+        mBillboardCloudFactory = std::make_unique<BillboardCloudTreeFactory>();
+        Ogre::Root::getSingleton().addMovableObjectFactory(mBillboardCloudFactory.get());
         Ogre::LogManager::getSingleton().logMessage("TreeLod: installed (techniques: " +
                                                     mTechniques->describe() + ")");
     }
@@ -47,6 +50,9 @@ namespace TreeLod
         if (mFoliageLodFactory)
             Ogre::Root::getSingleton().removeMovableObjectFactory(mFoliageLodFactory.get());
         mFoliageLodFactory.reset();
+        if (mBillboardCloudFactory)
+            Ogre::Root::getSingleton().removeMovableObjectFactory(mBillboardCloudFactory.get());
+        mBillboardCloudFactory.reset();
         delete mLodGenerator;
         mLodGenerator = nullptr;
         mAssetManager.reset();

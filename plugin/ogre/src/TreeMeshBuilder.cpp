@@ -54,7 +54,21 @@ namespace TreeLod
             std::uint32_t material = 0;
             std::vector<Vertex> vertices;
             std::vector<std::uint32_t> indices;
+            std::vector<std::uint32_t> source; ///< bark parts: model vertex of each vertex
         };
+
+        /// Source 1 of `data`: the AO of each vertex as a colour (ao, ao, ao, 1).
+        void addAoColours(Ogre::VertexData* data, const Part& part, const std::vector<std::uint8_t>& ao)
+        {
+            data->vertexDeclaration->addElement(1, 0, Ogre::VET_UBYTE4_NORM, Ogre::VES_DIFFUSE);
+            std::vector<std::uint8_t> colours(part.source.size() * 4, 255);
+            for (std::size_t v = 0; v < part.source.size(); ++v)
+                colours[4 * v] = colours[4 * v + 1] = colours[4 * v + 2] = ao[part.source[v]];
+            Ogre::HardwareVertexBufferSharedPtr buffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
+                4, part.source.size(), Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+            buffer->writeData(0, buffer->getSizeInBytes(), colours.data(), true);
+            data->vertexBufferBinding->setBinding(1, buffer);
+        }
 
         void addSubMesh(Ogre::Mesh& mesh, const Part& part, const std::vector<Ogre::String>& materialNames)
         {
@@ -83,6 +97,7 @@ namespace TreeLod
                         stamp[v] = m;
                         remap[v] = std::uint32_t(part.vertices.size());
                         part.vertices.push_back(model.barkVertices[v]);
+                        part.source.push_back(v);
                     }
                     part.indices.push_back(remap[v]);
                 }
@@ -125,10 +140,20 @@ namespace TreeLod
         if (!valid)
             OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, valid.error().message(), "buildTreeMesh");
 
+        if (!options.barkVertexAo.empty() && options.barkVertexAo.size() != model.barkVertices.size())
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                        "mesh '" + name + "': " + std::to_string(options.barkVertexAo.size()) + " AO values for " +
+                            std::to_string(model.barkVertices.size()) + " bark vertices",
+                        "buildTreeMesh");
+
         Ogre::MeshPtr mesh = Ogre::MeshManager::getSingleton().createManual(name, group);
         std::vector<Part> bark = barkParts(model);
         for (const Part& part : bark)
+        {
             addSubMesh(*mesh, part, materialNames);
+            if (!options.barkVertexAo.empty())
+                addAoColours(mesh->getSubMesh(mesh->getNumSubMeshes() - 1)->vertexData, part, options.barkVertexAo);
+        }
 
         Ogre::AxisAlignedBox box(model.boundsMin.x, model.boundsMin.y, model.boundsMin.z, model.boundsMax.x,
                                  model.boundsMax.y, model.boundsMax.z);

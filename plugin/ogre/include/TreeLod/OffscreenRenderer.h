@@ -18,6 +18,13 @@ namespace TreeLod
 {
     class TreeLodPlugin;
 
+    /// How the sun's shadow camera frames the view (OffscreenRenderer::setShadows).
+    enum class ShadowCamera
+    {
+        Focused, ///< Ogre::FocusedShadowCameraSetup: orthographic, fitted to the visible receivers
+        LiSPSM   ///< Ogre::LiSPSMShadowCameraSetup: light space perspective shadow maps [WSP04] (paper 000 §5.2)
+    };
+
     struct OffscreenOptions
     {
         std::string logFile = "";      ///< "" = no log file (messages dropped unless verbose)
@@ -54,10 +61,12 @@ namespace TreeLod
         void setLighting(const LightingSpec& lighting);
 
         /// Texture shadows from the sun: integrated additive technique, one float depth map of
-        /// `textureSize`^2 with the focused camera setup: an orthographic shadow camera, so the
-        /// stored depth is linear (OGRE-NOTES.md "Shadows"). Objects
-        /// choose receiving materials themselves (FoliageLodTree does).
-        void setShadows(bool enabled, unsigned textureSize = 2048);
+        /// `textureSize`^2 framed by `camera` (OGRE-NOTES.md "Shadows"); casters store the
+        /// shadow camera's window depth (materials/GLSL/TreeLodShading.glsl). The shadow far
+        /// distance reaches past the content from wherever the camera stands (render()): a
+        /// shorter one clipped the shadows of distant trees away, with either camera setup.
+        /// Objects choose receiving materials themselves (FoliageLodTree and BillboardCloudTree do).
+        void setShadows(bool enabled, unsigned textureSize = 2048, ShadowCamera camera = ShadowCamera::Focused);
 
         /// Camera LoD bias (> 1 = more detail). render() divides it by the supersampling
         /// factor's pixel count, so pixel-count LoD sees the output image's size.

@@ -7,10 +7,12 @@
 // names the resource, the chunk and the reason.
 #pragma once
 
+#include "TreeLod/BillboardCloudData.h"
 #include "TreeLod/FoliageLodData.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
 
+#include <OgreAxisAlignedBox.h>
 #include <OgreHardwareIndexBuffer.h>
 #include <OgreMesh.h>
 #include <OgreResource.h>
@@ -30,6 +32,46 @@ namespace TreeLod
         Ogre::HardwareIndexBufferSharedPtr buffer;
         std::vector<std::pair<std::size_t, std::size_t>> ranges; ///< (start, count) per leaf part
     };
+
+    /// A billboard cloud chunk on the GPU, built once per asset and shared by every
+    /// BillboardCloudTree drawing it (paper 000 §6: all levels' quads in one vertex buffer).
+    /// Vertex: position, normal (billboard normal), tangent (unit axisU), uv0 = billboard (u, v)
+    /// in [0, 1]^2, uv1 = (hashX, hashY, hashWidth, hashHeight) (§4.2: the vertices carry the
+    /// hash resolution), uv2 = the billboard's low-res rectangle in the atlas, normalised
+    /// (x0, y0, x1, y1). Materials per level: clones of TreeLod/BillboardCloud for layered levels
+    /// (material LoD: layers, then the low-res texture only), of TreeLod/BillboardCloudLowRes
+    /// for the others, with the chunk's textures bound and constants set.
+    struct BillboardCloudGpu
+    {
+        struct Level
+        {
+            std::size_t indexStart = 0;
+            std::size_t indexCount = 0;
+            bool layered = false;
+            float cellSize = 0.0f;        ///< metres (layered levels)
+            Ogre::String material;
+            Ogre::String shadowedMaterial; ///< receives texture shadows
+            /// Layered levels: the material LoD value (pixel_count, Ogre's perspective convention)
+            /// below which the low-res technique is used: where listFactor * projected cell
+            /// diagonal < 1 (billboardCloudPixelCount with entries = 1). 0 otherwise.
+            Ogre::Real lowResPixelCount = 0.0f;
+        };
+        std::unique_ptr<Ogre::VertexData> vertexData; ///< null when the cloud has no billboards
+        Ogre::HardwareIndexBufferSharedPtr indexBuffer;
+        std::vector<Level> levels;
+        Ogre::AxisAlignedBox bounds; ///< reference and billboards, local metres
+        Ogre::Real radius = 0.0f;    ///< Ogre's bounding radius of `bounds` (about the origin)
+        float listFactor = 1.0f;     ///< the chunk's
+        std::vector<Ogre::String> textures;
+        std::vector<Ogre::String> materials; ///< every material made for the cloud (casters too)
+    };
+
+    /// Pixel-count LoD value (AbsolutePixelCountLodStrategy's units for a perspective camera:
+    /// pi * r^2 * viewport area * P00 * P11 / d^2 = 4 pi r_px^2) at which a billboard cloud
+    /// whose hash cells are `cellSize` metres, in a tree of bounding radius `radius` metres,
+    /// walks `entries` list entries with shader LoD factor `listFactor` (paper 000 §5.1:
+    /// entries = listFactor * projected cell diagonal, the diagonal sqrt(2) * cellSize * r_px / radius).
+    Ogre::Real billboardCloudPixelCount(float entries, float cellSize, float radius, float listFactor);
 
     class TreeAsset : public Ogre::Resource
     {
@@ -68,6 +110,18 @@ namespace TreeLod
         std::size_t getFoliageLodLevelCount() const { return mFoliageLodLevels.size(); }
         std::uint64_t getFoliageLodLevelBytes() const;
 
+        /// The billboard cloud of chunk "billboard-cloud", or "classic-billboard-cloud" when
+        /// `classic` (decoded on first call, its bark AO checked against the reference).
+        const BillboardCloudData& getBillboardCloud(bool classic);
+        /// Its GPU resources (built on first call).
+        const BillboardCloudGpu& getBillboardCloudGpu(bool classic);
+        /// The bark mesh with the cloud's bark AO as a vertex colour, "<asset>/bark-ao/<chunk>",
+        /// with MeshLodGenerator levels and TreeLod/BarkAo materials (paper 000 §5.2, §6).
+        Ogre::MeshPtr getBarkAoMesh(bool classic);
+        /// Materials for getBarkAoMesh's submeshes ("TreeLod/<asset>/<i>/BarkAo"), and their
+        /// shadow-receiving clones ("/BarkAoShadowed"); leaf materials keep their plain names.
+        const std::vector<Ogre::String>& getBarkAoMaterialNames(bool shadowed);
+
         /// Local bounds of the tree in metres (from the reference chunk).
         Ogre::AxisAlignedBox getBounds();
 
@@ -85,8 +139,15 @@ namespace TreeLod
 
     private:
         void createTextures();
-        /// Clones of TreeLod/Bark<variant> and TreeLod/Leaf<variant>, one per model material.
-        std::vector<Ogre::String> createMaterials(const Ogre::String& variant);
+        /// Clones of `barkBase` and `leafBase`, one per model material, named
+        /// "TreeLod/<asset>/<i><suffix>"; an empty `leafBase` keeps the plain leaf materials.
+        std::vector<Ogre::String> createMaterials(const Ogre::String& barkBase, const Ogre::String& leafBase,
+                                                  const Ogre::String& suffix);
+        /// The bark of the reference alone as mesh `name` (bark AO as vertex colour when given).
+        Ogre::MeshPtr buildBarkMesh(const Ogre::String& name, const std::vector<Ogre::String>& materials,
+                                    const std::vector<std::uint8_t>& barkAo);
+        void createBillboardCloudMaterials(BillboardCloudGpu& gpu, const BillboardCloudData& data,
+                                           const Ogre::String& prefix);
         [[noreturn]] void raise(const Error& error) const;
         /// Level 0 of chunk `technique`, CRC-checked; throws naming what is missing or broken.
         std::vector<std::uint8_t> readChunk(const char* technique) const;
@@ -103,6 +164,10 @@ namespace TreeLod
         std::vector<Ogre::String> mShadowedMaterialNames;
         std::vector<Ogre::String> mMaterialNames;
         std::vector<Ogre::String> mTextureNames;
+        std::unique_ptr<BillboardCloudData> mBillboardClouds[2];  ///< [classic]
+        std::unique_ptr<BillboardCloudGpu> mBillboardCloudGpus[2]; ///< [classic]
+        Ogre::MeshPtr mBarkAoMeshes[2];                            ///< [classic]
+        std::vector<Ogre::String> mBarkAoMaterialNames[2];         ///< [shadowed]
     };
 
     typedef Ogre::SharedPtr<TreeAsset> TreeAssetPtr;

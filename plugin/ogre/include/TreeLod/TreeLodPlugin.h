@@ -17,6 +17,7 @@ namespace Ogre
 
 namespace TreeLod
 {
+    class BillboardCloudTreeFactory;
     class FoliageLodTreeFactory;
     class TreeAssetManager;
     class TechniqueRegistry;
@@ -37,6 +38,7 @@ namespace TreeLod
         std::unique_ptr<TreeAssetManager> mAssetManager;
         std::unique_ptr<TechniqueRegistry> mTechniques;
         std::unique_ptr<FoliageLodTreeFactory> mFoliageLodFactory;
+        std::unique_ptr<BillboardCloudTreeFactory> mBillboardCloudFactory;
         Ogre::MeshLodGenerator* mLodGenerator = nullptr; ///< owned only when we created it
     };
 }

@@ -4,7 +4,8 @@
 // vertex buffer (position float3, normal float3, uv0 float2) and 16-bit indices when
 // its vertices fit, 32-bit otherwise. Bark gets `barkLodLevels` MeshLodGenerator levels
 // (pixel-count strategy, DESIGN.md "LoD thresholds in screen pixels"); leaf submeshes
-// keep every leaf at every level (the technique issues are the foliage LoD).
+// keep every leaf at every level (the technique issues are the foliage LoD). Optionally the bark
+// carries a per-vertex ambient occlusion colour (MeshBuildOptions::barkVertexAo).
 #pragma once
 
 #include "TreeLod/TreeModel.h"
@@ -21,6 +22,10 @@ namespace TreeLod
         float firstLodPixels = 250000.0f;  ///< screen pixels below which level 1 is used
         float lodPixelRatio = 0.25f;       ///< each next level at this fraction of the previous pixels
         float lodReduction = 0.5f;         ///< fraction of bark vertices removed per level (cumulative)
+        /// Ambient occlusion per model bark vertex (0..255 = 0..1), or empty. When set, bark
+        /// submeshes get a second vertex buffer with a colour element (VES_DIFFUSE, UBYTE4_NORM,
+        /// ao in rgb) that the TreeLod/BarkAo materials read (paper 000 §5.2).
+        std::vector<std::uint8_t> barkVertexAo;
     };
 
     /// Vertex data over `vertices` as they are (position float3, normal float3, uv0 float2;

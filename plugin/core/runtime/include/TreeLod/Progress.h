@@ -7,7 +7,8 @@
 
 namespace TreeLod
 {
-    /// fraction in [0, 1] of the named step. May be empty: call through report().
+    /// fraction in [0, 1] of the named step. May be empty: call through report(). A step named
+    /// "warning: ..." is a message for the user (the CLI prints it whole, even when quiet).
     using ProgressCallback = std::function<void(const std::string& step, float fraction)>;
 
     inline void report(const ProgressCallback& cb, const std::string& step, float fraction)

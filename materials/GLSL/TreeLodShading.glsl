@@ -1,0 +1,34 @@
+// Shading helpers shared by TreeLodLit.frag and TreeLodBillboardCloud.frag: sRGB conversions
+// and, with SHADOW_RECEIVER, the sun's visibility in the integrated texture shadow.
+
+vec3 toLinear(vec3 c) { return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(0.04045, c)); }
+vec3 toSrgb(vec3 c)
+{
+    c = clamp(c, 0.0, 1.0);
+    return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+}
+
+#ifdef SHADOW_RECEIVER
+// Integrated texture shadows (OGRE-NOTES.md "Shadows"): the casters wrote the shadow
+// camera's window depth (TreeLodCaster.frag, TreeLodBillboardCloud.frag with CASTER), the
+// receiver computes the same from texture_viewproj_matrix; 3x3 percentage-closer filtering.
+uniform sampler2D shadowMap;
+uniform vec4 shadowTexelSize;  // 1 / width, 1 / height
+uniform float shadowBias;
+in vec4 vShadowPos;
+
+float sunVisibility()
+{
+    vec3 p = vShadowPos.xyz / vShadowPos.w;
+    float depth = 0.5 * p.z + 0.5 - shadowBias;
+    if (p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0 || depth >= 1.0)
+        return 1.0;
+    float lit = 0.0;
+    for (int y = -1; y <= 1; ++y)
+        for (int x = -1; x <= 1; ++x)
+            lit += depth <= texture(shadowMap, p.xy + vec2(x, y) * shadowTexelSize.xy).r ? 1.0 : 0.0;
+    return lit / 9.0;
+}
+#else
+float sunVisibility() { return 1.0; }
+#endif

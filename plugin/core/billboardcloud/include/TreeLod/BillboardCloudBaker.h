@@ -1,0 +1,94 @@
+// BillboardCloudBaker: TreeModel -> BillboardCloudData (BillboardCloudData.h), paper 000.
+//
+//   1. Clustering (§4.1): leaves grouped into planes, k-means-like on leaf planes with an
+//      error bound ([BCF*05], [GSSK05]); each billboard's quad bounds its leaves' projection.
+//      Three clouds of decreasing count (§6): counts C, C/3, C/9 (at least 1 each); the
+//      coarsest one is low-res only.
+//   2. Leaves Texture (§3, §5, §5.2): per leaf material, tiles for a hemi-octahedral set of
+//      orientations, both view sides, colour + normal map, mip-mapped.
+//   3. Hash and Lists (§4.2): per billboard a grid of cells; per cell the leaf fragments
+//      overlapping it, front to back (computed exactly on the CPU, instead of the paper's
+//      point sprites + depth peeling); AO per entry fitted to the tile corners (§5.2, Fig. 11).
+//   4. Low-resolution texture (§5.1) made by evaluating the layered representation, AO in alpha.
+//   5. Atlases (§6) and DXT compression (libsquish) of the colour textures.
+// The classic billboard cloud (the baseline of Fig. 13) is the finest cloud's billboards
+// with one plain RGBA texture each, its texel size chosen to fit a memory budget.
+//
+// Deterministic: the same model and options give byte-identical chunks for any thread count.
+#pragma once
+
+#include "TreeLod/BillboardCloudData.h"
+#include "TreeLod/PackageWriter.h"
+#include "TreeLod/Progress.h"
+#include "TreeLod/Result.h"
+#include "TreeLod/TreeModel.h"
+
+#include <cstdint>
+#include <string>
+
+namespace TreeLod
+{
+    struct BillboardCloudOptions
+    {
+        /// Billboards of the finest cloud; 0 = derived from the leaf count
+        /// (clamp(1.5 * sqrt(leaves), 8, 260), the paper's 60-260 for trees). Never more than
+        /// the leaves.
+        std::uint32_t billboardCount = 0;
+        /// Plane-fitting error bound: the largest distance of a leaf vertex from its billboard,
+        /// as a fraction of the tree's bounding-box diagonal.
+        float maxPlaneError = 0.04f;
+        /// Hash cell edge in median leaf lengths (cell size of a layered level). A leaf's length
+        /// here is its diameter (twice its largest vertex distance from its centre). 2: about
+        /// 1.6 entries per leaf per layered level, 1.5 MB for a 20k-leaf tree (README).
+        float cellLeafRatio = 2.0f;
+        /// Low-res texel edge of level 0 in median leaf lengths (levels 1 and 2: 2x and 4x).
+        float lowResLeafRatio = 0.75f;
+        std::uint32_t tileSize = 64;      ///< Leaves Texture tile edge, power of two >= 8
+        std::uint32_t orientationGrid = 5; ///< orientations per leaf material = grid^2 (odd: a cell centred on the leaf normal)
+        std::uint32_t listsAtlasWidth = 1024; ///< grows (power of two up to 4096) when needed
+        float listFactor = 1.0f;           ///< shader LoD factor stored in the chunk
+        bool compress = true;              ///< DXT5 leaves colour and low-res, DXT1 normals (libsquish)
+        int aoRays = 32;                   ///< per leaf vertex (AmbientOcclusion.h)
+    };
+
+    struct ClassicBillboardCloudOptions
+    {
+        BillboardCloudOptions cloud;  ///< clustering and compression settings (finest cloud)
+        /// GPU bytes for all billboard textures; 0 = the layered cloud's gpuBytes() with the
+        /// same options (the equal-memory comparison of paper 000 Fig. 13).
+        std::uint64_t memoryBytes = 0;
+    };
+
+    struct BillboardCloudStats
+    {
+        std::uint32_t leaves = 0;
+        std::uint32_t billboards[3] = {0, 0, 0};
+        std::uint32_t entries = 0;
+        std::uint32_t longestList = 0;    ///< before truncation (> 255: some lists were cut)
+        std::uint32_t truncatedCells = 0; ///< lists cut at 255 entries (reported, never silent)
+        float meanPlaneError = 0.0f;      ///< metres, finest cloud
+        float maxPlaneError = 0.0f;
+        std::uint64_t gpuBytes = 0;
+    };
+
+    /// Bake the multi-layered cloud. Errors (invalid model, an atlas beyond 2^24 entries or
+    /// GPU_TEXTURE_MAX_SIZE) name `label`. A model without leaves gives a valid cloud with no
+    /// billboards (the trunk is drawn by its mesh).
+    Result<BillboardCloudData> bakeBillboardCloud(const TreeModel& model, const BillboardCloudOptions& options,
+                                                  const std::string& label, const ProgressCallback& progress = {},
+                                                  BillboardCloudStats* stats = nullptr);
+
+    /// Bake the classic cloud (one level, `classic` set, no hash or lists).
+    Result<BillboardCloudData> bakeClassicBillboardCloud(const TreeModel& model,
+                                                         const ClassicBillboardCloudOptions& options,
+                                                         const std::string& label,
+                                                         const ProgressCallback& progress = {},
+                                                         BillboardCloudStats* stats = nullptr);
+
+    /// Package glue for `treelod bake` (BakeTechniques): adds the reference chunk (the trunk
+    /// mesh and materials come from it) and the cloud's chunk, default options.
+    Result<void> addBillboardCloudChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
+                                        const ProgressCallback& progress = {});
+    Result<void> addClassicBillboardCloudChunk(PackageWriter& writer, const TreeModel& model,
+                                               const std::string& label, const ProgressCallback& progress = {});
+}

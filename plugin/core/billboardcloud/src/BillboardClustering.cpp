@@ -1,0 +1,302 @@
+// BillboardClustering: leaf clustering into planes for the billboard clouds of paper 000 §4.1
+// (contract and deviations in BillboardClustering.h).
+#include "BillboardClustering.h"
+
+#include <Eigen/Dense>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace TreeLod
+{
+    namespace
+    {
+        constexpr float INF = std::numeric_limits<float>::infinity();
+        constexpr std::uint32_t NONE = std::numeric_limits<std::uint32_t>::max();
+
+        struct LeafData
+        {
+            glm::vec3 centre{0.0f}; ///< relative to the reference point
+            glm::vec3 normal{0.0f, 1.0f, 0.0f};
+            float weight = 1.0f; ///< area (least-squares weight)
+            float radius = 0.0f; ///< largest vertex distance from the centre
+            std::uint32_t first = 0, count = 0;
+        };
+
+        /// Largest distance of leaf `leaf`'s vertices to the plane (n, d); stops early, returning a
+        /// lower bound above `limit`, once that bound passes it.
+        float planeError(const LeafData& leaf, const std::vector<glm::vec3>& vertices, const glm::vec3& n, float d,
+                         float limit)
+        {
+            float e = 0.0f;
+            for (std::uint32_t v = leaf.first; v < leaf.first + leaf.count; ++v)
+            {
+                e = std::max(e, std::abs(glm::dot(n, vertices[v]) - d));
+                if (e > limit)
+                    return e;
+            }
+            return e;
+        }
+
+        glm::vec3 canonicalSign(const glm::vec3& n)
+        {
+            const glm::vec3 a = glm::abs(n);
+            const float big = a.x >= a.y && a.x >= a.z ? n.x : a.y >= a.z ? n.y : n.z;
+            return big < 0.0f ? -n : n;
+        }
+    }
+
+    LeafClustering clusterLeaves(const TreeModel& model, const LeafClusteringOptions& options)
+    {
+        LeafClustering out;
+        const std::uint32_t L = std::uint32_t(model.leaves.size());
+        if (L == 0)
+            return out;
+        const std::uint32_t C = std::clamp<std::uint32_t>(options.clusterCount, 1, L);
+        const float bound = std::max(options.errorBound, 0.0f);
+        const float w = std::max(options.spatialWeight, 0.0f);
+        const float wn = std::max(options.orientationWeight, 0.0f);
+
+        // Positions relative to the mean leaf centre (float precision for trees far from 0).
+        glm::dvec3 sum(0.0);
+        for (const Leaf& leaf : model.leaves)
+            sum += glm::dvec3(leaf.centre);
+        const glm::vec3 ref = glm::vec3(sum / double(L));
+        std::vector<glm::vec3> vertices(model.leafVertices.size());
+        for (std::size_t v = 0; v < vertices.size(); ++v)
+            vertices[v] = model.leafVertices[v].position - ref;
+        double areaSum = 0.0;
+        for (const Leaf& leaf : model.leaves)
+            areaSum += leaf.area;
+        const float fallbackWeight = areaSum > 0.0 ? float(areaSum / L) * 1e-3f : 1.0f;
+        std::vector<LeafData> leaves(L);
+        for (std::uint32_t i = 0; i < L; ++i)
+        {
+            const Leaf& src = model.leaves[i];
+            LeafData& leaf = leaves[i];
+            leaf.centre = src.centre - ref;
+            leaf.normal = glm::length(src.normal) > 0.0f ? glm::normalize(src.normal) : glm::vec3(0, 1, 0);
+            leaf.weight = src.area > 0.0f ? src.area : fallbackWeight;
+            leaf.first = src.firstVertex;
+            leaf.count = src.vertexCount;
+            for (std::uint32_t v = leaf.first; v < leaf.first + leaf.count; ++v)
+                leaf.radius = std::max(leaf.radius, glm::length(vertices[v] - leaf.centre));
+        }
+
+        // Seeds: farthest-point sampling of the centres.
+        std::vector<float> minDist(L, INF);
+        std::vector<std::uint32_t> seeds;
+        seeds.reserve(C);
+        std::uint32_t pick = 0;
+        for (std::uint32_t i = 1; i < L; ++i)
+            if (glm::length(leaves[i].centre) > glm::length(leaves[pick].centre))
+                pick = i;
+        for (std::uint32_t s = 0; s < C; ++s)
+        {
+            seeds.push_back(pick);
+            minDist[pick] = -1.0f; // chosen
+            const glm::vec3 c = leaves[pick].centre;
+            tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, L, 1024),
+                              [&](const tbb::blocked_range<std::uint32_t>& r) {
+                                  for (std::uint32_t i = r.begin(); i < r.end(); ++i)
+                                      if (minDist[i] >= 0.0f)
+                                          minDist[i] = std::min(minDist[i], glm::length(leaves[i].centre - c));
+                              });
+            if (s + 1 == C)
+                break;
+            float best = -1.0f;
+            for (std::uint32_t i = 0; i < L; ++i)
+                if (minDist[i] > best)
+                {
+                    best = minDist[i];
+                    pick = i;
+                }
+        }
+        std::vector<glm::vec3> normal(C), centroid(C);
+        std::vector<float> offset(C);
+        for (std::uint32_t k = 0; k < C; ++k)
+        {
+            const LeafData& leaf = leaves[seeds[k]];
+            normal[k] = leaf.normal;
+            offset[k] = glm::dot(leaf.normal, leaf.centre);
+            centroid[k] = leaf.centre;
+        }
+
+        std::vector<std::uint32_t> assign(L, NONE), next(L, NONE);
+        std::vector<float> error(L, 0.0f);
+        std::vector<std::vector<std::uint32_t>> members(C);
+
+        auto refit = [&]() {
+            for (auto& m : members)
+                m.clear();
+            for (std::uint32_t i = 0; i < L; ++i)
+                members[assign[i]].push_back(i);
+            tbb::parallel_for(std::uint32_t(0), C, [&](std::uint32_t k) {
+                const std::vector<std::uint32_t>& m = members[k];
+                if (m.empty())
+                    return;
+                double wsum = 0.0;
+                glm::dvec3 mean(0.0), g(0.0);
+                for (std::uint32_t i : m)
+                {
+                    const LeafData& leaf = leaves[i];
+                    const double wv = double(leaf.weight) / std::max<std::uint32_t>(leaf.count, 1);
+                    for (std::uint32_t v = leaf.first; v < leaf.first + leaf.count; ++v)
+                        mean += wv * glm::dvec3(vertices[v]);
+                    wsum += wv * leaf.count;
+                    g += double(leaf.weight) * glm::dvec3(leaf.centre);
+                }
+                double leafWeight = 0.0;
+                for (std::uint32_t i : m)
+                    leafWeight += leaves[i].weight;
+                if (!(wsum > 0.0) || !(leafWeight > 0.0))
+                    return;
+                mean /= wsum;
+                centroid[k] = glm::vec3(g / leafWeight);
+                Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+                for (std::uint32_t i : m)
+                {
+                    const LeafData& leaf = leaves[i];
+                    const double wv = double(leaf.weight) / std::max<std::uint32_t>(leaf.count, 1);
+                    for (std::uint32_t v = leaf.first; v < leaf.first + leaf.count; ++v)
+                    {
+                        const glm::dvec3 d = glm::dvec3(vertices[v]) - mean;
+                        const Eigen::Vector3d e(d.x, d.y, d.z);
+                        cov += wv * e * e.transpose();
+                    }
+                }
+                if (wn > 0.0f)
+                {
+                    // Orientation: minus the weighted leaf-normal scatter, scaled like the vertex
+                    // spread of a leaf (weight x (2 radius)^2).
+                    for (std::uint32_t i : m)
+                    {
+                        const LeafData& leaf = leaves[i];
+                        const Eigen::Vector3d nl(leaf.normal.x, leaf.normal.y, leaf.normal.z);
+                        const double l2 = 4.0 * double(leaf.radius) * leaf.radius;
+                        cov -= double(wn) * double(leaf.weight) * l2 * nl * nl.transpose();
+                    }
+                }
+                Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+                if (solver.info() != Eigen::Success)
+                    return;
+                const Eigen::Vector3d e = solver.eigenvectors().col(0);
+                glm::vec3 n(float(e.x()), float(e.y()), float(e.z()));
+                if (!(glm::length(n) > 0.5f) || !std::isfinite(n.x + n.y + n.z))
+                    return; // keep the previous plane
+                n = canonicalSign(glm::normalize(n));
+                normal[k] = n;
+                offset[k] = float(glm::dot(glm::dvec3(n), mean));
+            });
+        };
+
+        const std::uint32_t maxPasses = std::max<std::uint32_t>(options.maxIterations, 1);
+        std::uint32_t passes = 0;
+        while (passes < maxPasses)
+        {
+            ++passes;
+            // 1. Assignment (per leaf, in parallel).
+            tbb::parallel_for(
+                tbb::blocked_range<std::uint32_t>(0, L, 64), [&](const tbb::blocked_range<std::uint32_t>& r) {
+                    for (std::uint32_t i = r.begin(); i < r.end(); ++i)
+                    {
+                        const LeafData& leaf = leaves[i];
+                        float bestCost = INF, bestErr = 0.0f, fallbackErr = INF;
+                        std::uint32_t best = NONE, fallback = NONE;
+                        for (std::uint32_t k = 0; k < C; ++k)
+                        {
+                            const float spatial =
+                                w * glm::length(leaf.centre - centroid[k]) +
+                                wn * 2.0f * leaf.radius * (1.0f - std::abs(glm::dot(leaf.normal, normal[k])));
+                            if (best != NONE && spatial >= bestCost)
+                                continue;
+                            const float lower = std::abs(glm::dot(normal[k], leaf.centre) - offset[k]) - leaf.radius;
+                            if (lower > bound && (best != NONE || lower >= fallbackErr))
+                                continue;
+                            const float limit =
+                                best != NONE ? std::min(bound, bestCost - spatial) : std::max(bound, fallbackErr);
+                            const float e = planeError(leaf, vertices, normal[k], offset[k], limit);
+                            if (e <= bound)
+                            {
+                                if (e + spatial < bestCost)
+                                {
+                                    bestCost = e + spatial;
+                                    bestErr = e;
+                                    best = k;
+                                }
+                            }
+                            else if (e < fallbackErr)
+                            {
+                                fallbackErr = e;
+                                fallback = k;
+                            }
+                        }
+                        next[i] = best != NONE ? best : fallback;
+                        error[i] = best != NONE ? bestErr : fallbackErr;
+                    }
+                });
+            const bool changed = next != assign;
+            assign.swap(next);
+            if (!changed)
+                break;
+
+            // 2. Empty clusters take the worst-fitting leaves (of clusters that keep a leaf).
+            std::vector<std::uint32_t> count(C, 0);
+            for (std::uint32_t i = 0; i < L; ++i)
+                ++count[assign[i]];
+            std::vector<std::uint32_t> empty;
+            for (std::uint32_t k = 0; k < C; ++k)
+                if (count[k] == 0)
+                    empty.push_back(k);
+            if (!empty.empty())
+            {
+                std::vector<std::uint32_t> order(L);
+                std::iota(order.begin(), order.end(), 0u);
+                std::stable_sort(order.begin(), order.end(),
+                                 [&](std::uint32_t a, std::uint32_t b) { return error[a] > error[b]; });
+                std::size_t o = 0;
+                for (std::uint32_t k : empty)
+                {
+                    while (o < L && count[assign[order[o]]] <= 1)
+                        ++o;
+                    if (o == L)
+                        break;
+                    const std::uint32_t i = order[o++];
+                    --count[assign[i]];
+                    assign[i] = k;
+                    count[k] = 1;
+                    error[i] = 0.0f;
+                }
+            }
+
+            // 3. Refit planes and centroids.
+            refit();
+        }
+        refit(); // members of the final assignment (planes unchanged when it was stable)
+
+        // Final plane errors.
+        tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, L, 256),
+                          [&](const tbb::blocked_range<std::uint32_t>& r) {
+                              for (std::uint32_t i = r.begin(); i < r.end(); ++i)
+                                  error[i] = planeError(leaves[i], vertices, normal[assign[i]], offset[assign[i]], INF);
+                          });
+
+        out.normal = normal;
+        out.offset.resize(C);
+        out.centroid.resize(C);
+        for (std::uint32_t k = 0; k < C; ++k)
+        {
+            out.offset[k] = offset[k] + glm::dot(normal[k], ref);
+            out.centroid[k] = centroid[k] + ref;
+        }
+        out.cluster = std::move(assign);
+        out.error = std::move(error);
+        out.members = std::move(members);
+        out.iterations = passes;
+        return out;
+    }
+}

@@ -1,0 +1,151 @@
+// BillboardCloudTree: a tree drawn as a billboard cloud with multi-layered indirect texturing
+// (paper 000), or as the classic billboard cloud it is compared with. MovableObject type
+// "BillboardCloudTree".
+//
+// Foliage: the asset's billboard cloud chunk (TreeAsset::getBillboardCloudGpu): the quads of
+// all levels in one vertex buffer, one draw of one level's index range (§6). The fragment
+// shader (materials/GLSL/TreeLodBillboardCloud.frag) walks the hash/lists atlases (§5) with
+// shader LoD (§5.1); far away the material's LoD switches to the low-res technique.
+// Bark: the reference bark with its MeshLodGenerator levels, lit with the chunk's bark AO
+// (§5.2, §6 [Hop96]).
+//
+// Level of detail. Geometric (§6): the clouds are switched by an LoD value, Ogre's
+// AbsolutePixelCountLodStrategy units (pi * r^2 * viewport area * P00 * P11 / d^2, r the
+// bounding radius scaled by the node, the LoD camera's bias and the `lodBias` parameter
+// multiplying it; Ogre's pixel-count strategies ignore the bias) or, with
+// lodStrategy=distance, the squared distance to the world bounding box divided by the bias
+// (DistanceLodBoxStrategy's units; its thresholds are the pixel-count ones seen through the LoD
+// camera's projection). Thresholds follow the shader LoD so that a switch changes little
+// (§6: "consistent with the corresponding shader LoD at the time of the switch"):
+//   - a layered level gives way to the next layered level where its shader walks
+//     SWITCH_ENTRIES list entries (listFactor * projected cell diagonal = 4), the leaves the
+//     walk drops then come from the low-res texture in both;
+//   - the last layered level gives way to the low-res-only level exactly where its shader
+//     walks less than one entry, the value at which its material LoD (lod_values set by
+//     TreeAsset) selects the low-res technique: both draw the low-res texture alone there.
+// With a perspective camera the tree's projected radius is r_px = sqrt(value / (4 pi)) and a
+// hash cell's diagonal sqrt(2) * cellSize * r_px / radius pixels (billboardCloudPixelCount).
+// The shader's list factor is listFactor * sqrt(bias): supersampling by s with bias 1 / s^2
+// (OffscreenRenderer) walks the entries of the output image's pixels.
+//
+// Parameters (createMovableObject params, or the registry): asset (required with the factory),
+// group, classic (true | false: draw chunk "classic-billboard-cloud"), level (force level 0,
+// 1, 2...), lodStrategy (pixel_count, the default | distance), listFactor (overrides the
+// chunk's shader LoD factor; 0 = low-res texture only), lodBias (> 0, multiplies the camera's),
+// ambientOcclusion (true, the default | false: light like the polygonal reference, which has
+// no AO; the image-error study compares that way).
+#pragma once
+
+#include "TreeLod/TreeAsset.h"
+
+#include <OgreMovableObject.h>
+#include <OgreRenderable.h>
+
+#include <memory>
+#include <vector>
+
+namespace TreeLod
+{
+    class BillboardCloudTree : public Ogre::MovableObject
+    {
+    public:
+        enum class LodStrategy
+        {
+            PixelCount, ///< AbsolutePixelCountLodStrategy's value, times the bias
+            Distance    ///< squared distance to the bounding box, divided by the bias
+        };
+
+        struct Options
+        {
+            bool classic = false;
+            int level = -1;          ///< >= 0: always this level
+            LodStrategy strategy = LodStrategy::PixelCount;
+            float listFactor = -1.0f; ///< < 0: the chunk's
+            float lodBias = 1.0f;
+            bool ambientOcclusion = true; ///< false: no AO on leaves or bark (the polygonal reference's lighting)
+        };
+
+        /// List entries a layered level's shader walks where the next layered level takes over.
+        static constexpr float SWITCH_ENTRIES = 4.0f;
+
+        BillboardCloudTree(const Ogre::String& name, const TreeAssetPtr& asset, const Options& options);
+        ~BillboardCloudTree() override;
+
+        const TreeAssetPtr& getAsset() const { return mAsset; }
+        bool isClassic() const { return mOptions.classic; }
+        const Options& getOptions() const { return mOptions; }
+
+        /// Level drawn now (0 = finest cloud) and how many there are.
+        std::uint32_t getLevel() const { return mLevel; }
+        std::uint32_t getLevelCount() const { return std::uint32_t(mGpu->levels.size()); }
+        /// Force `level` (clamped), or follow the LoD strategy again with -1.
+        void setForcedLevel(int level);
+        /// Material LoD index of the drawn level's material: 0 layers, 1 low-res only.
+        unsigned short getMaterialLodIndex() const { return mMaterialLodIndex; }
+        /// Bark mesh LoD level in use (0 = full).
+        unsigned short getBarkLodIndex() const { return mBarkLodIndex; }
+
+        /// Shader LoD factor in use (the chunk's unless overridden); >= 0.
+        float getListFactor() const { return mListFactor; }
+        void setListFactor(float listFactor);
+
+        /// The last LoD value, in the strategy's units (bias applied), and its pixel-count
+        /// equivalent (what the thresholds and the material LoD compare).
+        Ogre::Real getLodValue() const { return mLodValue; }
+        Ogre::Real getPixelCountValue() const { return mPixelCountValue; }
+        /// Pixel-count value (bias applied) below which level `level` + 1 is drawn instead of
+        /// `level`; for level < getLevelCount() - 1.
+        Ogre::Real getSwitchPixelCount(std::uint32_t level) const { return mSwitchPixelCounts[level]; }
+        /// The level the strategy value `value` (its units, bias applied) selects; distance
+        /// values are converted with the projection of the last camera seen.
+        std::uint32_t levelForValue(Ogre::Real value) const;
+        /// The material LoD index for a pixel-count value (bias applied) at this list factor.
+        unsigned short materialLodIndexForPixelCount(Ogre::Real value) const;
+
+        // MovableObject
+        const Ogre::String& getMovableType() const override;
+        const Ogre::AxisAlignedBox& getBoundingBox() const override { return mGpu->bounds; }
+        Ogre::Real getBoundingRadius() const override { return mGpu->radius; }
+        void _notifyCurrentCamera(Ogre::Camera* camera) override;
+        void _updateRenderQueue(Ogre::RenderQueue* queue) override;
+        void visitRenderables(Ogre::Renderable::Visitor* visitor, bool debugRenderables = false) override;
+
+        /// Renderables: one per cloud level (its index range), one per bark submesh.
+        class Part;
+
+    private:
+        std::uint32_t levelForPixelCount(Ogre::Real value) const;
+        void updateSwitchValues();
+        void applyLevel();
+        bool useShadowedMaterials() const;
+
+        TreeAssetPtr mAsset;
+        const BillboardCloudGpu* mGpu;
+        Options mOptions;
+        float mListFactor = 1.0f;
+        std::vector<Ogre::Real> mSwitchPixelCounts;
+        std::vector<std::unique_ptr<Part>> mLevelParts;
+        std::vector<std::unique_ptr<Part>> mBarkParts;
+        Ogre::MeshPtr mBarkMesh;
+        std::uint32_t mLevel = 0;
+        unsigned short mMaterialLodIndex = 0;
+        unsigned short mBarkLodIndex = 0;
+        Ogre::Real mLodValue = 0.0f;
+        Ogre::Real mPixelCountValue = 0.0f;
+        Ogre::Real mBias = 1.0f;
+        Ogre::Real mDistanceToPixels = 0.0f; ///< pixel-count value * squared distance, last camera
+    };
+
+    class BillboardCloudTreeFactory : public Ogre::MovableObjectFactory
+    {
+    public:
+        static const Ogre::String FACTORY_TYPE_NAME;
+        const Ogre::String& getType() const override { return FACTORY_TYPE_NAME; }
+        /// Parse `params` (see BillboardCloudTree) into options; throws naming the bad parameter.
+        static BillboardCloudTree::Options parseOptions(const Ogre::NameValuePairList* params);
+
+    protected:
+        Ogre::MovableObject* createInstanceImpl(const Ogre::String& name,
+                                                const Ogre::NameValuePairList* params) override;
+    };
+}

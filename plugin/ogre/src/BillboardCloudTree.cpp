@@ -1,0 +1,356 @@
+// BillboardCloudTree: billboard clouds with multi-layered indirect texturing (paper 000 §5, §6).
+// See BillboardCloudTree.h for the LoD rules.
+#include "TreeLod/BillboardCloudTree.h"
+
+#include "TreeLod/TreeAssetManager.h"
+
+#include <OgreCamera.h>
+#include <OgreException.h>
+#include <OgreMaterialManager.h>
+#include <OgreNode.h>
+#include <OgreRenderQueue.h>
+#include <OgreSceneManager.h>
+#include <OgreSubMesh.h>
+#include <OgreTechnique.h>
+#include <OgreViewport.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace TreeLod
+{
+    /// One draw of a BillboardCloudTree: a cloud level's index range, or a bark submesh.
+    class BillboardCloudTree::Part : public Ogre::Renderable
+    {
+    public:
+        Part(BillboardCloudTree& parent, Ogre::VertexData* vertexData, const Ogre::String& material,
+             const Ogre::String& shadowedMaterial, bool cloud)
+            : mParent(parent), mVertexData(vertexData), mCloud(cloud)
+        {
+            const Ogre::String& group = parent.mAsset->getGroup();
+            mMaterial = Ogre::MaterialManager::getSingleton().getByName(material, group);
+            if (!shadowedMaterial.empty())
+                mShadowedMaterial = Ogre::MaterialManager::getSingleton().getByName(shadowedMaterial, group);
+            if (!mMaterial)
+                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND, "material '" + material + "' not found",
+                            "BillboardCloudTree");
+            for (Ogre::MaterialPtr* m : {&mMaterial, &mShadowedMaterial})
+                if (*m)
+                    (*m)->load();
+        }
+
+        Ogre::IndexData mIndexData;            ///< cloud parts: the level's range of the shared buffer
+        std::vector<Ogre::IndexData*> mLevels; ///< bark parts: index data per mesh LoD level
+
+        const Ogre::MaterialPtr& getMaterial() const override
+        {
+            return mShadowedMaterial && mParent.useShadowedMaterials() ? mShadowedMaterial : mMaterial;
+        }
+        /// Custom Renderables pick the material LoD technique themselves (§5.1: layers close
+        /// up, the low-res texture alone far away).
+        Ogre::Technique* getTechnique() const override
+        {
+            return getMaterial()->getBestTechnique(mCloud ? mParent.mMaterialLodIndex : 0, this);
+        }
+        void getRenderOperation(Ogre::RenderOperation& op) override
+        {
+            op.operationType = Ogre::RenderOperation::OT_TRIANGLE_LIST;
+            op.useIndexes = true;
+            op.vertexData = mVertexData;
+            op.indexData = mLevels.empty() ? &mIndexData
+                                           : mLevels[std::min<std::size_t>(mParent.mBarkLodIndex, mLevels.size() - 1)];
+        }
+        void getWorldTransforms(Ogre::Matrix4* xform) const override { *xform = mParent._getParentNodeFullTransform(); }
+        Ogre::Real getSquaredViewDepth(const Ogre::Camera* camera) const override
+        {
+            return mParent.getParentNode() ? mParent.getParentNode()->getSquaredViewDepth(camera) : 0.0f;
+        }
+        const Ogre::LightList& getLights() const override { return mParent.queryLights(); }
+        bool getCastsShadows() const override { return mParent.getCastShadows(); }
+
+    private:
+        BillboardCloudTree& mParent;
+        Ogre::VertexData* mVertexData;
+        bool mCloud;
+        Ogre::MaterialPtr mMaterial;
+        Ogre::MaterialPtr mShadowedMaterial;
+    };
+
+    const Ogre::String BillboardCloudTreeFactory::FACTORY_TYPE_NAME = "BillboardCloudTree";
+
+    BillboardCloudTree::BillboardCloudTree(const Ogre::String& name, const TreeAssetPtr& asset, const Options& options)
+        : Ogre::MovableObject(name), mAsset(asset), mGpu(&asset->getBillboardCloudGpu(options.classic)),
+          mOptions(options)
+    {
+        const std::uint32_t levels = getLevelCount();
+        if (mOptions.level >= 0 && std::uint32_t(mOptions.level) >= std::max<std::uint32_t>(levels, 1))
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                        "parameter 'level': " + std::to_string(mOptions.level) +
+                            " is not a level of the cloud (it has " + std::to_string(levels) + ")",
+                        "BillboardCloudTree '" + name + "'");
+        mListFactor = mOptions.listFactor >= 0.0f ? mOptions.listFactor : mGpu->listFactor;
+        updateSwitchValues();
+
+        if (mGpu->vertexData)
+            for (const BillboardCloudGpu::Level& level : mGpu->levels)
+            {
+                auto part = std::make_unique<Part>(*this, mGpu->vertexData.get(), level.material,
+                                                   level.shadowedMaterial, true);
+                part->mIndexData.indexBuffer = mGpu->indexBuffer;
+                part->mIndexData.indexStart = level.indexStart;
+                part->mIndexData.indexCount = level.indexCount;
+                mLevelParts.push_back(std::move(part));
+            }
+
+        if (!mAsset->getReference().model.barkIndices.empty())
+        {
+            // ambientOcclusion=false: the reference's own bark (no AO), lit like the polygonal tree.
+            const bool ao = mOptions.ambientOcclusion;
+            mBarkMesh = ao ? mAsset->getBarkAoMesh(mOptions.classic) : mAsset->getBarkMesh();
+            const std::vector<Ogre::String>& plain = ao ? mAsset->getBarkAoMaterialNames(false)
+                                                        : mAsset->getMaterialNames();
+            const std::vector<Ogre::String>& shadowed = ao ? mAsset->getBarkAoMaterialNames(true)
+                                                           : mAsset->getShadowedMaterialNames();
+            for (Ogre::SubMesh* sub : mBarkMesh->getSubMeshes())
+            {
+                const auto it = std::find(plain.begin(), plain.end(), sub->getMaterialName());
+                const Ogre::String receiver = it == plain.end() ? "" : shadowed[std::size_t(it - plain.begin())];
+                auto part = std::make_unique<Part>(*this, sub->vertexData, sub->getMaterialName(), receiver, false);
+                part->mLevels.push_back(sub->indexData);
+                for (Ogre::IndexData* level : sub->mLodFaceList)
+                    part->mLevels.push_back(level);
+                mBarkParts.push_back(std::move(part));
+            }
+        }
+        mLevel = mOptions.level >= 0 ? std::uint32_t(mOptions.level) : 0;
+        applyLevel();
+    }
+
+    BillboardCloudTree::~BillboardCloudTree() = default;
+
+    const Ogre::String& BillboardCloudTree::getMovableType() const
+    {
+        return BillboardCloudTreeFactory::FACTORY_TYPE_NAME;
+    }
+
+    void BillboardCloudTree::updateSwitchValues()
+    {
+        // §6: switches consistent with the shader LoD (BillboardCloudTree.h).
+        mSwitchPixelCounts.assign(mGpu->levels.size() > 1 ? mGpu->levels.size() - 1 : 0, 0.0f);
+        for (std::size_t l = 0; l < mSwitchPixelCounts.size(); ++l)
+        {
+            const BillboardCloudGpu::Level& level = mGpu->levels[l];
+            const BillboardCloudGpu::Level& next = mGpu->levels[l + 1];
+            if (level.layered)
+                mSwitchPixelCounts[l] = billboardCloudPixelCount(next.layered ? SWITCH_ENTRIES : 1.0f, level.cellSize,
+                                                                 float(mGpu->radius), mListFactor);
+            else // a low-res level before another: keep the finer one as long as the one before
+                mSwitchPixelCounts[l] = l > 0 ? mSwitchPixelCounts[l - 1] : 0.0f;
+            // listFactor 0: the layered levels walk nothing at any size.
+            if (mSwitchPixelCounts[l] == std::numeric_limits<Ogre::Real>::max() && l > 0)
+                mSwitchPixelCounts[l] = mSwitchPixelCounts[l - 1];
+        }
+    }
+
+    void BillboardCloudTree::setListFactor(float listFactor)
+    {
+        if (!(listFactor >= 0.0f) || !std::isfinite(listFactor))
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                        "listFactor must be a finite number >= 0, got " + std::to_string(listFactor),
+                        "BillboardCloudTree '" + mName + "'");
+        mListFactor = listFactor;
+        updateSwitchValues();
+        applyLevel();
+    }
+
+    void BillboardCloudTree::setForcedLevel(int level)
+    {
+        mOptions.level = level < 0 ? -1 : std::min(level, int(std::max<std::uint32_t>(getLevelCount(), 1)) - 1);
+        if (mOptions.level >= 0)
+            mLevel = std::uint32_t(mOptions.level);
+        applyLevel();
+    }
+
+    std::uint32_t BillboardCloudTree::levelForPixelCount(Ogre::Real value) const
+    {
+        for (std::uint32_t l = 0; l < mSwitchPixelCounts.size(); ++l)
+            if (value >= mSwitchPixelCounts[l])
+                return l;
+        return std::uint32_t(mSwitchPixelCounts.size());
+    }
+
+    std::uint32_t BillboardCloudTree::levelForValue(Ogre::Real value) const
+    {
+        if (mOptions.strategy == LodStrategy::Distance)
+            value = value > 0.0f ? mDistanceToPixels / value : std::numeric_limits<Ogre::Real>::max();
+        return levelForPixelCount(value);
+    }
+
+    unsigned short BillboardCloudTree::materialLodIndexForPixelCount(Ogre::Real value) const
+    {
+        if (mLevel >= mGpu->levels.size() || !mGpu->levels[mLevel].layered || mLevelParts.empty())
+            return 0;
+        // The clone's lod_values are for the chunk's list factor; the switch (one entry walked)
+        // moves with value * (listFactor / chunk's)^2.
+        const float ratio = mGpu->listFactor > 0.0f ? mListFactor / mGpu->listFactor : 0.0f;
+        const Ogre::MaterialPtr& material = mLevelParts[mLevel]->getMaterial();
+        return material->getLodIndex(value * ratio * ratio);
+    }
+
+    void BillboardCloudTree::applyLevel()
+    {
+        // The shader's list factor: bias multiplies pixel areas, so lengths scale by its root.
+        // y: weight of the ambient occlusion term (0 = none, as the polygonal reference draws).
+        const Ogre::Vector4 lodParams(mListFactor * std::sqrt(mBias), mOptions.ambientOcclusion ? 1.0f : 0.0f, 0.0f,
+                                      0.0f);
+        for (const std::unique_ptr<Part>& part : mLevelParts)
+            part->setCustomParameter(0, lodParams);
+        mMaterialLodIndex = materialLodIndexForPixelCount(mPixelCountValue);
+    }
+
+    void BillboardCloudTree::_notifyCurrentCamera(Ogre::Camera* camera)
+    {
+        Ogre::MovableObject::_notifyCurrentCamera(camera);
+        if (!mParentNode)
+            return;
+        // The LoD camera (the viewer's, for shadow cameras) and its bias decide.
+        const Ogre::Camera* lod = camera->getLodCamera();
+        mBias = lod->getLodBias() * mOptions.lodBias;
+        const Ogre::Viewport* viewport = lod->getViewport();
+        const Ogre::Real area = viewport ? Ogre::Real(viewport->getActualWidth() * viewport->getActualHeight()) : 0.0f;
+        const Ogre::Real radius = getBoundingRadiusScaled();
+        const Ogre::Real circle = Ogre::Math::PI * radius * radius;
+        const Ogre::Real maxValue = std::numeric_limits<Ogre::Real>::max();
+        Ogre::Real pixels = maxValue;
+        if (lod->getProjectionType() == Ogre::PT_PERSPECTIVE)
+        {
+            // AbsolutePixelCountLodStrategy, with the radius the node scales.
+            const Ogre::Matrix4& projection = lod->getProjectionMatrix();
+            mDistanceToPixels = circle * area * projection[0][0] * projection[1][1];
+            const Ogre::Real depth2 = mParentNode->getSquaredViewDepth(lod);
+            if (depth2 > std::numeric_limits<Ogre::Real>::epsilon())
+                pixels = mDistanceToPixels / depth2;
+        }
+        else
+        {
+            // The same units as a perspective camera's (4 pi r_px^2; Ogre's orthographic value is pi r_px^2).
+            const Ogre::Real window = lod->getOrthoWindowWidth() * lod->getOrthoWindowHeight();
+            mDistanceToPixels = 0.0f;
+            if (window > std::numeric_limits<Ogre::Real>::epsilon())
+                pixels = 4.0f * circle * area / window;
+        }
+        mPixelCountValue = pixels == maxValue ? maxValue : pixels * mBias;
+        if (mOptions.strategy == LodStrategy::Distance)
+        {
+            // DistanceLodBoxStrategy's value; its pixel-count equivalent through this projection.
+            const Ogre::Real distance = getWorldBoundingBox(true).distance(lod->getDerivedPosition());
+            mLodValue = distance * distance / mBias;
+            if (mDistanceToPixels > 0.0f)
+                mPixelCountValue = mLodValue > 0.0f ? mDistanceToPixels / mLodValue : maxValue;
+        }
+        else
+            mLodValue = mPixelCountValue;
+
+        if (mOptions.level < 0)
+            mLevel = levelForPixelCount(mPixelCountValue);
+        if (mBarkMesh)
+            mBarkLodIndex = mBarkMesh->getLodIndex(mPixelCountValue);
+        applyLevel();
+    }
+
+    bool BillboardCloudTree::useShadowedMaterials() const
+    {
+        return mManager && mManager->isShadowTechniqueTextureBased() && mManager->isShadowTechniqueIntegrated();
+    }
+
+    void BillboardCloudTree::_updateRenderQueue(Ogre::RenderQueue* queue)
+    {
+        for (const std::unique_ptr<Part>& part : mBarkParts)
+            queue->addRenderable(part.get(), mRenderQueueID, mRenderQueuePriority);
+        if (mLevel < mLevelParts.size() && mLevelParts[mLevel]->mIndexData.indexCount > 0)
+            queue->addRenderable(mLevelParts[mLevel].get(), mRenderQueueID, mRenderQueuePriority);
+    }
+
+    void BillboardCloudTree::visitRenderables(Ogre::Renderable::Visitor* visitor, bool)
+    {
+        for (const std::unique_ptr<Part>& part : mBarkParts)
+            visitor->visit(part.get(), 0, false);
+        for (std::size_t l = 0; l < mLevelParts.size(); ++l)
+            visitor->visit(mLevelParts[l].get(), Ogre::ushort(l), false);
+    }
+
+    BillboardCloudTree::Options BillboardCloudTreeFactory::parseOptions(const Ogre::NameValuePairList* params)
+    {
+        BillboardCloudTree::Options options;
+        if (!params)
+            return options;
+        auto bad = [](const char* key, const Ogre::String& value, const Ogre::String& expected) {
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                        Ogre::String("parameter '") + key + "': '" + value + "' is not " + expected,
+                        "BillboardCloudTreeFactory");
+        };
+        auto number = [&](const char* key, double lo, double hi, double& out) {
+            auto it = params->find(key);
+            if (it == params->end())
+                return false;
+            char* end = nullptr;
+            out = std::strtod(it->second.c_str(), &end);
+            if (it->second.empty() || *end != '\0' || !(out >= lo && out <= hi))
+                bad(key, it->second, "a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+            return true;
+        };
+        double v = 0.0;
+        auto classic = params->find("classic");
+        if (classic != params->end())
+        {
+            if (classic->second != "true" && classic->second != "false")
+                bad("classic", classic->second, "true or false");
+            options.classic = classic->second == "true";
+        }
+        if (number("level", 0.0, 255.0, v))
+        {
+            if (v != std::floor(v))
+                bad("level", params->at("level"), "a whole number");
+            options.level = int(v);
+        }
+        auto strategy = params->find("lodStrategy");
+        if (strategy != params->end())
+        {
+            if (strategy->second == "pixel_count")
+                options.strategy = BillboardCloudTree::LodStrategy::PixelCount;
+            else if (strategy->second == "distance")
+                options.strategy = BillboardCloudTree::LodStrategy::Distance;
+            else
+                bad("lodStrategy", strategy->second, "pixel_count or distance");
+        }
+        auto ao = params->find("ambientOcclusion");
+        if (ao != params->end())
+        {
+            if (ao->second != "true" && ao->second != "false")
+                bad("ambientOcclusion", ao->second, "true or false");
+            options.ambientOcclusion = ao->second == "true";
+        }
+        if (number("listFactor", 0.0, 1e6, v))
+            options.listFactor = float(v);
+        if (number("lodBias", 1e-6, 1e6, v))
+            options.lodBias = float(v);
+        return options;
+    }
+
+    Ogre::MovableObject* BillboardCloudTreeFactory::createInstanceImpl(const Ogre::String& name,
+                                                                       const Ogre::NameValuePairList* params)
+    {
+        auto asset = params ? params->find("asset") : Ogre::NameValuePairList::const_iterator();
+        if (!params || asset == params->end())
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                        "BillboardCloudTree '" + name + "': parameter 'asset' is required",
+                        "BillboardCloudTreeFactory::createInstanceImpl");
+        const BillboardCloudTree::Options options = parseOptions(params);
+        auto group = params->find("group");
+        TreeAssetPtr tree = TreeAssetManager::getSingleton().load(
+            asset->second, group == params->end() ? Ogre::ResourceGroupManager::AUTODETECT_RESOURCE_GROUP_NAME
+                                                  : group->second);
+        return new BillboardCloudTree(name, tree, options);
+    }
+}
