@@ -7,7 +7,8 @@
 //    (wall clock of bakeBillboardCloud on this machine, AO included), and the classic cloud
 //    baked at the same memory.
 // 2. Image error: the error tree seen with the tree filling the view (90 % of the height), a
-//    quarter of the view height and 32 px tall. Reference ("mesh"), classic and multi-layered
+//    quarter of the view height and 32 px tall, and close up (3x the view height: branches and
+//    leaves). Reference ("mesh"), classic and multi-layered
 //    are rendered by the same Ogre pipeline at S x S supersampling, the clouds without their AO
 //    term (the polygonal reference has none); multi-scale RMSE (paper 001 §4) and FLIP over the
 //    square around the tree. Pictures: reference | classic |
@@ -224,7 +225,10 @@ namespace TreeLod
                 params["listFactor"] = format("%g", args.listFactor);
             populate(renderer, scene, 1, 0.0f, params);
             const double height = tree.model.boundsMax.y - tree.model.boundsMin.y;
-            const std::vector<ErrorView> views = {{"fill", 0.9, 0.0}, {"quarter", 0.25, 0.0}, {"32px", 0.0, 32.0}};
+            // The three views, and a close-up (the tree 3x the view's height: branches and
+            // leaves, where paper 000 §7 says the layers matter most).
+            const std::vector<ErrorView> views = {
+                {"close", 3.0, 0.0}, {"fill", 0.9, 0.0}, {"quarter", 0.25, 0.0}, {"32px", 0.0, 32.0}};
             std::vector<ErrorRow> rows;
             for (const ErrorView& view : views)
             {
@@ -273,7 +277,7 @@ namespace TreeLod
                 Result<FlipResult> heat = flip(crops[0], crops[2], keep);
                 if (!heat)
                     throw StudyError("FLIP: " + heat.error().message());
-                const int panel = std::max(args.size / 2, 192);
+                const int panel = args.size;
                 const Crop whole{0, 0, crop.side};
                 Image p0 = magnify(crops[0], whole, panel), p1 = magnify(crops[1], whole, panel),
                       p2 = magnify(crops[2], whole, panel), p3 = magnify(flipHeatmap(*heat), whole, panel);

@@ -363,7 +363,7 @@ namespace TreeLod
 
         std::vector<std::uint32_t> levels;
         std::vector<Ogre::Real> values;
-        for (const char* view : {"orbit:30,10,0.5", "orbit:30,10,2", "orbit:30,10,6", "orbit:30,10,20"})
+        for (const char* view : {"orbit:30,10,0.5", "orbit:30,10,2", "orbit:30,10,6", "orbit:30,10,20", "orbit:30,10,80"})
         {
             r.render(camera(oak.model, view), 128, 128, 1);
             levels.push_back(tree->getLevel());
@@ -397,7 +397,7 @@ namespace TreeLod
         // down with distance, consistently with levelForValue.
         tree = placeCloud(oak.asset, {{"lodStrategy", "distance"}});
         std::vector<std::uint32_t> byDistance;
-        for (const char* view : {"orbit:30,10,0.5", "orbit:30,10,2", "orbit:30,10,6", "orbit:30,10,20"})
+        for (const char* view : {"orbit:30,10,0.5", "orbit:30,10,2", "orbit:30,10,6", "orbit:30,10,20", "orbit:30,10,80"})
         {
             const CameraSpec spec = camera(oak.model, view);
             r.render(spec, 128, 128, 1);

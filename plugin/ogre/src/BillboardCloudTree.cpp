@@ -2,6 +2,8 @@
 // See BillboardCloudTree.h for the LoD rules.
 #include "TreeLod/BillboardCloudTree.h"
 
+#include "TreePart.h"
+
 #include "TreeLod/TreeAssetManager.h"
 
 #include <OgreCamera.h>
@@ -21,60 +23,31 @@
 namespace TreeLod
 {
     /// One draw of a BillboardCloudTree: a cloud level's index range, or a bark submesh.
-    class BillboardCloudTree::Part : public Ogre::Renderable
+    class BillboardCloudTree::Part : public TreePart
     {
     public:
         Part(BillboardCloudTree& parent, Ogre::VertexData* vertexData, const Ogre::String& material,
              const Ogre::String& shadowedMaterial, bool cloud)
-            : mParent(parent), mVertexData(vertexData), mCloud(cloud)
+            : TreePart(parent, parent.mAsset->getGroup(), vertexData, material, shadowedMaterial,
+                       "BillboardCloudTree"),
+              mParent(parent), mCloud(cloud)
         {
-            const Ogre::String& group = parent.mAsset->getGroup();
-            mMaterial = Ogre::MaterialManager::getSingleton().getByName(material, group);
-            if (!shadowedMaterial.empty())
-                mShadowedMaterial = Ogre::MaterialManager::getSingleton().getByName(shadowedMaterial, group);
-            if (!mMaterial)
-                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND, "material '" + material + "' not found",
-                            "BillboardCloudTree");
-            for (Ogre::MaterialPtr* m : {&mMaterial, &mShadowedMaterial})
-                if (*m)
-                    (*m)->load();
         }
 
-        Ogre::IndexData mIndexData;            ///< cloud parts: the level's range of the shared buffer
-        std::vector<Ogre::IndexData*> mLevels; ///< bark parts: index data per mesh LoD level
-
-        const Ogre::MaterialPtr& getMaterial() const override
-        {
-            return mShadowedMaterial && mParent.useShadowedMaterials() ? mShadowedMaterial : mMaterial;
-        }
         /// Custom Renderables pick the material LoD technique themselves (§5.1: layers close
         /// up, the low-res texture alone far away).
         Ogre::Technique* getTechnique() const override
         {
             return getMaterial()->getBestTechnique(mCloud ? mParent.mMaterialLodIndex : 0, this);
         }
-        void getRenderOperation(Ogre::RenderOperation& op) override
-        {
-            op.operationType = Ogre::RenderOperation::OT_TRIANGLE_LIST;
-            op.useIndexes = true;
-            op.vertexData = mVertexData;
-            op.indexData = mLevels.empty() ? &mIndexData
-                                           : mLevels[std::min<std::size_t>(mParent.mBarkLodIndex, mLevels.size() - 1)];
-        }
-        void getWorldTransforms(Ogre::Matrix4* xform) const override { *xform = mParent._getParentNodeFullTransform(); }
-        Ogre::Real getSquaredViewDepth(const Ogre::Camera* camera) const override
-        {
-            return mParent.getParentNode() ? mParent.getParentNode()->getSquaredViewDepth(camera) : 0.0f;
-        }
-        const Ogre::LightList& getLights() const override { return mParent.queryLights(); }
-        bool getCastsShadows() const override { return mParent.getCastShadows(); }
+
+    protected:
+        bool useShadowedMaterials() const override { return mParent.useShadowedMaterials(); }
+        unsigned short barkLodIndex() const override { return mParent.mBarkLodIndex; }
 
     private:
         BillboardCloudTree& mParent;
-        Ogre::VertexData* mVertexData;
         bool mCloud;
-        Ogre::MaterialPtr mMaterial;
-        Ogre::MaterialPtr mShadowedMaterial;
     };
 
     const Ogre::String BillboardCloudTreeFactory::FACTORY_TYPE_NAME = "BillboardCloudTree";

@@ -1,5 +1,7 @@
 #include "TreeLod/FoliageLodTree.h"
 
+#include "TreePart.h"
+
 #include "TreeLod/TreeAssetManager.h"
 
 #include <OgreCamera.h>
@@ -19,53 +21,22 @@
 namespace TreeLod
 {
     /// One draw of a FoliageLodTree: a leaf material's regions, or a bark submesh.
-    class FoliageLodTree::Part : public Ogre::Renderable
+    class FoliageLodTree::Part : public TreePart
     {
     public:
         Part(FoliageLodTree& parent, Ogre::VertexData* vertexData, const Ogre::String& material,
              const Ogre::String& shadowedMaterial)
-            : mParent(parent), mVertexData(vertexData)
+            : TreePart(parent, parent.mAsset->getGroup(), vertexData, material, shadowedMaterial, "FoliageLodTree"),
+              mParent(parent)
         {
-            const Ogre::String& group = parent.mAsset->getGroup();
-            mMaterial = Ogre::MaterialManager::getSingleton().getByName(material, group);
-            if (!shadowedMaterial.empty())
-                mShadowedMaterial = Ogre::MaterialManager::getSingleton().getByName(shadowedMaterial, group);
-            for (Ogre::MaterialPtr* m : {&mMaterial, &mShadowedMaterial})
-                if (*m)
-                    (*m)->load();
-            if (!mMaterial)
-                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND, "material '" + material + "' not found",
-                            "FoliageLodTree");
         }
 
-        Ogre::IndexData mIndexData;           ///< leaf parts: start and count in the instance's buffer
-        std::vector<Ogre::IndexData*> mLevels; ///< bark parts: index data per mesh LoD level
-
-        const Ogre::MaterialPtr& getMaterial() const override
-        {
-            return mShadowedMaterial && mParent.useShadowedMaterials() ? mShadowedMaterial : mMaterial;
-        }
-        void getRenderOperation(Ogre::RenderOperation& op) override
-        {
-            op.operationType = Ogre::RenderOperation::OT_TRIANGLE_LIST;
-            op.useIndexes = true;
-            op.vertexData = mVertexData;
-            op.indexData = mLevels.empty() ? &mIndexData
-                                           : mLevels[std::min<std::size_t>(mParent.mBarkLodIndex, mLevels.size() - 1)];
-        }
-        void getWorldTransforms(Ogre::Matrix4* xform) const override { *xform = mParent._getParentNodeFullTransform(); }
-        Ogre::Real getSquaredViewDepth(const Ogre::Camera* camera) const override
-        {
-            return mParent.getParentNode() ? mParent.getParentNode()->getSquaredViewDepth(camera) : 0.0f;
-        }
-        const Ogre::LightList& getLights() const override { return mParent.queryLights(); }
-        bool getCastsShadows() const override { return mParent.getCastShadows(); }
+    protected:
+        bool useShadowedMaterials() const override { return mParent.useShadowedMaterials(); }
+        unsigned short barkLodIndex() const override { return mParent.mBarkLodIndex; }
 
     private:
         FoliageLodTree& mParent;
-        Ogre::VertexData* mVertexData;
-        Ogre::MaterialPtr mMaterial;
-        Ogre::MaterialPtr mShadowedMaterial;
     };
 
     const Ogre::String FoliageLodTreeFactory::FACTORY_TYPE_NAME = "FoliageLodTree";
