@@ -36,6 +36,7 @@ namespace TreeLod
             float pixelsPerLeaf = 0.0f;
             float lodBias = 1.0f;
             bool shadows = false;
+            std::string shadowCamera = "focused";
             int level = -1;
             float listFactor = -1.0f;
             std::vector<std::string> leafMaterials;
@@ -56,6 +57,8 @@ namespace TreeLod
                 return printError(fail("", "--supersample", "must be 1..8 samples per axis"));
             if (!(args.lodBias > 0.0f))
                 return printError(fail("", "--lod-bias", "must be a positive number"));
+            if (args.shadowCamera != "focused" && args.shadowCamera != "lispsm")
+                return printError(fail("", "--shadow-camera", "'" + args.shadowCamera + "' is not focused or lispsm"));
             if (args.renderer != "cpu" && args.renderer != "ogre")
                 return printError(fail("", "--renderer", "'" + args.renderer + "' is not ogre or cpu"));
             ProgressCallback progress = makeProgress();
@@ -116,7 +119,8 @@ namespace TreeLod
                         params["level"] = std::to_string(args.level);
                     if (args.listFactor >= 0.0f)
                         params["listFactor"] = std::to_string(args.listFactor);
-                    renderer.setShadows(args.shadows);
+                    renderer.setShadows(args.shadows, 2048,
+                                        args.shadowCamera == "lispsm" ? ShadowCamera::LiSPSM : ShadowCamera::Focused);
                     renderer.setLodBias(args.lodBias);
                     Ogre::MovableObject* object = TechniqueRegistry::getSingleton().createInstance(
                         args.technique, renderer.getSceneManager(), "tree", *asset, params);
@@ -157,7 +161,10 @@ namespace TreeLod
                         "billboard-cloud: shader LoD, list entries walked per pixel of projected hash-cell diagonal "
                         "(0 = low-res texture only; default from the package)");
         cmd->add_option("--lod-bias", args->lodBias, "camera LoD bias (> 1 = more detail)");
-        cmd->add_flag("--shadows", args->shadows, "texture shadows from the sun (focused shadow camera, 2048^2 float depth)");
+        cmd->add_flag("--shadows", args->shadows, "texture shadows from the sun (2048^2 float depth)");
+        cmd->add_option("--shadow-camera", args->shadowCamera,
+                        "with --shadows: focused (orthographic, Ogre's FocusedShadowCameraSetup) or lispsm "
+                        "(LiSPSMShadowCameraSetup, paper 000 §5.2)");
         cmd->add_option("--camera", args->camera,
                         "orbit:AZIMUTH,ELEVATION,DISTANCE (degrees; distance 1 = tree fills the view), "
                         "ortho:AZ,EL,DIST, or PX,PY,PZ,TX,TY,TZ[,FOV]");

@@ -16,9 +16,11 @@ done
 "$treelod" render "$out/oak.treelod" --technique billboard-cloud --camera orbit:30,10,8 --size 128x128 -o "$out/far.png"
 "$treelod" render "$out/oak.treelod" --technique billboard-cloud --level 2 --size 128x128 -o "$out/lowres.png"
 "$treelod" render "$out/oak.treelod" --technique classic-billboard-cloud --size 128x128 -o "$out/classic.png"
+"$treelod" render "$out/oak.treelod" --technique billboard-cloud --shadows --shadow-camera lispsm --size 128x128 \
+  -o "$out/shadows.png"
 # A .glb is baked in memory with the chunk the technique needs.
 "$treelod" render "$src/media/birch.glb" --technique billboard-cloud --size 128x128 --supersample 1 -o "$out/birch.png"
-for f in near far lowres classic birch; do [ -s "$out/$f.png" ] || { echo "$f.png missing"; exit 1; }; done
+for f in near far lowres classic shadows birch; do [ -s "$out/$f.png" ] || { echo "$f.png missing"; exit 1; }; done
 
 # A package without the chunk: exit 2, a message naming it, no output.
 "$treelod" bake "$src/media/birch.glb" -q -o "$out/birch-ref.treelod"
