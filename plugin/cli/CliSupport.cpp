@@ -40,7 +40,8 @@ namespace TreeLod
         return [state, tty, isWarning](const std::string& step, float fraction) {
             if (isWarning(step))
             {
-                std::fprintf(stderr, "%s%s\n", tty && state->shown >= 0 && state->shown < 100 ? "\n" : "", step.c_str());
+                const bool midBar = tty && state->shown >= 0 && state->shown < 100;
+                std::fprintf(stderr, "%s%s\n", midBar ? "\n" : "", step.c_str());
                 return;
             }
             int percent = int(fraction * 100.0f + 0.5f);

@@ -260,16 +260,6 @@ namespace TreeLod
 
         // ---- billboards (§4.1) -------------------------------------------------------------------
 
-        std::uint32_t gridCell(float g, std::uint32_t size)
-        {
-            const float f = std::floor(g);
-            if (!(f >= 0.0f))
-                return 0;
-            if (f >= float(size - 1))
-                return size - 1;
-            return std::uint32_t(f);
-        }
-
         /// The quad of cluster k: plane oriented outwards, axes by 2D PCA, the rectangle holding
         /// every leaf's projection and tile square, padded to whole cells of `cellSize`.
         void buildBillboard(const BakeContext& ctx, const LeafClustering& clustering, std::uint32_t k, float cellSize,
@@ -398,7 +388,8 @@ namespace TreeLod
                 const LeafPlacement& p = bb.placements[m];
                 memberAo[m] = tiles.fitAo(leaf, p, bb.origin, bb.U, bb.V, ctx.ao.leafVertex); // §5.2, Fig. 11
                 // The fragment as the shader sees it: the quantised entry of the centre's cell.
-                const std::uint32_t i0 = gridCell(p.centre.x / cell, W), j0 = gridCell(p.centre.y / cell, H);
+                const std::uint32_t i0 = billboardGridCell(p.centre.x / cell, W);
+                const std::uint32_t j0 = billboardGridCell(p.centre.y / cell, H);
                 const BillboardListEntry e0 = tiles.entryFor(p, cell, i0, j0);
                 const glm::vec2 centre(float(i0) + e0.centreX(), float(j0) + e0.centreY());
                 const float psi = e0.rotation(), side = e0.side();
@@ -535,7 +526,8 @@ namespace TreeLod
                             const float u = (float(x) + (float(sx) + 0.5f) / SUB) / float(w);
                             const float v = (float(y) + (float(sy) + 0.5f) / SUB) / float(h);
                             const float gx = u * float(bb.hashWidth), gy = v * float(bb.hashHeight);
-                            const std::uint32_t i = gridCell(gx, bb.hashWidth), j = gridCell(gy, bb.hashHeight);
+                            const std::uint32_t i = billboardGridCell(gx, bb.hashWidth);
+                            const std::uint32_t j = billboardGridCell(gy, bb.hashHeight);
                             const float px = gx - float(i), py = gy - float(j);
                             const std::uint32_t c = j * bb.hashWidth + i;
                             for (std::uint32_t e = bb.cellStart[c]; e < bb.cellStart[c + 1]; ++e)

@@ -67,20 +67,19 @@ namespace TreeLod
             return {};
         }
 
-        /// Grid cell of billboard coordinate g = u * size, clamped to [0, size - 1] (NaN -> 0).
-        /// GLSL: cell = clamp(floor(g), 0.0, float(size) - 1.0), exact for sizes <= 2^24.
-        std::uint32_t gridCell(float g, std::uint32_t size)
-        {
-            const float f = std::floor(g);
-            if (!(f >= 0.0f))
-                return 0;
-            if (f >= float(size - 1))
-                return size - 1;
-            return std::uint32_t(f);
-        }
     }
 
     // ---- list entries (§4.2, Fig. 8) -------------------------------------------------------
+
+    std::uint32_t billboardGridCell(float g, std::uint32_t size)
+    {
+        const float f = std::floor(g);
+        if (!(f >= 0.0f))
+            return 0;
+        if (f >= float(size - 1))
+            return size - 1;
+        return std::uint32_t(f);
+    }
 
     float BillboardListEntry::side() const { return std::exp2((float(words[3] & 0xffu) - 128.0f) / 32.0f); }
 
@@ -562,8 +561,8 @@ namespace TreeLod
         //   vec2 cell = clamp(floor(g), vec2(0.0), vec2(hashSize) - 1.0);
         //   uvec4 h = uvec4(texelFetch(hashAtlas, ivec2(hashOrigin) + ivec2(cell), 0) * 255.0 + 0.5);
         //   uint start = h.r | (h.g << 8u) | (h.b << 16u), length = h.a;
-        cell.i = gridCell(u * float(b.hashWidth), b.hashWidth);
-        cell.j = gridCell(v * float(b.hashHeight), b.hashHeight);
+        cell.i = billboardGridCell(u * float(b.hashWidth), b.hashWidth);
+        cell.j = billboardGridCell(v * float(b.hashHeight), b.hashHeight);
         const auto [start, length] = mData.cell(billboard, cell.i, cell.j);
         cell.start = start;
         cell.length = length;

@@ -44,7 +44,9 @@ namespace TreeLod
         /// Low-res texel edge of level 0 in median leaf lengths (levels 1 and 2: 2x and 4x).
         float lowResLeafRatio = 0.75f;
         std::uint32_t tileSize = 64;      ///< Leaves Texture tile edge, power of two >= 8
-        std::uint32_t orientationGrid = 5; ///< orientations per leaf material = grid^2 (odd: a cell centred on the leaf normal)
+        /// Orientations per leaf material = grid^2; odd, so that one cell is centred on the leaf
+        /// normal (the most common direction: billboards are fitted to leaf planes).
+        std::uint32_t orientationGrid = 5;
         std::uint32_t listsAtlasWidth = 1024; ///< grows (power of two up to 4096) when needed
         /// Shader LoD factor stored in the chunk: list entries walked per pixel of projected cell
         /// diagonal. 4 measured best against 1 and 2 on the 20k-leaf oak (README, treelod_bc_study).

@@ -196,6 +196,10 @@ namespace TreeLod
         Result<void> validate(const std::string& label) const;
     };
 
+    /// Grid cell of billboard coordinate g = u * size, clamped to [0, size - 1] (NaN -> 0).
+    /// GLSL: cell = clamp(floor(g), 0.0, float(size) - 1.0), exact for sizes <= 2^24.
+    std::uint32_t billboardGridCell(float g, std::uint32_t size);
+
     /// Unit direction d_k of orientation k' (0 <= k' < grid^2) on the hemisphere d.z >= 0
     /// (hemi-octahedral map: cell centre (x, y) in [-1, 1]^2 rotated 45 degrees onto the
     /// octahedron's upper half).
