@@ -54,6 +54,8 @@ namespace TreeLod
             int timingWidth = 640, timingHeight = 512;
             int timingFrames = 5;
             bool timing = true;
+            bool error = true;
+            int level = -1; ///< >= 0: force this cloud level
             int aoRays = BillboardCloudOptions().aoRays;
             double listFactor = -1.0; ///< < 0: the package's
             std::string out = "out/bc-study";
@@ -207,9 +209,11 @@ namespace TreeLod
                                               std::pair{CLASSIC_BILLBOARD_CLOUD_CHUNK, &scene.classic},
                                               std::pair{BILLBOARD_CLOUD_CHUNK, &scene.layered}})
                 {
+                    Ogre::NameValuePairList params = set == &scene.mesh ? Ogre::NameValuePairList() : cloudParams;
+                    if (set == &scene.classic)
+                        params.erase("level"); // the classic cloud has one level
                     Ogre::MovableObject* object =
-                        registry.createInstance(technique, sm, format("%s-%u", technique, i), *scene.asset,
-                                                set == &scene.mesh ? Ogre::NameValuePairList() : cloudParams);
+                        registry.createInstance(technique, sm, format("%s-%u", technique, i), *scene.asset, params);
                     node->attachObject(object);
                     set->push_back(object);
                 }
@@ -223,6 +227,8 @@ namespace TreeLod
             Ogre::NameValuePairList params{{"ambientOcclusion", "false"}};
             if (args.listFactor >= 0.0)
                 params["listFactor"] = format("%g", args.listFactor);
+            if (args.level >= 0)
+                params["level"] = std::to_string(args.level);
             populate(renderer, scene, 1, 0.0f, params);
             const double height = tree.model.boundsMax.y - tree.model.boundsMin.y;
             // The three views, and a close-up (the tree 3x the view's height: branches and
@@ -306,6 +312,8 @@ namespace TreeLod
                 Ogre::NameValuePairList params;
                 if (args.listFactor >= 0.0)
                     params["listFactor"] = format("%g", args.listFactor);
+                if (args.level >= 0)
+                    params["level"] = std::to_string(args.level);
                 populate(renderer, scene, count, spacing, params);
                 const std::uint32_t columns = std::uint32_t(std::ceil(std::sqrt(double(count))));
                 const float extent = float(columns - 1) * spacing;
@@ -388,6 +396,7 @@ namespace TreeLod
             };
 
             Scene scene;
+            if (args.error)
             {
                 BakedTree& e = find(args.errorTree);
                 scene.asset = TreeAssetManager::getSingleton().loadFromBytes("bc-study-error.treelod", Ogre::RGN_DEFAULT,
@@ -470,6 +479,8 @@ int main(int argc, char** argv)
     app.add_option("--timing-height", args.timingHeight);
     app.add_option("--timing-frames", args.timingFrames, "frames per median");
     app.add_flag("!--no-timing", args.timing, "skip the frame times");
+    app.add_flag("!--no-error", args.error, "skip the image error views");
+    app.add_option("--level", args.level, "force this cloud level (0 finest) instead of the LoD strategy's");
     app.add_option("--ao-rays", args.aoRays, "AO rays per leaf vertex in the bake");
     app.add_option("--list-factor", args.listFactor, "shader LoD list factor of the clouds (default: the package's)");
     app.add_option("--out", args.out, "output directory");
