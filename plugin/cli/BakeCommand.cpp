@@ -2,11 +2,11 @@
 // Imports the tree, bakes one chunk set per technique plus the "meta" chunk (source file
 // name, FNV-1a 64 hash of the input file's bytes, options) and writes the package atomically:
 // on any error nothing is written and the exit code is 2.
-#include "BakeTechniques.h"
 #include "CliSupport.h"
 #include "Commands.h"
 
 #include "TreeLod/AtomicFile.h"
+#include "TreeLod/BakeTechniques.h"
 #include "TreeLod/GltfImporter.h"
 #include "TreeLod/Package.h"
 #include "TreeLod/PackageWriter.h"

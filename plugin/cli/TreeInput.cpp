@@ -1,8 +1,7 @@
 #include "TreeInput.h"
 
-#include "BakeTechniques.h"
-
 #include "TreeLod/AtomicFile.h"
+#include "TreeLod/BakeTechniques.h"
 #include "TreeLod/GltfImporter.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"

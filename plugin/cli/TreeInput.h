@@ -25,7 +25,7 @@ namespace TreeLod
 
     /// .glb / .gltf (glTF importer), .treelod (package reader), or .mesh through `meshImporter`
     /// (an error naming the file when it is empty). Non-package inputs are baked in memory
-    /// with `chunks` (names of BakeTechniques.h); a package must already hold them.
+    /// with `chunks` (names of TreeLod/BakeTechniques.h); a package must already hold them.
     Result<TreeInput> loadTreeInput(const std::string& path, const std::vector<std::string>& leafMaterials,
                                     const ProgressCallback& progress, const MeshImporter& meshImporter = {},
                                     const std::vector<std::string>& chunks = {"reference"});

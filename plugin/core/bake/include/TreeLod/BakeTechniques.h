@@ -1,6 +1,6 @@
-// The chunks `treelod` can bake: one entry per technique, shared by `bake` (to a file) and
-// by `render`/`info` on a .glb (baked in memory). A new technique adds one line in
-// BakeTechniques.cpp.
+// The chunks TreeLodBake can bake: one entry per technique, shared by `treelod bake` (to a
+// file), `render`/`info` on a .glb (baked in memory) and the lazy baking cache (BakeCache.h).
+// A new technique adds one line in BakeTechniques.cpp.
 #pragma once
 
 #include "TreeLod/PackageWriter.h"

@@ -1,4 +1,5 @@
-#include "BakeTechniques.h"
+// The technique table of BakeTechniques.h.
+#include "TreeLod/BakeTechniques.h"
 
 #include "TreeLod/BillboardCloudBaker.h"
 #include "TreeLod/FoliageLodBaker.h"

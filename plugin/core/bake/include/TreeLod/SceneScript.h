@@ -1,0 +1,196 @@
+// SceneScript: samples/scenes/*.json, the scenes that `treelod bench`, the Forest and the
+// sample browser run (issue 5). samples/scenes/README.md documents the format key by key.
+//
+// Contract:
+// - Units: metres, degrees in the file (radians in PlacedTree::rotation), seconds for time.
+//   +Y up; the ground is a square of `size` metres centred at the origin.
+// - Errors name the file, the line and column (1-based, columns count bytes) and the key as
+//   a JSON pointer: "scene.json: line 12, column 9, key /placements/0/random/count: must be
+//   >= 1". JSON syntax errors give line and column only. Unknown keys, duplicate keys, wrong
+//   types, out-of-range values and keyframe times that do not increase are errors. A missing
+//   required key is reported at the object that lacks it. Comments (// and /* */) are allowed.
+// - Paths (species sources, the heightfield image) are relative to the script's folder and
+//   stored resolved; species files and the heightfield image must exist when the script loads.
+// - Placements are deterministic: the same script and options give the same trees on any
+//   machine (own sampling over std::mt19937, no std:: distributions, no threads).
+// - The camera path is a centripetal Catmull-Rom spline (alpha 0.5, Barry-Goldman form) through
+//   the keyframe positions and, separately, the targets; each segment's time maps linearly
+//   onto its knot interval, so the path passes through every keyframe at its time, is
+//   continuous with a continuous direction, and may change speed at a keyframe. End segments,
+//   and segments next to a repeated position (a hold: the camera stops and turns), use mirrored
+//   phantom points, so a hold is a corner. Outside the keyframe times the camera holds still.
+//   Splines overshoot: keep a low camera's neighbouring keyframes low too.
+#pragma once
+
+#include "TreeLod/Camera.h"
+#include "TreeLod/Result.h"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace TreeLod
+{
+    struct SceneGround
+    {
+        enum class Kind
+        {
+            Plane,     ///< y = 0 everywhere
+            Heightfield ///< grey image over the square; y = heightScale * grey (0..1), bilinear
+        };
+        Kind kind = Kind::Plane;
+        float size = 1000.0f;      ///< side of the square in metres, centred at the origin
+        std::string image;         ///< heightfield: resolved image path
+        float heightScale = 0.0f;  ///< heightfield: metres at grey 1
+        int heightsWidth = 0;      ///< heightfield: image columns (x from -size/2 to +size/2)
+        int heightsHeight = 0;     ///< heightfield: image rows (z from -size/2 to +size/2)
+        std::vector<float> heights; ///< heightfield: grey 0..1 (red channel), row-major
+    };
+
+    /// The technique a species is drawn with up to a distance or down to a screen size.
+    struct TechniqueBand
+    {
+        std::string technique; ///< registry name ("mesh", "lodf", "billboard-cloud", ...)
+        float maxDistance = 0.0f; ///< metres; 0 = open-ended (last band) or the band uses minPixels
+        float minPixels = 0.0f;   ///< tree height on screen in pixels; 0 = open-ended or maxDistance
+    };
+
+    struct SceneSpecies
+    {
+        std::string name;
+        std::string source;      ///< resolved file path, or "" for a generator preset
+        std::string preset;      ///< "oak", "conifer", "birch", "shrub" when source is "preset:NAME"
+        std::uint32_t seed = 1;  ///< preset only
+        std::uint32_t leaves = 0; ///< preset only, 0 = preset default
+        float height = 0.0f;     ///< preset only, metres, 0 = preset default
+        bool autoTechnique = true; ///< "techniques": "auto": the Forest chooses per screen size
+        std::vector<TechniqueBand> bands; ///< otherwise: near to far; all by distance or all by pixels
+        float scaleMin = 1.0f;   ///< uniform scale of each instance, drawn in [scaleMin, scaleMax]
+        float scaleMax = 1.0f;
+    };
+
+    /// A rectangle [min, max] or a disc (with an optional hole) in the ground plane (x, z).
+    struct SceneArea
+    {
+        enum class Kind
+        {
+            Rect,
+            Disc
+        };
+        Kind kind = Kind::Rect;
+        glm::vec2 min{0.0f}, max{0.0f};  ///< rect
+        glm::vec2 centre{0.0f};          ///< disc
+        float radius = 0.0f, innerRadius = 0.0f; ///< disc; innerRadius > 0 makes a ring
+
+        bool contains(const glm::vec2& p) const;
+        float areaM2() const;
+    };
+
+    struct ScenePlacement
+    {
+        std::vector<std::uint32_t> species; ///< indices into SceneScript::species; random picks one per tree
+        bool random = false;
+        /// explicit: x, z, rotation (radians), scale; one species
+        std::vector<glm::vec4> positions;
+        /// random:
+        std::uint32_t seed = 1;
+        std::uint32_t count = 0;   ///< trees; from density * free area when the script gives a density
+        float density = 0.0f;     ///< trees per hectare of the area outside `exclude`, 0 = count given
+        SceneArea area;
+        std::vector<SceneArea> exclude; ///< kept free (a plaza, a road)
+        float clumping = 0.0f;    ///< 0 uniform .. 1 tight clusters (Thomas process, see .cpp)
+    };
+
+    struct SceneSun
+    {
+        glm::vec3 direction{0.0f, 1.0f, 0.0f}; ///< unit, towards the sun
+        glm::vec3 colour{0.85f, 0.82f, 0.75f};
+        glm::vec3 ambient{0.35f, 0.38f, 0.45f};
+    };
+
+    struct SceneShadows
+    {
+        bool enabled = false;
+        int textureSize = 2048;       ///< power of two, 256..16384
+        std::string camera = "focused"; ///< "focused" | "lispsm" (Ogre's shadow camera setups)
+    };
+
+    struct SceneKeyframe
+    {
+        double time = 0.0; ///< seconds, strictly increasing
+        glm::vec3 position{0.0f};
+        glm::vec3 target{0.0f};
+    };
+
+    struct SceneCamera
+    {
+        float fovYDegrees = 45.0f;
+        float nearClip = 0.05f;
+        float farClip = 10000.0f;
+        bool linear = false; ///< "interpolation": "linear"; default "catmull-rom"
+        std::vector<SceneKeyframe> keyframes; ///< at least one
+    };
+
+    struct SceneScript
+    {
+        std::string file;    ///< path or label it came from
+        std::string name;
+        std::string description;
+        SceneGround ground;
+        std::vector<SceneSpecies> species;
+        std::vector<ScenePlacement> placements;
+        SceneSun sun;
+        SceneShadows shadows;
+        SceneCamera camera;
+        int width = 1280, height = 720; ///< "resolution": [w, h]
+        std::uint32_t frames = 1;       ///< frames spread over the camera path
+        /// Optional "counts" sweep (table2.json): total tree counts, one run each; see PlacementOptions.
+        std::vector<std::uint32_t> counts;
+    };
+
+    /// Read and check a scene script; paths inside resolve against the script's folder.
+    Result<SceneScript> loadSceneScript(const std::string& path);
+
+    /// Same from text; `label` names it in errors, `baseDir` resolves relative paths ("" = cwd).
+    Result<SceneScript> parseSceneScript(const std::string& text, const std::string& label,
+                                         const std::string& baseDir);
+
+    /// One tree of the scene, as the Forest takes it.
+    struct PlacedTree
+    {
+        std::uint32_t species = 0; ///< index into SceneScript::species
+        glm::vec3 position{0.0f};  ///< y on the ground
+        float rotation = 0.0f;     ///< radians about +Y
+        float scale = 1.0f;
+    };
+
+    struct PlacementOptions
+    {
+        /// Total number of trees (one entry of `counts`), 0 = as the script says. Explicit
+        /// placements are kept (the first totalCount of them if there are more); random
+        /// placements share the rest in proportion to their own counts.
+        std::uint32_t totalCount = 0;
+        /// `treelod bench --scale S`: every random placement's tree count times S (rounded, at
+        /// least 1) inside the same area, so the scene keeps its extent and layout and only
+        /// thins out; explicit placements are kept. Applied after totalCount. > 0.
+        double scale = 1.0;
+    };
+
+    /// All trees: explicit placements first, then random ones, in script order.
+    std::vector<PlacedTree> generatePlacements(const SceneScript& script, const PlacementOptions& options = {});
+
+    /// Ground height at (x, z): 0 on a plane; bilinear in the heightfield, clamped at its edges.
+    float groundHeight(const SceneGround& ground, float x, float z);
+
+    /// The camera at `time` seconds (clamped to the keyframes' times).
+    CameraSpec cameraAt(const SceneScript& script, double time);
+
+    /// Time of frame `frame` when `frameCount` frames (0 = script.frames) spread evenly from
+    /// the first keyframe's time to the last's, both included.
+    double frameTime(const SceneScript& script, std::uint32_t frame, std::uint32_t frameCount = 0);
+
+    /// The script's sun as the renderers' lighting (background stays the default).
+    LightingSpec sceneLighting(const SceneScript& script);
+}

@@ -1,0 +1,429 @@
+// BakeCache: keys, cache file validation, and baking only the missing techniques (BakeCache.h).
+#include "TreeLod/BakeCache.h"
+
+#include "TreeLod/AtomicFile.h"
+#include "TreeLod/BakeTechniques.h"
+#include "TreeLod/BillboardCloudData.h"
+#include "TreeLod/FoliageLodData.h"
+#include "TreeLod/GltfImporter.h"
+#include "TreeLod/ModelChunk.h"
+#include "TreeLod/Package.h"
+#include "TreeLod/PackageWriter.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <set>
+
+namespace TreeLod
+{
+    namespace
+    {
+        /// Bump when a baker's output changes without a chunk format version change, so that
+        /// caches made by older builds are not reused.
+        constexpr int BAKE_CACHE_KEY_VERSION = 1;
+
+        std::string hex16(std::uint64_t value)
+        {
+            char text[17];
+            std::snprintf(text, sizeof(text), "%016llx", (unsigned long long)value);
+            return text;
+        }
+
+        std::uint64_t hashString(const std::string& text) { return fnv1a64(text.data(), text.size()); }
+
+        std::string lowerExtension(const std::string& path)
+        {
+            std::string ext = std::filesystem::path(path).extension().string();
+            for (char& c : ext)
+                c = char(std::tolower(static_cast<unsigned char>(c)));
+            return ext;
+        }
+
+        /// A file-name-safe stem: [A-Za-z0-9._] kept, runs of anything else one '-', at most 48 bytes.
+        std::string safeStem(const std::string& text)
+        {
+            std::string out;
+            for (char c : text)
+            {
+                const bool keep = std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_';
+                if (keep)
+                    out += c;
+                else if (!out.empty() && out.back() != '-')
+                    out += '-';
+                if (out.size() >= 48)
+                    break;
+            }
+            while (!out.empty() && (out.back() == '-' || out.back() == '.'))
+                out.pop_back();
+            return out.empty() ? "tree" : out;
+        }
+
+        std::string percentDecode(const std::string& uri)
+        {
+            std::string out;
+            for (std::size_t i = 0; i < uri.size(); ++i)
+            {
+                if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
+                    std::isxdigit(static_cast<unsigned char>(uri[i + 2])))
+                {
+                    out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+                    i += 2;
+                }
+                else
+                    out += uri[i];
+            }
+            return out;
+        }
+
+        /// Hash of a file source: its bytes and, for glTF JSON, the external buffers and images it
+        /// names (so that editing a .bin or a texture beside a .gltf is a new key). References
+        /// that cannot be read hash as missing; the import reports them.
+        Result<std::uint64_t> hashFileSource(const std::string& path)
+        {
+            Result<std::vector<std::uint8_t>> bytes = readFile(path);
+            if (!bytes)
+                return bytes.error();
+            std::string digest = "file " + hex16(fnv1a64(bytes->data(), bytes->size()));
+            const auto first =
+                std::find_if(bytes->begin(), bytes->end(), [](std::uint8_t c) { return !std::isspace(c); });
+            if (first != bytes->end() && *first == '{')
+            {
+                const nlohmann::json json = nlohmann::json::parse(bytes->begin(), bytes->end(), nullptr, false);
+                const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+                for (const char* list : {"buffers", "images"})
+                {
+                    if (!json.is_object() || !json.contains(list) || !json[list].is_array())
+                        continue;
+                    for (const nlohmann::json& item : json[list])
+                    {
+                        if (!item.is_object() || !item.contains("uri") || !item["uri"].is_string())
+                            continue;
+                        const std::string uri = item["uri"].get<std::string>();
+                        if (uri.rfind("data:", 0) == 0)
+                            continue;
+                        Result<std::vector<std::uint8_t>> ref = readFile((dir / percentDecode(uri)).string());
+                        digest += "\n" + uri + " " +
+                                  (ref ? hex16(fnv1a64(ref->data(), ref->size())) : std::string("missing"));
+                    }
+                }
+            }
+            return hashString(digest);
+        }
+
+        /// The options as compact JSON with sorted keys; "" is {}.
+        Result<std::string> canonicalOptions(const std::string& source, const std::string& optionsJson)
+        {
+            if (optionsJson.find_first_not_of(" \t\r\n") == std::string::npos)
+                return std::string("{}");
+            const nlohmann::json json = nlohmann::json::parse(optionsJson, nullptr, false);
+            if (json.is_discarded() || !json.is_object())
+                return fail(source, "bake options", "not a JSON object: " + optionsJson);
+            return json.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+        }
+
+        /// Importer and baker steps shown as "<prefix>: step"; warnings stay warnings.
+        ProgressCallback prefixed(const ProgressCallback& progress, const std::string& prefix)
+        {
+            if (!progress)
+                return {};
+            return [progress, prefix](const std::string& step, float fraction) {
+                if (step.rfind("warning:", 0) == 0)
+                    progress("warning: " + prefix + ":" + step.substr(8), fraction);
+                else
+                    progress(prefix + ": " + step, fraction);
+            };
+        }
+
+        /// A chunk of the cached package, copied into the rewritten one byte for byte.
+        struct CachedChunk
+        {
+            ChunkInfo info;
+            std::vector<std::uint8_t> bytes;
+        };
+
+        /// Every chunk of the cache file but "meta", or an Error saying why the file is unusable.
+        Result<std::vector<CachedChunk>> readCachedPackage(const std::string& path, const std::string& sourceHash,
+                                                           const std::string& options)
+        {
+            Result<PackageReader> reader = PackageReader::open(path);
+            if (!reader)
+                return reader.error();
+            Result<std::vector<std::uint8_t>> meta = reader->readChunk(META_CHUNK, 0);
+            if (!meta)
+                return meta.error();
+            const nlohmann::json json = nlohmann::json::parse(meta->begin(), meta->end(), nullptr, false);
+            if (json.is_discarded() || !json.is_object() || !json.contains("sourceHash") || !json.contains("options"))
+                return fail(path, chunkElement(META_CHUNK, 0), "not the JSON object a bake writes");
+            if (json["sourceHash"] != sourceHash ||
+                json["options"].dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) != options)
+                return fail(path, chunkElement(META_CHUNK, 0), "made for another source or options");
+            std::vector<CachedChunk> chunks;
+            for (std::size_t i = 0; i < reader->chunks().size(); ++i)
+            {
+                const ChunkInfo& info = reader->chunks()[i];
+                if (info.technique == META_CHUNK)
+                    continue;
+                Result<std::vector<std::uint8_t>> bytes = reader->readChunk(i);
+                if (!bytes)
+                    return bytes.error();
+                chunks.push_back({info, std::move(bytes.value())});
+            }
+            return chunks;
+        }
+
+        std::string joined(const std::vector<std::string>& names)
+        {
+            std::string out;
+            for (const std::string& n : names)
+                out += (out.empty() ? "" : ", ") + n;
+            return out;
+        }
+    }
+
+    struct BakeCache::Key
+    {
+        std::string name;       ///< for messages: the file name, or the whole generator source
+        std::string sourceHash; ///< "fnv1a64:" + 16 hex, recorded in the meta chunk
+        std::string options;    ///< canonical options JSON
+        std::string path;       ///< the cache file
+        const GenerateFunction* generator = nullptr; ///< null for file sources
+    };
+
+    std::string BakeCacheEntry::describe() const
+    {
+        std::string out = (name.empty() ? source : name) + ":";
+        if (!discardedReason.empty())
+            out += " discarded the cached package (" + discardedReason + "),";
+        if (!builtTechniques.empty())
+        {
+            char seconds[32];
+            std::snprintf(seconds, sizeof(seconds), "%.1f s", bakeSeconds);
+            out += " baked " + joined(builtTechniques) + " (" + seconds + ")";
+        }
+        if (!reusedTechniques.empty())
+            out += std::string(builtTechniques.empty() ? "" : ",") + " reused " + joined(reusedTechniques);
+        return out + " -> " + path;
+    }
+
+    std::string defaultBakeCacheDirectory()
+    {
+        const char* xdg = std::getenv("XDG_CACHE_HOME");
+        if (xdg && std::filesystem::path(xdg).is_absolute())
+            return (std::filesystem::path(xdg) / "treelod").string();
+        const char* home = std::getenv("HOME");
+        if (home && *home)
+            return (std::filesystem::path(home) / ".cache" / "treelod").string();
+        std::error_code ec;
+        const std::filesystem::path temp = std::filesystem::temp_directory_path(ec);
+        return ((ec ? std::filesystem::path("/tmp") : temp) / "treelod-cache").string();
+    }
+
+    BakeCache::BakeCache(std::string directory) : mDirectory(std::move(directory)) {}
+
+    Result<void> BakeCache::addGenerator(const std::string& scheme, GenerateFunction generate)
+    {
+        const bool valid = scheme.size() >= 2 && std::all_of(scheme.begin(), scheme.end(), [](char c) {
+                               return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-';
+                           });
+        if (!valid)
+            return fail("", "generator scheme '" + scheme + "'", "must be two or more characters of [a-z0-9-]");
+        if (!generate)
+            return fail("", "generator scheme '" + scheme + "'", "no function given");
+        mGenerators[scheme] = std::move(generate);
+        return {};
+    }
+
+    Result<BakeCache::Key> BakeCache::makeKey(const std::string& source, const std::string& optionsJson) const
+    {
+        Key key;
+        std::uint64_t sourceHash = 0;
+        const std::size_t colon = source.find(':');
+        const auto generator =
+            colon == std::string::npos ? mGenerators.end() : mGenerators.find(source.substr(0, colon));
+        if (generator != mGenerators.end())
+        {
+            key.name = source;
+            key.generator = &generator->second;
+            sourceHash = hashString("generated " + source);
+        }
+        else
+        {
+            key.name = std::filesystem::path(source).filename().string();
+            Result<std::uint64_t> hash = hashFileSource(source);
+            if (!hash)
+            {
+                Error error = hash.error();
+                if (colon != std::string::npos && colon >= 2 && source.find('/') > colon)
+                    error.reason += " (and no generator is registered for '" + source.substr(0, colon) + ":' sources)";
+                return error;
+            }
+            sourceHash = hash.value();
+        }
+        key.sourceHash = "fnv1a64:" + hex16(sourceHash);
+
+        Result<std::string> options = canonicalOptions(source, optionsJson);
+        if (!options)
+            return options.error();
+        key.options = options.value();
+
+        // Every version that changes what a cached chunk means: a bump gives a new file name.
+        char versions[160];
+        std::snprintf(versions, sizeof(versions), "cache %d package %u reference %u lodf %u billboard-cloud %u",
+                      BAKE_CACHE_KEY_VERSION, unsigned(PACKAGE_VERSION), unsigned(REFERENCE_CHUNK_FORMAT_VERSION),
+                      unsigned(FOLIAGE_LOD_CHUNK_FORMAT_VERSION), unsigned(BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION));
+        const std::uint64_t fileKey = hashString(std::string(versions) + "\nsource " + key.sourceHash +
+                                                 "\noptions " + key.options);
+        const std::string stem =
+            safeStem(key.generator ? source : std::filesystem::path(source).stem().string());
+        key.path = (std::filesystem::path(mDirectory) / (stem + "-" + hex16(fileKey) + ".treelod")).string();
+        return key;
+    }
+
+    Result<std::string> BakeCache::packagePath(const std::string& source, const std::string& optionsJson) const
+    {
+        Result<Key> key = makeKey(source, optionsJson);
+        if (!key)
+            return key.error();
+        return key->path;
+    }
+
+    Result<BakeCacheEntry> BakeCache::require(const std::string& source, const std::vector<std::string>& techniques,
+                                              const std::string& optionsJson, const ProgressCallback& progress,
+                                              const ImportFunction& import) const
+    {
+        // The request: known techniques, each once, before any file is read.
+        std::vector<const BakeTechnique*> requested;
+        for (const std::string& name : techniques)
+        {
+            const BakeTechnique* technique = findBakeTechnique(name);
+            if (!technique)
+                return fail(source, "technique '" + name + "'",
+                            "not a known technique (known: " + knownBakeTechniques() + ")");
+            if (std::find(requested.begin(), requested.end(), technique) == requested.end())
+                requested.push_back(technique);
+        }
+        if (requested.empty())
+            return fail(source, "techniques", "none requested (known: " + knownBakeTechniques() + ")");
+
+        Result<Key> keyResult = makeKey(source, optionsJson);
+        if (!keyResult)
+            return keyResult.error();
+        const Key& key = keyResult.value();
+
+        BakeCacheEntry entry;
+        entry.source = source;
+        entry.name = key.name;
+        entry.path = key.path;
+
+        // What the cache holds; an unusable file is baked again from scratch.
+        std::vector<CachedChunk> cached;
+        std::error_code ec;
+        if (std::filesystem::exists(key.path, ec))
+        {
+            Result<std::vector<CachedChunk>> read = readCachedPackage(key.path, key.sourceHash, key.options);
+            if (read)
+                cached = std::move(read.value());
+            else
+                entry.discardedReason = read.error().message();
+        }
+        std::set<std::string> present;
+        for (const CachedChunk& chunk : cached)
+            present.insert(chunk.info.technique);
+        std::vector<const BakeTechnique*> missing;
+        for (const BakeTechnique* technique : requested)
+        {
+            if (present.count(technique->name))
+                entry.reusedTechniques.push_back(technique->name);
+            else
+                missing.push_back(technique);
+        }
+        if (missing.empty())
+            return entry;
+
+        // Bake the missing techniques from one import, then put the cached chunks back over
+        // whatever the bakers added again (the reference), so their bytes stay as they were.
+        const auto start = std::chrono::steady_clock::now();
+        Result<TreeModel> model = fail(source, "", "not imported");
+        if (key.generator)
+            model = (*key.generator)(source, prefixed(progress, key.name));
+        else
+        {
+            const std::string ext = lowerExtension(source);
+            if (ext == ".glb" || ext == ".gltf")
+            {
+                ImportOptions options;
+                const nlohmann::json json = nlohmann::json::parse(key.options);
+                if (json.contains("leafMaterials"))
+                {
+                    const nlohmann::json& names = json["leafMaterials"];
+                    bool strings = names.is_array();
+                    for (const nlohmann::json& n : names)
+                        strings = strings && n.is_string();
+                    if (!strings)
+                        return fail(source, "bake options", "\"leafMaterials\" must be an array of strings");
+                    options.leafMaterials = names.get<std::vector<std::string>>();
+                }
+                options.progress = prefixed(progress, key.name);
+                ImportReport importReport;
+                model = importGltf(source, options, &importReport);
+                for (const std::string& warning : importReport.warnings)
+                    report(progress, "warning: " + key.name + ": " + warning, 1.0f);
+            }
+            else if (import)
+                model = import(source);
+            else
+                return fail(source, "", "no importer for '" + ext + "' files (.glb and .gltf are built in; other "
+                                        "formats need the caller's ImportFunction)");
+        }
+        if (!model)
+            return model.error();
+
+        PackageWriter writer;
+        for (const BakeTechnique* technique : missing)
+        {
+            Result<void> baked = technique->bake(writer, model.value(), source,
+                                                 prefixed(progress, key.name + " " + technique->name));
+            if (!baked)
+                return baked.error();
+            entry.builtTechniques.push_back(technique->name);
+        }
+        std::set<std::string> contents(present);
+        for (CachedChunk& chunk : cached)
+        {
+            Result<void> added = writer.addChunk(chunk.info.technique, chunk.info.level, chunk.info.formatVersion,
+                                                 std::move(chunk.bytes));
+            if (!added)
+                return added.error();
+        }
+        for (const std::string& name : entry.builtTechniques)
+            contents.insert(name);
+        if (writer.hasChunk(REFERENCE_CHUNK, 0))
+            contents.insert(REFERENCE_CHUNK);
+
+        PackageMeta meta;
+        meta.source = key.generator ? source : key.name;
+        meta.sourceHash = key.sourceHash;
+        meta.optionsJson = key.options;
+        meta.techniques.assign(contents.begin(), contents.end());
+        Result<void> added = addMetaChunk(writer, meta);
+        if (!added)
+            return added.error();
+
+        report(progress, key.name + ": write", 0.0f);
+        std::filesystem::create_directories(mDirectory, ec);
+        if (!std::filesystem::is_directory(mDirectory, ec))
+            return fail(mDirectory, "", "cannot create the bake cache directory" + (ec ? ": " + ec.message() : ""));
+        Result<void> written = writer.write(key.path);
+        if (!written)
+            return written.error();
+        report(progress, key.name + ": write", 1.0f);
+        entry.bakeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return entry;
+    }
+}

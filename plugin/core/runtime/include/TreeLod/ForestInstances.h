@@ -1,0 +1,236 @@
+// ForestInstances: the Forest's packed instance data (issue 5, "Forest"), and its per-frame
+// culling and level-of-detail selection in one tight loop, without Ogre.
+//
+// Storage is structure-of-arrays: per instance its position, rotation about +Y, uniform scale
+// and kind; a kind is one (asset, technique) pair with its local bounding sphere and LoD table.
+// Each frame `cull` tests every instance's world bounding sphere against the six frustum
+// planes, picks the visible ones' level from their kind's table, and counting-sorts them into
+// buckets (kind, level) with one packed 3x4 world matrix per instance, ready to be copied into
+// an instance vertex buffer (Ogre's hardware instancing reads three float4 rows).
+//
+// LoD value (the units of Ogre's AbsolutePixelCountLodStrategy, as in BillboardCloudTree):
+//   perspective:  value = pi * R^2 * (W * H * P00 * P11) / d^2 * bias
+//   orthographic: value = pi * R^2 * (W * H * P00 * P11) * bias
+// R = local radius * scale, W x H the LoD camera's viewport in pixels, P00, P11 its
+// projection's diagonal, d the distance from the LoD camera to the instance's position (its
+// origin, as Ogre's Node::getSquaredViewDepth). For a sphere seen at distance d the projected
+// radius is r_px = R * P11 * H / (2 d) (and R * P00 * W / (2 d) across), so value = 4 pi r_px^2:
+// four times the projected disc's area in pixels. An orthographic projection has P00 = 2 / w,
+// P11 = 2 / h for a view window w x h, which gives the same units (4 pi r_px^2). At d^2 <=
+// FLT_EPSILON the value is FLT_MAX (Ogre's base value: finest level).
+// Distance tables instead compare d^2 / bias (DistanceLodStrategy's squared distance).
+#pragma once
+
+#include "TreeLod/Camera.h"
+#include "TreeLod/Result.h"
+
+#include <glm/glm.hpp>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace TreeLod
+{
+    /// How a kind's LoD table is read.
+    enum class ForestLodMode : std::uint8_t
+    {
+        PixelCount, ///< thresholds in decreasing order; level i while value >= thresholds[i]
+        Distance    ///< squared metres, increasing; level i while d^2 / bias <= thresholds[i]
+    };
+
+    /// One (asset, technique) pair: what the Forest draws with one instanced batch per level.
+    struct ForestKind
+    {
+        std::string name;                  ///< for errors and stats, e.g. "oak.treelod/lodf"
+        glm::vec3 boundsCentre{0.0f};      ///< local bounding sphere (metres, unscaled)
+        float boundsRadius = 1.0f;         ///< > 0
+        ForestLodMode lodMode = ForestLodMode::PixelCount;
+        /// Level switch values; the kind has thresholds.size() + 1 levels (the last one may be a
+        /// camera-facing quad; the Ogre side decides what a level draws). Finite, >= 0, at most
+        /// MAX_THRESHOLDS, non-increasing (PixelCount) or non-decreasing (Distance).
+        std::vector<float> thresholds;
+    };
+
+    /// One tree. Rotation in radians about +Y (right-handed), uniform scale > 0.
+    struct ForestInstance
+    {
+        glm::vec3 position{0.0f};
+        float rotationY = 0.0f;
+        float scale = 1.0f;
+        std::uint32_t kind = 0;
+    };
+
+    /// Stable name of an instance: valid from add to remove. Ids of removed instances are reused.
+    using ForestHandle = std::uint32_t;
+
+    /// The camera `cull` sees: the frustum that culls and the LoD camera that picks levels. They
+    /// differ for shadow cameras (Ogre: cull with the light's camera, pick levels with
+    /// Camera::getLodCamera()), so the Ogre side may overwrite `planes` from its own frustum.
+    struct CullCamera
+    {
+        /// World-space planes (normal xyz, unit length, pointing inside; offset w): a point p is
+        /// inside where dot(n, p) + w >= 0. Order: left, right, bottom, top, near, far. A plane
+        /// with a zero normal (an infinite far plane) passes everything when w >= 0.
+        std::array<glm::vec4, 6> planes{};
+        glm::vec3 lodPosition{0.0f};  ///< LoD camera position, world space
+        float lodPixelScale = 0.0f;   ///< W * H * P00 * P11 of the LoD camera (pixels)
+        bool lodOrthographic = false; ///< value does not fall with distance
+
+        /// Planes of an OpenGL-convention clip space (clip = viewProjection * world, inside where
+        /// -w <= x, y, z <= w), normalised (Gribb & Hartmann's extraction, in double). The far
+        /// plane is the difference of two nearly equal rows: a product taken in float moves it by
+        /// decimetres at 8 km, so fromMatrices multiplies in double.
+        static std::array<glm::vec4, 6> frustumPlanes(const glm::dmat4& viewProjection);
+
+        /// Culling and LoD from one camera: view and projection as GLM (column-major, OpenGL
+        /// clip), viewport in pixels. Orthographic when projection[3][3] != 0.
+        static CullCamera fromMatrices(const glm::mat4& view, const glm::mat4& projection, float viewportWidth,
+                                       float viewportHeight);
+
+        /// From a CameraSpec (aspect = width / height).
+        static CullCamera fromSpec(const CameraSpec& spec, float viewportWidth, float viewportHeight);
+    };
+
+    /// Instances of one (kind, level), in ForestVisibility's packed arrays at [first, first + count).
+    struct ForestBucket
+    {
+        std::uint32_t kind = 0;
+        std::uint32_t level = 0;
+        std::uint32_t first = 0;
+        std::uint32_t count = 0;
+    };
+
+    /// What `cull` produced. Reuse one per camera: its arrays only grow, so `cull` allocates only
+    /// when the instance, bucket or visible count exceeds that of every earlier frame.
+    class ForestVisibility
+    {
+    public:
+        static constexpr std::size_t TRANSFORM_FLOATS = 12; ///< 3x4 world matrix, row-major
+
+        /// One bucket per (kind, level), kind-major, including empty ones.
+        const std::vector<ForestBucket>& getBuckets() const { return mBuckets; }
+        std::size_t getBucketCount() const { return mBuckets.size(); }
+        const ForestBucket& getBucket(std::size_t bucket) const { return mBuckets[bucket]; }
+
+        /// Instance indices (ForestInstances' dense indices), grouped by bucket: getVisibleCount() of them.
+        const std::uint32_t* getIndices() const { return mIndices.data(); }
+        /// 12 floats per visible instance, same order as getIndices(): rows of the world matrix
+        /// [R*s | t]: (m00 m01 m02 tx) (m10 m11 m12 ty) (m20 m21 m22 tz).
+        const float* getTransforms() const { return mTransforms.data(); }
+        const std::uint32_t* getBucketIndices(std::size_t bucket) const
+        {
+            return mIndices.data() + mBuckets[bucket].first;
+        }
+        const float* getBucketTransforms(std::size_t bucket) const
+        {
+            return mTransforms.data() + TRANSFORM_FLOATS * mBuckets[bucket].first;
+        }
+
+        std::uint32_t getVisibleCount() const { return mVisibleCount; }
+        std::uint32_t getCulledCount() const { return mCulledCount; }
+
+        /// Bytes reserved by the arrays (to check that a second cull allocates nothing).
+        std::size_t getCapacityBytes() const;
+
+    private:
+        friend class ForestInstances;
+        std::vector<ForestBucket> mBuckets;
+        std::vector<std::uint32_t> mIndices;     // sized to the instance count
+        std::vector<float> mTransforms;          // sized to 12 x the instance count
+        std::vector<std::uint32_t> mVisible;     // scratch: visible instances in input order
+        std::vector<std::uint32_t> mVisibleBucket; // scratch: their buckets
+        std::vector<std::uint32_t> mCursor;      // scratch: fill position per bucket
+        std::uint32_t mVisibleCount = 0;
+        std::uint32_t mCulledCount = 0;
+    };
+
+    /// The instance store. Removal swaps the last instance into the hole, so dense indices
+    /// change on remove; handles do not. Not thread-safe for writes; `cull` is const and may run
+    /// for several cameras at once, each into its own ForestVisibility.
+    class ForestInstances
+    {
+    public:
+        static constexpr std::size_t MAX_THRESHOLDS = 15; ///< at most 16 levels per kind
+
+        /// Add a kind; returns its index. Kinds are never removed.
+        Result<std::uint32_t> addKind(const ForestKind& kind);
+        std::uint32_t getKindCount() const { return std::uint32_t(mKinds.size()); }
+        const ForestKind& getKind(std::uint32_t kind) const { return mKinds[kind]; }
+        std::uint32_t getLevelCount(std::uint32_t kind) const
+        {
+            return std::uint32_t(mKinds[kind].thresholds.size() + 1);
+        }
+        /// Bucket of (kind, level) in ForestVisibility::getBuckets().
+        std::uint32_t getBucketIndex(std::uint32_t kind, std::uint32_t level) const
+        {
+            return mKindFirstBucket[kind] + level;
+        }
+        std::uint32_t getBucketCount() const { return mBucketCount; }
+
+        /// Add one instance. Error (element "instance N", N the index it would get) on a
+        /// non-finite value, scale <= 0 or an unknown kind; nothing is added then.
+        Result<ForestHandle> add(const ForestInstance& instance);
+        /// Add many: all or nothing; the error names the instance by its index in `instances`.
+        Result<std::vector<ForestHandle>> add(const std::vector<ForestInstance>& instances);
+        /// Replace an instance's data; same checks as add.
+        Result<void> update(ForestHandle handle, const ForestInstance& instance);
+        /// Remove an instance: the last one moves into its dense index.
+        Result<void> remove(ForestHandle handle);
+        void clear();
+        void reserve(std::size_t count);
+
+        std::size_t size() const { return mKind.size(); }
+        bool contains(ForestHandle handle) const;
+        /// The instance (handle must be valid).
+        ForestInstance get(ForestHandle handle) const { return getAt(mSlotOfHandle[handle]); }
+        /// By dense index (< size()), as `cull` reports them.
+        ForestInstance getAt(std::size_t index) const;
+        ForestHandle getHandleAt(std::size_t index) const { return mHandleOfSlot[index]; }
+        std::uint32_t getIndexOf(ForestHandle handle) const { return mSlotOfHandle[handle]; }
+
+        /// World bounding sphere (centre xyz, radius w) of the instance at a dense index.
+        glm::vec4 getWorldSphere(std::size_t index) const;
+
+        /// LoD value of the instance at a dense index for a LoD camera and bias (the formula above;
+        /// for Distance kinds the squared distance divided by the bias).
+        float lodValue(std::size_t index, const CullCamera& camera, float lodBias) const;
+        /// Level a kind's table gives for a value from lodValue.
+        std::uint32_t levelForValue(std::uint32_t kind, float value) const;
+
+        /// Cull and select levels for every instance (see the file comment). Error if the bias is
+        /// not finite and > 0 or the camera has a non-finite value; `out` is untouched then.
+        Result<void> cull(const CullCamera& camera, float lodBias, ForestVisibility& out) const;
+
+    private:
+        std::string check(const ForestInstance& instance) const; ///< "" or the reason it is refused
+        ForestHandle takeHandle();
+        std::array<std::vector<float>*, 11> floatArrays(); ///< every per-instance float array
+        void write(std::size_t slot, const ForestInstance& instance);
+        void push(const ForestInstance& instance, ForestHandle handle);
+
+        // kinds
+        std::vector<ForestKind> mKinds;
+        std::vector<std::uint32_t> mKindFirstBucket;
+        std::vector<std::uint32_t> mKindLevels;   // thresholds.size() + 1
+        std::vector<std::uint8_t> mKindDistance;  // 1 for ForestLodMode::Distance
+        /// Per kind MAX_THRESHOLDS keys, compared as key >= table[i]: pixel thresholds as they
+        /// are, distance thresholds negated (value = -d^2 / bias), padding never reached.
+        std::vector<float> mKindTable;
+        std::uint32_t mBucketCount = 0;
+
+        // instances (structure of arrays, dense)
+        std::vector<float> mX, mY, mZ;             // position
+        std::vector<float> mRotation, mScale;
+        std::vector<float> mCosScale, mSinScale;   // scale * cos / sin of the rotation
+        std::vector<float> mSphereX, mSphereY, mSphereZ, mSphereR; // world bounding sphere
+        std::vector<std::uint32_t> mKind;
+        std::vector<ForestHandle> mHandleOfSlot;
+
+        // handles
+        std::vector<std::uint32_t> mSlotOfHandle; // INVALID for free ids
+        std::vector<ForestHandle> mFreeHandles;
+    };
+}

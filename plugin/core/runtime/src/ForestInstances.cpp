@@ -1,0 +1,446 @@
+// ForestInstances: packed instances, frustum culling, LoD selection and bucketing (see the header).
+#include "TreeLod/ForestInstances.h"
+
+#include <glm/gtc/constants.hpp>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace TreeLod
+{
+    namespace
+    {
+        constexpr std::uint32_t INVALID_SLOT = std::numeric_limits<std::uint32_t>::max();
+
+        bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+        std::string text(const glm::vec3& v)
+        {
+            std::ostringstream out;
+            out << "(" << v.x << ", " << v.y << ", " << v.z << ")";
+            return out.str();
+        }
+
+        std::string text(float v)
+        {
+            std::ostringstream out;
+            out << v;
+            return out.str();
+        }
+
+        /// The per-frame constants of the LoD value (the header's formula).
+        struct LodConstants
+        {
+            float pixelFactor; // pi * W * H * P00 * P11 * bias
+            float bias;
+            bool orthographic;
+        };
+
+        LodConstants lodConstants(const CullCamera& camera, float lodBias)
+        {
+            return {glm::pi<float>() * camera.lodPixelScale * lodBias, lodBias, camera.lodOrthographic};
+        }
+
+        /// The key compared with a kind's table: the pixel value, or -d^2 / bias for distance kinds.
+        inline float lodKey(float d2, float radius, bool distance, const LodConstants& c)
+        {
+            if (distance)
+                return -(d2 / c.bias);
+            if (c.orthographic)
+                return c.pixelFactor * radius * radius;
+            return d2 > FLT_EPSILON ? c.pixelFactor * radius * radius / d2 : FLT_MAX;
+        }
+
+        /// Number of table entries the key is below: the level (the tables are monotone).
+        inline std::uint32_t levelForKey(const float* table, float key)
+        {
+            std::uint32_t level = 0;
+            for (std::size_t i = 0; i < ForestInstances::MAX_THRESHOLDS; ++i)
+                level += key < table[i] ? 1u : 0u;
+            return level;
+        }
+    }
+
+    // ---- CullCamera ------------------------------------------------------------------------------
+
+    std::array<glm::vec4, 6> CullCamera::frustumPlanes(const glm::dmat4& m)
+    {
+        auto row = [&](int i) { return glm::dvec4(m[0][i], m[1][i], m[2][i], m[3][i]); };
+        const glm::dvec4 r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
+        const glm::dvec4 raw[6] = {r3 + r0, r3 - r0, r3 + r1, r3 - r1, r3 + r2, r3 - r2};
+        const double scale = std::max(glm::length(glm::dvec3(r3)), 1e-300);
+        std::array<glm::vec4, 6> planes;
+        for (int p = 0; p < 6; ++p)
+        {
+            const double length = glm::length(glm::dvec3(raw[p]));
+            if (length <= 1e-6 * scale)
+                // Degenerate (an infinite far plane): all inside or all outside.
+                planes[p] = glm::vec4(0.0f, 0.0f, 0.0f, raw[p].w >= 0.0 ? 0.0f : -FLT_MAX);
+            else
+                planes[p] = glm::vec4(raw[p] / length);
+        }
+        return planes;
+    }
+
+    CullCamera CullCamera::fromMatrices(const glm::mat4& view, const glm::mat4& projection, float viewportWidth,
+                                        float viewportHeight)
+    {
+        CullCamera camera;
+        camera.planes = frustumPlanes(glm::dmat4(projection) * glm::dmat4(view));
+        camera.lodPosition = glm::vec3(glm::inverse(glm::dmat4(view))[3]);
+        camera.lodPixelScale =
+            float(double(viewportWidth) * double(viewportHeight) * std::abs(projection[0][0] * projection[1][1]));
+        camera.lodOrthographic = projection[3][3] != 0.0f;
+        return camera;
+    }
+
+    CullCamera CullCamera::fromSpec(const CameraSpec& spec, float viewportWidth, float viewportHeight)
+    {
+        return fromMatrices(spec.viewMatrix(), spec.projectionMatrix(viewportWidth / viewportHeight), viewportWidth,
+                            viewportHeight);
+    }
+
+    // ---- ForestVisibility ------------------------------------------------------------------------
+
+    std::size_t ForestVisibility::getCapacityBytes() const
+    {
+        return mBuckets.capacity() * sizeof(ForestBucket) +
+               (mIndices.capacity() + mVisible.capacity() + mVisibleBucket.capacity() + mCursor.capacity()) *
+                   sizeof(std::uint32_t) +
+               mTransforms.capacity() * sizeof(float);
+    }
+
+    // ---- kinds -----------------------------------------------------------------------------------
+
+    Result<std::uint32_t> ForestInstances::addKind(const ForestKind& kind)
+    {
+        const std::string element = "kind " + std::to_string(mKinds.size()) + " '" + kind.name + "'";
+        if (!finite(kind.boundsCentre))
+            return fail("", element, "bounding sphere centre " + text(kind.boundsCentre) + " is not finite");
+        if (!std::isfinite(kind.boundsRadius) || !(kind.boundsRadius > 0.0f))
+            return fail("", element, "bounding radius " + text(kind.boundsRadius) + " is not finite and > 0");
+        if (kind.thresholds.size() > MAX_THRESHOLDS)
+            return fail("", element, std::to_string(kind.thresholds.size()) + " LoD thresholds (at most " +
+                                         std::to_string(MAX_THRESHOLDS) + ")");
+        const bool distance = kind.lodMode == ForestLodMode::Distance;
+        for (std::size_t i = 0; i < kind.thresholds.size(); ++i)
+        {
+            const float t = kind.thresholds[i];
+            if (!std::isfinite(t) || t < 0.0f)
+                return fail("", element, "LoD threshold " + std::to_string(i) + " (" + text(t) +
+                                             ") is not finite and >= 0");
+            if (i > 0 && (distance ? t < kind.thresholds[i - 1] : t > kind.thresholds[i - 1]))
+                return fail("", element, "LoD threshold " + std::to_string(i) + " (" + text(t) + ") is " +
+                                             (distance ? "below" : "above") + " the previous one (" +
+                                             text(kind.thresholds[i - 1]) + "); " +
+                                             (distance ? "distance thresholds increase" :
+                                                         "pixel-count thresholds decrease"));
+        }
+
+        const std::uint32_t index = std::uint32_t(mKinds.size());
+        mKinds.push_back(kind);
+        mKindFirstBucket.push_back(mBucketCount);
+        mKindLevels.push_back(std::uint32_t(kind.thresholds.size() + 1));
+        mKindDistance.push_back(distance ? 1 : 0);
+        for (std::size_t i = 0; i < MAX_THRESHOLDS; ++i)
+        {
+            if (i >= kind.thresholds.size())
+                mKindTable.push_back(-std::numeric_limits<float>::infinity()); // never above the key
+            else
+                mKindTable.push_back(distance ? -kind.thresholds[i] : kind.thresholds[i]);
+        }
+        mBucketCount += mKindLevels.back();
+        // Instances already placed keep their kinds; their spheres do not depend on new kinds.
+        return index;
+    }
+
+    // ---- instances -------------------------------------------------------------------------------
+
+    std::string ForestInstances::check(const ForestInstance& instance) const
+    {
+        if (!finite(instance.position))
+            return "position " + text(instance.position) + " is not finite";
+        if (!std::isfinite(instance.rotationY))
+            return "rotation " + text(instance.rotationY) + " is not finite";
+        if (!std::isfinite(instance.scale) || !(instance.scale > 0.0f))
+            return "scale " + text(instance.scale) + " is not finite and > 0";
+        if (instance.kind >= mKinds.size())
+            return "kind " + std::to_string(instance.kind) + " does not exist (" + std::to_string(mKinds.size()) +
+                   " kinds)";
+        const ForestKind& kind = mKinds[instance.kind];
+        const float radius = kind.boundsRadius * instance.scale;
+        const glm::vec3 centre = instance.position + instance.scale * kind.boundsCentre;
+        if (!std::isfinite(radius * radius) || !finite(centre))
+            return "scale " + text(instance.scale) + " makes the bounding sphere overflow";
+        return {};
+    }
+
+    void ForestInstances::write(std::size_t slot, const ForestInstance& instance)
+    {
+        const ForestKind& kind = mKinds[instance.kind];
+        const float s = instance.scale;
+        const float cs = s * std::cos(instance.rotationY), ss = s * std::sin(instance.rotationY);
+        const glm::vec3& c = kind.boundsCentre;
+        mX[slot] = instance.position.x;
+        mY[slot] = instance.position.y;
+        mZ[slot] = instance.position.z;
+        mRotation[slot] = instance.rotationY;
+        mScale[slot] = s;
+        mCosScale[slot] = cs;
+        mSinScale[slot] = ss;
+        // World centre = position + (R * s) * local centre, R about +Y (see the transform rows).
+        mSphereX[slot] = instance.position.x + cs * c.x + ss * c.z;
+        mSphereY[slot] = instance.position.y + s * c.y;
+        mSphereZ[slot] = instance.position.z - ss * c.x + cs * c.z;
+        mSphereR[slot] = s * kind.boundsRadius;
+        mKind[slot] = instance.kind;
+    }
+
+    std::array<std::vector<float>*, 11> ForestInstances::floatArrays()
+    {
+        return {&mX, &mY, &mZ, &mRotation, &mScale, &mCosScale, &mSinScale, &mSphereX, &mSphereY, &mSphereZ, &mSphereR};
+    }
+
+    ForestHandle ForestInstances::takeHandle()
+    {
+        if (mFreeHandles.empty())
+            return ForestHandle(mSlotOfHandle.size());
+        const ForestHandle handle = mFreeHandles.back();
+        mFreeHandles.pop_back();
+        return handle;
+    }
+
+    void ForestInstances::push(const ForestInstance& instance, ForestHandle handle)
+    {
+        const std::size_t slot = size();
+        for (std::vector<float>* a : floatArrays())
+            a->push_back(0.0f);
+        mKind.push_back(0);
+        mHandleOfSlot.push_back(handle);
+        if (handle >= mSlotOfHandle.size())
+            mSlotOfHandle.resize(std::size_t(handle) + 1, INVALID_SLOT);
+        mSlotOfHandle[handle] = std::uint32_t(slot);
+        write(slot, instance);
+    }
+
+    Result<ForestHandle> ForestInstances::add(const ForestInstance& instance)
+    {
+        const std::string reason = check(instance);
+        if (!reason.empty())
+            return fail("", "instance " + std::to_string(size()), reason);
+        const ForestHandle handle = takeHandle();
+        push(instance, handle);
+        return handle;
+    }
+
+    Result<std::vector<ForestHandle>> ForestInstances::add(const std::vector<ForestInstance>& instances)
+    {
+        for (std::size_t i = 0; i < instances.size(); ++i)
+        {
+            const std::string reason = check(instances[i]);
+            if (!reason.empty())
+                return fail("", "instance " + std::to_string(i), reason);
+        }
+        reserve(size() + instances.size());
+        std::vector<ForestHandle> handles;
+        handles.reserve(instances.size());
+        for (const ForestInstance& instance : instances)
+        {
+            handles.push_back(takeHandle());
+            push(instance, handles.back());
+        }
+        return handles;
+    }
+
+    Result<void> ForestInstances::update(ForestHandle handle, const ForestInstance& instance)
+    {
+        const std::string element = "instance handle " + std::to_string(handle);
+        if (!contains(handle))
+            return fail("", element, "no such instance");
+        const std::string reason = check(instance);
+        if (!reason.empty())
+            return fail("", element, reason);
+        write(mSlotOfHandle[handle], instance);
+        return {};
+    }
+
+    Result<void> ForestInstances::remove(ForestHandle handle)
+    {
+        if (!contains(handle))
+            return fail("", "instance handle " + std::to_string(handle), "no such instance");
+        const std::uint32_t slot = mSlotOfHandle[handle];
+        const std::uint32_t last = std::uint32_t(size() - 1);
+        for (std::vector<float>* a : floatArrays())
+        {
+            (*a)[slot] = (*a)[last];
+            a->pop_back();
+        }
+        mKind[slot] = mKind[last];
+        mKind.pop_back();
+        const ForestHandle moved = mHandleOfSlot[last];
+        mHandleOfSlot[slot] = moved;
+        mHandleOfSlot.pop_back();
+        mSlotOfHandle[moved] = slot;
+        mSlotOfHandle[handle] = INVALID_SLOT;
+        mFreeHandles.push_back(handle);
+        return {};
+    }
+
+    void ForestInstances::clear()
+    {
+        for (std::vector<float>* a : floatArrays())
+            a->clear();
+        mKind.clear();
+        mHandleOfSlot.clear();
+        mSlotOfHandle.clear();
+        mFreeHandles.clear();
+    }
+
+    void ForestInstances::reserve(std::size_t count)
+    {
+        for (std::vector<float>* a : floatArrays())
+            a->reserve(count);
+        mKind.reserve(count);
+        mHandleOfSlot.reserve(count);
+    }
+
+    bool ForestInstances::contains(ForestHandle handle) const
+    {
+        return handle < mSlotOfHandle.size() && mSlotOfHandle[handle] != INVALID_SLOT;
+    }
+
+    ForestInstance ForestInstances::getAt(std::size_t index) const
+    {
+        ForestInstance instance;
+        instance.position = glm::vec3(mX[index], mY[index], mZ[index]);
+        instance.rotationY = mRotation[index];
+        instance.scale = mScale[index];
+        instance.kind = mKind[index];
+        return instance;
+    }
+
+    glm::vec4 ForestInstances::getWorldSphere(std::size_t index) const
+    {
+        return glm::vec4(mSphereX[index], mSphereY[index], mSphereZ[index], mSphereR[index]);
+    }
+
+    // ---- level of detail -------------------------------------------------------------------------
+
+    float ForestInstances::lodValue(std::size_t index, const CullCamera& camera, float lodBias) const
+    {
+        const LodConstants c = lodConstants(camera, lodBias);
+        const float dx = mX[index] - camera.lodPosition.x, dy = mY[index] - camera.lodPosition.y,
+                    dz = mZ[index] - camera.lodPosition.z;
+        const bool distance = mKindDistance[mKind[index]] != 0;
+        const float key = lodKey(dx * dx + dy * dy + dz * dz, mSphereR[index], distance, c);
+        return distance ? -key : key;
+    }
+
+    std::uint32_t ForestInstances::levelForValue(std::uint32_t kind, float value) const
+    {
+        const float key = mKindDistance[kind] ? -value : value;
+        return levelForKey(mKindTable.data() + kind * MAX_THRESHOLDS, key);
+    }
+
+    // ---- the per-frame loop ----------------------------------------------------------------------
+
+    Result<void> ForestInstances::cull(const CullCamera& camera, float lodBias, ForestVisibility& out) const
+    {
+        if (!std::isfinite(lodBias) || !(lodBias > 0.0f))
+            return fail("", "LoD bias", text(lodBias) + " is not finite and > 0");
+        for (std::size_t p = 0; p < 6; ++p)
+            if (!finite(glm::vec3(camera.planes[p])) || !std::isfinite(camera.planes[p].w))
+                return fail("", "camera", "frustum plane " + std::to_string(p) + " is not finite");
+        if (!finite(camera.lodPosition) || !std::isfinite(camera.lodPixelScale) || camera.lodPixelScale < 0.0f)
+            return fail("", "camera", "LoD position or pixel scale is not finite");
+
+        // Warm-up: arrays grow to the instance and bucket counts, never shrink.
+        const std::size_t n = size();
+        if (out.mVisible.size() < n)
+        {
+            out.mVisible.resize(n);
+            out.mVisibleBucket.resize(n);
+        }
+        out.mBuckets.resize(mBucketCount);
+        out.mCursor.assign(mBucketCount, 0u);
+
+        // Pass 1: cull, pick the level, count per bucket. Planes copied out for the compiler.
+        float pl[6][4];
+        for (int p = 0; p < 6; ++p)
+            for (int k = 0; k < 4; ++k)
+                pl[p][k] = camera.planes[p][k];
+        const LodConstants c = lodConstants(camera, lodBias);
+        const glm::vec3 eye = camera.lodPosition;
+        const float* sx = mSphereX.data();
+        const float* sy = mSphereY.data();
+        const float* sz = mSphereZ.data();
+        const float* sr = mSphereR.data();
+        const float* px = mX.data();
+        const float* py = mY.data();
+        const float* pz = mZ.data();
+        const std::uint32_t* kinds = mKind.data();
+        const std::uint8_t* kindDistance = mKindDistance.data();
+        const std::uint32_t* kindFirst = mKindFirstBucket.data();
+        const float* tables = mKindTable.data();
+        std::uint32_t* visible = out.mVisible.data();
+        std::uint32_t* visibleBucket = out.mVisibleBucket.data();
+        std::uint32_t* counts = out.mCursor.data();
+        std::uint32_t visibleCount = 0;
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            const float x = sx[i], y = sy[i], z = sz[i], negR = -sr[i];
+            bool inside = true;
+            for (int p = 0; p < 6; ++p)
+                inside &= pl[p][0] * x + pl[p][1] * y + pl[p][2] * z + pl[p][3] >= negR;
+            if (!inside)
+                continue;
+            const std::uint32_t kind = kinds[i];
+            const float dx = px[i] - eye.x, dy = py[i] - eye.y, dz = pz[i] - eye.z;
+            const float key = lodKey(dx * dx + dy * dy + dz * dz, sr[i], kindDistance[kind] != 0, c);
+            const std::uint32_t bucket = kindFirst[kind] + levelForKey(tables + kind * MAX_THRESHOLDS, key);
+            visible[visibleCount] = std::uint32_t(i);
+            visibleBucket[visibleCount] = bucket;
+            ++counts[bucket];
+            ++visibleCount;
+        }
+
+        // Prefix sums: bucket ranges; counts become fill cursors.
+        std::uint32_t first = 0;
+        for (std::uint32_t k = 0, b = 0; k < mKinds.size(); ++k)
+            for (std::uint32_t l = 0; l < mKindLevels[k]; ++l, ++b)
+            {
+                out.mBuckets[b] = ForestBucket{k, l, first, counts[b]};
+                first += counts[b];
+                counts[b] = out.mBuckets[b].first;
+            }
+
+        // Pass 2: fill indices and world matrices, bucket by bucket in input order.
+        if (out.mIndices.size() < visibleCount)
+        {
+            out.mIndices.resize(visibleCount);
+            out.mTransforms.resize(ForestVisibility::TRANSFORM_FLOATS * visibleCount);
+        }
+        std::uint32_t* indices = out.mIndices.data();
+        float* transforms = out.mTransforms.data();
+        const float* cosScale = mCosScale.data();
+        const float* sinScale = mSinScale.data();
+        const float* scale = mScale.data();
+        for (std::uint32_t j = 0; j < visibleCount; ++j)
+        {
+            const std::uint32_t i = visible[j];
+            const std::uint32_t slot = counts[visibleBucket[j]]++;
+            indices[slot] = i;
+            float* m = transforms + ForestVisibility::TRANSFORM_FLOATS * slot;
+            const float cs = cosScale[i], ss = sinScale[i];
+            m[0] = cs, m[1] = 0.0f, m[2] = ss, m[3] = px[i];
+            m[4] = 0.0f, m[5] = scale[i], m[6] = 0.0f, m[7] = py[i];
+            m[8] = -ss, m[9] = 0.0f, m[10] = cs, m[11] = pz[i];
+        }
+        out.mVisibleCount = visibleCount;
+        out.mCulledCount = std::uint32_t(n - visibleCount);
+        return {};
+    }
+}

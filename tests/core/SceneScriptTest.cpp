@@ -1,0 +1,447 @@
+// SceneScript: the shipped scenes, error positions, placements and the camera path.
+#include "TreeLod/SceneScript.h"
+
+#include "TreeLod/Image.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+namespace TreeLod
+{
+    namespace
+    {
+        std::string scenePath(const std::string& name)
+        {
+            return std::string(TREELOD_SOURCE_DIR) + "/samples/scenes/" + name;
+        }
+
+        /// A small valid script; tests replace parts of it.
+        const std::string MINIMAL = R"({
+  "name": "t",
+  "ground": {"kind": "plane", "size": 100},
+  "species": [{"name": "a", "source": "preset:oak", "techniques": "auto"}],
+  "placements": [{"species": "a", "random": {"seed": 1, "count": 10, "area": {"rect": [-10, -10, 10, 10]}}}],
+  "camera": {"keyframes": [{"time": 0, "position": [0, 2, 10], "target": [0, 2, 0]},
+                           {"time": 1, "position": [0, 2, 20], "target": [0, 2, 0]}]},
+  "resolution": [64, 64],
+  "frames": 2
+})";
+
+        std::string replaced(std::string text, const std::string& from, const std::string& to)
+        {
+            std::size_t at = text.find(from);
+            EXPECT_NE(at, std::string::npos) << from;
+            if (at != std::string::npos)
+                text.replace(at, from.size(), to);
+            return text;
+        }
+
+        /// "line L, column C" of the first occurrence of `needle` (1-based, bytes), counted here
+        /// independently of the parser.
+        std::string positionOf(const std::string& text, const std::string& needle)
+        {
+            std::size_t at = text.find(needle), line = 1, column = 1;
+            for (std::size_t i = 0; i < at; ++i)
+            {
+                column = text[i] == '\n' ? 1 : column + 1;
+                line += text[i] == '\n';
+            }
+            return "line " + std::to_string(line) + ", column " + std::to_string(column);
+        }
+
+        /// Parses `text`, expects failure; returns the message.
+        std::string errorOf(const std::string& text)
+        {
+            Result<SceneScript> r = parseSceneScript(text, "test.json", "");
+            EXPECT_FALSE(r.ok());
+            return r.ok() ? std::string() : r.error().message();
+        }
+
+        SceneScript parsed(const std::string& text)
+        {
+            Result<SceneScript> r = parseSceneScript(text, "test.json", "");
+            EXPECT_TRUE(r.ok()) << r.error().message();
+            return r.ok() ? r.value() : SceneScript();
+        }
+
+        /// Mean distance from each point to its nearest neighbour (brute force).
+        double meanNearestNeighbour(const std::vector<PlacedTree>& trees)
+        {
+            double sum = 0.0;
+            for (std::size_t i = 0; i < trees.size(); ++i)
+            {
+                double best = 1e30;
+                for (std::size_t j = 0; j < trees.size(); ++j)
+                    if (j != i)
+                    {
+                        glm::vec2 d(trees[i].position.x - trees[j].position.x,
+                                    trees[i].position.z - trees[j].position.z);
+                        best = std::min(best, double(glm::length(d)));
+                    }
+                sum += best;
+            }
+            return sum / double(trees.size());
+        }
+    }
+
+    TEST(SceneScript, shippedScenesParse)
+    {
+        for (const char* name : {"single-tree.json", "table2.json", "flythrough-10k.json", "plaza-290.json"})
+        {
+            Result<SceneScript> s = loadSceneScript(scenePath(name));
+            ASSERT_TRUE(s.ok()) << s.error().message();
+            EXPECT_FALSE(s->name.empty()) << name;
+            EXPECT_FALSE(s->description.empty()) << name;
+            EXPECT_GE(s->camera.keyframes.size(), 2u) << name;
+            for (const SceneSpecies& sp : s->species)
+                EXPECT_TRUE(!sp.preset.empty() || std::filesystem::is_regular_file(sp.source)) << sp.source;
+        }
+    }
+
+    TEST(SceneScript, shippedScenesHaveTheirTreeCounts)
+    {
+        // flythrough: paper 001's 10 000 plants; plaza: paper 002's 290, none on the free square.
+        std::vector<PlacedTree> fly = generatePlacements(*loadSceneScript(scenePath("flythrough-10k.json")));
+        EXPECT_EQ(fly.size(), 10000u);
+        Result<SceneScript> plaza = loadSceneScript(scenePath("plaza-290.json"));
+        ASSERT_TRUE(plaza.ok());
+        std::vector<PlacedTree> trees = generatePlacements(*plaza);
+        EXPECT_EQ(trees.size(), 290u);
+        std::vector<int> perSpecies(plaza->species.size(), 0);
+        for (const PlacedTree& t : trees)
+        {
+            EXPECT_FALSE(std::abs(t.position.x) < 30.0f && std::abs(t.position.z) < 30.0f);
+            ++perSpecies[t.species];
+        }
+        for (int n : perSpecies)
+            EXPECT_GT(n, 50); // three species mixed, about 97 each
+        // Walking height all along the path.
+        for (std::uint32_t f = 0; f < plaza->frames; f += 7)
+            EXPECT_NEAR(cameraAt(*plaza, frameTime(*plaza, f)).position.y, 1.7f, 1e-3f);
+    }
+
+    TEST(SceneScript, shippedCamerasStayAboveGroundAndOutOfTrunks)
+    {
+        // Splines overshoot: a walk at 1.7 m must not dip under the ground, and a low camera must
+        // not pass through a trunk (the flythrough's glade and track keep trees off its path).
+        for (const char* name : {"single-tree.json", "table2.json", "flythrough-10k.json", "plaza-290.json"})
+        {
+            Result<SceneScript> s = loadSceneScript(scenePath(name));
+            ASSERT_TRUE(s.ok()) << s.error().message();
+            std::vector<PlacedTree> trees = generatePlacements(*s);
+            double lowest = 1e30, closest = 1e30;
+            for (std::uint32_t f = 0; f < s->frames; ++f)
+            {
+                CameraSpec cam = cameraAt(*s, frameTime(*s, f));
+                double above = cam.position.y - groundHeight(s->ground, cam.position.x, cam.position.z);
+                lowest = std::min(lowest, above);
+                EXPECT_GT(glm::length(cam.target - cam.position), 1.0f) << name << " frame " << f;
+                if (above > 20.0)
+                    continue; // above the crowns
+                for (const PlacedTree& t : trees)
+                    closest = std::min(closest, double(glm::length(glm::vec2(cam.position.x - t.position.x,
+                                                                             cam.position.z - t.position.z))));
+            }
+            EXPECT_GT(lowest, 1.0) << name;
+            EXPECT_GT(closest, 0.5) << name; // single-tree starts 1 m from the trunk
+        }
+    }
+
+    TEST(SceneScript, singleTreeOrbitSpans1mTo2km)
+    {
+        Result<SceneScript> s = loadSceneScript(scenePath("single-tree.json"));
+        ASSERT_TRUE(s.ok()) << s.error().message();
+        std::vector<PlacedTree> trees = generatePlacements(*s);
+        ASSERT_EQ(trees.size(), 1u);
+        const glm::vec3 crown = trees[0].position + glm::vec3(0.0f, 6.0f, 0.0f);
+        double nearest = 1e30, farthest = 0.0, previous = 0.0;
+        int decreases = 0;
+        for (std::uint32_t f = 0; f < s->frames; ++f)
+        {
+            CameraSpec cam = cameraAt(*s, frameTime(*s, f));
+            double d = glm::length(cam.position - crown);
+            nearest = std::min(nearest, d);
+            farthest = std::max(farthest, d);
+            decreases += f > 0 && d < previous;
+            previous = d;
+            EXPECT_LT(glm::length(cam.target - crown), 1e-4f); // always looking at the crown
+            EXPECT_GT(cam.farClip, d);
+        }
+        EXPECT_NEAR(nearest, 1.0, 0.02);
+        EXPECT_NEAR(farthest, 2000.0, 2.0);
+        EXPECT_LT(decreases, int(s->frames) / 20); // an outward spiral, not back and forth
+    }
+
+    TEST(SceneScript, table2CountSweep)
+    {
+        Result<SceneScript> s = loadSceneScript(scenePath("table2.json"));
+        ASSERT_TRUE(s.ok()) << s.error().message();
+        ASSERT_EQ(s->counts, (std::vector<std::uint32_t>{1, 50, 100, 1000, 10000}));
+        for (std::uint32_t n : s->counts)
+        {
+            PlacementOptions o;
+            o.totalCount = n;
+            std::vector<PlacedTree> trees = generatePlacements(*s, o);
+            ASSERT_EQ(trees.size(), n);
+            EXPECT_EQ(trees[0].position, glm::vec3(0.0f)); // the explicit tree in front of the camera
+        }
+        // --scale 0.1 thins the forest in the same area and keeps the origin tree.
+        PlacementOptions o;
+        o.totalCount = 10000;
+        o.scale = 0.1;
+        std::vector<PlacedTree> scaled = generatePlacements(*s, o);
+        EXPECT_EQ(scaled.size(), 1u + 1000u);
+        float minZ = 0.0f;
+        for (const PlacedTree& t : scaled)
+            minZ = std::min(minZ, t.position.z);
+        EXPECT_LT(minZ, -500.0f); // still reaching the forest's far edge (-560)
+    }
+
+    TEST(SceneScript, syntaxErrorGivesLineAndColumn)
+    {
+        // The missing comma: the error shows at the last character read, the closing quote of
+        // the next key ("frames" spans columns 3 to 10 of line 3).
+        std::string text = "{\n  \"name\": \"t\"\n  \"frames\": 2\n}";
+        std::string message = errorOf(text);
+        EXPECT_EQ(message.rfind("test.json: line 3, column 10: ", 0), 0u) << message;
+        EXPECT_NE(message.find("syntax error"), std::string::npos) << message;
+    }
+
+    TEST(SceneScript, semanticErrorsNameLineColumnAndKey)
+    {
+        struct Case
+        {
+            std::string from, to;   ///< edit of MINIMAL
+            std::string at;         ///< text whose start the error must point at
+            std::string key;        ///< JSON pointer in the message
+            std::string reason;     ///< part of the reason
+        };
+        const std::vector<Case> cases = {
+            // missing key: reported at the key of the object that lacks it
+            {"\"kind\": \"plane\", ", "", "\"ground\"", "/ground/kind", "missing required key"},
+            // wrong type
+            {"\"size\": 100", "\"size\": \"big\"", "\"size\"", "/ground/size", "expected a number, got string"},
+            {"\"frames\": 2", "\"frames\": 2.5", "\"frames\"", "/frames", "expected an integer"},
+            // unknown key (a typo)
+            {"\"seed\": 1,", "\"sead\": 1,", "\"sead\"", "/placements/0/random/sead", "unknown key 'sead'"},
+            // keyframe times must increase
+            {"\"time\": 1", "\"time\": 0", "\"time\": 0, \"position\": [0, 2, 20]", "/camera/keyframes/1/time",
+             "greater than the previous keyframe's time"},
+            // negative density
+            {"\"count\": 10", "\"density\": -5", "\"density\"", "/placements/0/random/density", "must be > 0"},
+            // a duplicate key (nlohmann alone would keep the last silently)
+            {"\"frames\": 2", "\"frames\": 2, \"frames\": 3", "\"frames\": 3", "/frames", "duplicate key"},
+            // unknown species, technique name syntax, area outside the ground
+            {"\"species\": \"a\"", "\"species\": \"b\"", "\"species\": \"b\"", "/placements/0/species",
+             "no species named 'b'"},
+            {"\"techniques\": \"auto\"", "\"techniques\": [{\"technique\": \"Bill Board\"}]", "\"technique\":",
+             "/species/0/techniques/0/technique", "not a technique name"},
+            {"[-10, -10, 10, 10]", "[-10, -10, 10, 60]", "60", "/placements/0/random/area/rect/3", "<= 50"},
+        };
+        for (const Case& c : cases)
+        {
+            std::string text = replaced(MINIMAL, c.from, c.to);
+            std::string message = errorOf(text);
+            std::string expected = "test.json: " + positionOf(text, c.at) + ", key " + c.key + ": ";
+            EXPECT_EQ(message.rfind(expected, 0), 0u) << "expected '" << expected << "' in\n" << message;
+            EXPECT_NE(message.find(c.reason), std::string::npos) << message;
+        }
+    }
+
+    TEST(SceneScript, techniqueBandsParseAndMustBeOrdered)
+    {
+        SceneScript s = parsed(replaced(MINIMAL, "\"techniques\": \"auto\"",
+                                        "\"techniques\": [{\"technique\": \"mesh\", \"maxDistance\": 20}, "
+                                        "{\"technique\": \"lodf\", \"maxDistance\": 200}, "
+                                        "{\"technique\": \"billboard-cloud\"}]"));
+        ASSERT_EQ(s.species.size(), 1u);
+        EXPECT_FALSE(s.species[0].autoTechnique);
+        ASSERT_EQ(s.species[0].bands.size(), 3u);
+        EXPECT_EQ(s.species[0].bands[1].technique, "lodf");
+        EXPECT_EQ(s.species[0].bands[1].maxDistance, 200.0f);
+        EXPECT_EQ(s.species[0].bands[2].maxDistance, 0.0f); // open-ended
+
+        std::string message = errorOf(replaced(MINIMAL, "\"techniques\": \"auto\"",
+                                               "\"techniques\": [{\"technique\": \"mesh\", \"maxDistance\": 20}, "
+                                               "{\"technique\": \"lodf\", \"maxDistance\": 10}]"));
+        EXPECT_NE(message.find("key /species/0/techniques/1/maxDistance"), std::string::npos) << message;
+        message = errorOf(replaced(MINIMAL, "\"techniques\": \"auto\"",
+                                   "\"techniques\": [{\"technique\": \"mesh\", \"maxDistance\": 20}, "
+                                   "{\"technique\": \"lodf\", \"minPixels\": 10}]"));
+        EXPECT_NE(message.find("same measure"), std::string::npos) << message;
+    }
+
+    TEST(SceneScript, missingFileNamesThePath)
+    {
+        Result<SceneScript> r = loadSceneScript("/nonexistent/scene.json");
+        ASSERT_FALSE(r.ok());
+        EXPECT_NE(r.error().message().find("/nonexistent/scene.json"), std::string::npos);
+        std::string message = errorOf(replaced(MINIMAL, "\"preset:oak\"", "\"no-such-tree.glb\""));
+        EXPECT_NE(message.find("key /species/0/source: no such file"), std::string::npos) << message;
+    }
+
+    TEST(SceneScript, placementsAreDeterministicInsideTheAreaAndCounted)
+    {
+        SceneScript s = parsed(replaced(MINIMAL, "\"count\": 10", "\"count\": 500"));
+        std::vector<PlacedTree> a = generatePlacements(s), b = generatePlacements(s);
+        ASSERT_EQ(a.size(), 500u);
+        for (std::size_t i = 0; i < a.size(); ++i)
+        {
+            EXPECT_EQ(a[i].position, b[i].position);
+            EXPECT_EQ(a[i].rotation, b[i].rotation);
+            EXPECT_TRUE(std::abs(a[i].position.x) <= 10.0f && std::abs(a[i].position.z) <= 10.0f);
+            EXPECT_EQ(a[i].position.y, 0.0f);
+            EXPECT_TRUE(a[i].rotation >= 0.0f && a[i].rotation < 6.2832f);
+        }
+        // Another seed, other trees.
+        SceneScript other = parsed(replaced(replaced(MINIMAL, "\"count\": 10", "\"count\": 500"), "\"seed\": 1",
+                                            "\"seed\": 2"));
+        EXPECT_NE(generatePlacements(other)[0].position, a[0].position);
+
+        // Density: trees per hectare of the free area. A 100 m disc with a 50 m hole: 2.356 ha.
+        std::string ringText = replaced(replaced(MINIMAL, "\"count\": 10", "\"density\": 120"),
+                                        "\"area\": {\"rect\": [-10, -10, 10, 10]}",
+                                        "\"area\": {\"disc\": [0, 0, 100]}, "
+                                        "\"exclude\": [{\"disc\": [0, 0, 50]}], \"clumping\": 0.5");
+        SceneScript d = parsed(replaced(ringText, "\"size\": 100", "\"size\": 300"));
+        std::vector<PlacedTree> ring = generatePlacements(d);
+        const double freeHa = 3.14159265 * (100.0 * 100.0 - 50.0 * 50.0) / 10000.0;
+        // The free area is estimated on a 512^2 grid: allow 1 %.
+        EXPECT_NEAR(double(ring.size()), 120.0 * freeHa, 0.01 * 120.0 * freeHa);
+        for (const PlacedTree& t : ring)
+        {
+            float r = glm::length(glm::vec2(t.position.x, t.position.z));
+            EXPECT_TRUE(r >= 50.0f && r <= 100.0f) << r;
+        }
+    }
+
+    TEST(SceneScript, clumpingShrinksNearestNeighbourDistances)
+    {
+        // Clark-Evans: for n uniform points on area A the mean nearest-neighbour distance is
+        // about 0.5 / sqrt(n / A) (a little more at the edges). Clumping must pull it far below.
+        const std::string base = replaced(replaced(MINIMAL, "\"count\": 10", "\"count\": 800"),
+                                          "[-10, -10, 10, 10]", "[-40, -40, 40, 40]");
+        const double expected = 0.5 / std::sqrt(800.0 / (80.0 * 80.0));
+        std::vector<PlacedTree> uniform = generatePlacements(parsed(base));
+        double uniformNN = meanNearestNeighbour(uniform);
+        EXPECT_NEAR(uniformNN, expected, 0.12 * expected);
+        double previous = uniformNN;
+        for (const char* c : {"0.3", "0.6", "1"})
+        {
+            std::string text = replaced(base, "\"count\": 800", std::string("\"count\": 800, \"clumping\": ") + c);
+            std::vector<PlacedTree> clumped = generatePlacements(parsed(text));
+            ASSERT_EQ(clumped.size(), 800u);
+            double nn = meanNearestNeighbour(clumped);
+            EXPECT_LT(nn, previous) << "clumping " << c;
+            previous = nn;
+        }
+        EXPECT_LT(previous, 0.5 * uniformNN);
+    }
+
+    TEST(SceneScript, explicitPositionsAndSpeciesMix)
+    {
+        std::string text = replaced(MINIMAL, "{\"species\": \"a\", \"random\"",
+                                    "{\"species\": \"a\", \"positions\": [[1, 2], [3, 4, 90, 2]]}, "
+                                    "{\"species\": [\"a\", \"b\"], \"random\"");
+        text = replaced(text, "\"techniques\": \"auto\"}",
+                        "\"techniques\": \"auto\"}, {\"name\": \"b\", \"source\": \"preset:birch\", "
+                        "\"techniques\": \"auto\", \"scale\": [2, 3]}");
+        SceneScript s = parsed(text);
+        std::vector<PlacedTree> trees = generatePlacements(s);
+        ASSERT_EQ(trees.size(), 12u);
+        EXPECT_EQ(trees[1].position, glm::vec3(3, 0, 4));
+        EXPECT_NEAR(trees[1].rotation, 3.14159265f / 2.0f, 1e-6f);
+        EXPECT_EQ(trees[1].scale, 2.0f);
+        EXPECT_EQ(trees[0].scale, 1.0f);
+        int speciesB = 0;
+        for (std::size_t i = 2; i < trees.size(); ++i)
+        {
+            speciesB += trees[i].species == 1;
+            const float lo = trees[i].species == 1 ? 2.0f : 1.0f, hi = trees[i].species == 1 ? 3.0f : 1.0f;
+            EXPECT_TRUE(trees[i].scale >= lo && trees[i].scale <= hi);
+        }
+        EXPECT_TRUE(speciesB > 0 && speciesB < 10); // both species drawn (P(all one) = 2 * 2^-10)
+        // The sweep keeps explicit trees first: a total of 1 is the first explicit tree.
+        PlacementOptions one;
+        one.totalCount = 1;
+        ASSERT_EQ(generatePlacements(s, one).size(), 1u);
+        EXPECT_EQ(generatePlacements(s, one)[0].position, glm::vec3(1, 0, 2));
+    }
+
+    TEST(SceneScript, cameraPassesThroughKeyframesAndIsContinuous)
+    {
+        std::string text = replaced(MINIMAL, "{\"time\": 1, \"position\": [0, 2, 20], \"target\": [0, 2, 0]}",
+                                    "{\"time\": 1, \"position\": [0, 2, 20], \"target\": [0, 2, 0]},"
+                                    "{\"time\": 3, \"position\": [40, 30, -5], \"target\": [1, 2, 0]},"
+                                    "{\"time\": 3.5, \"position\": [41, 30, -5], \"target\": [1, 2, 0]},"
+                                    "{\"time\": 10, \"position\": [500, 80, 900], \"target\": [3, 5, 7]}");
+        SceneScript s = parsed(text);
+        for (const SceneKeyframe& k : s.camera.keyframes)
+        {
+            CameraSpec c = cameraAt(s, k.time);
+            EXPECT_EQ(c.position, k.position) << k.time;
+            EXPECT_EQ(c.target, k.target) << k.time;
+        }
+        // Clamped outside the path.
+        EXPECT_EQ(cameraAt(s, -5.0).position, s.camera.keyframes.front().position);
+        EXPECT_EQ(cameraAt(s, 50.0).position, s.camera.keyframes.back().position);
+        // Continuous: 10^4 steps of 1 ms; no step moves more than a few times the path's
+        // fastest average keyframe-to-keyframe speed (about 160 m/s here) would allow.
+        double maxStep = 0.0;
+        glm::vec3 previous = cameraAt(s, 0.0).position;
+        for (int i = 1; i <= 10000; ++i)
+        {
+            glm::vec3 p = cameraAt(s, i * 1e-3).position;
+            maxStep = std::max(maxStep, double(glm::length(p - previous)));
+            previous = p;
+        }
+        EXPECT_LT(maxStep, 3.0 * 160.0 * 1e-3);
+        EXPECT_GT(maxStep, 0.0);
+        // Not linear: between keyframes the spline leaves the chord.
+        glm::vec3 mid = cameraAt(s, 2.0).position;
+        glm::vec3 chordMid = 0.5f * (s.camera.keyframes[1].position + s.camera.keyframes[2].position);
+        EXPECT_GT(glm::length(mid - chordMid), 0.1f);
+        s.camera.linear = true;
+        EXPECT_LT(glm::length(cameraAt(s, 2.0).position - chordMid), 1e-4f);
+    }
+
+    TEST(SceneScript, framesSpreadOverThePath)
+    {
+        SceneScript s = parsed(replaced(MINIMAL, "\"frames\": 2", "\"frames\": 5"));
+        EXPECT_EQ(frameTime(s, 0), 0.0);
+        EXPECT_EQ(frameTime(s, 2), 0.5);
+        EXPECT_EQ(frameTime(s, 4), 1.0);
+        EXPECT_EQ(frameTime(s, 99), 1.0);
+        EXPECT_EQ(frameTime(s, 1, 3), 0.5); // --frames 3
+        EXPECT_EQ(frameTime(s, 0, 1), 0.0);
+    }
+
+    TEST(SceneScript, heightfieldGivesTreesTheirHeight)
+    {
+        const char* env = std::getenv("TREELOD_TEST_OUT");
+        std::filesystem::path dir = std::filesystem::path(env && *env ? env : TREELOD_BINARY_DIR "/test-out") /
+                                    "scene";
+        std::filesystem::create_directories(dir);
+        // A ramp: grey = column / 3 over 4 x 2 pixels, so height = 30 * (x / 100 + 0.5) on a 100 m square.
+        Image ramp(4, 2);
+        for (int y = 0; y < 2; ++y)
+            for (int x = 0; x < 4; ++x)
+                ramp.at(x, y) = glm::vec4(glm::vec3(x / 3.0f), 1.0f);
+        ASSERT_TRUE(writePng((dir / "ramp.png").string(), ramp).ok());
+        std::string text = replaced(MINIMAL, "{\"kind\": \"plane\", \"size\": 100}",
+                                    "{\"kind\": \"heightfield\", \"size\": 100, \"image\": \"ramp.png\", "
+                                    "\"heightScale\": 30}");
+        Result<SceneScript> r = parseSceneScript(text, "test.json", dir.string());
+        ASSERT_TRUE(r.ok()) << r.error().message();
+        for (const PlacedTree& t : generatePlacements(*r))
+            // 8-bit PNG: grey steps of 1/255 of 30 m.
+            EXPECT_NEAR(t.position.y, 30.0f * (t.position.x / 100.0f + 0.5f), 30.0f / 255.0f);
+        EXPECT_NEAR(groundHeight(r->ground, -80.0f, 0.0f), 0.0f, 1e-6f); // clamped at the edge
+
+        std::string message = errorOf(replaced(text, "ramp.png", "missing.png"));
+        EXPECT_NE(message.find("key /ground/image"), std::string::npos) << message;
+    }
+}
