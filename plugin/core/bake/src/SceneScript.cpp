@@ -537,8 +537,9 @@ namespace TreeLod
                 names.emplace_back(text(species, speciesPointer), speciesPointer);
             for (const auto& [name, namePointer] : names)
             {
+                const std::string& wanted = name; // C++17 lambdas cannot capture structured bindings
                 auto it = std::find_if(script.species.begin(), script.species.end(),
-                                       [&](const SceneSpecies& s) { return s.name == name; });
+                                       [&wanted](const SceneSpecies& s) { return s.name == wanted; });
                 if (it == script.species.end())
                     bad(namePointer, "no species named '" + name + "'");
                 p.species.push_back(std::uint32_t(it - script.species.begin()));
