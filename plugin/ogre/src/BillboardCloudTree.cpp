@@ -2,6 +2,7 @@
 // See BillboardCloudTree.h for the LoD rules.
 #include "TreeLod/BillboardCloudTree.h"
 
+#include "ObjectParams.h"
 #include "TreePart.h"
 
 #include "TreeLod/TreeAssetManager.h"
@@ -256,57 +257,28 @@ namespace TreeLod
     BillboardCloudTree::Options BillboardCloudTreeFactory::parseOptions(const Ogre::NameValuePairList* params)
     {
         BillboardCloudTree::Options options;
-        if (!params)
-            return options;
-        auto bad = [](const char* key, const Ogre::String& value, const Ogre::String& expected) {
-            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
-                        Ogre::String("parameter '") + key + "': '" + value + "' is not " + expected,
-                        "BillboardCloudTreeFactory");
-        };
-        auto number = [&](const char* key, double lo, double hi, double& out) {
-            auto it = params->find(key);
-            if (it == params->end())
-                return false;
-            char* end = nullptr;
-            out = std::strtod(it->second.c_str(), &end);
-            if (it->second.empty() || *end != '\0' || !(out >= lo && out <= hi))
-                bad(key, it->second, "a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-            return true;
-        };
+        const ObjectParams p(params, "BillboardCloudTreeFactory");
         double v = 0.0;
-        auto classic = params->find("classic");
-        if (classic != params->end())
-        {
-            if (classic->second != "true" && classic->second != "false")
-                bad("classic", classic->second, "true or false");
-            options.classic = classic->second == "true";
-        }
-        if (number("level", 0.0, 255.0, v))
+        p.flag("classic", options.classic);
+        if (p.number("level", 0.0, 255.0, v))
         {
             if (v != std::floor(v))
-                bad("level", params->at("level"), "a whole number");
+                p.bad("level", *p.find("level"), "a whole number");
             options.level = int(v);
         }
-        auto strategy = params->find("lodStrategy");
-        if (strategy != params->end())
+        if (const Ogre::String* strategy = p.find("lodStrategy"))
         {
-            if (strategy->second == "pixel_count")
+            if (*strategy == "pixel_count")
                 options.strategy = BillboardCloudTree::LodStrategy::PixelCount;
-            else if (strategy->second == "distance")
+            else if (*strategy == "distance")
                 options.strategy = BillboardCloudTree::LodStrategy::Distance;
             else
-                bad("lodStrategy", strategy->second, "pixel_count or distance");
+                p.bad("lodStrategy", *strategy, "pixel_count or distance");
         }
-        auto ao = params->find("ambientOcclusion");
-        if (ao != params->end())
-        {
-            if (ao->second != "true" && ao->second != "false")
-                bad("ambientOcclusion", ao->second, "true or false");
-            options.ambientOcclusion = ao->second == "true";
-        }
-        if (number("listFactor", 0.0, 1e6, v))
+        p.flag("ambientOcclusion", options.ambientOcclusion);
+        if (p.number("listFactor", 0.0, 1e6, v))
             options.listFactor = float(v);
-        if (number("lodBias", 1e-6, 1e6, v))
+        if (p.number("lodBias", 1e-6, 1e6, v))
             options.lodBias = float(v);
         return options;
     }
@@ -314,16 +286,8 @@ namespace TreeLod
     Ogre::MovableObject* BillboardCloudTreeFactory::createInstanceImpl(const Ogre::String& name,
                                                                        const Ogre::NameValuePairList* params)
     {
-        auto asset = params ? params->find("asset") : Ogre::NameValuePairList::const_iterator();
-        if (!params || asset == params->end())
-            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
-                        "BillboardCloudTree '" + name + "': parameter 'asset' is required",
-                        "BillboardCloudTreeFactory::createInstanceImpl");
-        const BillboardCloudTree::Options options = parseOptions(params);
-        auto group = params->find("group");
-        TreeAssetPtr tree = TreeAssetManager::getSingleton().load(
-            asset->second, group == params->end() ? Ogre::ResourceGroupManager::AUTODETECT_RESOURCE_GROUP_NAME
-                                                  : group->second);
-        return new BillboardCloudTree(name, tree, options);
+        const ObjectParams p(params, "BillboardCloudTreeFactory::createInstanceImpl");
+        const BillboardCloudTree::Options options = parseOptions(params); // bad parameters before loading
+        return new BillboardCloudTree(name, p.loadAsset(name, "BillboardCloudTree"), options);
     }
 }

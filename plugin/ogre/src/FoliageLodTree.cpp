@@ -1,5 +1,6 @@
 #include "TreeLod/FoliageLodTree.h"
 
+#include "ObjectParams.h"
 #include "TreePart.h"
 
 #include "TreeLod/TreeAssetManager.h"
@@ -251,27 +252,13 @@ namespace TreeLod
     FoliageLodTree::Options FoliageLodTreeFactory::parseOptions(const Ogre::NameValuePairList* params)
     {
         FoliageLodTree::Options options;
-        if (!params)
-            return options;
-        auto number = [&](const char* key, double lo, double hi, double& out) {
-            auto it = params->find(key);
-            if (it == params->end())
-                return false;
-            char* end = nullptr;
-            out = std::strtod(it->second.c_str(), &end);
-            if (it->second.empty() || *end != '\0' || !(out >= lo && out <= hi))
-                OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
-                            Ogre::String("parameter '") + key + "': '" + it->second + "' is not a number in [" +
-                                std::to_string(lo) + ", " + std::to_string(hi) + "]",
-                            "FoliageLodTreeFactory");
-            return true;
-        };
+        const ObjectParams p(params, "FoliageLodTreeFactory");
         double v = 0.0;
-        if (number("leaves", 0.0, 4294967295.0, v))
+        if (p.number("leaves", 0.0, 4294967295.0, v))
             options.fixedLeafCount = std::uint32_t(v);
-        if (number("pixelsPerLeaf", 1e-6, 1e9, v))
+        if (p.number("pixelsPerLeaf", 1e-6, 1e9, v))
             options.pixelsPerLeaf = float(v);
-        if (number("quantise", 0.0, 1024.0, v))
+        if (p.number("quantise", 0.0, 1024.0, v))
             options.quantiseLevels = std::uint32_t(v);
         return options;
     }
@@ -279,14 +266,8 @@ namespace TreeLod
     Ogre::MovableObject* FoliageLodTreeFactory::createInstanceImpl(const Ogre::String& name,
                                                                   const Ogre::NameValuePairList* params)
     {
-        auto asset = params ? params->find("asset") : Ogre::NameValuePairList::const_iterator();
-        if (!params || asset == params->end())
-            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, "FoliageLodTree '" + name + "': parameter 'asset' is required",
-                        "FoliageLodTreeFactory::createInstanceImpl");
-        auto group = params->find("group");
-        TreeAssetPtr tree = TreeAssetManager::getSingleton().load(
-            asset->second, group == params->end() ? Ogre::ResourceGroupManager::AUTODETECT_RESOURCE_GROUP_NAME
-                                                  : group->second);
+        const ObjectParams p(params, "FoliageLodTreeFactory::createInstanceImpl");
+        TreeAssetPtr tree = p.loadAsset(name, "FoliageLodTree");
         return new FoliageLodTree(name, tree, parseOptions(params));
     }
 }

@@ -15,6 +15,23 @@ namespace TreeLod
     TechniqueRegistry& TechniqueRegistry::getSingleton() { return *msSingleton; }
     TechniqueRegistry* TechniqueRegistry::getSingletonPtr() { return msSingleton; }
 
+    namespace
+    {
+        /// A create function for a tree object factory: `params` plus the asset (and `extra`).
+        decltype(TechniqueInfo::create) byFactory(const Ogre::String& type, Ogre::NameValuePairList extra = {})
+        {
+            return [type, extra](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset,
+                                 const Ogre::NameValuePairList& params) {
+                Ogre::NameValuePairList all = params;
+                all["asset"] = asset.getName();
+                all["group"] = asset.getGroup();
+                for (const auto& [key, value] : extra)
+                    all[key] = value;
+                return sm.createMovableObject(name, type, &all);
+            };
+        }
+    }
+
     TechniqueRegistry::TechniqueRegistry()
     {
         // The polygonal reference: every comparison in this project is against it.
@@ -26,27 +43,16 @@ namespace TreeLod
         // paper 004: continuous foliage LoD by leaf collapse.
         add({"lodf", "LoDF: every leaf geometric, leaf count continuous with screen size (paper 004)",
              FOLIAGE_LOD_CHUNK, FoliageLodTreeFactory::FACTORY_TYPE_NAME,
-             [](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset, const Ogre::NameValuePairList& params) {
-                 Ogre::NameValuePairList all = params;
-                 all["asset"] = asset.getName();
-                 all["group"] = asset.getGroup();
-                 return sm.createMovableObject(name, FoliageLodTreeFactory::FACTORY_TYPE_NAME, &all);
-             }});
+             byFactory(FoliageLodTreeFactory::FACTORY_TYPE_NAME)});
         // paper 000: billboard clouds with multi-layered indirect texturing, and the classic cloud.
-        for (const bool classic : {false, true})
-            add({classic ? CLASSIC_BILLBOARD_CLOUD_CHUNK : BILLBOARD_CLOUD_CHUNK,
-                 classic ? "classic billboard cloud: one RGBA texture per billboard, the baseline of paper 000 Fig. 13"
-                         : "billboard clouds with multi-layered indirect texturing and shader LoD (paper 000)",
-                 classic ? CLASSIC_BILLBOARD_CLOUD_CHUNK : BILLBOARD_CLOUD_CHUNK,
-                 BillboardCloudTreeFactory::FACTORY_TYPE_NAME,
-                 [classic](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset,
-                           const Ogre::NameValuePairList& params) {
-                     Ogre::NameValuePairList all = params;
-                     all["asset"] = asset.getName();
-                     all["group"] = asset.getGroup();
-                     all["classic"] = classic ? "true" : "false";
-                     return sm.createMovableObject(name, BillboardCloudTreeFactory::FACTORY_TYPE_NAME, &all);
-                 }});
+        add({BILLBOARD_CLOUD_CHUNK,
+             "billboard clouds with multi-layered indirect texturing and shader LoD (paper 000)",
+             BILLBOARD_CLOUD_CHUNK, BillboardCloudTreeFactory::FACTORY_TYPE_NAME,
+             byFactory(BillboardCloudTreeFactory::FACTORY_TYPE_NAME, {{"classic", "false"}})});
+        add({CLASSIC_BILLBOARD_CLOUD_CHUNK,
+             "classic billboard cloud: one RGBA texture per billboard, the baseline of paper 000 Fig. 13",
+             CLASSIC_BILLBOARD_CLOUD_CHUNK, BillboardCloudTreeFactory::FACTORY_TYPE_NAME,
+             byFactory(BillboardCloudTreeFactory::FACTORY_TYPE_NAME, {{"classic", "true"}})});
         // Technique issues add their line here.
     }
 

@@ -22,6 +22,48 @@
 
 namespace TreeLod
 {
+    namespace
+    {
+        /// A clone of TreeLod's material `base` named `name` in `group`; throws naming `base` when
+        /// TreeLod's materials are not in a resource group.
+        Ogre::MaterialPtr cloneBaseMaterial(const Ogre::String& base, const Ogre::String& name,
+                                            const Ogre::String& group)
+        {
+            Ogre::MaterialPtr parent = Ogre::MaterialManager::getSingleton().getByName(base, Ogre::RGN_DEFAULT);
+            if (!parent)
+                parent = Ogre::MaterialManager::getSingleton().getByName(base);
+            if (!parent)
+                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
+                            "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
+                            "TreeAsset");
+            return parent->clone(name, true, group);
+        }
+
+        Ogre::PixelFormat ogreFormat(GpuTextureFormat format)
+        {
+            switch (format)
+            {
+            case GpuTextureFormat::DXT1:
+                return Ogre::PF_DXT1;
+            case GpuTextureFormat::DXT5:
+                return Ogre::PF_DXT5;
+            default:
+                return Ogre::PF_BYTE_RGBA;
+            }
+        }
+
+        /// Upload `bytes` (level 0 then its mips, tightly packed) as texture `name`.
+        void uploadTexture(const Ogre::String& name, const Ogre::String& group, const std::uint8_t* bytes,
+                           std::uint32_t width, std::uint32_t height, Ogre::PixelFormat format, std::uint32_t mips)
+        {
+            Ogre::Image image;
+            image.loadDynamicImage(const_cast<Ogre::uchar*>(bytes), width, height, 1, format, false, 1,
+                                   mips > 0 ? mips - 1 : 0);
+            Ogre::TextureManager::getSingleton().loadImage(name, group, image, Ogre::TEX_TYPE_2D,
+                                                           int(mips > 0 ? mips - 1 : 0));
+        }
+    }
+
     TreeAsset::TreeAsset(Ogre::ResourceManager* creator, const Ogre::String& name, Ogre::ResourceHandle handle,
                          const Ogre::String& group, bool isManual, Ogre::ManualResourceLoader* loader)
         : Ogre::Resource(creator, name, handle, group, isManual, loader)
@@ -177,12 +219,8 @@ namespace TreeLod
         for (std::size_t t = 0; t < ref.textures.size(); ++t)
         {
             const GpuTexture& gpu = ref.textures[t];
-            Ogre::Image image;
-            image.loadDynamicImage(const_cast<Ogre::uchar*>(gpu.data.data()), gpu.width, gpu.height, 1,
-                                   Ogre::PF_BYTE_RGBA, false, 1, gpu.mipCount > 0 ? gpu.mipCount - 1 : 0);
             const Ogre::String name = prefix + "texture" + std::to_string(t);
-            Ogre::TextureManager::getSingleton().loadImage(name, mGroup, image, Ogre::TEX_TYPE_2D,
-                                                           int(gpu.mipCount > 0 ? gpu.mipCount - 1 : 0));
+            uploadTexture(name, mGroup, gpu.data.data(), gpu.width, gpu.height, Ogre::PF_BYTE_RGBA, gpu.mipCount);
             mTextureNames.push_back(name);
         }
     }
@@ -203,16 +241,8 @@ namespace TreeLod
                 names.push_back(getMaterialNames()[i]);
                 continue;
             }
-            const Ogre::String base = src.isLeaf ? leafBase : barkBase;
-            Ogre::MaterialPtr parent = Ogre::MaterialManager::getSingleton().getByName(base, Ogre::RGN_DEFAULT);
-            if (!parent)
-                parent = Ogre::MaterialManager::getSingleton().getByName(base);
-            if (!parent)
-                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
-                            "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
-                            "TreeAsset::createMaterials");
             const Ogre::String name = prefix + std::to_string(i) + suffix;
-            Ogre::MaterialPtr mat = parent->clone(name, true, mGroup);
+            Ogre::MaterialPtr mat = cloneBaseMaterial(src.isLeaf ? leafBase : barkBase, name, mGroup);
             const Ogre::String texture = src.texture >= 0 ? mTextureNames[std::size_t(src.texture)] : "TreeLodWhite.png";
             glm::vec3 back = src.backColour == glm::vec3(0.0f) ? glm::vec3(src.baseColour) : src.backColour;
 
@@ -320,33 +350,6 @@ namespace TreeLod
                            "leaf material " + std::to_string(m.material) + " is not a material of the reference"));
         slot = std::make_unique<BillboardCloudData>(std::move(data.value()));
         return *slot;
-    }
-
-    namespace
-    {
-        Ogre::PixelFormat ogreFormat(GpuTextureFormat format)
-        {
-            switch (format)
-            {
-            case GpuTextureFormat::DXT1:
-                return Ogre::PF_DXT1;
-            case GpuTextureFormat::DXT5:
-                return Ogre::PF_DXT5;
-            default:
-                return Ogre::PF_BYTE_RGBA;
-            }
-        }
-
-        /// Upload `bytes` (level 0 then its mips, tightly packed) as texture `name`.
-        void uploadTexture(const Ogre::String& name, const Ogre::String& group, const std::uint8_t* bytes,
-                           std::uint32_t width, std::uint32_t height, Ogre::PixelFormat format, std::uint32_t mips)
-        {
-            Ogre::Image image;
-            image.loadDynamicImage(const_cast<Ogre::uchar*>(bytes), width, height, 1, format, false, 1,
-                                   mips > 0 ? mips - 1 : 0);
-            Ogre::TextureManager::getSingleton().loadImage(name, group, image, Ogre::TEX_TYPE_2D,
-                                                           int(mips > 0 ? mips - 1 : 0));
-        }
     }
 
     const BillboardCloudGpu& TreeAsset::getBillboardCloudGpu(bool classic)
@@ -505,14 +508,7 @@ namespace TreeLod
                 }
         };
         auto clone = [&](const Ogre::String& base, const Ogre::String& name) {
-            Ogre::MaterialPtr parent = Ogre::MaterialManager::getSingleton().getByName(base, Ogre::RGN_DEFAULT);
-            if (!parent)
-                parent = Ogre::MaterialManager::getSingleton().getByName(base);
-            if (!parent)
-                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
-                            "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
-                            "TreeAsset::createBillboardCloudMaterials");
-            Ogre::MaterialPtr material = parent->clone(name, true, mGroup);
+            Ogre::MaterialPtr material = cloneBaseMaterial(base, name, mGroup);
             configure(material);
             gpu.materials.push_back(name);
             return material;
