@@ -1,11 +1,12 @@
 // treelod bake INPUT.glb -o OUT.treelod [--technique NAME]... [--leaf-material NAME]... [-q]
 // Imports the tree, bakes one chunk set per technique plus the "meta" chunk (source file
-// name, FNV-1a 64 hash of the input file's bytes, options) and writes the package atomically:
+// name, its sourceHashOf() as the bake cache records it, options) and writes the package atomically:
 // on any error nothing is written and the exit code is 2.
 #include "CliSupport.h"
 #include "Commands.h"
 
 #include "TreeLod/AtomicFile.h"
+#include "TreeLod/BakeCache.h"
 #include "TreeLod/BakeTechniques.h"
 #include "TreeLod/GltfImporter.h"
 #include "TreeLod/Package.h"
@@ -52,19 +53,16 @@ namespace TreeLod
             if (!outDir.empty() && !std::filesystem::is_directory(outDir, ec))
                 return printError(fail(args.output, "", "directory '" + outDir.string() + "' does not exist"));
 
-            Result<std::vector<std::uint8_t>> inputBytes = readFile(args.input);
-            if (!inputBytes)
-                return printError(inputBytes.error());
-            char hash[32];
-            std::snprintf(hash, sizeof(hash), "fnv1a64:%016llx",
-                          (unsigned long long)fnv1a64(inputBytes->data(), inputBytes->size()));
+            const std::string ext = lowerCaseExtension(args.input);
+            if (ext != ".glb" && ext != ".gltf")
+                return printError(fail(args.input, "", "unknown tree format '" + ext + "' (expected .glb or .gltf)"));
+            Result<std::string> hash = sourceHashOf(args.input);
+            if (!hash)
+                return printError(hash.error());
 
             const ProgressCallback progress = makeProgress(args.quiet);
-            ImportOptions options;
-            options.leafMaterials = args.leafMaterials;
-            options.progress = progress;
             ImportReport importReport;
-            Result<TreeModel> model = importGltf(args.input, options, &importReport);
+            Result<TreeModel> model = importTreeFile(args.input, args.leafMaterials, progress, {}, &importReport);
             if (!model)
                 return printError(model.error());
             for (const std::string& w : importReport.warnings)
@@ -73,7 +71,7 @@ namespace TreeLod
             PackageWriter writer;
             PackageMeta meta;
             meta.source = std::filesystem::path(args.input).filename().string();
-            meta.sourceHash = hash;
+            meta.sourceHash = hash.value();
             meta.optionsJson = nlohmann::json{{"leafMaterials", args.leafMaterials}}.dump(
                 -1, ' ', false, nlohmann::json::error_handler_t::replace);
             for (const BakeTechnique* t : techniques)

@@ -1,8 +1,9 @@
+// TreeInput: loading a tree file for a command (TreeInput.h).
 #include "TreeInput.h"
 
 #include "TreeLod/AtomicFile.h"
+#include "TreeLod/BakeCache.h"
 #include "TreeLod/BakeTechniques.h"
-#include "TreeLod/GltfImporter.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
 #include "TreeLod/PackageWriter.h"
@@ -11,24 +12,13 @@
 
 namespace TreeLod
 {
-    namespace
-    {
-        std::string lowerExtension(const std::string& path)
-        {
-            std::string ext = std::filesystem::path(path).extension().string();
-            for (char& c : ext)
-                c = char(std::tolower(static_cast<unsigned char>(c)));
-            return ext;
-        }
-    }
-
     Result<TreeInput> loadTreeInput(const std::string& path, const std::vector<std::string>& leafMaterials,
                                     const ProgressCallback& progress, const MeshImporter& meshImporter,
                                     const std::vector<std::string>& chunks)
     {
         TreeInput input;
         input.name = std::filesystem::path(path).filename().string();
-        const std::string ext = lowerExtension(path);
+        const std::string ext = lowerCaseExtension(path);
         if (ext == ".treelod")
         {
             Result<PackageReader> package = PackageReader::open(path);
@@ -55,10 +45,7 @@ namespace TreeLod
             return fail(path, "", "unknown tree format '" + ext + "' (expected .glb, .gltf, .mesh or .treelod)");
         if (ext == ".mesh" && !meshImporter)
             return fail(path, "", ".mesh input needs Ogre: use the Ogre renderer");
-        ImportOptions options;
-        options.leafMaterials = leafMaterials;
-        options.progress = progress;
-        Result<TreeModel> model = ext == ".mesh" ? meshImporter(path) : importGltf(path, options);
+        Result<TreeModel> model = importTreeFile(path, leafMaterials, progress, meshImporter);
         if (!model)
             return model.error();
         input.model = std::move(model.value());

@@ -2,6 +2,7 @@
 // (100 leaves, 16-texel textures) into its own directory under TREELOD_TEST_OUT.
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/BakeCache.h"
+#include "TreeLod/BillboardCloudData.h"
 #include "TreeLod/FoliageLodData.h"
 #include "TreeLod/GltfExporter.h"
 #include "TreeLod/Package.h"
@@ -297,6 +298,96 @@ TEST(BakeCache, CorruptCacheFileIsRebaked)
     EXPECT_EQ(foreign.builtTechniques, Strings{"reference"});
     EXPECT_NE(foreign.discardedReason.find("another source"), std::string::npos) << foreign.discardedReason;
     EXPECT_EQ(fileBytes(first.path), good);
+}
+
+// A hit verifies the chunks it returns (the technique's and the reference) and no others; a
+// rewrite copies every cached chunk, so a damaged one is found then and everything is rebaked.
+TEST(BakeCache, HitVerifiesOnlyTheRequestedChunks)
+{
+    const std::string dir = testDir("verify");
+    const std::string glb = writeTinyGlb(dir, "oak.glb");
+    const BakeCache cache(dir + "/cache");
+    const BakeCacheEntry first = requireOk(cache, glb, {"reference", FOLIAGE_LOD_CHUNK});
+    const std::vector<std::uint8_t> lodfBytes = chunkBytes(first.path, FOLIAGE_LOD_CHUNK);
+    ASSERT_FALSE(lodfBytes.empty());
+    std::vector<std::uint8_t> damaged = fileBytes(first.path);
+    Result<PackageReader> reader = PackageReader::open(first.path);
+    ASSERT_TRUE(reader.ok()) << reader.error().message();
+    const int lodf = reader->findChunk(FOLIAGE_LOD_CHUNK, 0);
+    ASSERT_GE(lodf, 0);
+    const ChunkInfo& info = reader->chunks()[std::size_t(lodf)];
+    ASSERT_GT(info.size, 2u);
+    damaged[std::size_t(info.offset + info.size / 2)] ^= 0x5a;
+    ASSERT_TRUE(writeFileAtomic(first.path, damaged).ok());
+
+    // The reference alone: the damaged lodf chunk is not read, nothing is rebaked.
+    const BakeCacheEntry hit = requireOk(cache, glb, {"reference"});
+    EXPECT_EQ(hit.reusedTechniques, Strings{"reference"});
+    EXPECT_TRUE(hit.builtTechniques.empty());
+    EXPECT_TRUE(hit.discardedReason.empty()) << hit.discardedReason;
+    EXPECT_EQ(fileBytes(first.path), damaged);
+
+    // A new technique rewrites the package: the damaged chunk is found and the request rebaked whole.
+    const BakeCacheEntry rewrite = requireOk(cache, glb, {"reference", BILLBOARD_CLOUD_CHUNK});
+    EXPECT_EQ(rewrite.builtTechniques, (Strings{"reference", BILLBOARD_CLOUD_CHUNK}));
+    EXPECT_TRUE(rewrite.reusedTechniques.empty());
+    EXPECT_NE(rewrite.discardedReason.find("checksum"), std::string::npos) << rewrite.discardedReason;
+    EXPECT_TRUE(chunkBytes(rewrite.path, FOLIAGE_LOD_CHUNK).empty()) << "the damaged chunk is not copied";
+    EXPECT_FALSE(chunkBytes(rewrite.path, BILLBOARD_CLOUD_CHUNK).empty());
+
+    // Asking for the damaged technique itself verifies it.
+    ASSERT_TRUE(writeFileAtomic(first.path, damaged).ok());
+    const BakeCacheEntry again = requireOk(cache, glb, {FOLIAGE_LOD_CHUNK});
+    EXPECT_EQ(again.builtTechniques, Strings{FOLIAGE_LOD_CHUNK});
+    EXPECT_NE(again.discardedReason.find("checksum"), std::string::npos) << again.discardedReason;
+    EXPECT_EQ(chunkBytes(again.path, FOLIAGE_LOD_CHUNK), lodfBytes);
+}
+
+// The options reach the importer: "leafMaterials" is checked and changes what is baked.
+TEST(BakeCache, LeafMaterialsOptionReachesTheImporter)
+{
+    const std::string dir = testDir("leaf-materials");
+    const std::string glb = writeTinyGlb(dir, "oak.glb");
+    const BakeCache cache(dir + "/cache");
+
+    Result<BakeCacheEntry> bad = cache.require(glb, {"reference"}, "{\"leafMaterials\": \"Leaves\"}");
+    ASSERT_FALSE(bad.ok());
+    EXPECT_EQ(bad.error().file, glb);
+    EXPECT_EQ(bad.error().element, "bake options");
+    EXPECT_NE(bad.error().reason.find("\"leafMaterials\" must be an array of strings"), std::string::npos)
+        << bad.error().message();
+    EXPECT_FALSE(std::filesystem::exists(dir + "/cache")) << "nothing written";
+
+    const BakeCacheEntry byDefault = requireOk(cache, glb, {"reference"});
+    const std::vector<std::uint8_t> reference = chunkBytes(byDefault.path, REFERENCE_CHUNK);
+    ASSERT_FALSE(reference.empty());
+
+    // No material declared a leaf: the leaves become bark, a different reference chunk.
+    StepLog log;
+    const BakeCacheEntry noLeaves =
+        requireOk(cache, glb, {"reference"}, "{\"leafMaterials\": [\"NoSuchMaterial\"]}", log.callback());
+    EXPECT_EQ(noLeaves.builtTechniques, Strings{"reference"});
+    EXPECT_NE(noLeaves.path, byDefault.path);
+    const std::vector<std::uint8_t> bark = chunkBytes(noLeaves.path, REFERENCE_CHUNK);
+    ASSERT_FALSE(bark.empty());
+    EXPECT_NE(bark, reference);
+    EXPECT_TRUE(log.any("warning: oak.glb: leaf material")) << "the importer's warning, prefixed";
+
+    // The meta chunk records the options and the same source hash as sourceHashOf().
+    const std::vector<std::uint8_t> meta = chunkBytes(noLeaves.path, META_CHUNK);
+    const nlohmann::json json = nlohmann::json::parse(meta.begin(), meta.end(), nullptr, false);
+    ASSERT_TRUE(json.is_object());
+    EXPECT_EQ(json["options"], nlohmann::json::parse("{\"leafMaterials\": [\"NoSuchMaterial\"]}"));
+    Result<std::string> hash = sourceHashOf(glb);
+    ASSERT_TRUE(hash.ok()) << hash.error().message();
+    EXPECT_EQ(json["sourceHash"], hash.value());
+    EXPECT_EQ(hash.value().rfind("fnv1a64:", 0), 0u);
+    EXPECT_EQ(hash.value().size(), 8u + 16u);
+
+    // Naming the leaf material the importer finds by itself bakes the default's chunk under another key.
+    const BakeCacheEntry named = requireOk(cache, glb, {"reference"}, "{\"leafMaterials\": [\"Leaves\"]}");
+    EXPECT_NE(named.path, byDefault.path);
+    EXPECT_EQ(chunkBytes(named.path, REFERENCE_CHUNK), reference);
 }
 
 TEST(BakeCache, BadRequestsNameWhatIsWrong)

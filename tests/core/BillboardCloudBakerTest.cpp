@@ -781,6 +781,45 @@ namespace TreeLod
         EXPECT_EQ(missing, 0u) << missing << " of " << points << " opaque leaf points have no entry in their cell";
     }
 
+    // §3, §5: the chunk's Leaves Texture is the tiles' colour and normal map at level 0, with
+    // their layout; the normal map's coarser levels hold unit normals (renormalised averages).
+    TEST(BillboardCloudBaker, leavesTextureIsTheTilesAtLevelZeroWithUnitNormalMips)
+    {
+        const TreeModel& m = generatedOak(1500);
+        const BillboardCloudOptions options = fastOptions();
+        const BillboardCloudData data = bakeOrFail(m, options);
+        const BillboardLeafTiles tiles(m, options.tileSize, options.orientationGrid);
+        EXPECT_EQ(data.tileColumns, tiles.tileColumns());
+        EXPECT_EQ(data.orientationGrid, tiles.grid());
+        EXPECT_EQ(data.orientationGrid, options.orientationGrid);
+        EXPECT_EQ(data.tileSize, tiles.tileSize());
+        ASSERT_EQ(data.leavesColour.format, GpuTextureFormat::RGBA8);
+        ASSERT_EQ(data.leavesNormal.format, GpuTextureFormat::RGBA8);
+        ASSERT_EQ(data.leavesColour.width, std::uint32_t(tiles.colour().width));
+        ASSERT_EQ(data.leavesColour.height, std::uint32_t(tiles.colour().height));
+        ASSERT_EQ(data.leavesNormal.width, std::uint32_t(tiles.normal().width));
+        ASSERT_EQ(data.leavesNormal.height, std::uint32_t(tiles.normal().height));
+        const auto level0 = [](const GpuTexture& t) {
+            return std::vector<std::uint8_t>(t.data.begin(), t.data.begin() + std::ptrdiff_t(t.mipBytes(0)));
+        };
+        EXPECT_TRUE(level0(data.leavesColour) == tiles.colour().rgba);
+        EXPECT_TRUE(level0(data.leavesNormal) == tiles.normal().rgba);
+        ASSERT_GT(data.leavesNormal.mipCount, 1u);
+        // 8-bit components: |n| within sqrt(3) / 255 of 1, plus rounding slack.
+        float worst = 0.0f;
+        for (std::uint32_t mip = 1; mip < data.leavesNormal.mipCount; ++mip)
+        {
+            const std::uint8_t* p = data.leavesNormal.data.data() + data.leavesNormal.mipOffset(mip);
+            const std::uint64_t texels = data.leavesNormal.mipBytes(mip) / 4;
+            for (std::uint64_t t = 0; t < texels; ++t)
+            {
+                const glm::vec3 n = glm::vec3(p[4 * t], p[4 * t + 1], p[4 * t + 2]) / 255.0f * 2.0f - 1.0f;
+                worst = std::max(worst, std::abs(glm::length(n) - 1.0f));
+            }
+        }
+        EXPECT_LT(worst, 0.01f);
+    }
+
     TEST(BillboardCloudBaker, chunkRoundTripsAndIsDeterministicForAnyThreadCount)
     {
         const TreeModel& m = generatedOak(1500);

@@ -425,23 +425,62 @@ namespace TreeLod
         std::filesystem::path dir = std::filesystem::path(env && *env ? env : TREELOD_BINARY_DIR "/test-out") /
                                     "scene";
         std::filesystem::create_directories(dir);
-        // A ramp: grey = column / 3 over 4 x 2 pixels, so height = 30 * (x / 100 + 0.5) on a 100 m square.
-        Image ramp(4, 2);
-        for (int y = 0; y < 2; ++y)
+        // A ramp in both directions: grey = (column + 4 row) / 11 over 4 x 3 pixels. Columns span
+        // x and rows z over the 100 m square (row 0 at z = -50), so with u = x / 100 + 0.5 and
+        // v = z / 100 + 0.5, height = 30 * (3u + 8v) / 11.
+        Image ramp(4, 3);
+        for (int y = 0; y < 3; ++y)
             for (int x = 0; x < 4; ++x)
-                ramp.at(x, y) = glm::vec4(glm::vec3(x / 3.0f), 1.0f);
+                ramp.at(x, y) = glm::vec4(glm::vec3((x + 4.0f * y) / 11.0f), 1.0f);
+        auto expected = [](float x, float z) {
+            return 30.0f * (3.0f * (x / 100.0f + 0.5f) + 8.0f * (z / 100.0f + 0.5f)) / 11.0f;
+        };
         ASSERT_TRUE(writePng((dir / "ramp.png").string(), ramp).ok());
         std::string text = replaced(MINIMAL, "{\"kind\": \"plane\", \"size\": 100}",
                                     "{\"kind\": \"heightfield\", \"size\": 100, \"image\": \"ramp.png\", "
                                     "\"heightScale\": 30}");
         Result<SceneScript> r = parseSceneScript(text, "test.json", dir.string());
         ASSERT_TRUE(r.ok()) << r.error().message();
+        ASSERT_EQ(r->ground.heightsWidth, 4);
+        ASSERT_EQ(r->ground.heightsHeight, 3);
         for (const PlacedTree& t : generatePlacements(*r))
             // 8-bit PNG: grey steps of 1/255 of 30 m.
-            EXPECT_NEAR(t.position.y, 30.0f * (t.position.x / 100.0f + 0.5f), 30.0f / 255.0f);
-        EXPECT_NEAR(groundHeight(r->ground, -80.0f, 0.0f), 0.0f, 1e-6f); // clamped at the edge
+            EXPECT_NEAR(t.position.y, expected(t.position.x, t.position.z), 30.0f / 255.0f);
+        // Rows run along z, row 0 at -z: the corners, the middle row, and halfway between rows.
+        EXPECT_NEAR(groundHeight(r->ground, -50.0f, -50.0f), 0.0f, 1e-6f);
+        EXPECT_NEAR(groundHeight(r->ground, 50.0f, 50.0f), 30.0f, 1e-6f);
+        EXPECT_NEAR(groundHeight(r->ground, -50.0f, 50.0f), 30.0f * 8.0f / 11.0f, 30.0f / 255.0f);
+        EXPECT_NEAR(groundHeight(r->ground, 50.0f, -50.0f), 30.0f * 3.0f / 11.0f, 30.0f / 255.0f);
+        EXPECT_NEAR(groundHeight(r->ground, -50.0f, 0.0f), 30.0f * 4.0f / 11.0f, 30.0f / 255.0f);
+        EXPECT_NEAR(groundHeight(r->ground, -50.0f, -25.0f), 30.0f * 2.0f / 11.0f, 30.0f / 255.0f);
+        EXPECT_NEAR(groundHeight(r->ground, 10.0f, 30.0f), expected(10.0f, 30.0f), 30.0f / 255.0f);
+        // Clamped at the edges.
+        EXPECT_NEAR(groundHeight(r->ground, -80.0f, -70.0f), 0.0f, 1e-6f);
+        EXPECT_NEAR(groundHeight(r->ground, -80.0f, 0.0f), groundHeight(r->ground, -50.0f, 0.0f), 1e-6f);
+        EXPECT_NEAR(groundHeight(r->ground, 0.0f, 90.0f), groundHeight(r->ground, 0.0f, 50.0f), 1e-6f);
 
         std::string message = errorOf(replaced(text, "ramp.png", "missing.png"));
         EXPECT_NE(message.find("key /ground/image"), std::string::npos) << message;
+    }
+
+    // samples/scenes/README.md: azimuth 0 is the +Z side, 90 the +X side; elevation above the horizon.
+    TEST(SceneScript, sunAzimuthAndElevationGiveTheDocumentedDirection)
+    {
+        std::string text = replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"sun\": {\"azimuth\": 90, "
+                                                          "\"elevation\": 30, \"colour\": [1, 0.5, 0.25]}");
+        Result<SceneScript> r = parseSceneScript(text, "test.json", ".");
+        ASSERT_TRUE(r.ok()) << r.error().message();
+        const LightingSpec lighting = sceneLighting(*r);
+        EXPECT_NEAR(lighting.sunDirection.x, std::sqrt(3.0f) / 2.0f, 1e-6f);
+        EXPECT_NEAR(lighting.sunDirection.y, 0.5f, 1e-6f);
+        EXPECT_NEAR(lighting.sunDirection.z, 0.0f, 1e-6f);
+        EXPECT_EQ(lighting.sunColour, glm::vec3(1.0f, 0.5f, 0.25f));
+        EXPECT_EQ(lighting.ambientColour, SceneSun().ambient);
+
+        // Azimuth 0 is the +Z side.
+        r = parseSceneScript(replaced(text, "\"azimuth\": 90", "\"azimuth\": 0"), "test.json", ".");
+        ASSERT_TRUE(r.ok()) << r.error().message();
+        EXPECT_NEAR(sceneLighting(*r).sunDirection.x, 0.0f, 1e-6f);
+        EXPECT_NEAR(sceneLighting(*r).sunDirection.z, std::sqrt(3.0f) / 2.0f, 1e-6f);
     }
 }

@@ -37,14 +37,6 @@ namespace TreeLod
 
         std::uint64_t hashString(const std::string& text) { return fnv1a64(text.data(), text.size()); }
 
-        std::string lowerExtension(const std::string& path)
-        {
-            std::string ext = std::filesystem::path(path).extension().string();
-            for (char& c : ext)
-                c = char(std::tolower(static_cast<unsigned char>(c)));
-            return ext;
-        }
-
         /// A file-name-safe stem: [A-Za-z0-9._] kept, runs of anything else one '-', at most 48 bytes.
         std::string safeStem(const std::string& text)
         {
@@ -147,9 +139,11 @@ namespace TreeLod
             std::vector<std::uint8_t> bytes;
         };
 
-        /// Every chunk of the cache file but "meta", or an Error saying why the file is unusable.
-        Result<std::vector<CachedChunk>> readCachedPackage(const std::string& path, const std::string& sourceHash,
-                                                           const std::string& options)
+        /// The cache file opened, its meta checked against the key and the chunks a request for
+        /// `requested` returns (theirs and the reference every technique adds) verified; an Error
+        /// says why the file is unusable. Other chunks are not read.
+        Result<PackageReader> openCachedPackage(const std::string& path, const std::string& sourceHash,
+                                                const std::string& options, const std::set<std::string>& requested)
         {
             Result<PackageReader> reader = PackageReader::open(path);
             if (!reader)
@@ -163,18 +157,49 @@ namespace TreeLod
             if (json["sourceHash"] != sourceHash ||
                 json["options"].dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) != options)
                 return fail(path, chunkElement(META_CHUNK, 0), "made for another source or options");
-            std::vector<CachedChunk> chunks;
             for (std::size_t i = 0; i < reader->chunks().size(); ++i)
             {
-                const ChunkInfo& info = reader->chunks()[i];
-                if (info.technique == META_CHUNK)
+                const std::string& technique = reader->chunks()[i].technique;
+                if (technique != REFERENCE_CHUNK && !requested.count(technique))
                     continue;
                 Result<std::vector<std::uint8_t>> bytes = reader->readChunk(i);
+                if (!bytes)
+                    return bytes.error();
+            }
+            return reader;
+        }
+
+        /// Every chunk of the cached package but "meta", each CRC-checked.
+        Result<std::vector<CachedChunk>> readCachedChunks(const PackageReader& reader)
+        {
+            std::vector<CachedChunk> chunks;
+            for (std::size_t i = 0; i < reader.chunks().size(); ++i)
+            {
+                const ChunkInfo& info = reader.chunks()[i];
+                if (info.technique == META_CHUNK)
+                    continue;
+                Result<std::vector<std::uint8_t>> bytes = reader.readChunk(i);
                 if (!bytes)
                     return bytes.error();
                 chunks.push_back({info, std::move(bytes.value())});
             }
             return chunks;
+        }
+
+        /// The "leafMaterials" option (canonical options JSON) for importGltf.
+        Result<std::vector<std::string>> leafMaterialsOption(const std::string& source, const std::string& options)
+        {
+            const nlohmann::json json = nlohmann::json::parse(options);
+            if (!json.contains("leafMaterials"))
+                return std::vector<std::string>();
+            const nlohmann::json& names = json["leafMaterials"];
+            bool strings = names.is_array();
+            if (strings)
+                for (const nlohmann::json& n : names)
+                    strings = strings && n.is_string();
+            if (!strings)
+                return fail(source, "bake options", "\"leafMaterials\" must be an array of strings");
+            return names.get<std::vector<std::string>>();
         }
 
         std::string joined(const std::vector<std::string>& names)
@@ -211,6 +236,40 @@ namespace TreeLod
         return out + " -> " + path;
     }
 
+    std::string lowerCaseExtension(const std::string& path)
+    {
+        std::string ext = std::filesystem::path(path).extension().string();
+        for (char& c : ext)
+            c = char(std::tolower(static_cast<unsigned char>(c)));
+        return ext;
+    }
+
+    Result<std::string> sourceHashOf(const std::string& path)
+    {
+        Result<std::uint64_t> hash = hashFileSource(path);
+        if (!hash)
+            return hash.error();
+        return "fnv1a64:" + hex16(hash.value());
+    }
+
+    Result<TreeModel> importTreeFile(const std::string& path, const std::vector<std::string>& leafMaterials,
+                                     const ProgressCallback& progress, const ImportFunction& import,
+                                     ImportReport* report)
+    {
+        const std::string ext = lowerCaseExtension(path);
+        if (ext == ".glb" || ext == ".gltf")
+        {
+            ImportOptions options;
+            options.leafMaterials = leafMaterials;
+            options.progress = progress;
+            return importGltf(path, options, report);
+        }
+        if (!import)
+            return fail(path, "", "no importer for '" + ext + "' files (.glb and .gltf are built in; other "
+                                  "formats need the caller's ImportFunction)");
+        return import(path);
+    }
+
     std::string defaultBakeCacheDirectory()
     {
         const char* xdg = std::getenv("XDG_CACHE_HOME");
@@ -242,7 +301,6 @@ namespace TreeLod
     Result<BakeCache::Key> BakeCache::makeKey(const std::string& source, const std::string& optionsJson) const
     {
         Key key;
-        std::uint64_t sourceHash = 0;
         const std::size_t colon = source.find(':');
         const auto generator =
             colon == std::string::npos ? mGenerators.end() : mGenerators.find(source.substr(0, colon));
@@ -250,12 +308,12 @@ namespace TreeLod
         {
             key.name = source;
             key.generator = &generator->second;
-            sourceHash = hashString("generated " + source);
+            key.sourceHash = "fnv1a64:" + hex16(hashString("generated " + source));
         }
         else
         {
             key.name = std::filesystem::path(source).filename().string();
-            Result<std::uint64_t> hash = hashFileSource(source);
+            Result<std::string> hash = sourceHashOf(source);
             if (!hash)
             {
                 Error error = hash.error();
@@ -263,9 +321,8 @@ namespace TreeLod
                     error.reason += " (and no generator is registered for '" + source.substr(0, colon) + ":' sources)";
                 return error;
             }
-            sourceHash = hash.value();
+            key.sourceHash = hash.value();
         }
-        key.sourceHash = "fnv1a64:" + hex16(sourceHash);
 
         Result<std::string> options = canonicalOptions(source, optionsJson);
         if (!options)
@@ -321,30 +378,60 @@ namespace TreeLod
         entry.name = key.name;
         entry.path = key.path;
 
-        // What the cache holds; an unusable file is baked again from scratch.
-        std::vector<CachedChunk> cached;
+        // Checked before the cache is, so that a bad option fails whatever the cache holds.
+        Result<std::vector<std::string>> leafMaterials = leafMaterialsOption(source, key.options);
+        if (!leafMaterials)
+            return leafMaterials.error();
+
+        // What the cache holds; an unusable file is baked again from scratch. Only the chunks this
+        // request returns are verified here; the others are read when the package is rewritten.
+        std::set<std::string> requestedNames;
+        for (const BakeTechnique* technique : requested)
+            requestedNames.insert(technique->name);
+        PackageReader reader;
         std::error_code ec;
         if (std::filesystem::exists(key.path, ec))
         {
-            Result<std::vector<CachedChunk>> read = readCachedPackage(key.path, key.sourceHash, key.options);
+            Result<PackageReader> opened = openCachedPackage(key.path, key.sourceHash, key.options, requestedNames);
+            if (opened)
+                reader = std::move(opened.value());
+            else
+                entry.discardedReason = opened.error().message();
+        }
+        std::set<std::string> present;
+        for (const ChunkInfo& info : reader.chunks())
+            if (info.technique != META_CHUNK)
+                present.insert(info.technique);
+        auto partition = [&] {
+            std::vector<const BakeTechnique*> missing;
+            entry.reusedTechniques.clear();
+            for (const BakeTechnique* technique : requested)
+            {
+                if (present.count(technique->name))
+                    entry.reusedTechniques.push_back(technique->name);
+                else
+                    missing.push_back(technique);
+            }
+            return missing;
+        };
+        std::vector<const BakeTechnique*> missing = partition();
+        if (missing.empty())
+            return entry;
+
+        // The package is rewritten: every cached chunk is copied, so all must be intact.
+        std::vector<CachedChunk> cached;
+        if (!present.empty())
+        {
+            Result<std::vector<CachedChunk>> read = readCachedChunks(reader);
             if (read)
                 cached = std::move(read.value());
             else
+            {
                 entry.discardedReason = read.error().message();
+                present.clear();
+                missing = partition();
+            }
         }
-        std::set<std::string> present;
-        for (const CachedChunk& chunk : cached)
-            present.insert(chunk.info.technique);
-        std::vector<const BakeTechnique*> missing;
-        for (const BakeTechnique* technique : requested)
-        {
-            if (present.count(technique->name))
-                entry.reusedTechniques.push_back(technique->name);
-            else
-                missing.push_back(technique);
-        }
-        if (missing.empty())
-            return entry;
 
         // Bake the missing techniques from one import, then put the cached chunks back over
         // whatever the bakers added again (the reference), so their bytes stay as they were.
@@ -354,32 +441,10 @@ namespace TreeLod
             model = (*key.generator)(source, prefixed(progress, key.name));
         else
         {
-            const std::string ext = lowerExtension(source);
-            if (ext == ".glb" || ext == ".gltf")
-            {
-                ImportOptions options;
-                const nlohmann::json json = nlohmann::json::parse(key.options);
-                if (json.contains("leafMaterials"))
-                {
-                    const nlohmann::json& names = json["leafMaterials"];
-                    bool strings = names.is_array();
-                    for (const nlohmann::json& n : names)
-                        strings = strings && n.is_string();
-                    if (!strings)
-                        return fail(source, "bake options", "\"leafMaterials\" must be an array of strings");
-                    options.leafMaterials = names.get<std::vector<std::string>>();
-                }
-                options.progress = prefixed(progress, key.name);
-                ImportReport importReport;
-                model = importGltf(source, options, &importReport);
-                for (const std::string& warning : importReport.warnings)
-                    report(progress, "warning: " + key.name + ": " + warning, 1.0f);
-            }
-            else if (import)
-                model = import(source);
-            else
-                return fail(source, "", "no importer for '" + ext + "' files (.glb and .gltf are built in; other "
-                                        "formats need the caller's ImportFunction)");
+            ImportReport importReport;
+            model = importTreeFile(source, leafMaterials.value(), prefixed(progress, key.name), import, &importReport);
+            for (const std::string& warning : importReport.warnings)
+                report(progress, "warning: " + key.name + ": " + warning, 1.0f);
         }
         if (!model)
             return model.error();

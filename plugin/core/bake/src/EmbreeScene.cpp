@@ -101,9 +101,6 @@ namespace TreeLod
         mMaterials.back().name = "default";
 
         // Textures: sRGB colour decoded once through a table, straight alpha.
-        float decode[256];
-        for (int i = 0; i < 256; ++i)
-            decode[i] = srgbToLinear(float(i) / 255.0f);
         mTextures.resize(model.textures.size());
         for (std::size_t i = 0; i < model.textures.size(); ++i)
         {
@@ -119,7 +116,8 @@ namespace TreeLod
             for (std::size_t p = 0; p < count; ++p)
             {
                 const std::uint8_t* c = &src.rgba[p * 4];
-                dst.texels[p] = glm::vec4(decode[c[0]], decode[c[1]], decode[c[2]], float(c[3]) * (1.0f / 255.0f));
+                dst.texels[p] = glm::vec4(srgbByteToLinear(c[0]), srgbByteToLinear(c[1]), srgbByteToLinear(c[2]),
+                                          float(c[3]) * (1.0f / 255.0f));
                 dst.alpha[p] = c[3];
             }
         }

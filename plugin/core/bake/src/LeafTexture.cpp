@@ -471,7 +471,7 @@ namespace TreeLod
             if (a < 0.5)
                 continue;
             for (int c = 0; c < 3; ++c)
-                sum[c] += a * srgbToLinear(leafTexture.rgba[i + std::size_t(c)] / 255.0f);
+                sum[c] += a * srgbByteToLinear(leafTexture.rgba[i + std::size_t(c)]);
             weight += a;
         }
         return weight > 0.0 ? glm::vec3(sum / weight) : glm::vec3(0.1f, 0.2f, 0.05f);

@@ -87,8 +87,6 @@ namespace TreeLod
             return dst;
         }
 
-        std::uint8_t toByte(float v) { return std::uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
-
         /// Smallest 8-bit alpha that passes `alpha >= cutoff` in a shader reading a / 255.
         std::uint32_t cutoffByte(float cutoff)
         {
@@ -211,9 +209,6 @@ namespace TreeLod
         tex.data.resize(gpuTextureBytes(tex.format, tex.width, tex.height, tex.mipCount));
         std::copy(image.rgba.begin(), image.rgba.end(), tex.data.begin());
 
-        std::array<float, 256> toLinear;
-        for (int i = 0; i < 256; ++i)
-            toLinear[i] = srgbToLinear(float(i) / 255.0f);
         Level level;
         level.width = tex.width;
         level.height = tex.height;
@@ -223,7 +218,8 @@ namespace TreeLod
         for (std::size_t i = 0; i < level.texels.size(); ++i)
         {
             const std::uint8_t* p = &image.rgba[4 * i];
-            level.texels[i] = glm::vec4(toLinear[p[0]], toLinear[p[1]], toLinear[p[2]], float(p[3]) / 255.0f);
+            level.texels[i] = glm::vec4(srgbByteToLinear(p[0]), srgbByteToLinear(p[1]), srgbByteToLinear(p[2]),
+                                        float(p[3]) / 255.0f);
             covered += p[3] >= K ? 1 : 0;
         }
         const double coverage = double(covered) / double(level.texels.size());
@@ -236,10 +232,10 @@ namespace TreeLod
             for (std::size_t i = 0; i < level.texels.size(); ++i)
             {
                 const glm::vec4& t = level.texels[i];
-                out[4 * i + 0] = toByte(linearToSrgb(t.r));
-                out[4 * i + 1] = toByte(linearToSrgb(t.g));
-                out[4 * i + 2] = toByte(linearToSrgb(t.b));
-                out[4 * i + 3] = toByte(t.a);
+                out[4 * i + 0] = unitToByte(linearToSrgb(t.r));
+                out[4 * i + 1] = unitToByte(linearToSrgb(t.g));
+                out[4 * i + 2] = unitToByte(linearToSrgb(t.b));
+                out[4 * i + 3] = unitToByte(t.a);
             }
             if (preserve)
                 preserveCoverage(out, level.texels.size(), coverage * double(level.texels.size()), K);

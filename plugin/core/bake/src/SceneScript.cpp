@@ -10,6 +10,7 @@
 //   "Parameterization and applications of Catmull-Rom curves", CAD 43(7), 2011.
 #include "TreeLod/SceneScript.h"
 
+#include "TreeLod/AtomicFile.h"
 #include "TreeLod/Image.h"
 #include "TreeLod/TreeGenerator.h"
 
@@ -18,7 +19,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <random>
 #include <sstream>
@@ -586,7 +586,8 @@ namespace TreeLod
                 for (std::size_t i = 0; i < ex->size(); ++i)
                     p.exclude.push_back(readArea((*ex)[i], child(child(rp, "exclude"), i), script.ground.size));
             }
-            double free = freeArea(p.area, p.exclude);
+            p.freeAreaM2 = freeArea(p.area, p.exclude);
+            const double free = p.freeAreaM2;
             if (free <= 0.0)
                 bad(child(rp, "exclude"), "leaves no free ground in the area");
             const Json* count = find(*random, "count");
@@ -826,10 +827,12 @@ namespace TreeLod
             }
             const std::uint32_t k =
                 std::max<std::uint32_t>(1, std::uint32_t(std::lround(n / (1.0 + 19.0 * p.clumping))));
+            // The parser's figure; a placement built in code (freeAreaM2 0) is sampled here.
+            const double free = p.freeAreaM2 > 0.0 ? p.freeAreaM2 : freeArea(p.area, p.exclude);
             std::vector<glm::vec2> centres;
             for (std::uint32_t i = 0; i < k; ++i)
                 centres.push_back(freePoint(p, rng));
-            const double sigma = (0.25 - 0.1875 * p.clumping) * std::sqrt(freeArea(p.area, p.exclude) / k);
+            const double sigma = (0.25 - 0.1875 * p.clumping) * std::sqrt(free / k);
             for (std::uint32_t i = 0; i < n; ++i)
             {
                 glm::vec2 q;
@@ -938,14 +941,11 @@ namespace TreeLod
 
     Result<SceneScript> loadSceneScript(const std::string& path)
     {
-        std::ifstream in(path, std::ios::binary);
-        if (!in)
-            return fail(path, "", "cannot open the scene script");
-        std::ostringstream text;
-        text << in.rdbuf();
-        if (!in.good() && !in.eof())
-            return fail(path, "", "read error");
-        return parseSceneScript(text.str(), path, std::filesystem::path(path).parent_path().string());
+        Result<std::vector<std::uint8_t>> bytes = readFile(path);
+        if (!bytes)
+            return bytes.error();
+        return parseSceneScript(std::string(bytes->begin(), bytes->end()), path,
+                                std::filesystem::path(path).parent_path().string());
     }
 
     float groundHeight(const SceneGround& ground, float x, float z)

@@ -52,8 +52,6 @@ namespace TreeLod
         constexpr float LEVEL_TEXEL_FACTOR[3] = {1.0f, 2.0f, 4.0f};
         constexpr std::uint8_t LOW_RES_ALPHA_BYTE = 64; ///< A >= 64 <=> A / 255 >= LOW_RES_ALPHA_CUTOFF
 
-        std::uint8_t toByte(float v) { return std::uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
-
         std::uint32_t nextPowerOfTwo(std::uint64_t v)
         {
             std::uint64_t p = 1;
@@ -534,10 +532,8 @@ namespace TreeLod
                             {
                                 const Decoded& d = decoded[e];
                                 const float qx = px - d.cx, qy = py - d.cy;
-                                glm::vec2 local((d.c * qx + d.s * qy) * d.inverseSide + 0.5f,
-                                                (-d.s * qx + d.c * qy) * d.inverseSide + 0.5f);
-                                if (d.mirror)
-                                    local.x = 1.0f - local.x;
+                                const glm::vec2 local =
+                                    billboardTileLocal(glm::vec2(qx, qy), d.c, d.s, d.inverseSide, d.mirror);
                                 if (!(local.x >= 0.0f && local.x <= 1.0f && local.y >= 0.0f && local.y <= 1.0f))
                                     continue;
                                 const glm::vec4 sample = tiles.sample(d.tile, local);
@@ -634,11 +630,11 @@ namespace TreeLod
             for (std::size_t t = 0; t < texels; ++t)
             {
                 const glm::vec3 c = known[t] ? albedo[t] : fill;
-                bb.lowRes[4 * t + 0] = toByte(linearToSrgb(std::clamp(c.r, 0.0f, 1.0f)));
-                bb.lowRes[4 * t + 1] = toByte(linearToSrgb(std::clamp(c.g, 0.0f, 1.0f)));
-                bb.lowRes[4 * t + 2] = toByte(linearToSrgb(std::clamp(c.b, 0.0f, 1.0f)));
+                bb.lowRes[4 * t + 0] = unitToByte(linearToSrgb(std::clamp(c.r, 0.0f, 1.0f)));
+                bb.lowRes[4 * t + 1] = unitToByte(linearToSrgb(std::clamp(c.g, 0.0f, 1.0f)));
+                bb.lowRes[4 * t + 2] = unitToByte(linearToSrgb(std::clamp(c.b, 0.0f, 1.0f)));
                 // §5.2: AO in alpha where the texel is covered.
-                bb.lowRes[4 * t + 3] = hits[t] >= least ? toByte(0.5f + 0.5f * ao[t]) : 0;
+                bb.lowRes[4 * t + 3] = hits[t] >= least ? unitToByte(0.5f + 0.5f * ao[t]) : 0;
             }
             bb.lowResCoverage.resize(texels);
             for (std::size_t t = 0; t < texels; ++t)
@@ -712,9 +708,6 @@ namespace TreeLod
             tex.mipCount = fullMipCount(width, height);
             tex.data.resize(gpuTextureBytes(tex.format, width, height, tex.mipCount));
             std::copy(level0.begin(), level0.end(), tex.data.begin());
-            std::array<float, 256> toLinear;
-            for (int i = 0; i < 256; ++i)
-                toLinear[std::size_t(i)] = srgbToLinear(float(i) / 255.0f);
             std::size_t covered = 0;
             for (std::size_t t = 0; t < std::size_t(width) * height; ++t)
                 covered += level0[4 * t + 3] >= LOW_RES_ALPHA_BYTE ? 1 : 0;
@@ -745,7 +738,8 @@ namespace TreeLod
                             {
                                 const std::size_t i = std::size_t(yy) * sw + xx;
                                 const std::uint8_t* p = src + i * 4;
-                                const glm::vec3 rgb(toLinear[p[0]], toLinear[p[1]], toLinear[p[2]]);
+                                const glm::vec3 rgb(srgbByteToLinear(p[0]), srgbByteToLinear(p[1]),
+                                                    srgbByteToLinear(p[2]));
                                 all += rgb;
                                 weighted += coverage[i] * rgb;
                                 aoSum += coverage[i] * ao[i];
@@ -757,9 +751,9 @@ namespace TreeLod
                         nextCoverage[o] = cov / float(n);
                         nextAo[o] = cov > 0.0f ? aoSum / cov : 1.0f;
                         std::uint8_t* q = dst + o * 4;
-                        q[0] = toByte(linearToSrgb(rgb.r));
-                        q[1] = toByte(linearToSrgb(rgb.g));
-                        q[2] = toByte(linearToSrgb(rgb.b));
+                        q[0] = unitToByte(linearToSrgb(rgb.r));
+                        q[1] = unitToByte(linearToSrgb(rgb.g));
+                        q[2] = unitToByte(linearToSrgb(rgb.b));
                         q[3] = 0;
                     }
                 });
@@ -776,7 +770,7 @@ namespace TreeLod
                     std::nth_element(order.begin(), order.begin() + std::ptrdiff_t(keep), order.end(), higher);
                 for (std::size_t k = 0; k < keep; ++k)
                     if (nextCoverage[order[k]] > 0.0f)
-                        dst[4 * std::size_t(order[k]) + 3] = toByte(0.5f + 0.5f * nextAo[order[k]]);
+                        dst[4 * std::size_t(order[k]) + 3] = unitToByte(0.5f + 0.5f * nextAo[order[k]]);
                 coverage = std::move(nextCoverage);
                 ao = std::move(nextAo);
             }
@@ -814,9 +808,9 @@ namespace TreeLod
                             }
                         n = glm::length(n) > 1e-6f ? glm::normalize(n) : glm::vec3(0, 0, 1);
                         std::uint8_t* q = dst + (std::size_t(y) * dw + x) * 4;
-                        q[0] = toByte(n.x * 0.5f + 0.5f);
-                        q[1] = toByte(n.y * 0.5f + 0.5f);
-                        q[2] = toByte(n.z * 0.5f + 0.5f);
+                        q[0] = unitToByte(n.x * 0.5f + 0.5f);
+                        q[1] = unitToByte(n.y * 0.5f + 0.5f);
+                        q[2] = unitToByte(n.z * 0.5f + 0.5f);
                         q[3] = 255;
                     }
                 });
@@ -913,7 +907,7 @@ namespace TreeLod
         /// Low-res atlas of all levels' billboards (2-texel gutters, edge colours extended into
         /// them with A = 0), mip chain, optional DXT5. Sets each billboard's rect.
         Result<GpuTexture> lowResAtlas(const BakeContext& ctx, const std::vector<LevelBuild*>& levels,
-                                       std::vector<Billboard>& billboards)
+                                       std::vector<Billboard>& billboards, bool compress)
         {
             std::vector<const BillboardBuild*> all;
             for (const LevelBuild* level : levels)
@@ -967,7 +961,7 @@ namespace TreeLod
                 billboards[b].lowResHeight = all[b]->lowResHeight;
             }
             GpuTexture tex = lowResMipChain("billboard low-res", W, H, atlas, std::move(coverage), std::move(ao));
-            if (ctx.options.compress)
+            if (compress)
                 tex = compressTexture(tex, GpuTextureFormat::DXT5);
             return tex;
         }
@@ -986,7 +980,7 @@ namespace TreeLod
         {
             std::vector<std::uint8_t> out(ctx.ao.barkVertex.size());
             for (std::size_t v = 0; v < out.size(); ++v)
-                out[v] = toByte(ctx.ao.barkVertex[v]);
+                out[v] = unitToByte(ctx.ao.barkVertex[v]);
             return out;
         }
 
@@ -1011,9 +1005,28 @@ namespace TreeLod
             return std::clamp<std::uint32_t>(c, 1, std::max<std::uint32_t>(leaves, 1));
         }
 
+        /// No leaves: the placeholders of fillEmpty and the bark AO, nothing else.
+        BillboardCloudData emptyCloud(BillboardCloudData data, BillboardCloudStats& s, BillboardCloudStats* stats)
+        {
+            s.gpuBytes = data.gpuBytes();
+            if (stats)
+                *stats = s;
+            return data;
+        }
+
         // ---- the multi-layered cloud --------------------------------------------------------------
 
-        Result<BillboardCloudData> bakeLayered(const BakeContext& ctx, BillboardCloudStats* stats)
+        /// Bytes `texture` takes once compressed to `format` (DXT sizes follow from the dimensions).
+        std::uint64_t compressedBytes(const GpuTexture& texture, GpuTextureFormat format)
+        {
+            return gpuTextureBytes(format, texture.width, texture.height, texture.mipCount);
+        }
+
+        /// The layered bake. `sizeOnly`: skip the DXT compression and report in stats->gpuBytes
+        /// what the compressed textures would take (the data returned keeps them uncompressed).
+        /// `finest`: receives level 0's build (for the classic cloud, which clusters the same way).
+        Result<BillboardCloudData> bakeLayered(const BakeContext& ctx, BillboardCloudStats* stats,
+                                               bool sizeOnly = false, LevelBuild* finest = nullptr)
         {
             BillboardCloudData data;
             fillEmpty(ctx, data, false);
@@ -1021,12 +1034,7 @@ namespace TreeLod
             const std::uint32_t L = std::uint32_t(ctx.model.leaves.size());
             s.leaves = L;
             if (L == 0)
-            {
-                s.gpuBytes = data.gpuBytes();
-                if (stats)
-                    *stats = s;
-                return data;
-            }
+                return emptyCloud(std::move(data), s, stats);
             const BillboardLeafTiles& tiles = *ctx.tiles;
 
             // §4.1, §6: three clouds of decreasing count; the coarsest is low-res only.
@@ -1137,7 +1145,9 @@ namespace TreeLod
             data.listsAtlasHeight = entryCount ? rowsFor(listsWidth) : 0;
             report(ctx.progress, "billboard atlases", 0.5f);
 
-            Result<GpuTexture> lowRes = lowResAtlas(ctx, {&levels[0], &levels[1], &levels[2]}, data.billboards);
+            const bool compress = ctx.options.compress && !sizeOnly;
+            Result<GpuTexture> lowRes =
+                lowResAtlas(ctx, {&levels[0], &levels[1], &levels[2]}, data.billboards, compress);
             if (!lowRes)
                 return lowRes.error();
             data.lowRes = std::move(lowRes.value());
@@ -1158,7 +1168,7 @@ namespace TreeLod
             data.leavesColour = buildMipChain(tiles.colour(), mips);
             data.leavesNormal = normalMipChain(tiles.normal());
             data.leavesMaxLod = std::min(data.leavesMaxLod, data.leavesColour.mipCount - 1);
-            if (ctx.options.compress)
+            if (compress)
             {
                 data.leavesColour = compressTexture(data.leavesColour, GpuTextureFormat::DXT5);
                 data.leavesNormal = compressTexture(data.leavesNormal, GpuTextureFormat::DXT1);
@@ -1170,15 +1180,23 @@ namespace TreeLod
                 return valid.error();
             s.entries = std::uint32_t(data.entries.size());
             s.gpuBytes = data.gpuBytes();
+            if (sizeOnly && ctx.options.compress)
+                s.gpuBytes = s.gpuBytes - data.lowRes.data.size() - data.leavesColour.data.size() -
+                             data.leavesNormal.data.size() + compressedBytes(data.lowRes, GpuTextureFormat::DXT5) +
+                             compressedBytes(data.leavesColour, GpuTextureFormat::DXT5) +
+                             compressedBytes(data.leavesNormal, GpuTextureFormat::DXT1);
             if (stats)
                 *stats = s;
+            if (finest)
+                *finest = std::move(levels[0]);
             return data;
         }
 
         // ---- the classic cloud (Fig. 13's baseline) --------------------------------------------------
 
+        /// `built`: level 0 of a layered bake with the same options (the same clustering), or null.
         Result<BillboardCloudData> bakeClassic(const BakeContext& ctx, std::uint64_t memoryBytes,
-                                               BillboardCloudStats* stats)
+                                               BillboardCloudStats* stats, LevelBuild* built = nullptr)
         {
             BillboardCloudData data;
             fillEmpty(ctx, data, true);
@@ -1186,13 +1204,10 @@ namespace TreeLod
             const std::uint32_t L = std::uint32_t(ctx.model.leaves.size());
             s.leaves = L;
             if (L == 0)
-            {
-                s.gpuBytes = data.gpuBytes();
-                if (stats)
-                    *stats = s;
-                return data;
-            }
-            LevelBuild level = buildLevel(ctx, finestCount(ctx.options, L), false, "billboard clustering");
+                return emptyCloud(std::move(data), s, stats);
+            LevelBuild level =
+                built ? std::move(*built) : buildLevel(ctx, finestCount(ctx.options, L), false, "billboard clustering");
+            level.layered = false;
             s.billboards[0] = std::uint32_t(level.billboards.size());
             s.meanPlaneError = level.meanError;
             s.maxPlaneError = level.maxError;
@@ -1237,7 +1252,7 @@ namespace TreeLod
             data.levels[0].layered = false;
             data.levels[0].cellSize = 0.0f;
             data.levels[0].lowResTexelSize = texel;
-            Result<GpuTexture> lowRes = lowResAtlas(ctx, {&level}, data.billboards);
+            Result<GpuTexture> lowRes = lowResAtlas(ctx, {&level}, data.billboards, ctx.options.compress);
             if (!lowRes)
                 return lowRes.error();
             data.lowRes = std::move(lowRes.value());
@@ -1275,59 +1290,77 @@ namespace TreeLod
         std::uint64_t memory = options.memoryBytes;
         if (memory == 0)
         {
-            // Fig. 13: the same memory as the multi-layered cloud.
-            Result<BillboardCloudData> layered = bakeLayered(ctx, nullptr);
+            // Fig. 13: the same memory as the multi-layered cloud. Its size needs no compression,
+            // and its finest clustering is the classic cloud's.
+            BillboardCloudStats layeredStats;
+            LevelBuild finest;
+            Result<BillboardCloudData> layered = bakeLayered(ctx, &layeredStats, true, &finest);
             if (!layered)
                 return layered.error();
-            memory = layered->gpuBytes();
+            memory = layeredStats.gpuBytes;
+            if (!finest.billboards.empty())
+                return bakeClassic(ctx, memory, stats, &finest);
         }
         return bakeClassic(ctx, memory, stats);
+    }
+
+    namespace
+    {
+        /// The reference chunk if missing, then `chunk` from `bake`'s data.
+        template <typename Bake>
+        Result<void> addCloudChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
+                                   const ProgressCallback& progress, const std::string& chunk, Bake bake)
+        {
+            if (!writer.hasChunk(REFERENCE_CHUNK, 0))
+            {
+                Result<void> added = addReferenceChunk(writer, model, label, progress);
+                if (!added)
+                    return added;
+            }
+            Result<BillboardCloudData> data = bake();
+            if (!data)
+                return data.error();
+            Result<void> added =
+                writer.addChunk(chunk, 0, BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION,
+                                encodeBillboardCloudChunk(data.value()));
+            if (!added)
+                return fail(label, added.error().element, added.error().reason);
+            return {};
+        }
     }
 
     Result<void> addBillboardCloudChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
                                         const ProgressCallback& progress)
     {
-        if (!writer.hasChunk(REFERENCE_CHUNK, 0))
-        {
-            Result<void> added = addReferenceChunk(writer, model, label, progress);
-            if (!added)
-                return added;
-        }
-        BillboardCloudStats stats;
-        Result<BillboardCloudData> data = bakeBillboardCloud(model, BillboardCloudOptions{}, label, progress, &stats);
-        if (!data)
-            return data.error();
-        // Truncated lists are not an error (the front and back ends are kept) but must not be silent.
-        if (stats.truncatedCells > 0)
-            report(progress,
-                   "warning: " + label + ": " + std::to_string(stats.truncatedCells) + " hash cells hold more than " +
-                       std::to_string(BILLBOARD_MAX_LIST_LENGTH) +
-                       " leaf fragments; their lists keep the 127 frontmost and 128 backmost",
-                   1.0f);
-        Result<void> added = writer.addChunk(BILLBOARD_CLOUD_CHUNK, 0, BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION,
-                                             encodeBillboardCloudChunk(data.value()));
-        if (!added)
-            return fail(label, added.error().element, added.error().reason);
-        return {};
+        return addCloudChunk(writer, model, label, progress, BILLBOARD_CLOUD_CHUNK, [&]() {
+            BillboardCloudStats stats;
+            Result<BillboardCloudData> data =
+                bakeBillboardCloud(model, BillboardCloudOptions{}, label, progress, &stats);
+            // Truncated lists are not an error (the front and back ends are kept) but must not be silent.
+            if (data && stats.truncatedCells > 0)
+                report(progress,
+                       "warning: " + label + ": " + std::to_string(stats.truncatedCells) +
+                           " hash cells hold more than " + std::to_string(BILLBOARD_MAX_LIST_LENGTH) +
+                           " leaf fragments; their lists keep the 127 frontmost and 128 backmost",
+                       1.0f);
+            return data;
+        });
     }
 
     Result<void> addClassicBillboardCloudChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
                                                const ProgressCallback& progress)
     {
-        if (!writer.hasChunk(REFERENCE_CHUNK, 0))
-        {
-            Result<void> added = addReferenceChunk(writer, model, label, progress);
-            if (!added)
-                return added;
-        }
-        Result<BillboardCloudData> data =
-            bakeClassicBillboardCloud(model, ClassicBillboardCloudOptions{}, label, progress);
-        if (!data)
-            return data.error();
-        Result<void> added = writer.addChunk(CLASSIC_BILLBOARD_CLOUD_CHUNK, 0, BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION,
-                                             encodeBillboardCloudChunk(data.value()));
-        if (!added)
-            return fail(label, added.error().element, added.error().reason);
-        return {};
+        return addCloudChunk(writer, model, label, progress, CLASSIC_BILLBOARD_CLOUD_CHUNK, [&]() {
+            ClassicBillboardCloudOptions options;
+            // Fig. 13: the layered cloud's memory; a layered chunk baked with the default options
+            // already in the package gives it without baking again.
+            if (const std::vector<std::uint8_t>* layered = writer.chunkBytes(BILLBOARD_CLOUD_CHUNK, 0))
+            {
+                Result<BillboardCloudData> decoded = decodeBillboardCloudChunk(*layered, label);
+                if (decoded && decoded->gpuBytes() > 0)
+                    options.memoryBytes = decoded->gpuBytes();
+            }
+            return bakeClassicBillboardCloud(model, options, label, progress);
+        });
     }
 }

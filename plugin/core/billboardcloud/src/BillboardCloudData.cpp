@@ -602,11 +602,8 @@ namespace TreeLod
             const float qy = py - entry.centreY();
             const float psi = entry.rotation();
             const float c = std::cos(psi), s = std::sin(psi);
-            const float edge = entry.side();
-            glm::vec2 local((c * qx + s * qy) / edge + 0.5f, (-s * qx + c * qy) / edge + 0.5f);
             const std::uint32_t mirror = entry.mirrored() ? 1u : 0u;
-            if (mirror)
-                local.x = 1.0f - local.x;
+            const glm::vec2 local = billboardTileLocal(glm::vec2(qx, qy), c, s, 1.0f / entry.side(), mirror != 0);
             if (!(local.x >= 0.0f && local.x <= 1.0f && local.y >= 0.0f && local.y <= 1.0f))
                 continue;
             out.push_back({e, entry.orientation() + (side ^ mirror) * mData.orientationCount(), local});

@@ -139,7 +139,7 @@ namespace TreeLod
                 const std::vector<std::uint32_t>& m = members[k];
                 if (m.empty())
                     return;
-                double wsum = 0.0;
+                double wsum = 0.0, leafWeight = 0.0;
                 glm::dvec3 mean(0.0), g(0.0);
                 for (std::uint32_t i : m)
                 {
@@ -149,10 +149,8 @@ namespace TreeLod
                         mean += wv * glm::dvec3(vertices[v]);
                     wsum += wv * leaf.count;
                     g += double(leaf.weight) * glm::dvec3(leaf.centre);
+                    leafWeight += leaf.weight;
                 }
-                double leafWeight = 0.0;
-                for (std::uint32_t i : m)
-                    leafWeight += leaves[i].weight;
                 if (!(wsum > 0.0) || !(leafWeight > 0.0))
                     return;
                 mean /= wsum;
@@ -276,7 +274,8 @@ namespace TreeLod
             // 3. Refit planes and centroids.
             refit();
         }
-        refit(); // members of the final assignment (planes unchanged when it was stable)
+        // The first pass always changes the assignment (from none), so the last refit above saw
+        // the final assignment: members and planes are current.
 
         // Final plane errors.
         tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, L, 256),
@@ -293,10 +292,8 @@ namespace TreeLod
             out.offset[k] = offset[k] + glm::dot(normal[k], ref);
             out.centroid[k] = centroid[k] + ref;
         }
-        out.cluster = std::move(assign);
         out.error = std::move(error);
         out.members = std::move(members);
-        out.iterations = passes;
         return out;
     }
 }

@@ -57,10 +57,8 @@ namespace TreeLod
         std::vector<glm::vec3> normal;                   ///< per cluster, unit (sign arbitrary)
         std::vector<float> offset;                       ///< per cluster: plane dot(normal, p) = offset, world metres
         std::vector<glm::vec3> centroid;                 ///< per cluster, world
-        std::vector<std::uint32_t> cluster;              ///< per leaf
         std::vector<float> error;                        ///< per leaf: plane error to its cluster's final plane
         std::vector<std::vector<std::uint32_t>> members; ///< per cluster, increasing leaf index
-        std::uint32_t iterations = 0;
     };
 
     /// Cluster all leaves of `model` (validated, at least one leaf).

@@ -70,8 +70,6 @@ namespace TreeLod
 
         float luminance(const glm::vec4& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
 
-        std::uint8_t toByte(float v) { return std::uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
-
         glm::vec3 anyOrthogonal(const glm::vec3& n)
         {
             const glm::vec3 e = std::abs(n.x) < 0.6f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
@@ -345,9 +343,6 @@ namespace TreeLod
 
         // Linear copies of the textures the blocks read.
         std::vector<LinearImage> images(blocks);
-        float decode[256];
-        for (int i = 0; i < 256; ++i)
-            decode[i] = srgbToLinear(float(i) / 255.0f);
         for (std::size_t b = 0; b < blocks; ++b)
         {
             const std::int32_t tex = model.materials[mMaterials[b].material].texture;
@@ -362,8 +357,8 @@ namespace TreeLod
             dst.height = src.height;
             dst.texels.resize(texels);
             for (std::size_t p = 0; p < texels; ++p)
-                dst.texels[p] = glm::vec4(decode[src.rgba[p * 4]], decode[src.rgba[p * 4 + 1]],
-                                          decode[src.rgba[p * 4 + 2]], float(src.rgba[p * 4 + 3]) / 255.0f);
+                dst.texels[p] = glm::vec4(srgbByteToLinear(src.rgba[p * 4]), srgbByteToLinear(src.rgba[p * 4 + 1]),
+                                          srgbByteToLinear(src.rgba[p * 4 + 2]), float(src.rgba[p * 4 + 3]) / 255.0f);
         }
 
         // Rasterise: one job per (block, orientation) writes its side 0 and side 1 tiles.
@@ -504,16 +499,16 @@ namespace TreeLod
                         const std::size_t i = std::size_t(py) * T + px;
                         const std::size_t o = (std::size_t(oy + py) * mColour.width + ox + px) * 4;
                         const glm::vec3 c = tint * (known[i] ? albedo[i] : mean);
-                        mColour.rgba[o + 0] = toByte(linearToSrgb(std::clamp(c.r, 0.0f, 1.0f)));
-                        mColour.rgba[o + 1] = toByte(linearToSrgb(std::clamp(c.g, 0.0f, 1.0f)));
-                        mColour.rgba[o + 2] = toByte(linearToSrgb(std::clamp(c.b, 0.0f, 1.0f)));
-                        mColour.rgba[o + 3] = toByte(coverage[i]);
+                        mColour.rgba[o + 0] = unitToByte(linearToSrgb(std::clamp(c.r, 0.0f, 1.0f)));
+                        mColour.rgba[o + 1] = unitToByte(linearToSrgb(std::clamp(c.g, 0.0f, 1.0f)));
+                        mColour.rgba[o + 2] = unitToByte(linearToSrgb(std::clamp(c.b, 0.0f, 1.0f)));
+                        mColour.rgba[o + 3] = unitToByte(coverage[i]);
                         // The normal facing this side's viewer, in the tile frame.
                         const glm::vec3 nl = side == 0 ? normal[i] : -normal[i];
                         const glm::vec3 nt(glm::dot(nl, x), glm::dot(nl, y), glm::dot(nl, z));
-                        mNormal.rgba[o + 0] = toByte(nt.x * 0.5f + 0.5f);
-                        mNormal.rgba[o + 1] = toByte(nt.y * 0.5f + 0.5f);
-                        mNormal.rgba[o + 2] = toByte(nt.z * 0.5f + 0.5f);
+                        mNormal.rgba[o + 0] = unitToByte(nt.x * 0.5f + 0.5f);
+                        mNormal.rgba[o + 1] = unitToByte(nt.y * 0.5f + 0.5f);
+                        mNormal.rgba[o + 2] = unitToByte(nt.z * 0.5f + 0.5f);
                         mNormal.rgba[o + 3] = 255;
                     }
             }
@@ -613,10 +608,7 @@ namespace TreeLod
                 continue;
             const glm::vec3 p = mModel.leafVertices[v].position - origin;
             const glm::vec2 q = glm::vec2(glm::dot(p, U), glm::dot(p, V)) - placement.centre;
-            glm::vec2 local(c * q.x + s * q.y, -s * q.x + c * q.y); // R(-psi) q
-            local = local / side + 0.5f;
-            if (placement.mirrored)
-                local.x = 1.0f - local.x;
+            const glm::vec2 local = billboardTileLocal(q, c, s, 1.0f / side, placement.mirrored);
             if (!std::isfinite(local.x) || !std::isfinite(local.y))
                 continue;
             const Eigen::Vector4d basis((1.0 - local.x) * (1.0 - local.y), local.x * (1.0 - local.y),
@@ -645,12 +637,6 @@ namespace TreeLod
     {
         if (tile >= tileCount() || !(local.x >= 0.0f && local.x <= 1.0f && local.y >= 0.0f && local.y <= 1.0f))
             return glm::vec4(0.0f);
-        static const std::array<float, 256> decode = [] {
-            std::array<float, 256> table{};
-            for (int i = 0; i < 256; ++i)
-                table[std::size_t(i)] = srgbToLinear(float(i) / 255.0f);
-            return table;
-        }();
         const int T = int(mTileSize);
         const int ox = int(tile % mColumns) * T, oy = int(tile / mColumns) * T;
         // Bilinear within the tile (texel centres at (i + 0.5) / T, clamped at its edges).
@@ -662,7 +648,8 @@ namespace TreeLod
             y = std::clamp(y, 0, T - 1);
             const std::uint8_t* p =
                 &mColour.rgba[(std::size_t(oy + y) * std::size_t(mColour.width) + std::size_t(ox + x)) * 4];
-            return glm::vec4(decode[p[0]], decode[p[1]], decode[p[2]], float(p[3]) / 255.0f);
+            return glm::vec4(srgbByteToLinear(p[0]), srgbByteToLinear(p[1]), srgbByteToLinear(p[2]),
+                             float(p[3]) / 255.0f);
         };
         const int x0 = int(x0f), y0 = int(y0f);
         const glm::vec4 top = glm::mix(texel(x0, y0), texel(x0 + 1, y0), ax);

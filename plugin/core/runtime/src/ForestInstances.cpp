@@ -143,7 +143,6 @@ namespace TreeLod
         const std::uint32_t index = std::uint32_t(mKinds.size());
         mKinds.push_back(kind);
         mKindFirstBucket.push_back(mBucketCount);
-        mKindLevels.push_back(std::uint32_t(kind.thresholds.size() + 1));
         mKindDistance.push_back(distance ? 1 : 0);
         for (std::size_t i = 0; i < MAX_THRESHOLDS; ++i)
         {
@@ -152,7 +151,7 @@ namespace TreeLod
             else
                 mKindTable.push_back(distance ? -kind.thresholds[i] : kind.thresholds[i]);
         }
-        mBucketCount += mKindLevels.back();
+        mBucketCount += getLevelCount(index);
         // Instances already placed keep their kinds; their spheres do not depend on new kinds.
         return index;
     }
@@ -410,7 +409,7 @@ namespace TreeLod
         // Prefix sums: bucket ranges; counts become fill cursors.
         std::uint32_t first = 0;
         for (std::uint32_t k = 0, b = 0; k < mKinds.size(); ++k)
-            for (std::uint32_t l = 0; l < mKindLevels[k]; ++l, ++b)
+            for (std::uint32_t l = 0, levels = getLevelCount(k); l < levels; ++l, ++b)
             {
                 out.mBuckets[b] = ForestBucket{k, l, first, counts[b]};
                 first += counts[b];

@@ -5,7 +5,7 @@
 // built and what it reused.
 //
 // Layout: one package per (source content, options): <directory>/<stem>-<16 hex>.treelod,
-// the hex being FNV-1a 64 over the source's content hash, the canonical options JSON and the
+// the hex being FNV-1a 64 over the source's content hash (sourceHashOf), the canonical options JSON and the
 // package and chunk format versions (a format change gives new files; old ones are never read
 // again and may be deleted). The technique list is not part of the key: the package holds every
 // chunk asked for so far, and a request for a new technique bakes that one alone and rewrites the
@@ -24,7 +24,9 @@
 //
 // Failures: unknown technique, missing or unreadable source, import or bake errors return an
 // Error naming the source (or the cache file) and write nothing. A cached file that cannot be
-// used (truncated, checksum mismatch, foreign meta) is rebaked whole and the entry says why.
+// used (truncated, checksum mismatch, foreign meta) is rebaked whole and the entry says why. A
+// request that finds everything verifies only the chunks it returns (its techniques' and the
+// reference); one that rewrites the package verifies every chunk it copies.
 //
 // Concurrency: packages are written to a temporary file and renamed (PackageWriter::write), so
 // a reader sees an old or a new package, never a torn one. Two processes (or threads) baking
@@ -33,6 +35,7 @@
 // it. No lock is taken: the cost of a race is repeated work, not a corrupt cache.
 #pragma once
 
+#include "TreeLod/GltfImporter.h"
 #include "TreeLod/Progress.h"
 #include "TreeLod/Result.h"
 #include "TreeLod/TreeModel.h"
@@ -47,6 +50,22 @@ namespace TreeLod
     /// Reads a tree file the cache has no importer for (the Ogre side's .mesh reader). `path` as
     /// given to BakeCache::require().
     using ImportFunction = std::function<Result<TreeModel>(const std::string& path)>;
+
+    /// The extension of `path` with its dot, lower-cased: "Oak.GLB" -> ".glb".
+    std::string lowerCaseExtension(const std::string& path);
+
+    /// "fnv1a64:" + 16 hex digits identifying a tree file's content: FNV-1a 64 over its bytes and,
+    /// for a .gltf (JSON), the external buffers and images it references (missing ones hash as
+    /// missing; the import reports them). The meta chunk's "sourceHash" of `treelod bake` and of
+    /// the cache. Error when the file cannot be read.
+    Result<std::string> sourceHashOf(const std::string& path);
+
+    /// Imports a tree file: .glb/.gltf with importGltf (`leafMaterials` as ImportOptions, `progress`
+    /// its steps, `report` filled when given), any other format with `import`; an error naming
+    /// the file and its extension when that is empty.
+    Result<TreeModel> importTreeFile(const std::string& path, const std::vector<std::string>& leafMaterials,
+                                     const ProgressCallback& progress, const ImportFunction& import = {},
+                                     ImportReport* report = nullptr);
 
     /// Makes a tree from a whole source string ("preset:oak?leaves=20000&seed=1").
     using GenerateFunction =

@@ -7,6 +7,11 @@
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+
 #include <string>
 #include <vector>
 
@@ -37,4 +42,17 @@ namespace TreeLod
     /// sRGB <-> linear transfer (IEC 61966-2-1), per channel.
     float srgbToLinear(float c);
     float linearToSrgb(float c);
+    /// srgbToLinear(b / 255), from a 256-entry table.
+    inline float srgbByteToLinear(std::uint8_t b)
+    {
+        static const std::array<float, 256> table = [] {
+            std::array<float, 256> t{};
+            for (int i = 0; i < 256; ++i)
+                t[std::size_t(i)] = srgbToLinear(float(i) / 255.0f);
+            return t;
+        }();
+        return table[b];
+    }
+    /// A [0, 1] value as a byte: round(clamp(v, 0, 1) * 255).
+    inline std::uint8_t unitToByte(float v) { return std::uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
 }

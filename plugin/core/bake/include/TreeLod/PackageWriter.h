@@ -32,6 +32,12 @@ namespace TreeLod
         {
             return mChunks.count({technique, level}) != 0;
         }
+        /// The bytes of chunk (technique, level), or null if none was added.
+        const std::vector<std::uint8_t>* chunkBytes(const std::string& technique, std::uint32_t level) const
+        {
+            const auto it = mChunks.find({technique, level});
+            return it == mChunks.end() ? nullptr : &it->second.bytes;
+        }
 
         /// The whole package.
         std::vector<std::uint8_t> toBytes() const;
@@ -83,7 +89,7 @@ namespace TreeLod
     struct PackageMeta
     {
         std::string source;       ///< input file name without directories (so moving it changes nothing)
-        std::string sourceHash;   ///< e.g. "fnv1a64:" + 16 hex digits of the input file's bytes
+        std::string sourceHash;   ///< sourceHashOf(input) (BakeCache.h): "fnv1a64:" + 16 hex digits
         std::string optionsJson = "{}"; ///< bake options as a JSON object (stored as a string if not JSON)
         std::vector<std::string> techniques; ///< chunks the bake produced, besides "meta"
 

@@ -101,6 +101,9 @@ namespace TreeLod
         SceneArea area;
         std::vector<SceneArea> exclude; ///< kept free (a plaza, a road)
         float clumping = 0.0f;    ///< 0 uniform .. 1 tight clusters (Thomas process, see .cpp)
+        /// m^2 of `area` outside `exclude`, sampled once by the parser (0 in a placement built in
+        /// code: generatePlacements() then samples it itself)
+        double freeAreaM2 = 0.0;
     };
 
     struct SceneSun

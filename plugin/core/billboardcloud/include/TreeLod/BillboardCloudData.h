@@ -200,6 +200,17 @@ namespace TreeLod
     /// GLSL: cell = clamp(floor(g), 0.0, float(size) - 1.0), exact for sizes <= 2^24.
     std::uint32_t billboardGridCell(float g, std::uint32_t size);
 
+    /// The entry's tile-local position (contract above): local = R(-psi) q / side + 0.5, then
+    /// local.x = 1 - local.x when mirrored. q: the point relative to the tile centre, in hash cells.
+    inline glm::vec2 billboardTileLocal(glm::vec2 q, float cosPsi, float sinPsi, float invSide, bool mirrored)
+    {
+        glm::vec2 local((cosPsi * q.x + sinPsi * q.y) * invSide + 0.5f,
+                        (-sinPsi * q.x + cosPsi * q.y) * invSide + 0.5f);
+        if (mirrored)
+            local.x = 1.0f - local.x;
+        return local;
+    }
+
     /// Unit direction d_k of orientation k' (0 <= k' < grid^2) on the hemisphere d.z >= 0
     /// (hemi-octahedral map: cell centre (x, y) in [-1, 1]^2 rotated 45 degrees onto the
     /// octahedron's upper half).

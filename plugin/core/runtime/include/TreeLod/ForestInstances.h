@@ -138,8 +138,8 @@ namespace TreeLod
     private:
         friend class ForestInstances;
         std::vector<ForestBucket> mBuckets;
-        std::vector<std::uint32_t> mIndices;     // sized to the instance count
-        std::vector<float> mTransforms;          // sized to 12 x the instance count
+        std::vector<std::uint32_t> mIndices;     // grown to the largest visible count so far
+        std::vector<float> mTransforms;          // grown to 12 x the largest visible count so far
         std::vector<std::uint32_t> mVisible;     // scratch: visible instances in input order
         std::vector<std::uint32_t> mVisibleBucket; // scratch: their buckets
         std::vector<std::uint32_t> mCursor;      // scratch: fill position per bucket
@@ -214,7 +214,6 @@ namespace TreeLod
         // kinds
         std::vector<ForestKind> mKinds;
         std::vector<std::uint32_t> mKindFirstBucket;
-        std::vector<std::uint32_t> mKindLevels;   // thresholds.size() + 1
         std::vector<std::uint8_t> mKindDistance;  // 1 for ForestLodMode::Distance
         /// Per kind MAX_THRESHOLDS keys, compared as key >= table[i]: pixel thresholds as they
         /// are, distance thresholds negated (value = -d^2 / bias), padding never reached.
