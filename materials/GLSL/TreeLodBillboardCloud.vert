@@ -5,6 +5,7 @@
 // CASTER: the shadow camera's clip z and w, and the direction towards the light (the shadow
 // camera's view +z, a directional light) instead of the camera.
 // SHADOW_RECEIVER: the position in the sun's shadow texture.
+// INSTANCED: placed by the Forest's instance data first (TreeLodInstance.glsl).
 uniform mat4 worldViewProj;
 uniform mat4 world;
 #ifdef CASTER
@@ -32,20 +33,32 @@ flat out vec4 vHash;
 out vec3 vNormal;
 out vec3 vTangent;
 out vec3 vToCamera;
+#ifdef INSTANCED
+#include "TreeLodInstance.glsl"
+#endif
 
 void main()
 {
-    gl_Position = worldViewProj * vertex;
-    vec3 position = (world * vertex).xyz;
+#ifdef INSTANCED
+    vec4 local = instancePosition(vertex);
+    vec3 objectNormal = instanceDirection(normal);
+    vec3 objectTangent = instanceDirection(tangent);
+#else
+    vec4 local = vertex;
+    vec3 objectNormal = normal;
+    vec3 objectTangent = tangent;
+#endif
+    gl_Position = worldViewProj * local;
+    vec3 position = (world * local).xyz;
 #ifdef CASTER
     vClipZW = gl_Position.zw;
-    vNormal = mat3(world) * normal;
+    vNormal = mat3(world) * objectNormal;
     vToCamera = vec3(view[0][2], view[1][2], view[2][2]);
 #else
-    vNormal = mat3(normalMatrix) * normal;
+    vNormal = mat3(normalMatrix) * objectNormal;
     vToCamera = cameraPosition.xyz - position;
 #endif
-    vTangent = mat3(world) * tangent;
+    vTangent = mat3(world) * objectTangent;
     vUv = uv0;
     vHash = uv1;
     vLowResUv = mix(uv2.xy, uv2.zw, uv0);

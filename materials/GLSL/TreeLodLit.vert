@@ -1,7 +1,8 @@
 #version 330 core
 // Lit tree surfaces (bark and leaves): world-space normal and UV to the fragment stage;
 // SHADOW_RECEIVER: also the position in the sun's shadow texture. AO: the vertex colour's red
-// channel (ambient occlusion) to the fragment stage.
+// channel (ambient occlusion) to the fragment stage. INSTANCED: placed by the Forest's
+// instance data first (TreeLodInstance.glsl).
 uniform mat4 worldViewProj;
 uniform mat4 world;
 uniform mat4 normalMatrix;
@@ -22,17 +23,27 @@ out float vAo;
 uniform mat4 texViewProj; // the sun's shadow camera, clip space to texture space
 out vec4 vShadowPos;
 #endif
+#ifdef INSTANCED
+#include "TreeLodInstance.glsl"
+#endif
 
 void main()
 {
-    gl_Position = worldViewProj * vertex;
-    vNormal = mat3(normalMatrix) * normal;
-    vToCamera = cameraPosition.xyz - (world * vertex).xyz;
+#ifdef INSTANCED
+    vec4 position = instancePosition(vertex);
+    vec3 objectNormal = instanceDirection(normal);
+#else
+    vec4 position = vertex;
+    vec3 objectNormal = normal;
+#endif
+    gl_Position = worldViewProj * position;
+    vNormal = mat3(normalMatrix) * objectNormal;
+    vToCamera = cameraPosition.xyz - (world * position).xyz;
     vUv = uv0;
 #ifdef AO
     vAo = colour.r;
 #endif
 #ifdef SHADOW_RECEIVER
-    vShadowPos = texViewProj * (world * vertex);
+    vShadowPos = texViewProj * (world * position);
 #endif
 }

@@ -11,4 +11,5 @@ namespace TreeLod
     void addInfoCommand(CLI::App& app);
     void addBakeCommand(CLI::App& app);
     void addRenderCommand(CLI::App& app);
+    void addBenchCommand(CLI::App& app);
 }

@@ -9,6 +9,7 @@
 #include "TreeLod/BillboardCloudData.h"
 #include "TreeLod/FoliageLodData.h"
 #include "TreeLod/GltfImporter.h"
+#include "TreeLod/ImpostorData.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
 
@@ -113,6 +114,7 @@ namespace TreeLod
             std::optional<ReferenceChunk> reference;
             std::optional<FoliageLodData> foliageLod;
             std::vector<BillboardCloudData> clouds; ///< billboard-cloud, classic-billboard-cloud
+            std::optional<ImpostorData> impostor;
             json meta;
             for (std::size_t i = 0; i < reader.chunks().size(); ++i)
             {
@@ -171,6 +173,23 @@ namespace TreeLod
                     else if (!firstError)
                         firstError = decoded.error();
                 }
+                else if (c.technique == IMPOSTOR_CHUNK && c.level == 0)
+                {
+                    if (c.formatVersion != IMPOSTOR_CHUNK_FORMAT_VERSION)
+                    {
+                        if (!firstError)
+                            firstError = fail(reader.label(), c.element(),
+                                              "unsupported format version " + std::to_string(c.formatVersion) +
+                                                  ", this build reads " +
+                                                  std::to_string(IMPOSTOR_CHUNK_FORMAT_VERSION));
+                        continue;
+                    }
+                    Result<ImpostorData> decoded = decodeImpostorChunk(bytes.value(), reader.label());
+                    if (decoded)
+                        impostor = std::move(decoded.value());
+                    else if (!firstError)
+                        firstError = decoded.error();
+                }
             }
 
             std::vector<TextureRow> textures;
@@ -216,6 +235,15 @@ namespace TreeLod
                         {"lowResTexture", {cloud.lowRes.width, cloud.lowRes.height}},
                         {"gpuBytes", cloud.gpuBytes()}};
                 }
+                if (impostor)
+                    j[IMPOSTOR_CHUNK] = {{"halfWidth", impostor->halfWidth},
+                                         {"bottom", impostor->bottom},
+                                         {"top", impostor->top},
+                                         {"alphaCutoff", impostor->alphaCutoff},
+                                         {"texture", {impostor->colour.width, impostor->colour.height}},
+                                         {"mipCount", impostor->colour.mipCount},
+                                         {"compressed", isBlockCompressed(impostor->colour.format)},
+                                         {"gpuBytes", impostor->gpuBytes()}};
                 if (firstError)
                     j["error"] = firstError->message();
                 std::printf("%s\n", j.dump(2, ' ', false, json::error_handler_t::replace).c_str());
@@ -263,6 +291,14 @@ namespace TreeLod
                                 cloud.leavesColour.height, cloud.lowRes.width, cloud.lowRes.height,
                                 (unsigned long long)cloud.gpuBytes());
                 }
+                if (impostor)
+                    std::printf("%s: quad %.3f x %.3f m (y %.3f .. %.3f), colour and normal textures %ux%u %s, %u "
+                                "mip levels, alpha cutoff %.2f, %llu bytes on the GPU\n",
+                                IMPOSTOR_CHUNK, 2.0f * impostor->halfWidth, impostor->top - impostor->bottom,
+                                impostor->bottom, impostor->top, impostor->colour.width, impostor->colour.height,
+                                isBlockCompressed(impostor->colour.format) ? "DXT5 / DXT1" : "RGBA8",
+                                impostor->colour.mipCount, impostor->alphaCutoff,
+                                (unsigned long long)impostor->gpuBytes());
             }
             if (firstError)
                 return printError(*firstError);

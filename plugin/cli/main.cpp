@@ -11,6 +11,7 @@ int main(int argc, char** argv)
     TreeLod::addInfoCommand(app);
     TreeLod::addBakeCommand(app);
     TreeLod::addRenderCommand(app);
+    TreeLod::addBenchCommand(app);
     TreeLod::addCompareCommand(app);
     try
     {

@@ -2,7 +2,8 @@
 // every "reference" chunk decoded, every "lodf" chunk decoded and walked through its
 // levels as FoliageLodTree does (writeCluster must stay inside each cluster's region), and
 // every "billboard-cloud" / "classic-billboard-cloud" chunk decoded and sampled as the
-// shader addresses it (BillboardCloudSampler). Must never crash, read out of bounds or
+// shader addresses it (BillboardCloudSampler), and every "impostor" chunk decoded and its
+// texture mips walked. Must never crash, read out of bounds or
 // allocate more than a small multiple of the input (Package.h, "Hostile input").
 //
 // Seeds: tests/fuzz/corpus/package/ (small valid packages). The chunk CRCs stop most
@@ -11,6 +12,7 @@
 #include "TreeLod/BillboardCloudData.h"
 #include "TreeLod/Crc32.h"
 #include "TreeLod/FoliageLodState.h"
+#include "TreeLod/ImpostorData.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
 
@@ -105,6 +107,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                             if (f.entry >= decoded->entries.size() || f.tile >= decoded->tileCount())
                                 __builtin_trap();
             sampler.walk(billboards, 0.5f, 0.5f, true); // out of range: no fragments, no crash
+        }
+        else if (reader->chunks()[i].technique == TreeLod::IMPOSTOR_CHUNK)
+        {
+            TreeLod::Result<TreeLod::ImpostorData> decoded = TreeLod::decodeImpostorChunk(chunk.value(), "fuzz");
+            if (!decoded)
+                continue;
+            // What TreeAsset::getImpostorGpu uploads: every mip of both textures.
+            for (const TreeLod::GpuTexture* t : {&decoded->colour, &decoded->normal})
+                for (std::uint32_t level = 0; level < t->mipCount; ++level)
+                    if (t->mipOffset(level) + t->mipBytes(level) > t->data.size())
+                        __builtin_trap();
         }
         else if (reader->chunks()[i].technique == TreeLod::FOLIAGE_LOD_CHUNK)
         {

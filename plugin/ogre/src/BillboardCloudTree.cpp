@@ -108,23 +108,30 @@ namespace TreeLod
         return BillboardCloudTreeFactory::FACTORY_TYPE_NAME;
     }
 
-    void BillboardCloudTree::updateSwitchValues()
+    std::vector<Ogre::Real> BillboardCloudTree::switchPixelCounts(const BillboardCloudGpu& gpu, float listFactor,
+                                                                  float radius)
     {
         // §6: switches consistent with the shader LoD (BillboardCloudTree.h).
-        mSwitchPixelCounts.assign(mGpu->levels.size() > 1 ? mGpu->levels.size() - 1 : 0, 0.0f);
-        for (std::size_t l = 0; l < mSwitchPixelCounts.size(); ++l)
+        std::vector<Ogre::Real> switches(gpu.levels.size() > 1 ? gpu.levels.size() - 1 : 0, 0.0f);
+        for (std::size_t l = 0; l < switches.size(); ++l)
         {
-            const BillboardCloudGpu::Level& level = mGpu->levels[l];
-            const BillboardCloudGpu::Level& next = mGpu->levels[l + 1];
+            const BillboardCloudGpu::Level& level = gpu.levels[l];
+            const BillboardCloudGpu::Level& next = gpu.levels[l + 1];
             if (level.layered)
-                mSwitchPixelCounts[l] = billboardCloudPixelCount(next.layered ? SWITCH_ENTRIES : 1.0f, level.cellSize,
-                                                                 float(mGpu->radius), mListFactor);
+                switches[l] = billboardCloudPixelCount(next.layered ? SWITCH_ENTRIES : 1.0f, level.cellSize, radius,
+                                                       listFactor);
             else // a low-res level before another: keep the finer one as long as the one before
-                mSwitchPixelCounts[l] = l > 0 ? mSwitchPixelCounts[l - 1] : 0.0f;
+                switches[l] = l > 0 ? switches[l - 1] : 0.0f;
             // listFactor 0: the layered levels walk nothing at any size.
-            if (mSwitchPixelCounts[l] == std::numeric_limits<Ogre::Real>::max() && l > 0)
-                mSwitchPixelCounts[l] = mSwitchPixelCounts[l - 1];
+            if (switches[l] == std::numeric_limits<Ogre::Real>::max() && l > 0)
+                switches[l] = switches[l - 1];
         }
+        return switches;
+    }
+
+    void BillboardCloudTree::updateSwitchValues()
+    {
+        mSwitchPixelCounts = switchPixelCounts(*mGpu, mListFactor, float(mGpu->radius));
     }
 
     void BillboardCloudTree::setListFactor(float listFactor)

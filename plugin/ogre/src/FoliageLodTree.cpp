@@ -189,8 +189,19 @@ namespace TreeLod
 
     std::uint32_t FoliageLodTree::leafCountForPixels(Ogre::Real pixels, Ogre::Real bias) const
     {
-        const double leaves = std::max(0.0, double(pixels) * double(bias) / double(mOptions.pixelsPerLeaf));
-        return std::uint32_t(std::clamp(std::ceil(leaves), double(mData->minLeafCount()), double(mData->maxLeafCount())));
+        return leafCountOnCurve(*mData, Ogre::Real(double(pixels) * double(bias)), mOptions.pixelsPerLeaf);
+    }
+
+    std::uint32_t FoliageLodTree::leafCountOnCurve(const FoliageLodData& data, Ogre::Real pixels, float pixelsPerLeaf)
+    {
+        const double leaves = std::max(0.0, double(pixels) / double(pixelsPerLeaf));
+        return std::uint32_t(std::clamp(std::ceil(leaves), double(data.minLeafCount()), double(data.maxLeafCount())));
+    }
+
+    Ogre::Real FoliageLodTree::pixelCountForLeaves(std::uint32_t leaves, float pixelsPerLeaf)
+    {
+        // ceil(pixels / pixelsPerLeaf) <= leaves  <=>  pixels <= leaves * pixelsPerLeaf.
+        return Ogre::Real(double(leaves) * double(pixelsPerLeaf));
     }
 
     void FoliageLodTree::setFixedLeafCount(std::uint32_t count)

@@ -122,16 +122,22 @@ namespace TreeLod
         mLogManager.reset();
     }
 
+    void applyLighting(Ogre::SceneManager& sceneManager, Ogre::Light& sun, const LightingSpec& lighting)
+    {
+        const glm::vec3& a = lighting.ambientColour;
+        const glm::vec3& c = lighting.sunColour;
+        sceneManager.setAmbientLight(Ogre::ColourValue(a.r, a.g, a.b));
+        sun.setType(Ogre::Light::LT_DIRECTIONAL);
+        sun.setDiffuseColour(Ogre::ColourValue(c.r, c.g, c.b));
+        sun.setSpecularColour(Ogre::ColourValue::Black);
+        glm::vec3 d = -glm::normalize(lighting.sunDirection); // Ogre: the direction light travels
+        sun.getParentSceneNode()->setDirection(Ogre::Vector3(d.x, d.y, d.z), Ogre::Node::TS_WORLD);
+    }
+
     void OffscreenRenderer::setLighting(const LightingSpec& lighting)
     {
         mLighting = lighting;
-        const glm::vec3& a = lighting.ambientColour;
-        const glm::vec3& s = lighting.sunColour;
-        mSceneManager->setAmbientLight(Ogre::ColourValue(a.r, a.g, a.b));
-        mSun->setDiffuseColour(Ogre::ColourValue(s.r, s.g, s.b));
-        mSun->setSpecularColour(Ogre::ColourValue::Black);
-        glm::vec3 d = -glm::normalize(lighting.sunDirection); // Ogre: the direction light travels
-        mSun->getParentSceneNode()->setDirection(Ogre::Vector3(d.x, d.y, d.z), Ogre::Node::TS_WORLD);
+        applyLighting(*mSceneManager, *mSun, lighting);
     }
 
     void OffscreenRenderer::ensureTarget(int width, int height)
@@ -159,11 +165,15 @@ namespace TreeLod
             mContentNode->_update(true, false);
             const Ogre::AxisAlignedBox& box = mContentNode->_getWorldAABB();
             const Ogre::Real radius = box.isFinite() ? 0.5f * box.getSize().length() : 10.0f;
-            mSceneManager->setShadowDirectionalLightExtrusionDistance(2.0f * radius + 1.0f);
+            Ogre::Real extrusion = 2.0f * radius + 1.0f;
+            if (mShadowFarDistance > 0.0f) // casters farther up-sun than this are out of reach anyway
+                extrusion = std::min(extrusion, 2.0f * mShadowFarDistance + 50.0f);
+            mSceneManager->setShadowDirectionalLightExtrusionDistance(extrusion);
             // Shadows reach past the far side of the content however far the camera stands.
             const Ogre::Vector3 eye(spec.position.x, spec.position.y, spec.position.z);
             const Ogre::Real reach = box.isFinite() ? eye.distance(box.getCenter()) + 2.0f * radius : 0.0f;
-            mSceneManager->setShadowFarDistance(std::max(4.0f * radius + 2.0f, reach));
+            mSceneManager->setShadowFarDistance(mShadowFarDistance > 0.0f ? mShadowFarDistance
+                                                                          : std::max(4.0f * radius + 2.0f, reach));
         }
         mCamera->setLodBias(mLodBias / float(samplesPerAxis * samplesPerAxis));
         mCamera->setNearClipDistance(spec.nearClip);
@@ -184,25 +194,31 @@ namespace TreeLod
         mCameraNode->lookAt(Ogre::Vector3(spec.target.x, spec.target.y, spec.target.z), Ogre::Node::TS_WORLD);
     }
 
-    void OffscreenRenderer::setShadows(bool enabled, unsigned textureSize, ShadowCamera camera)
+    void applyTextureShadows(Ogre::SceneManager& sceneManager, Ogre::Light& sun, bool enabled, unsigned textureSize,
+                             ShadowCamera camera)
     {
         if (!enabled)
         {
-            mSceneManager->setShadowTechnique(Ogre::SHADOWTYPE_NONE);
+            sceneManager.setShadowTechnique(Ogre::SHADOWTYPE_NONE);
             return;
         }
-        mSceneManager->setShadowTechnique(Ogre::SHADOWTYPE_TEXTURE_ADDITIVE_INTEGRATED);
-        mSceneManager->setShadowTextureCount(1);
-        mSceneManager->setShadowTextureSettings(textureSize, 1, Ogre::PF_FLOAT32_R);
-        mSceneManager->setShadowTextureSelfShadow(true);
+        sceneManager.setShadowTechnique(Ogre::SHADOWTYPE_TEXTURE_ADDITIVE_INTEGRATED);
+        sceneManager.setShadowTextureCount(1);
+        sceneManager.setShadowTextureSettings(textureSize, 1, Ogre::PF_FLOAT32_R);
+        sceneManager.setShadowTextureSelfShadow(true);
         if (camera == ShadowCamera::LiSPSM)
-            mSceneManager->setShadowCameraSetup(Ogre::ShadowCameraSetupPtr(new Ogre::LiSPSMShadowCameraSetup()));
+            sceneManager.setShadowCameraSetup(Ogre::ShadowCameraSetupPtr(new Ogre::LiSPSMShadowCameraSetup()));
         else
-            mSceneManager->setShadowCameraSetup(Ogre::ShadowCameraSetupPtr(new Ogre::FocusedShadowCameraSetup()));
-        mSun->setCastShadows(true);
+            sceneManager.setShadowCameraSetup(Ogre::ShadowCameraSetupPtr(new Ogre::FocusedShadowCameraSetup()));
+        sun.setCastShadows(true);
     }
 
-    std::vector<double> OffscreenRenderer::timeFrames(const CameraSpec& spec, int width, int height, int frames)
+    void OffscreenRenderer::setShadows(bool enabled, unsigned textureSize, ShadowCamera camera)
+    {
+        applyTextureShadows(*mSceneManager, *mSun, enabled, textureSize, camera);
+    }
+
+    FrameTiming OffscreenRenderer::renderTimedFrame(const CameraSpec& spec, int width, int height)
     {
         ensureTarget(width, height);
         placeCamera(spec, width, height, 1);
@@ -211,15 +227,27 @@ namespace TreeLod
         rt->getViewport(0)->setBackgroundColour(Ogre::ColourValue(bg.r, bg.g, bg.b, 1.0f));
         std::uint8_t pixel[4];
         Ogre::PixelBox one(1, 1, 1, Ogre::PF_BYTE_RGBA, pixel);
+        FrameTiming timing;
+        const auto start = std::chrono::steady_clock::now();
+        mRoot->renderOneFrame();
+        rt->update();
+        timing.cpuMilliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        rt->copyContentsToMemory(Ogre::Box(0, 0, 1, 1), one, Ogre::RenderTarget::FB_AUTO);
+        timing.frameMilliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        const Ogre::RenderTarget::FrameStats& stats = rt->getStatistics();
+        timing.batches = stats.batchCount;
+        timing.triangles = stats.triangleCount;
+        return timing;
+    }
+
+    std::vector<double> OffscreenRenderer::timeFrames(const CameraSpec& spec, int width, int height, int frames)
+    {
         std::vector<double> ms;
         for (int f = -1; f < frames; ++f)
         {
-            const auto start = std::chrono::steady_clock::now();
-            mRoot->renderOneFrame();
-            rt->update();
-            rt->copyContentsToMemory(Ogre::Box(0, 0, 1, 1), one, Ogre::RenderTarget::FB_AUTO);
+            const double t = renderTimedFrame(spec, width, height).frameMilliseconds;
             if (f >= 0)
-                ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+                ms.push_back(t);
         }
         return ms;
     }

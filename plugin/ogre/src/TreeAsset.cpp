@@ -121,6 +121,15 @@ namespace TreeLod
         }
         for (std::unique_ptr<BillboardCloudData>& data : mBillboardClouds)
             data.reset();
+        if (mImpostorGpu)
+        {
+            const ImpostorGpu& gpu = *mImpostorGpu;
+            for (const Ogre::String& m : {gpu.material, gpu.shadowedMaterial, gpu.material + "/Caster"})
+                Ogre::MaterialManager::getSingleton().remove(m, mGroup);
+            for (const Ogre::String& t : {gpu.texture, gpu.normalTexture})
+                Ogre::TextureManager::getSingleton().remove(t, mGroup);
+            mImpostorGpu.reset();
+        }
         for (std::vector<Ogre::String>& names : mBarkAoMaterialNames)
         {
             for (const Ogre::String& m : names)

@@ -1,6 +1,10 @@
 #include "TreeLod/TreeAssetManager.h"
 
+#include <OgreException.h>
 #include <OgreResourceGroupManager.h>
+
+#include <fstream>
+#include <iterator>
 
 template <> TreeLod::TreeAssetManager* Ogre::Singleton<TreeLod::TreeAssetManager>::msSingleton = nullptr;
 
@@ -45,6 +49,32 @@ namespace TreeLod
         asset->setPackageBytes(std::move(packageBytes));
         asset->load();
         return asset;
+    }
+
+    TreeAssetPtr TreeAssetManager::require(const Ogre::String& source, const std::vector<Ogre::String>& techniques,
+                                           const Ogre::String& group)
+    {
+        if (!mBaker)
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALID_STATE,
+                        "'" + source + "': no baker registered (TreeAssetManager::setBaker), cannot bake on demand",
+                        "TreeAssetManager::require");
+        const Ogre::String path = mBaker->requirePackage(source, techniques);
+        const Ogre::String name = path.substr(path.find_last_of('/') + 1);
+        if (TreeAssetPtr existing = getByName(name, group))
+        {
+            bool complete = existing->isLoaded();
+            for (const Ogre::String& technique : techniques)
+                complete = complete && existing->hasChunk(technique);
+            if (complete)
+                return existing;
+            remove(existing); // the cache rewrote the package with more chunks
+        }
+        std::ifstream in(path, std::ios::binary);
+        if (!in)
+            OGRE_EXCEPT(Ogre::Exception::ERR_FILE_NOT_FOUND,
+                        "'" + source + "': baked package '" + path + "' cannot be opened", "TreeAssetManager::require");
+        std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        return loadFromBytes(name, group, std::move(bytes));
     }
 
     Ogre::Resource* TreeAssetManager::createImpl(const Ogre::String& name, Ogre::ResourceHandle handle,

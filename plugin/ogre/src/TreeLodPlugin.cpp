@@ -2,6 +2,7 @@
 
 #include "TreeLod/BillboardCloudTree.h"
 #include "TreeLod/FoliageLodTree.h"
+#include "TreeLod/Forest.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 
@@ -29,6 +30,8 @@ namespace TreeLod
         Ogre::Root::getSingleton().addMovableObjectFactory(mFoliageLodFactory.get());
         mBillboardCloudFactory = std::make_unique<BillboardCloudTreeFactory>();
         Ogre::Root::getSingleton().addMovableObjectFactory(mBillboardCloudFactory.get());
+        mForestFactory = std::make_unique<ForestFactory>();
+        Ogre::Root::getSingleton().addMovableObjectFactory(mForestFactory.get());
         Ogre::LogManager::getSingleton().logMessage("TreeLod: installed (techniques: " +
                                                     mTechniques->describe() + ")");
     }
@@ -53,6 +56,9 @@ namespace TreeLod
         if (mBillboardCloudFactory)
             Ogre::Root::getSingleton().removeMovableObjectFactory(mBillboardCloudFactory.get());
         mBillboardCloudFactory.reset();
+        if (mForestFactory)
+            Ogre::Root::getSingleton().removeMovableObjectFactory(mForestFactory.get());
+        mForestFactory.reset();
         delete mLodGenerator;
         mLodGenerator = nullptr;
         mAssetManager.reset();

@@ -6,6 +6,7 @@
 #include "TreeLod/BillboardCloudData.h"
 #include "TreeLod/FoliageLodData.h"
 #include "TreeLod/GltfImporter.h"
+#include "TreeLod/ImpostorData.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
 #include "TreeLod/PackageWriter.h"
@@ -331,9 +332,10 @@ namespace TreeLod
 
         // Every version that changes what a cached chunk means: a bump gives a new file name.
         char versions[160];
-        std::snprintf(versions, sizeof(versions), "cache %d package %u reference %u lodf %u billboard-cloud %u",
+        std::snprintf(versions, sizeof(versions), "cache %d package %u reference %u lodf %u billboard-cloud %u impostor %u",
                       BAKE_CACHE_KEY_VERSION, unsigned(PACKAGE_VERSION), unsigned(REFERENCE_CHUNK_FORMAT_VERSION),
-                      unsigned(FOLIAGE_LOD_CHUNK_FORMAT_VERSION), unsigned(BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION));
+                      unsigned(FOLIAGE_LOD_CHUNK_FORMAT_VERSION), unsigned(BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION),
+                      unsigned(IMPOSTOR_CHUNK_FORMAT_VERSION));
         const std::uint64_t fileKey = hashString(std::string(versions) + "\nsource " + key.sourceHash +
                                                  "\noptions " + key.options);
         const std::string stem =

@@ -4,6 +4,7 @@
 #include "TreeLod/BillboardCloudBaker.h"
 #include "TreeLod/FoliageLodBaker.h"
 #include "TreeLod/FoliageLodData.h"
+#include "TreeLod/ImpostorBaker.h"
 #include "TreeLod/Package.h"
 
 namespace TreeLod
@@ -19,6 +20,9 @@ namespace TreeLod
             {CLASSIC_BILLBOARD_CLOUD_CHUNK,
              "classic billboard cloud at equal memory, paper 000 Fig. 13 (adds reference)",
              &addClassicBillboardCloudChunk},
+            {IMPOSTOR_CHUNK,
+             "one camera-facing quad with baked colour and normal textures, the speed floor (adds reference)",
+             &addImpostorChunk},
         };
         return techniques;
     }

@@ -116,4 +116,81 @@ namespace TreeLod
     {
         return c <= 0.0031308f ? c * 12.92f : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
     }
+
+    void bleedValues(std::vector<glm::vec3>& values, const std::vector<std::uint8_t>& known, int width, int height,
+                     int rings, const glm::vec3& fallback)
+    {
+        const std::size_t count = std::size_t(std::max(width, 0)) * std::size_t(std::max(height, 0));
+        if (values.size() != count || known.size() != count)
+            return;
+        std::vector<std::uint8_t> filled(known);
+        glm::dvec3 sum(0.0);
+        std::size_t knownCount = 0;
+        for (std::size_t i = 0; i < count; ++i)
+            if (filled[i])
+            {
+                sum += glm::dvec3(values[i]);
+                ++knownCount;
+            }
+        auto forNeighbours = [width, height](std::size_t i, auto&& visit) {
+            const int px = int(i % std::size_t(width)), py = int(i / std::size_t(width));
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx)
+                {
+                    const int x = px + dx, y = py + dy;
+                    if ((dx != 0 || dy != 0) && x >= 0 && y >= 0 && x < width && y < height)
+                        visit(std::size_t(y) * std::size_t(width) + std::size_t(x));
+                }
+        };
+        // The frontier: empty texels next to a filled one, in index order.
+        std::vector<std::uint8_t> queued(count, 0);
+        std::vector<std::size_t> frontier, next;
+        for (std::size_t i = 0; i < count; ++i)
+            if (!filled[i])
+                forNeighbours(i, [&](std::size_t j) {
+                    if (filled[j] && !queued[i])
+                    {
+                        queued[i] = 1;
+                        frontier.push_back(i);
+                    }
+                });
+        std::vector<glm::vec3> ring;
+        for (int r = 0; r < rings && !frontier.empty(); ++r)
+        {
+            ring.assign(frontier.size(), glm::vec3(0.0f));
+            for (std::size_t k = 0; k < frontier.size(); ++k)
+            {
+                glm::vec3 s(0.0f);
+                int n = 0;
+                forNeighbours(frontier[k], [&](std::size_t j) {
+                    if (filled[j])
+                    {
+                        s += values[j];
+                        ++n;
+                    }
+                });
+                ring[k] = s / float(n);
+            }
+            next.clear();
+            for (std::size_t k = 0; k < frontier.size(); ++k)
+            {
+                values[frontier[k]] = ring[k];
+                filled[frontier[k]] = 1;
+            }
+            for (std::size_t i : frontier)
+                forNeighbours(i, [&](std::size_t j) {
+                    if (!filled[j] && !queued[j])
+                    {
+                        queued[j] = 1;
+                        next.push_back(j);
+                    }
+                });
+            std::sort(next.begin(), next.end());
+            frontier.swap(next);
+        }
+        const glm::vec3 mean = knownCount ? glm::vec3(sum / double(knownCount)) : fallback;
+        for (std::size_t i = 0; i < count; ++i)
+            if (!filled[i])
+                values[i] = mean;
+    }
 }

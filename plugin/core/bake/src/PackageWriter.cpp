@@ -11,6 +11,8 @@
 #include "TreeLod/Package.h"
 
 #include <nlohmann/json.hpp>
+#include <squish.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -241,6 +243,33 @@ namespace TreeLod
                 preserveCoverage(out, level.texels.size(), coverage * double(level.texels.size()), K);
         }
         return tex;
+    }
+
+    GpuTexture compressTexture(const GpuTexture& src, GpuTextureFormat format)
+    {
+        GpuTexture out;
+        out.name = src.name;
+        out.format = format;
+        out.width = src.width;
+        out.height = src.height;
+        out.mipCount = src.mipCount;
+        out.data.resize(gpuTextureBytes(format, src.width, src.height, src.mipCount));
+        const int flags =
+            (format == GpuTextureFormat::DXT5 ? squish::kDxt5 : squish::kDxt1) | squish::kColourClusterFit;
+        const std::size_t blockBytes = format == GpuTextureFormat::DXT5 ? 16 : 8;
+        for (std::uint32_t mip = 0; mip < src.mipCount; ++mip)
+        {
+            const std::uint32_t w = src.mipWidth(mip), h = src.mipHeight(mip);
+            const std::uint8_t* in = src.data.data() + src.mipOffset(mip);
+            std::uint8_t* blocks = out.data.data() + out.mipOffset(mip);
+            const std::size_t rowBytes = std::size_t((w + 3) / 4) * blockBytes;
+            tbb::parallel_for(std::uint32_t(0), (h + 3) / 4, [&](std::uint32_t r) {
+                const std::uint32_t rows = std::min(4u, h - 4 * r);
+                squish::CompressImage(in + std::size_t(4 * r) * w * 4, int(w), int(rows), blocks + r * rowBytes,
+                                      flags);
+            });
+        }
+        return out;
     }
 
     ReferenceChunk makeReferenceChunk(const TreeModel& model)

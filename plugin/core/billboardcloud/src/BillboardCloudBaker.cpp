@@ -28,7 +28,6 @@
 #include "TreeLod/Image.h"
 #include "TreeLod/Package.h"
 
-#include <squish.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -816,35 +815,6 @@ namespace TreeLod
                 });
             }
             return tex;
-        }
-
-        /// DXT1 / DXT5 of every mip level (libsquish, cluster fit); block rows in parallel (each
-        /// block depends on its own texels only, so the bytes do not depend on the threads).
-        GpuTexture compressTexture(const GpuTexture& src, GpuTextureFormat format)
-        {
-            GpuTexture out;
-            out.name = src.name;
-            out.format = format;
-            out.width = src.width;
-            out.height = src.height;
-            out.mipCount = src.mipCount;
-            out.data.resize(gpuTextureBytes(format, src.width, src.height, src.mipCount));
-            const int flags =
-                (format == GpuTextureFormat::DXT5 ? squish::kDxt5 : squish::kDxt1) | squish::kColourClusterFit;
-            const std::size_t blockBytes = format == GpuTextureFormat::DXT5 ? 16 : 8;
-            for (std::uint32_t mip = 0; mip < src.mipCount; ++mip)
-            {
-                const std::uint32_t w = src.mipWidth(mip), h = src.mipHeight(mip);
-                const std::uint8_t* in = src.data.data() + src.mipOffset(mip);
-                std::uint8_t* blocks = out.data.data() + out.mipOffset(mip);
-                const std::size_t rowBytes = std::size_t((w + 3) / 4) * blockBytes;
-                tbb::parallel_for(std::uint32_t(0), (h + 3) / 4, [&](std::uint32_t r) {
-                    const std::uint32_t rows = std::min(4u, h - 4 * r);
-                    squish::CompressImage(in + std::size_t(4 * r) * w * 4, int(w), int(rows), blocks + r * rowBytes,
-                                          flags);
-                });
-            }
-            return out;
         }
 
         // ---- levels -------------------------------------------------------------------------------

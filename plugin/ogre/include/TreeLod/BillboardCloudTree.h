@@ -96,6 +96,10 @@ namespace TreeLod
         /// Pixel-count value (bias applied) below which level `level` + 1 is drawn instead of
         /// `level`; for level < getLevelCount() - 1.
         Ogre::Real getSwitchPixelCount(std::uint32_t level) const { return mSwitchPixelCounts[level]; }
+        /// Pixel-count values (bias applied) below which level l + 1 of `gpu` replaces level l,
+        /// for shader LoD factor `listFactor` and a bounding radius of `radius` metres (the LoD
+        /// value's units: 4 pi r_px^2 of that radius); the rules of the file comment.
+        static std::vector<Ogre::Real> switchPixelCounts(const BillboardCloudGpu& gpu, float listFactor, float radius);
         /// The level the strategy value `value` (its units, bias applied) selects; distance
         /// values are converted with the projection of the last camera seen.
         std::uint32_t levelForValue(Ogre::Real value) const;

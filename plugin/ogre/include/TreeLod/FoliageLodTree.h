@@ -49,10 +49,13 @@ namespace TreeLod
     class FoliageLodTree : public Ogre::MovableObject
     {
     public:
+        /// Projected pixels per leaf of the default curve.
+        static constexpr float DEFAULT_PIXELS_PER_LEAF = 4.0f;
+
         struct Options
         {
             std::uint32_t fixedLeafCount = 0; ///< 0 = from the LoD strategy
-            float pixelsPerLeaf = 4.0f;       ///< projected pixels per leaf at full curve
+            float pixelsPerLeaf = DEFAULT_PIXELS_PER_LEAF; ///< projected pixels per leaf at full curve
             std::uint32_t quantiseLevels = 0; ///< 0 = continuous
         };
 
@@ -68,6 +71,11 @@ namespace TreeLod
         bool isQuantised() const { return mOptions.quantiseLevels > 1; }
         /// Leaves the curve gives for `pixels` (projected bounding-sphere area) and `bias`.
         std::uint32_t leafCountForPixels(Ogre::Real pixels, Ogre::Real bias = 1.0f) const;
+        /// The curve (the file comment) for `data`: leaves at LoD value `pixels` (bias applied).
+        static std::uint32_t leafCountOnCurve(const FoliageLodData& data, Ogre::Real pixels, float pixelsPerLeaf);
+        /// The largest LoD value (bias applied) at which the curve asks for at most `leaves`
+        /// leaves (before clamping): levels that draw a fixed count switch there (the Forest).
+        static Ogre::Real pixelCountForLeaves(std::uint32_t leaves, float pixelsPerLeaf);
 
         /// Move to `count` leaves now (what a camera change does); returns the clusters rewritten.
         std::uint32_t updateLeafCount(std::uint32_t count);

@@ -41,6 +41,24 @@ namespace TreeLod
         std::vector<std::uint8_t> pixels;
     };
 
+    /// Sun (a directional light) and ambient light as `lighting` says (its background is the
+    /// viewport's business). Shared by OffscreenRenderer and the scene builder (ForestScene).
+    void applyLighting(Ogre::SceneManager& sceneManager, Ogre::Light& sun, const LightingSpec& lighting);
+
+    /// Texture shadows from `sun`, or none: integrated additive technique, one float depth map of
+    /// `textureSize`^2 framed by `camera` (see OffscreenRenderer::setShadows).
+    void applyTextureShadows(Ogre::SceneManager& sceneManager, Ogre::Light& sun, bool enabled, unsigned textureSize,
+                             ShadowCamera camera);
+
+    /// One timed frame (OffscreenRenderer::renderTimedFrame).
+    struct FrameTiming
+    {
+        double cpuMilliseconds = 0.0;   ///< renderOneFrame + the target's update: until the commands are submitted
+        double frameMilliseconds = 0.0; ///< until a one-pixel read-back returns: the GPU has finished the frame
+        std::size_t batches = 0;        ///< draws (RenderTarget statistics)
+        std::size_t triangles = 0;      ///< triangles submitted (RenderTarget statistics)
+    };
+
     class OffscreenRenderer
     {
     public:
@@ -68,6 +86,10 @@ namespace TreeLod
         /// Objects choose receiving materials themselves (FoliageLodTree and BillboardCloudTree do).
         void setShadows(bool enabled, unsigned textureSize = 2048, ShadowCamera camera = ShadowCamera::Focused);
 
+        /// Shadow far distance in metres from the camera; 0 (default) = past the content's far
+        /// side from wherever the camera stands (right for one tree, too far for a forest).
+        void setShadowFarDistance(float metres) { mShadowFarDistance = metres; }
+
         /// Camera LoD bias (> 1 = more detail). render() divides it by the supersampling
         /// factor's pixel count, so pixel-count LoD sees the output image's size.
         void setLodBias(float bias) { mLodBias = bias; }
@@ -81,6 +103,9 @@ namespace TreeLod
         /// per pixel), each ended by reading one pixel back so the GPU has finished it; after
         /// one untimed warm-up frame. For benchmarks.
         std::vector<double> timeFrames(const CameraSpec& camera, int width, int height, int frames);
+
+        /// One frame from `camera` at width x height (one sample per pixel), timed; no warm-up.
+        FrameTiming renderTimedFrame(const CameraSpec& camera, int width, int height);
 
         /// Save as PNG through Ogre's codec, atomically. Throws on failure.
         static void savePng(const RgbaImage& image, const std::string& path);
@@ -101,5 +126,6 @@ namespace TreeLod
         Ogre::TexturePtr mTarget;
         LightingSpec mLighting;
         float mLodBias = 1.0f;
+        float mShadowFarDistance = 0.0f;
     };
 }

@@ -66,6 +66,22 @@ namespace TreeLod
         std::vector<Ogre::String> materials; ///< every material made for the cloud (casters too)
     };
 
+    /// The impostor of chunk "impostor" on the GPU (ImpostorData.h): one quad, rotated about +Y
+    /// towards the camera in the vertex program, for the Forest's "quad" level. Instanced only:
+    /// its materials' vertex programs read the Forest's instance data (uv4, uv5; Forest.h).
+    /// Vertex: position (local, the quad in the x-y plane: x in [-halfWidth, halfWidth], y in
+    /// [bottom, top]), uv0. Built on first use by TreeAsset::getImpostorGpu.
+    struct ImpostorGpu
+    {
+        std::unique_ptr<Ogre::VertexData> vertexData;
+        Ogre::HardwareIndexBufferSharedPtr indexBuffer; ///< two triangles
+        Ogre::String material;         ///< clone of TreeLod/Impostor with the textures bound
+        Ogre::String shadowedMaterial; ///< receives texture shadows
+        Ogre::String texture;          ///< colour and coverage (unit 0)
+        Ogre::String normalTexture;    ///< normal and ambient occlusion (unit 1)
+        std::uint64_t gpuBytes = 0;    ///< textures + vertices + indices
+    };
+
     /// Pixel-count LoD value (AbsolutePixelCountLodStrategy's units for a perspective camera:
     /// pi * r^2 * viewport area * P00 * P11 / d^2 = 4 pi r_px^2) at which a billboard cloud
     /// whose hash cells are `cellSize` metres, in a tree of bounding radius `radius` metres,
@@ -122,6 +138,10 @@ namespace TreeLod
         /// shadow-receiving clones ("/BarkAoShadowed"); leaf materials keep their plain names.
         const std::vector<Ogre::String>& getBarkAoMaterialNames(bool shadowed);
 
+        /// The impostor (chunk "impostor"), built on first call; throws naming the asset when the
+        /// package lacks the chunk.
+        const ImpostorGpu& getImpostorGpu();
+
         /// Local bounds of the tree in metres (from the reference chunk).
         Ogre::AxisAlignedBox getBounds();
 
@@ -166,6 +186,7 @@ namespace TreeLod
         std::vector<Ogre::String> mTextureNames;
         std::unique_ptr<BillboardCloudData> mBillboardClouds[2];  ///< [classic]
         std::unique_ptr<BillboardCloudGpu> mBillboardCloudGpus[2]; ///< [classic]
+        std::unique_ptr<ImpostorGpu> mImpostorGpu;
         Ogre::MeshPtr mBarkAoMeshes[2];                            ///< [classic]
         std::vector<Ogre::String> mBarkAoMaterialNames[2];         ///< [shadowed]
     };

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "TreeLod/TreeAsset.h"
+#include "TreeLod/TreeBaker.h"
 
 #include <OgreResourceManager.h>
 #include <OgreSingleton.h>
@@ -25,6 +26,17 @@ namespace TreeLod
         TreeAssetPtr loadFromBytes(const Ogre::String& name, const Ogre::String& group,
                                    std::vector<std::uint8_t> packageBytes);
 
+        /// The baker require() asks (not owned; nullptr = none). See TreeBaker.h.
+        void setBaker(TreeBaker* baker) { mBaker = baker; }
+        TreeBaker* getBaker() const { return mBaker; }
+
+        /// Lazy baking: the asset for `source` holding the chunks of `techniques`, baked by the
+        /// registered baker if missing, loaded into `group` under the package's file name (a
+        /// second call for more techniques reloads it). Throws Ogre::InvalidStateException when
+        /// no baker is registered, else what the baker or the loader throws.
+        TreeAssetPtr require(const Ogre::String& source, const std::vector<Ogre::String>& techniques,
+                             const Ogre::String& group);
+
         static TreeAssetManager& getSingleton();
         static TreeAssetManager* getSingletonPtr();
 
@@ -32,5 +44,8 @@ namespace TreeLod
         Ogre::Resource* createImpl(const Ogre::String& name, Ogre::ResourceHandle handle, const Ogre::String& group,
                                    bool isManual, Ogre::ManualResourceLoader* loader,
                                    const Ogre::NameValuePairList* params) override;
+
+    private:
+        TreeBaker* mBaker = nullptr;
     };
 }

@@ -19,6 +19,7 @@ namespace TreeLod
 {
     class BillboardCloudTreeFactory;
     class FoliageLodTreeFactory;
+    class ForestFactory;
     class TreeAssetManager;
     class TechniqueRegistry;
 
@@ -39,6 +40,7 @@ namespace TreeLod
         std::unique_ptr<TechniqueRegistry> mTechniques;
         std::unique_ptr<FoliageLodTreeFactory> mFoliageLodFactory;
         std::unique_ptr<BillboardCloudTreeFactory> mBillboardCloudFactory;
+        std::unique_ptr<ForestFactory> mForestFactory;
         Ogre::MeshLodGenerator* mLodGenerator = nullptr; ///< owned only when we created it
     };
 }

@@ -55,4 +55,13 @@ namespace TreeLod
     }
     /// A [0, 1] value as a byte: round(clamp(v, 0, 1) * 255).
     inline std::uint8_t unitToByte(float v) { return std::uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
+
+    /// Bleeding: fill the texels of a width x height grid (row-major) where `known` is 0 with
+    /// the values of their known neighbours, so that bilinear filtering, mips and block
+    /// compression next to them do not pull in an unrelated (dark) value. `rings` rings
+    /// outwards, each texel the mean of its already filled 8-neighbours; texels still empty
+    /// then take the mean of the known texels (`fallback` when none is known). Work is
+    /// proportional to the texels filled. Deterministic.
+    void bleedValues(std::vector<glm::vec3>& values, const std::vector<std::uint8_t>& known, int width, int height,
+                     int rings, const glm::vec3& fallback);
 }

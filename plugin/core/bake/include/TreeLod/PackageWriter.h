@@ -1,5 +1,5 @@
-// Writing *.treelod packages (format in TreeLod/Package.h), GPU-ready mip chains, and the
-// reference bake: TreeModel -> "reference" + "meta" chunks -> file.
+// Writing *.treelod packages (format in TreeLod/Package.h), GPU-ready mip chains and their
+// block compression, and the reference bake: TreeModel -> "reference" + "meta" chunks -> file.
 #pragma once
 
 #include "TreeLod/ModelChunk.h"
@@ -74,6 +74,11 @@ namespace TreeLod
     /// coverage then matches level 0 as closely as the level's alpha histogram allows.
     /// An empty image (0x0) gives a GpuTexture with mipCount 0 and no data.
     GpuTexture buildMipChain(const TextureImage& image, const MipChainOptions& options = {});
+
+    /// `rgba8` (an RGBA8 GpuTexture, every mip level) block-compressed to `format` (DXT1 or
+    /// DXT5) with libsquish's cluster fit, level by level. Block rows run in parallel; each
+    /// block depends on its own texels only, so the bytes do not depend on the thread count.
+    GpuTexture compressTexture(const GpuTexture& rgba8, GpuTextureFormat format);
 
     /// The reference chunk of `model`: the model without its decoded textures plus a mip chain
     /// per texture, alpha-coverage preserving (with that material's cutoff) for the textures

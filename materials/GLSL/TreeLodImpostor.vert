@@ -1,0 +1,60 @@
+#version 330 core
+// The one-quad impostor (ImpostorData.h), instanced by the Forest (Forest.h): per instance
+// uv4 = position (the Forest's local space) + uniform scale, uv5 = cos, sin of the rotation
+// about +Y, unused: the quad (vertex.xy, metres, facing +Z) turns about the instance's +Y axis
+// until its +Z faces the camera (a cylindrical billboard), so the tree's rotation cannot show.
+// The quad frame (right, up, towards the camera) goes to the fragment stage in world space,
+// where the baked normal is turned with it.
+// CASTER: faces the light: the shadow camera's view +z (a directional light's direction) instead
+// of the camera position; passes clip z and w on.
+// SHADOW_RECEIVER: the position in the sun's shadow texture.
+uniform mat4 worldViewProj;
+uniform mat4 world;
+#ifdef CASTER
+uniform mat4 view;
+out vec2 vClipZW;
+#else
+uniform vec4 cameraPosition; // in the Forest's local space
+out vec3 vRight;
+out vec3 vUp;
+out vec3 vTowards;
+#endif
+#ifdef SHADOW_RECEIVER
+uniform mat4 texViewProj; // the sun's shadow camera, clip space to texture space
+out vec4 vShadowPos;
+#endif
+
+in vec4 vertex;
+in vec2 uv0;
+in vec4 uv4;
+
+out vec2 vUv;
+
+void main()
+{
+    vec3 centre = uv4.xyz;
+#ifdef CASTER
+    // The view's +z axis (towards the shadow camera) in the Forest's local space.
+    vec3 away = transpose(mat3(world)) * vec3(view[0][2], view[1][2], view[2][2]);
+#else
+    vec3 away = cameraPosition.xyz - centre;
+#endif
+    // Straight above or below: keep the quad's own orientation.
+    vec2 f = dot(away.xz, away.xz) > 1e-12 * dot(away, away) ? normalize(away.xz) : vec2(0.0, 1.0);
+    vec3 towards = vec3(f.x, 0.0, f.y);
+    vec3 right = vec3(f.y, 0.0, -f.x);
+    vec4 position = vec4(centre + uv4.w * (vertex.x * right + vec3(0.0, vertex.y, 0.0)), 1.0);
+    gl_Position = worldViewProj * position;
+    vUv = uv0;
+#ifdef CASTER
+    vClipZW = gl_Position.zw;
+#else
+    mat3 toWorld = mat3(world);
+    vRight = toWorld * right;
+    vUp = toWorld * vec3(0.0, 1.0, 0.0);
+    vTowards = toWorld * towards;
+#endif
+#ifdef SHADOW_RECEIVER
+    vShadowPos = texViewProj * (world * position);
+#endif
+}

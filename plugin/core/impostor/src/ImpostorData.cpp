@@ -1,0 +1,101 @@
+// ImpostorData: the "impostor" chunk (layout and meaning in ImpostorData.h).
+#include "TreeLod/ImpostorData.h"
+
+#include "TreeLod/ByteReader.h"
+#include "TreeLod/ByteWriter.h"
+#include "TreeLod/Package.h"
+
+#include <cmath>
+
+namespace TreeLod
+{
+    namespace
+    {
+        constexpr std::uint32_t KNOWN_FLAGS = 0;
+
+        std::string size(std::uint32_t w, std::uint32_t h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+        /// What is wrong with `tex` as the colour (or normal) texture, "" when nothing.
+        std::string textureProblem(const GpuTexture& tex, bool colour)
+        {
+            const bool formatOk = tex.format == GpuTextureFormat::RGBA8 ||
+                                  tex.format == (colour ? GpuTextureFormat::DXT5 : GpuTextureFormat::DXT1);
+            if (!formatOk)
+                return "format " + std::to_string(std::uint32_t(tex.format)) +
+                       (colour ? " (RGBA8 or DXT5 needed)" : " (RGBA8 or DXT1 needed)");
+            if (tex.width < 1 || tex.height < 1 || tex.width > GPU_TEXTURE_MAX_SIZE ||
+                tex.height > GPU_TEXTURE_MAX_SIZE)
+                return "size " + size(tex.width, tex.height) + " outside 1.." + std::to_string(GPU_TEXTURE_MAX_SIZE);
+            if (tex.mipCount < 1 || tex.mipCount > fullMipCount(tex.width, tex.height))
+                return std::to_string(tex.mipCount) + " mip levels for a " + size(tex.width, tex.height) + " texture";
+            const std::uint64_t expected = gpuTextureBytes(tex.format, tex.width, tex.height, tex.mipCount);
+            if (tex.data.size() != expected)
+                return std::to_string(tex.data.size()) + " bytes of texel data, expected " + std::to_string(expected);
+            return {};
+        }
+    }
+
+    Result<void> ImpostorData::validate(const std::string& label) const
+    {
+        const std::string name = chunkElement(IMPOSTOR_CHUNK, 0);
+        if (!std::isfinite(halfWidth) || !std::isfinite(bottom) || !std::isfinite(top) || !(halfWidth > 0.0f) ||
+            !(top > bottom) || !std::isfinite(top - bottom))
+            return fail(label, name + ", quad",
+                        "half width " + std::to_string(halfWidth) + ", y from " + std::to_string(bottom) + " to " +
+                            std::to_string(top) + " (finite, width > 0 and top > bottom needed)");
+        if (!(alphaCutoff > 0.0f && alphaCutoff <= 1.0f))
+            return fail(label, name + ", quad", "alpha cutoff " + std::to_string(alphaCutoff) + " outside (0, 1]");
+        for (const GpuTexture* tex : {&colour, &normal})
+        {
+            const bool isColour = tex == &colour;
+            const std::string problem = textureProblem(*tex, isColour);
+            if (!problem.empty())
+                return fail(label, name + (isColour ? ", colour texture '" : ", normal texture '") + tex->name + "'",
+                            problem);
+        }
+        if (normal.width != colour.width || normal.height != colour.height || normal.mipCount != colour.mipCount)
+            return fail(label, name + ", normal texture '" + normal.name + "'",
+                        size(normal.width, normal.height) + " with " + std::to_string(normal.mipCount) +
+                            " mip levels, the colour texture is " + size(colour.width, colour.height) + " with " +
+                            std::to_string(colour.mipCount));
+        return {};
+    }
+
+    std::vector<std::uint8_t> encodeImpostorChunk(const ImpostorData& data)
+    {
+        ByteWriter w;
+        w.reserve(128 + data.colour.data.size() + data.normal.data.size());
+        w.u32(KNOWN_FLAGS);
+        w.f32(data.halfWidth);
+        w.f32(data.bottom);
+        w.f32(data.top);
+        w.f32(data.alphaCutoff);
+        writeGpuTexture(w, data.colour);
+        writeGpuTexture(w, data.normal);
+        return w.take();
+    }
+
+    Result<ImpostorData> decodeImpostorChunk(const std::vector<std::uint8_t>& bytes, const std::string& label)
+    {
+        const std::string name = chunkElement(IMPOSTOR_CHUNK, 0);
+        ByteReader r(bytes.data(), bytes.size(), label, name);
+        ImpostorData data;
+        const std::uint32_t flags = r.u32();
+        if (r.ok() && (flags & ~KNOWN_FLAGS) != 0)
+            r.failHere("unknown flags " + std::to_string(flags));
+        r.setElement(name + ", quad");
+        data.halfWidth = r.f32();
+        data.bottom = r.f32();
+        data.top = r.f32();
+        data.alphaCutoff = r.f32();
+        if (!r.ok() || !readGpuTexture(r, name + ", colour texture", data.colour) ||
+            !readGpuTexture(r, name + ", normal texture", data.normal))
+            return r.error();
+        if (r.remaining() != 0)
+            return fail(label, name, std::to_string(r.remaining()) + " trailing bytes");
+        Result<void> valid = data.validate(label);
+        if (!valid)
+            return valid.error();
+        return data;
+    }
+}

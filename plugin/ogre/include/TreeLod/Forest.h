@@ -1,0 +1,202 @@
+// Forest: thousands of trees of several TreeAssets in one MovableObject (issue 5). MovableObject
+// type "Forest".
+//
+// Instances live in a ForestInstances (packed structure of arrays, no SceneNode per tree). A
+// species is one TreeAsset drawn by a list of levels, near to far; each level is one
+// technique's drawable at one of its own levels of detail:
+//   "mesh"                     the polygonal reference (bark + every leaf)
+//   "lodf"                     LoDF (paper 004) at a quantised leaf count: the asset's shared
+//                              level (TreeAsset::getFoliageLodLevel) + the bark mesh
+//   "billboard-cloud"          billboard cloud level N (paper 000), layered or low-res material
+//   "classic-billboard-cloud"  the classic cloud's level N
+//   "quad"                     one camera-facing quad with the baked impostor (TreeAsset::getImpostorGpu):
+//                              the cheapest representation, the speed floor of `treelod bench`
+// Every frame and for every camera that renders the Forest (the viewer's and the shadow
+// cameras), _updateRenderQueue culls all instances against that camera's frustum and picks each
+// visible one's level from its LoD camera (Camera::getLodCamera(), so shadows see the viewer's
+// levels) in one loop (ForestInstances::cull), then queues one instanced draw per (species,
+// level, part) with at least one instance: the instance data (24 bytes: position + scale as
+// uv4 float4, cos/sin of the rotation about +Y as uv5 float2) goes into a per-camera,
+// per-bucket instance vertex buffer written with HBL_DISCARD and grown by doubling. Parts are
+// drawn with instanced clones of the asset's materials (vertex programs with INSTANCED=1), and
+// their shadow-receiving / caster variants under integrated texture shadows.
+//
+// LoD value: Ogre's absolute pixel count (4 pi r_px^2 of the instance's bounding sphere, see
+// ForestInstances.h) times the camera's LoD bias times the Forest's own bias. Instances are in
+// the Forest's local space (its node's transform applies to all); LoD is measured there, which
+// equals the world's under a uniform node scale.
+//
+// Parameters (createMovableObject params): none required; "lodBias" (default 1).
+// Species and instances are added through the C++ API.
+//
+// Refinements of the first contract (public names unchanged):
+// - Units. ForestLevel::minPixelCount is the LoD value of the asset's reference sphere:
+//   Ogre's sphere about the tree's origin holding TreeAsset::getBounds(), the value an Entity,
+//   FoliageLodTree or BillboardCloudTree of the asset sees (so their switch values carry over).
+//   A species' ForestKind sphere is tighter (centre and half diagonal of the box holding the
+//   reference and, where drawn, the billboard cloud) and its thresholds are the levels' values
+//   times (kind radius / reference radius)^2: the same switches, better culling.
+// - Bark: a level draws its bark mesh at the MeshLodGenerator level the mesh gives for the
+//   largest value the level is drawn at (the first level: full detail); levelsForBands splits
+//   a technique's levels where that mesh's LoD levels switch, so each tree's bark is the one
+//   it would pick alone (BillboardCloudTree, FoliageLodTree: biased value against the mesh's).
+// - Per-camera state: each camera keeps its own ForestVisibility, instance buffers (one per
+//   bucket; its vertex data clones the part's declaration and binding, not its buffers, and
+//   adds the instance buffer) and Renderables; nothing is allocated once a camera has seen
+//   its largest bucket sizes. A frozen LoD keeps each camera's last LoD camera data.
+// - Materials: the Forest clones each part's material (and its shadow caster's) once, with
+//   every pass's vertex program swapped for its INSTANCED variant "<program>/Instanced" (made
+//   in code from the plain program: same source, defines + INSTANCED=1, shared by every
+//   Forest); the clones are the Forest's and go with it. The quad's materials are instanced
+//   already and used as they are.
+// - ForestStats describe the last viewer camera (one whose LoD camera is itself, outside shadow
+//   texture rendering); they are cleared before each viewer's visibility pass, so a viewer that
+//   does not see the Forest's bounds reports nothing visible. Cameras without a viewport (area
+//   0) see every tree at its last level. Camera states live as long as the Forest.
+#pragma once
+
+#include "TreeLod/ForestInstances.h"
+#include "TreeLod/TreeAsset.h"
+
+#include <OgreMaterial.h>
+#include <OgreMovableObject.h>
+
+#include <map>
+#include <memory>
+#include <vector>
+
+namespace TreeLod
+{
+    /// One level of a species: what its trees draw while their LoD value is >= minPixelCount.
+    struct ForestLevel
+    {
+        Ogre::String technique;            ///< see the file comment
+        std::uint32_t techniqueLevel = 0;  ///< lodf: leaf count (0 = all); clouds: cloud level; else 0
+        bool lowRes = false;               ///< billboard-cloud: the low-res material of a layered level
+        Ogre::Real minPixelCount = 0.0f;   ///< Ogre pixel-count units; the last level's is 0
+    };
+
+    /// A technique over a band of screen sizes, near to far (scene scripts' "techniques").
+    struct ForestBand
+    {
+        Ogre::String technique;
+        /// The band draws trees whose height on screen is >= this many pixels (at LoD bias 1);
+        /// the last band's is 0.
+        Ogre::Real minHeightPixels = 0.0f;
+    };
+
+    /// What the last frame of the viewer's camera drew.
+    struct ForestStats
+    {
+        std::uint32_t instances = 0;          ///< in the Forest
+        std::uint32_t visibleInstances = 0;   ///< after frustum culling
+        std::uint32_t batches = 0;            ///< instanced draws queued (all parts)
+        std::uint64_t triangles = 0;          ///< submitted, summed over instances
+        /// Visible instances per species and level: levelCounts[species][level].
+        std::vector<std::vector<std::uint32_t>> levelCounts;
+        double cullMilliseconds = 0.0;        ///< ForestInstances::cull of the viewer's camera
+        std::uint64_t instanceBufferBytes = 0; ///< instance vertex buffers, all cameras
+    };
+
+    class Forest : public Ogre::MovableObject
+    {
+    public:
+        explicit Forest(const Ogre::String& name);
+        ~Forest() override;
+
+        /// The default technique choice ("techniques": "auto"): lodf while the tree is at least
+        /// 160 px tall on screen, billboard-cloud down to 24 px, then quad.
+        static std::vector<ForestBand> getAutoBands();
+
+        /// The levels `bands` give for `asset`: each band's technique contributes its own levels
+        /// (lodf: halving leaf counts on its pixel curve; billboard-cloud: layered, low-res, then
+        /// coarser clouds; mesh and quad: one; split where the bark mesh's LoD switches) clipped
+        /// to the band's screen-size range. At most ForestInstances::MAX_THRESHOLDS + 1. Throws
+        /// Ogre::InvalidParametersException naming the band and technique when a technique is
+        /// unknown or the asset lacks its chunk.
+        static std::vector<ForestLevel> levelsForBands(TreeAsset& asset, const std::vector<ForestBand>& bands);
+
+        /// Add a species; returns its index (= ForestInstances kind). Levels near to far (at most
+        /// ForestInstances::MAX_THRESHOLDS + 1), strictly decreasing minPixelCount, the last 0;
+        /// lowRes only on layered billboard-cloud levels. Throws as levelsForBands, naming the
+        /// species and level; nothing is added then.
+        std::uint32_t addSpecies(const TreeAssetPtr& asset, const std::vector<ForestLevel>& levels);
+        std::uint32_t getSpeciesCount() const;
+        const std::vector<ForestLevel>& getLevels(std::uint32_t species) const;
+        const TreeAssetPtr& getAsset(std::uint32_t species) const;
+
+        /// The instance store (add, update, remove instances; kind = species index).
+        ForestInstances& getInstances() { return mInstances; }
+        const ForestInstances& getInstances() const { return mInstances; }
+        /// Add instances all or nothing; throws Ogre::InvalidParametersException with
+        /// ForestInstances' message (instance index and reason). Updates the bounds.
+        std::vector<ForestHandle> addInstances(const std::vector<ForestInstance>& instances);
+        /// Recompute the local bounds after changing instances through getInstances().
+        void updateBounds();
+
+        /// Multiplies the camera's LoD bias (> 0).
+        void setLodBias(Ogre::Real bias);
+        Ogre::Real getLodBias() const { return mLodBias; }
+        /// Keep the LoD camera of the last frame (levels stop changing; culling goes on).
+        void setLodFrozen(bool frozen);
+        bool isLodFrozen() const { return mLodFrozen; }
+
+        const ForestStats& getStats() const { return mStats; }
+        /// GPU bytes of the assets' drawables in use (vertex and index buffers and textures, all
+        /// mips, of every level's parts, each counted once) plus the instance buffers.
+        std::uint64_t getGpuBytes() const;
+
+        // MovableObject
+        const Ogre::String& getMovableType() const override;
+        const Ogre::AxisAlignedBox& getBoundingBox() const override { return mBounds; }
+        Ogre::Real getBoundingRadius() const override { return mRadius; }
+        void _notifyCurrentCamera(Ogre::Camera* camera) override;
+        void _notifyManager(Ogre::SceneManager* manager) override;
+        void _updateRenderQueue(Ogre::RenderQueue* queue) override;
+        void visitRenderables(Ogre::Renderable::Visitor* visitor, bool debugRenderables = false) override;
+
+    private:
+        struct Part;
+        struct Species;
+        class Batch;
+        struct BucketState;
+        struct CameraState;
+        class ViewerListener;
+
+        /// The parts `level` of `asset` draws (instanced materials made on the way).
+        std::vector<std::unique_ptr<Part>> buildParts(TreeAsset& asset, const ForestLevel& level,
+                                                      Ogre::Real upperPixelCount, Ogre::AxisAlignedBox& drawnBox);
+        /// This Forest's instanced clone of material `name` (and of its shadow casters).
+        Ogre::MaterialPtr instancedMaterial(const Ogre::String& name, const Ogre::String& group);
+        bool useShadowedMaterials() const;
+        /// Write the instances of `state`'s bucket `bucket` into its instance buffer (grown if needed).
+        void fillBucket(CameraState& state, std::uint32_t bucket);
+        /// Zero the per-frame counts of mStats (a viewer's visibility pass begins).
+        void clearFrameStats();
+
+        ForestInstances mInstances;
+        std::vector<std::unique_ptr<Species>> mSpecies;
+        std::map<const Ogre::Camera*, std::unique_ptr<CameraState>> mCameras;
+        std::map<Ogre::String, Ogre::MaterialPtr> mInstancedMaterials; ///< by source material name
+        Ogre::String mMaterialPrefix;
+        Ogre::Camera* mCurrentCamera = nullptr;
+        Ogre::AxisAlignedBox mBounds;
+        Ogre::Real mRadius = 0.0f;
+        Ogre::Real mLodBias = 1.0f;
+        bool mLodFrozen = false;
+        ForestStats mStats;
+        std::uint64_t mInstanceBufferBytes = 0;
+        std::unique_ptr<ViewerListener> mViewerListener; ///< registered with mManager
+    };
+
+    class ForestFactory : public Ogre::MovableObjectFactory
+    {
+    public:
+        static const Ogre::String FACTORY_TYPE_NAME;
+        const Ogre::String& getType() const override { return FACTORY_TYPE_NAME; }
+
+    protected:
+        Ogre::MovableObject* createInstanceImpl(const Ogre::String& name,
+                                                const Ogre::NameValuePairList* params) override;
+    };
+}

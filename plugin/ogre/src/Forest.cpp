@@ -1,0 +1,918 @@
+// Forest: many trees in one MovableObject, culled and LoD-selected in one loop
+// (ForestInstances::cull) and drawn with hardware instancing. See Forest.h.
+#include "TreeLod/Forest.h"
+
+#include "ObjectParams.h"
+
+#include "TreeLod/BillboardCloudTree.h"
+#include "TreeLod/FoliageLodTree.h"
+#include "TreeLod/ImpostorData.h"
+
+#include <OgreCamera.h>
+#include <OgreException.h>
+#include <OgreHardwareBufferManager.h>
+#include <OgreHighLevelGpuProgram.h>
+#include <OgreHighLevelGpuProgramManager.h>
+#include <OgreLogManager.h>
+#include <OgreMaterialManager.h>
+#include <OgrePixelCountLodStrategy.h>
+#include <OgrePass.h>
+#include <OgreRenderQueue.h>
+#include <OgreSceneManager.h>
+#include <OgreSceneNode.h>
+#include <OgreSubMesh.h>
+#include <OgreTechnique.h>
+#include <OgreTextureManager.h>
+#include <OgreViewport.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <set>
+
+namespace TreeLod
+{
+    namespace
+    {
+        /// Per instance: uv4 = position xyz + uniform scale, uv5 = cos, sin of the rotation (Forest.h).
+        constexpr std::size_t INSTANCE_FLOATS = 6;
+        constexpr std::size_t INSTANCE_BYTES = INSTANCE_FLOATS * sizeof(float);
+        static_assert(INSTANCE_BYTES == 24, "the instance layout of Forest.h");
+        constexpr std::size_t MIN_INSTANCE_CAPACITY = 16;
+        constexpr std::size_t MAX_LEVELS = ForestInstances::MAX_THRESHOLDS + 1;
+        constexpr Ogre::Real NO_UPPER = std::numeric_limits<Ogre::Real>::max();
+
+        enum class Technique
+        {
+            Mesh,
+            Lodf,
+            BillboardCloud,
+            ClassicBillboardCloud,
+            Quad
+        };
+
+        const char* const KNOWN_TECHNIQUES = "mesh, lodf, billboard-cloud, classic-billboard-cloud, quad";
+
+        bool parseTechnique(const Ogre::String& name, Technique& out)
+        {
+            static const std::pair<const char*, Technique> names[] = {
+                {"mesh", Technique::Mesh},
+                {FOLIAGE_LOD_CHUNK, Technique::Lodf},
+                {BILLBOARD_CLOUD_CHUNK, Technique::BillboardCloud},
+                {CLASSIC_BILLBOARD_CLOUD_CHUNK, Technique::ClassicBillboardCloud},
+                {"quad", Technique::Quad}};
+            for (const auto& n : names)
+                if (name == n.first)
+                {
+                    out = n.second;
+                    return true;
+                }
+            return false;
+        }
+
+        bool isCloud(Technique t) { return t == Technique::BillboardCloud || t == Technique::ClassicBillboardCloud; }
+
+        [[noreturn]] void invalid(const Ogre::String& text, const char* source)
+        {
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, text, source);
+        }
+
+        /// Radius of the asset's reference sphere: the units of ForestLevel::minPixelCount (Forest.h).
+        Ogre::Real referenceRadius(TreeAsset& asset) { return Ogre::Math::boundingRadiusFromAABB(asset.getBounds()); }
+
+        /// Ogre (row-major) to GLM (column-major), in double for the frustum planes.
+        glm::dmat4 toGlm(const Ogre::Matrix4& m)
+        {
+            glm::dmat4 g;
+            for (int r = 0; r < 4; ++r)
+                for (int c = 0; c < 4; ++c)
+                    g[c][r] = double(m[r][c]);
+            return g;
+        }
+
+        /// A technique's level with the LoD values it is drawn at: [level.minPixelCount, upper).
+        struct Span
+        {
+            ForestLevel level;
+            Ogre::Real upper = NO_UPPER;
+        };
+
+        /// Every level of `technique` over all LoD values, near to far (reference-sphere units).
+        std::vector<Span> techniqueSpans(TreeAsset& asset, Technique technique, const Ogre::String& name)
+        {
+            std::vector<Span> spans;
+            auto add = [&](std::uint32_t techniqueLevel, bool lowRes, Ogre::Real lower, Ogre::Real upper) {
+                if (lower < upper)
+                    spans.push_back(Span{ForestLevel{name, techniqueLevel, lowRes, lower}, upper});
+            };
+            switch (technique)
+            {
+            case Technique::Mesh:
+                asset.getReferenceMesh();
+                add(0, false, 0.0f, NO_UPPER);
+                break;
+            case Technique::Quad:
+                asset.getImpostorGpu();
+                add(0, false, 0.0f, NO_UPPER);
+                break;
+            case Technique::Lodf:
+            {
+                // Leaf counts halving from all leaves; the level drawing N leaves keeps them while
+                // FoliageLodTree's curve asks for more than N / 2, so it never draws fewer leaves
+                // than the curve (the same rule as FoliageLodState::quantise, which rounds up).
+                const FoliageLodData& data = asset.getFoliageLod();
+                const float perLeaf = FoliageLodTree::DEFAULT_PIXELS_PER_LEAF;
+                std::uint32_t count = data.maxLeafCount();
+                Ogre::Real upper = NO_UPPER;
+                while (true)
+                {
+                    const std::uint32_t next = std::max((count + 1) / 2, data.minLeafCount());
+                    if (data.clusters.empty() || next >= count)
+                    {
+                        add(count, false, 0.0f, upper);
+                        break;
+                    }
+                    const Ogre::Real lower = FoliageLodTree::pixelCountForLeaves(next, perLeaf);
+                    add(count, false, lower, upper);
+                    upper = lower;
+                    count = next;
+                }
+                break;
+            }
+            case Technique::BillboardCloud:
+            case Technique::ClassicBillboardCloud:
+            {
+                // The switches BillboardCloudTree makes (§6), in the reference sphere's units; a
+                // layered level splits where its material LoD turns to the low-res technique (§5.1).
+                const bool classic = technique == Technique::ClassicBillboardCloud;
+                const BillboardCloudGpu& gpu = asset.getBillboardCloudGpu(classic);
+                const float radius = float(referenceRadius(asset));
+                const std::vector<Ogre::Real> switches =
+                    BillboardCloudTree::switchPixelCounts(gpu, gpu.listFactor, radius);
+                if (gpu.levels.empty())
+                    add(0, false, 0.0f, NO_UPPER);
+                for (std::uint32_t l = 0; l < gpu.levels.size(); ++l)
+                {
+                    const Ogre::Real upper = l == 0 ? NO_UPPER : switches[l - 1];
+                    const Ogre::Real lower = l < switches.size() ? switches[l] : 0.0f;
+                    if (!gpu.levels[l].layered)
+                    {
+                        add(l, false, lower, upper);
+                        continue;
+                    }
+                    const Ogre::Real lowRes =
+                        billboardCloudPixelCount(1.0f, gpu.levels[l].cellSize, radius, gpu.listFactor);
+                    add(l, false, std::max(lowRes, lower), upper);
+                    add(l, true, lower, std::min(lowRes, upper));
+                }
+                break;
+            }
+            }
+
+            // Bark: split where the drawn mesh's own LoD levels switch (MeshLodGenerator levels,
+            // pixel-count values), so that a level's bark level (the one of its largest value,
+            // Forest::buildParts) is the one each of its trees would pick alone.
+            Ogre::MeshPtr bark;
+            const bool hasBark = !asset.getReference().model.barkIndices.empty();
+            if (technique == Technique::Mesh)
+                bark = asset.getReferenceMesh();
+            else if (technique == Technique::Lodf && hasBark)
+                bark = asset.getBarkMesh();
+            else if (isCloud(technique) && hasBark)
+                bark = asset.getBarkAoMesh(technique == Technique::ClassicBillboardCloud);
+            if (!bark || bark->getLodStrategy() != Ogre::AbsolutePixelCountLodStrategy::getSingletonPtr())
+                return spans;
+            std::vector<Span> split;
+            for (const Span& span : spans)
+            {
+                Ogre::Real upper = span.upper;
+                for (unsigned short l = 1; l < bark->getNumLodLevels(); ++l)
+                {
+                    const Ogre::Real value = bark->getLodLevel(l).value;
+                    if (value > span.level.minPixelCount && value < upper)
+                    {
+                        split.push_back(Span{span.level, upper});
+                        split.back().level.minPixelCount = value;
+                        upper = value;
+                    }
+                }
+                split.push_back(Span{span.level, upper});
+            }
+            return split;
+        }
+
+        std::uint64_t textureBytes(const Ogre::Texture& texture)
+        {
+            std::uint64_t bytes = 0;
+            for (std::uint32_t mip = 0; mip <= texture.getNumMipmaps(); ++mip)
+                bytes += Ogre::PixelUtil::getMemorySize(std::max<std::uint32_t>(texture.getWidth() >> mip, 1),
+                                                        std::max<std::uint32_t>(texture.getHeight() >> mip, 1),
+                                                        std::max<std::uint32_t>(texture.getDepth() >> mip, 1),
+                                                        texture.getFormat());
+            return bytes * texture.getNumFaces();
+        }
+
+        /// The INSTANCED variant of vertex program `plain`: "<name>/Instanced", same source and
+        /// defines + INSTANCED=1, made once in the plain program's group.
+        Ogre::String instancedProgram(const Ogre::GpuProgramPtr& plain)
+        {
+            const Ogre::String name = plain->getName() + "/Instanced";
+            Ogre::HighLevelGpuProgramManager& programs = Ogre::HighLevelGpuProgramManager::getSingleton();
+            if (programs.resourceExists(name, plain->getGroup()))
+                return name;
+            Ogre::HighLevelGpuProgramPtr program =
+                programs.createProgram(name, plain->getGroup(), plain->getLanguage(), Ogre::GPT_VERTEX_PROGRAM);
+            program->setSourceFile(plain->getSourceFile());
+            const Ogre::String defines = plain->getParameter("preprocessor_defines");
+            program->setParameter("preprocessor_defines", defines.empty() ? "INSTANCED=1" : defines + ",INSTANCED=1");
+            program->load();
+            if (plain->hasDefaultParameters() && program->isSupported())
+                program->getDefaultParameters()->copyMatchingNamedConstantsFrom(*plain->getDefaultParameters());
+            return name;
+        }
+    }
+
+    // ---- parts, batches, per-camera state --------------------------------------------------------
+
+    /// One draw of a level: an index range over the asset's vertices with an instanced material.
+    struct Forest::Part
+    {
+        Ogre::VertexData* vertexData = nullptr; ///< the asset's
+        Ogre::IndexData* indexData = nullptr;   ///< the asset's, or &ownIndexData
+        Ogre::IndexData ownIndexData;
+        Ogre::MaterialPtr material;
+        Ogre::MaterialPtr shadowedMaterial; ///< may be null
+        unsigned short techniqueLod = 0;    ///< billboard-cloud: 1 = the low-res technique
+        bool cloud = false;                 ///< takes the list factor (custom parameter 0)
+        float listFactor = 0.0f;            ///< the cloud's shader LoD factor (paper 000 §5.1)
+    };
+
+    struct Forest::Species
+    {
+        TreeAssetPtr asset;
+        std::vector<ForestLevel> levels;
+        std::vector<std::vector<std::unique_ptr<Part>>> parts; ///< per level
+    };
+
+    /// One instanced draw of one camera: a Part with that camera's instance buffer of its bucket.
+    class Forest::Batch : public Ogre::Renderable
+    {
+    public:
+        Batch(const Forest& forest, const Part& part) : mForest(forest), mPart(part)
+        {
+            // The part's declaration and binding (not its buffers), plus the instance source.
+            mVertexData = part.vertexData->clone(false);
+            Ogre::VertexDeclaration* decl = mVertexData->vertexDeclaration;
+            mSource = static_cast<unsigned short>(decl->getMaxSource() + 1);
+            decl->addElement(mSource, 0, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 4);
+            decl->addElement(mSource, 4 * sizeof(float), Ogre::VET_FLOAT2, Ogre::VES_TEXTURE_COORDINATES, 5);
+        }
+        ~Batch() override { delete mVertexData; }
+
+        void setInstanceBuffer(const Ogre::HardwareVertexBufferSharedPtr& buffer)
+        {
+            mVertexData->vertexBufferBinding->setBinding(mSource, buffer);
+        }
+        const Part& getPart() const { return mPart; }
+
+        std::uint32_t mInstanceCount = 0;
+
+        const Ogre::MaterialPtr& getMaterial() const override
+        {
+            return mPart.shadowedMaterial && mForest.useShadowedMaterials() ? mPart.shadowedMaterial : mPart.material;
+        }
+        Ogre::Technique* getTechnique() const override
+        {
+            return getMaterial()->getBestTechnique(mPart.techniqueLod, this);
+        }
+        void getRenderOperation(Ogre::RenderOperation& op) override
+        {
+            op.operationType = Ogre::RenderOperation::OT_TRIANGLE_LIST;
+            op.useIndexes = true;
+            op.vertexData = mVertexData;
+            op.indexData = mPart.indexData;
+            op.numberOfInstances = mInstanceCount;
+            op.srcRenderable = this;
+        }
+        void getWorldTransforms(Ogre::Matrix4* xform) const override
+        {
+            *xform = mForest._getParentNodeFullTransform();
+        }
+        Ogre::Real getSquaredViewDepth(const Ogre::Camera* camera) const override
+        {
+            return mForest.getParentNode() ? mForest.getParentNode()->getSquaredViewDepth(camera) : 0.0f;
+        }
+        const Ogre::LightList& getLights() const override { return mForest.queryLights(); }
+        bool getCastsShadows() const override { return mForest.getCastShadows(); }
+
+    private:
+        const Forest& mForest;
+        const Part& mPart;
+        Ogre::VertexData* mVertexData = nullptr;
+        unsigned short mSource = 0;
+    };
+
+    struct Forest::BucketState
+    {
+        Ogre::HardwareVertexBufferSharedPtr buffer;
+        std::size_t capacity = 0; ///< instances
+        std::vector<std::unique_ptr<Batch>> batches; ///< one per part of the bucket's level
+    };
+
+    struct Forest::CameraState
+    {
+        ForestVisibility visibility;
+        CullCamera camera;  ///< planes of this frame; LoD data kept while the LoD is frozen
+        float lodBias = 1.0f;
+        bool hasLod = false;
+        std::vector<std::unique_ptr<BucketState>> buckets; ///< by ForestInstances bucket index
+    };
+
+    /// Clears the viewer's stats before each visibility pass of a viewport (not of shadow textures).
+    class Forest::ViewerListener : public Ogre::SceneManager::Listener
+    {
+    public:
+        explicit ViewerListener(Forest& forest) : mForest(forest) {}
+        void preFindVisibleObjects(Ogre::SceneManager*, Ogre::SceneManager::IlluminationRenderStage stage,
+                                   Ogre::Viewport*) override
+        {
+            if (stage != Ogre::SceneManager::IRS_RENDER_TO_TEXTURE)
+                mForest.clearFrameStats();
+        }
+
+    private:
+        Forest& mForest;
+    };
+
+    // ---- Forest ----------------------------------------------------------------------------------
+
+    const Ogre::String ForestFactory::FACTORY_TYPE_NAME = "Forest";
+
+    Forest::Forest(const Ogre::String& name) : Ogre::MovableObject(name)
+    {
+        static std::atomic<std::uint32_t> serial{0};
+        mMaterialPrefix = "TreeLod/Forest" + std::to_string(serial++) + "/";
+        mBounds.setNull();
+    }
+
+    Forest::~Forest()
+    {
+        if (mManager && mViewerListener)
+            mManager->removeListener(mViewerListener.get());
+        mCameras.clear();
+        mSpecies.clear();
+        if (Ogre::MaterialManager* materials = Ogre::MaterialManager::getSingletonPtr())
+            for (const auto& entry : mInstancedMaterials)
+                materials->remove(entry.second);
+    }
+
+    const Ogre::String& Forest::getMovableType() const { return ForestFactory::FACTORY_TYPE_NAME; }
+
+    std::vector<ForestBand> Forest::getAutoBands()
+    {
+        return {ForestBand{FOLIAGE_LOD_CHUNK, 160.0f}, ForestBand{BILLBOARD_CLOUD_CHUNK, 24.0f},
+                ForestBand{"quad", 0.0f}};
+    }
+
+    std::vector<ForestLevel> Forest::levelsForBands(TreeAsset& asset, const std::vector<ForestBand>& bands)
+    {
+        const char* source = "Forest::levelsForBands";
+        const Ogre::String label = "asset '" + asset.getName() + "': ";
+        if (bands.empty())
+            invalid(label + "no technique bands", source);
+        const Ogre::AxisAlignedBox bounds = asset.getBounds();
+        const Ogre::Real height = bounds.getMaximum().y - bounds.getMinimum().y;
+        const Ogre::Real radius = referenceRadius(asset);
+        if (!(height > 0.0f) || !(radius > 0.0f))
+            invalid(label + "the tree has no height: no screen size to choose levels by", source);
+        // A tree h metres tall drawn h_px pixels tall: r_px = h_px * R / h, value = 4 pi r_px^2.
+        auto pixelCount = [&](Ogre::Real heightPixels) {
+            const double rPx = double(heightPixels) * double(radius) / double(height);
+            return Ogre::Real(std::min(4.0 * Ogre::Math::PI * rPx * rPx, double(FLT_MAX)));
+        };
+
+        std::vector<ForestLevel> levels;
+        Ogre::Real upper = NO_UPPER;
+        Ogre::Real previousHeight = std::numeric_limits<Ogre::Real>::infinity();
+        for (std::size_t b = 0; b < bands.size(); ++b)
+        {
+            const ForestBand& band = bands[b];
+            const Ogre::String element = label + "band " + std::to_string(b) + " '" + band.technique + "': ";
+            Technique technique;
+            if (!parseTechnique(band.technique, technique))
+                invalid(element + "unknown technique (known: " + KNOWN_TECHNIQUES + ")", source);
+            const bool last = b + 1 == bands.size();
+            if (last && band.minHeightPixels != 0.0f)
+                invalid(element + "the last band must reach 0 pixels, not " + std::to_string(band.minHeightPixels),
+                        source);
+            if (!last && !(std::isfinite(band.minHeightPixels) && band.minHeightPixels > 0.0f &&
+                           band.minHeightPixels < previousHeight))
+                invalid(element + "minHeightPixels " + std::to_string(band.minHeightPixels) +
+                            " is not finite, > 0 and below the previous band's",
+                        source);
+            previousHeight = band.minHeightPixels;
+            const Ogre::Real lower = last ? 0.0f : pixelCount(band.minHeightPixels);
+            std::vector<Span> spans;
+            try
+            {
+                spans = techniqueSpans(asset, technique, band.technique);
+            }
+            catch (const Ogre::Exception& e)
+            {
+                invalid(element + e.getDescription(), source);
+            }
+            // The technique's levels clipped to the band's values [lower, upper).
+            for (const Span& span : spans)
+                if (span.level.minPixelCount < upper && span.upper > lower)
+                {
+                    levels.push_back(span.level);
+                    levels.back().minPixelCount = std::max(span.level.minPixelCount, lower);
+                }
+            upper = lower;
+        }
+        if (levels.size() > MAX_LEVELS)
+            invalid(label + "the bands give " + std::to_string(levels.size()) + " levels (at most " +
+                        std::to_string(MAX_LEVELS) + ")",
+                    source);
+        return levels;
+    }
+
+    Ogre::MaterialPtr Forest::instancedMaterial(const Ogre::String& name, const Ogre::String& group)
+    {
+        auto found = mInstancedMaterials.find(name);
+        if (found != mInstancedMaterials.end())
+            return found->second;
+        Ogre::MaterialPtr material = Ogre::MaterialManager::getSingleton().getByName(name, group);
+        if (!material)
+            OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND, "material '" + name + "' not found",
+                        "Forest '" + mName + "'");
+        material->load();
+        Ogre::MaterialPtr clone = material->clone(mMaterialPrefix + name, true, material->getGroup());
+        for (Ogre::Technique* technique : clone->getTechniques())
+        {
+            for (Ogre::Pass* pass : technique->getPasses())
+            {
+                if (!pass->hasVertexProgram())
+                    OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                                "material '" + name + "' technique '" + technique->getName() + "' pass '" +
+                                    pass->getName() + "' has no vertex program to draw instanced",
+                                "Forest '" + mName + "'");
+                const Ogre::GpuProgramParametersSharedPtr plain = pass->getVertexProgramParameters();
+                pass->setVertexProgram(instancedProgram(pass->getVertexProgram()), true);
+                pass->getVertexProgramParameters()->copyMatchingNamedConstantsFrom(*plain);
+            }
+            if (Ogre::MaterialPtr caster = technique->getShadowCasterMaterial())
+                technique->setShadowCasterMaterial(instancedMaterial(caster->getName(), caster->getGroup()));
+        }
+        clone->compile();
+        clone->load();
+        mInstancedMaterials.emplace(name, clone);
+        return clone;
+    }
+
+    std::vector<std::unique_ptr<Forest::Part>> Forest::buildParts(TreeAsset& asset, const ForestLevel& level,
+                                                                  Ogre::Real upperPixelCount,
+                                                                  Ogre::AxisAlignedBox& drawnBox)
+    {
+        Technique technique;
+        if (!parseTechnique(level.technique, technique))
+            invalid("unknown technique (known: " + Ogre::String(KNOWN_TECHNIQUES) + ")", "Forest");
+        const Ogre::String& group = asset.getGroup();
+        std::vector<std::unique_ptr<Part>> parts;
+        auto addPart = [&](Ogre::VertexData* vertices, const Ogre::String& material, const Ogre::String& shadowed) {
+            auto part = std::make_unique<Part>();
+            part->vertexData = vertices;
+            part->material = instancedMaterial(material, group);
+            if (!shadowed.empty())
+                part->shadowedMaterial = instancedMaterial(shadowed, group);
+            parts.push_back(std::move(part));
+            return parts.back().get();
+        };
+        auto addRange = [&](Ogre::VertexData* vertices, const Ogre::HardwareIndexBufferSharedPtr& buffer,
+                            std::size_t start, std::size_t count, const Ogre::String& material,
+                            const Ogre::String& shadowed) -> Part* {
+            if (count == 0 || !vertices)
+                return nullptr;
+            Part* part = addPart(vertices, material, shadowed);
+            part->ownIndexData.indexBuffer = buffer;
+            part->ownIndexData.indexStart = start;
+            part->ownIndexData.indexCount = count;
+            part->indexData = &part->ownIndexData;
+            return part;
+        };
+        // A mesh's submeshes at the LoD level its strategy gives for the level's largest value.
+        auto addMesh = [&](const Ogre::MeshPtr& mesh, const std::vector<Ogre::String>& plain,
+                           const std::vector<Ogre::String>& shadowed) {
+            const unsigned short lod = upperPixelCount == NO_UPPER ? 0 : mesh->getLodIndex(upperPixelCount);
+            for (Ogre::SubMesh* sub : mesh->getSubMeshes())
+            {
+                Ogre::IndexData* indices =
+                    lod == 0 || sub->mLodFaceList.empty()
+                        ? sub->indexData
+                        : sub->mLodFaceList[std::min<std::size_t>(lod, sub->mLodFaceList.size()) - 1];
+                if (indices->indexCount == 0)
+                    continue;
+                const auto it = std::find(plain.begin(), plain.end(), sub->getMaterialName());
+                const Ogre::String receiver = it == plain.end() ? "" : shadowed[std::size_t(it - plain.begin())];
+                addPart(sub->vertexData, sub->getMaterialName(), receiver)->indexData = indices;
+            }
+        };
+        const bool hasBark = !asset.getReference().model.barkIndices.empty();
+
+        switch (technique)
+        {
+        case Technique::Mesh:
+            addMesh(asset.getReferenceMesh(), asset.getMaterialNames(), asset.getShadowedMaterialNames());
+            break;
+        case Technique::Lodf:
+        {
+            const FoliageLodData& data = asset.getFoliageLod();
+            const std::vector<Ogre::String>& materials = asset.getMaterialNames();
+            const std::vector<Ogre::String>& shadowed = asset.getShadowedMaterialNames();
+            if (!data.clusters.empty())
+            {
+                const FoliageLodLevel& shared =
+                    asset.getFoliageLodLevel(level.techniqueLevel == 0 ? data.maxLeafCount() : level.techniqueLevel);
+                // One range per run of same-material clusters (TreeAsset::getFoliageLodLevel).
+                std::size_t run = 0;
+                for (std::size_t c = 0; c < data.clusters.size(); ++run)
+                {
+                    const std::uint32_t material = data.clusters[c].material;
+                    while (c < data.clusters.size() && data.clusters[c].material == material)
+                        ++c;
+                    addRange(asset.getLeafVertexData(), shared.buffer, shared.ranges[run].first,
+                             shared.ranges[run].second, materials[material], shadowed[material]);
+                }
+            }
+            if (hasBark)
+                addMesh(asset.getBarkMesh(), materials, shadowed);
+            break;
+        }
+        case Technique::BillboardCloud:
+        case Technique::ClassicBillboardCloud:
+        {
+            const bool classic = technique == Technique::ClassicBillboardCloud;
+            const BillboardCloudGpu& gpu = asset.getBillboardCloudGpu(classic);
+            if (level.techniqueLevel < gpu.levels.size())
+            {
+                const BillboardCloudGpu::Level& cloud = gpu.levels[level.techniqueLevel];
+                if (Part* part = addRange(gpu.vertexData.get(), gpu.indexBuffer, cloud.indexStart, cloud.indexCount,
+                                          cloud.material, cloud.shadowedMaterial))
+                {
+                    part->techniqueLod = level.lowRes ? 1 : 0;
+                    part->cloud = true;
+                    part->listFactor = gpu.listFactor;
+                }
+                drawnBox.merge(gpu.bounds);
+            }
+            if (hasBark)
+                addMesh(asset.getBarkAoMesh(classic), asset.getBarkAoMaterialNames(false),
+                        asset.getBarkAoMaterialNames(true));
+            break;
+        }
+        case Technique::Quad:
+        {
+            // Instanced already (TreeLodImpostor.vert): its materials as they are.
+            const ImpostorGpu& gpu = asset.getImpostorGpu();
+            auto part = std::make_unique<Part>();
+            part->vertexData = gpu.vertexData.get();
+            part->ownIndexData.indexBuffer = gpu.indexBuffer;
+            part->ownIndexData.indexStart = 0;
+            part->ownIndexData.indexCount = 6;
+            part->indexData = &part->ownIndexData;
+            part->material = Ogre::MaterialManager::getSingleton().getByName(gpu.material, group);
+            part->shadowedMaterial = Ogre::MaterialManager::getSingleton().getByName(gpu.shadowedMaterial, group);
+            if (!part->material || !part->shadowedMaterial)
+                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
+                            "impostor material '" + gpu.material + "' or its shadowed variant not found",
+                            "Forest '" + mName + "'");
+            part->material->load();
+            part->shadowedMaterial->load();
+            parts.push_back(std::move(part));
+            break;
+        }
+        }
+        return parts;
+    }
+
+    std::uint32_t Forest::addSpecies(const TreeAssetPtr& asset, const std::vector<ForestLevel>& levels)
+    {
+        const char* source = "Forest::addSpecies";
+        const Ogre::String label = "Forest '" + mName + "' species " + std::to_string(mSpecies.size()) + " ('" +
+                                   (asset ? asset->getName() : Ogre::String("null")) + "'): ";
+        if (!asset)
+            invalid(label + "no asset", source);
+        if (levels.empty() || levels.size() > MAX_LEVELS)
+            invalid(label + std::to_string(levels.size()) + " levels (1 to " + std::to_string(MAX_LEVELS) + ")",
+                    source);
+        auto species = std::make_unique<Species>();
+        species->asset = asset;
+        species->levels = levels;
+        Ogre::AxisAlignedBox drawn = asset->getBounds();
+        for (std::size_t l = 0; l < levels.size(); ++l)
+        {
+            const ForestLevel& level = levels[l];
+            const Ogre::String element = label + "level " + std::to_string(l) + " '" + level.technique + "': ";
+            Technique technique;
+            if (!parseTechnique(level.technique, technique))
+                invalid(element + "unknown technique (known: " + KNOWN_TECHNIQUES + ")", source);
+            const bool last = l + 1 == levels.size();
+            if (!std::isfinite(level.minPixelCount) || level.minPixelCount < 0.0f ||
+                (l > 0 && !(level.minPixelCount < levels[l - 1].minPixelCount)) ||
+                (last && level.minPixelCount != 0.0f))
+                invalid(element + "minPixelCount " + std::to_string(level.minPixelCount) +
+                            " (finite, >= 0, below the previous level's, 0 for the last level)",
+                        source);
+            try
+            {
+                if (isCloud(technique))
+                {
+                    const BillboardCloudGpu& gpu =
+                        asset->getBillboardCloudGpu(technique == Technique::ClassicBillboardCloud);
+                    if (level.techniqueLevel >= std::max<std::size_t>(gpu.levels.size(), 1))
+                        invalid("cloud level " + std::to_string(level.techniqueLevel) + " does not exist (" +
+                                    std::to_string(gpu.levels.size()) + " levels)",
+                                source);
+                    if (level.lowRes && !(level.techniqueLevel < gpu.levels.size() &&
+                                          gpu.levels[level.techniqueLevel].layered))
+                        invalid("lowRes on a cloud level that is not layered", source);
+                }
+                else if (level.lowRes)
+                    invalid("lowRes is for billboard-cloud levels only", source);
+                species->parts.push_back(
+                    buildParts(*asset, level, l == 0 ? NO_UPPER : levels[l - 1].minPixelCount, drawn));
+            }
+            catch (const Ogre::Exception& e)
+            {
+                invalid(element + e.getDescription(), source);
+            }
+        }
+
+        // The kind: a tight sphere about what is drawn; thresholds in its units (Forest.h).
+        const Ogre::Real referenceR = referenceRadius(*asset);
+        const Ogre::Vector3 centre = drawn.getCenter();
+        const Ogre::Real radius = std::max(0.5f * drawn.getSize().length(), 1e-6f);
+        if (!(referenceR > 0.0f))
+            invalid(label + "the tree has no extent", source);
+        const double unit = double(radius) * double(radius) / (double(referenceR) * double(referenceR));
+        ForestKind kind;
+        kind.name = asset->getName() + " species " + std::to_string(mSpecies.size());
+        kind.boundsCentre = glm::vec3(centre.x, centre.y, centre.z);
+        kind.boundsRadius = radius;
+        for (std::size_t l = 0; l + 1 < levels.size(); ++l)
+            kind.thresholds.push_back(float(std::min(double(levels[l].minPixelCount) * unit, double(FLT_MAX))));
+        Result<std::uint32_t> added = mInstances.addKind(kind);
+        if (!added)
+            invalid(label + added.error().message(), source);
+        OgreAssert(added.value() == mSpecies.size(), "kinds and species share indices");
+        mSpecies.push_back(std::move(species));
+        mStats.levelCounts.emplace_back(levels.size(), 0u);
+        return added.value();
+    }
+
+    std::uint32_t Forest::getSpeciesCount() const { return std::uint32_t(mSpecies.size()); }
+    const std::vector<ForestLevel>& Forest::getLevels(std::uint32_t species) const
+    {
+        return mSpecies.at(species)->levels;
+    }
+    const TreeAssetPtr& Forest::getAsset(std::uint32_t species) const { return mSpecies.at(species)->asset; }
+
+    std::vector<ForestHandle> Forest::addInstances(const std::vector<ForestInstance>& instances)
+    {
+        Result<std::vector<ForestHandle>> handles = mInstances.add(instances);
+        if (!handles)
+            invalid("Forest '" + mName + "': " + handles.error().message(), "Forest::addInstances");
+        updateBounds();
+        return std::move(handles.value());
+    }
+
+    void Forest::updateBounds()
+    {
+        glm::vec3 lo(FLT_MAX), hi(-FLT_MAX);
+        for (std::size_t i = 0; i < mInstances.size(); ++i)
+        {
+            const glm::vec4 sphere = mInstances.getWorldSphere(i);
+            lo = glm::min(lo, glm::vec3(sphere) - sphere.w);
+            hi = glm::max(hi, glm::vec3(sphere) + sphere.w);
+        }
+        if (mInstances.size() == 0)
+            mBounds.setNull();
+        else
+            mBounds.setExtents(lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
+        mRadius = mBounds.isNull() ? 0.0f : Ogre::Math::boundingRadiusFromAABB(mBounds);
+        if (mParentNode)
+            mParentNode->needUpdate();
+    }
+
+    void Forest::setLodBias(Ogre::Real bias)
+    {
+        if (!std::isfinite(bias) || !(bias > 0.0f))
+            invalid("Forest '" + mName + "': LoD bias " + std::to_string(bias) + " is not finite and > 0",
+                    "Forest::setLodBias");
+        mLodBias = bias;
+    }
+
+    void Forest::setLodFrozen(bool frozen) { mLodFrozen = frozen; }
+
+    bool Forest::useShadowedMaterials() const
+    {
+        return mManager && mManager->isShadowTechniqueTextureBased() && mManager->isShadowTechniqueIntegrated();
+    }
+
+    std::uint64_t Forest::getGpuBytes() const
+    {
+        std::set<const void*> seen;
+        std::uint64_t bytes = 0;
+        auto once = [&](const void* what, std::uint64_t size) {
+            if (what && seen.insert(what).second)
+                bytes += size;
+        };
+        for (const std::unique_ptr<Species>& species : mSpecies)
+            for (const auto& level : species->parts)
+                for (const std::unique_ptr<Part>& part : level)
+                {
+                    for (const auto& binding : part->vertexData->vertexBufferBinding->getBindings())
+                        once(binding.second.get(), binding.second->getSizeInBytes());
+                    once(part->indexData->indexBuffer.get(), part->indexData->indexBuffer->getSizeInBytes());
+                    for (const Ogre::MaterialPtr* material : {&part->material, &part->shadowedMaterial})
+                        if (*material)
+                            for (Ogre::Technique* technique : (*material)->getTechniques())
+                                for (Ogre::Pass* pass : technique->getPasses())
+                                    for (Ogre::TextureUnitState* unit : pass->getTextureUnitStates())
+                                        if (unit->getContentType() == Ogre::TextureUnitState::CONTENT_NAMED)
+                                            if (const Ogre::TexturePtr& texture = unit->_getTexturePtr())
+                                                once(texture.get(), textureBytes(*texture));
+                }
+        return bytes + mInstanceBufferBytes;
+    }
+
+    void Forest::_notifyManager(Ogre::SceneManager* manager)
+    {
+        if (mManager && mViewerListener)
+            mManager->removeListener(mViewerListener.get());
+        Ogre::MovableObject::_notifyManager(manager);
+        if (!mViewerListener)
+            mViewerListener = std::make_unique<ViewerListener>(*this);
+        if (mManager)
+            mManager->addListener(mViewerListener.get());
+    }
+
+    void Forest::clearFrameStats()
+    {
+        mStats.instances = std::uint32_t(mInstances.size());
+        mStats.visibleInstances = 0;
+        mStats.batches = 0;
+        mStats.triangles = 0;
+        mStats.cullMilliseconds = 0.0;
+        for (std::vector<std::uint32_t>& counts : mStats.levelCounts)
+            std::fill(counts.begin(), counts.end(), 0u);
+    }
+
+    void Forest::_notifyCurrentCamera(Ogre::Camera* camera)
+    {
+        Ogre::MovableObject::_notifyCurrentCamera(camera);
+        mCurrentCamera = camera;
+    }
+
+    void Forest::fillBucket(CameraState& state, std::uint32_t b)
+    {
+        const ForestBucket& bucket = state.visibility.getBucket(b);
+        BucketState& slot = *state.buckets[b];
+        if (slot.batches.empty())
+            for (const std::unique_ptr<Part>& part : mSpecies[bucket.kind]->parts[bucket.level])
+                slot.batches.push_back(std::make_unique<Batch>(*this, *part));
+        if (bucket.count > slot.capacity)
+        {
+            // Grown by doubling, never shrunk: steady frames allocate nothing.
+            const std::size_t capacity =
+                std::max({std::size_t(bucket.count), 2 * slot.capacity, MIN_INSTANCE_CAPACITY});
+            slot.buffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
+                INSTANCE_BYTES, capacity, Ogre::HardwareBuffer::HBU_DYNAMIC_WRITE_ONLY_DISCARDABLE);
+            slot.buffer->setIsInstanceData(true);
+            slot.buffer->setInstanceDataStepRate(1);
+            mInstanceBufferBytes += (capacity - slot.capacity) * INSTANCE_BYTES;
+            slot.capacity = capacity;
+            for (const std::unique_ptr<Batch>& batch : slot.batches)
+                batch->setInstanceBuffer(slot.buffer);
+        }
+        // The cull's rows [R*s | t] (ForestInstances.h): t, s = m11, cos = m00 / s, sin = m02 / s.
+        const float* m = state.visibility.getBucketTransforms(b);
+        float* out = static_cast<float*>(
+            slot.buffer->lock(0, std::size_t(bucket.count) * INSTANCE_BYTES, Ogre::HardwareBuffer::HBL_DISCARD));
+        for (std::uint32_t i = 0; i < bucket.count;
+             ++i, m += ForestVisibility::TRANSFORM_FLOATS, out += INSTANCE_FLOATS)
+        {
+            const float scale = m[5], inverse = 1.0f / scale;
+            out[0] = m[3];
+            out[1] = m[7];
+            out[2] = m[11];
+            out[3] = scale;
+            out[4] = m[0] * inverse;
+            out[5] = m[2] * inverse;
+        }
+        slot.buffer->unlock();
+    }
+
+    void Forest::_updateRenderQueue(Ogre::RenderQueue* queue)
+    {
+        Ogre::Camera* camera = mCurrentCamera;
+        if (!camera || mSpecies.empty())
+            return;
+        const bool viewer = camera->getLodCamera() == camera &&
+                            !(mManager && mManager->_getCurrentRenderStage() ==
+                                              Ogre::SceneManager::IRS_RENDER_TO_TEXTURE);
+        std::unique_ptr<CameraState>& entry = mCameras[camera];
+        if (!entry)
+            entry = std::make_unique<CameraState>();
+        CameraState& state = *entry;
+        while (state.buckets.size() < mInstances.getBucketCount()) // species added since
+            state.buckets.push_back(std::make_unique<BucketState>());
+
+        // Culling: this camera's frustum in the Forest's local space (instances are local).
+        const Ogre::Affine3& world = _getParentNodeFullTransform();
+        state.camera.planes = CullCamera::frustumPlanes(toGlm(camera->getProjectionMatrix()) *
+                                                        toGlm(camera->getViewMatrix()) * toGlm(world));
+        // LoD: the LoD camera (the viewer's, for shadow cameras), unless frozen.
+        if (!mLodFrozen || !state.hasLod)
+        {
+            const Ogre::Camera* lod = camera->getLodCamera();
+            const Ogre::Vector3 eye = world.inverse() * lod->getDerivedPosition();
+            const Ogre::Viewport* viewport = lod->getViewport();
+            const float area = viewport ? float(viewport->getActualWidth()) * float(viewport->getActualHeight()) : 0.0f;
+            const Ogre::Matrix4& projection = lod->getProjectionMatrix();
+            state.camera.lodPosition = glm::vec3(eye.x, eye.y, eye.z);
+            state.camera.lodPixelScale = area * std::abs(projection[0][0] * projection[1][1]);
+            state.camera.lodOrthographic = lod->getProjectionType() == Ogre::PT_ORTHOGRAPHIC;
+            state.lodBias = lod->getLodBias() * mLodBias;
+            state.hasLod = true;
+        }
+
+        const auto start = std::chrono::steady_clock::now();
+        const Result<void> culled = mInstances.cull(state.camera, state.lodBias, state.visibility);
+        const double cullMs =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        if (!culled)
+        {
+            Ogre::LogManager::getSingleton().logError("Forest '" + mName + "': " + culled.error().message());
+            return;
+        }
+
+        std::uint32_t batches = 0;
+        std::uint64_t triangles = 0;
+        const Ogre::Vector4 cloudParams(0.0f, 1.0f, 0.0f, 0.0f);
+        for (std::uint32_t b = 0; b < state.visibility.getBucketCount(); ++b)
+        {
+            const ForestBucket& bucket = state.visibility.getBucket(b);
+            if (viewer)
+                mStats.levelCounts[bucket.kind][bucket.level] = bucket.count;
+            if (bucket.count == 0)
+                continue;
+            fillBucket(state, b);
+            for (const std::unique_ptr<Batch>& batch : state.buckets[b]->batches)
+            {
+                batch->mInstanceCount = bucket.count;
+                if (batch->getPart().cloud)
+                {
+                    // x: the shader's list factor, the bias applied to lengths; y: AO on (TreeLod.program).
+                    Ogre::Vector4 params = cloudParams;
+                    params.x = batch->getPart().listFactor * std::sqrt(state.lodBias);
+                    batch->setCustomParameter(0, params);
+                }
+                queue->addRenderable(batch.get(), mRenderQueueID, mRenderQueuePriority);
+                ++batches;
+                triangles += std::uint64_t(batch->getPart().indexData->indexCount / 3) * bucket.count;
+            }
+        }
+        if (viewer)
+        {
+            mStats.instances = std::uint32_t(mInstances.size());
+            mStats.visibleInstances = state.visibility.getVisibleCount();
+            mStats.batches = batches;
+            mStats.triangles = triangles;
+            mStats.cullMilliseconds = cullMs;
+        }
+        mStats.instanceBufferBytes = mInstanceBufferBytes;
+    }
+
+    void Forest::visitRenderables(Ogre::Renderable::Visitor* visitor, bool)
+    {
+        for (const auto& camera : mCameras)
+            for (const std::unique_ptr<BucketState>& bucket : camera.second->buckets)
+                for (const std::unique_ptr<Batch>& batch : bucket->batches)
+                    visitor->visit(batch.get(), 0, false);
+    }
+
+    Ogre::MovableObject* ForestFactory::createInstanceImpl(const Ogre::String& name,
+                                                           const Ogre::NameValuePairList* params)
+    {
+        const ObjectParams p(params, "ForestFactory::createInstanceImpl");
+        double bias = 1.0;
+        p.number("lodBias", 1e-6, 1e6, bias);
+        auto forest = std::make_unique<Forest>(name);
+        forest->setLodBias(Ogre::Real(bias));
+        return forest.release();
+    }
+}

@@ -1,0 +1,136 @@
+// TreeAsset::getImpostorGpu: the one-quad impostor (chunk "impostor", ImpostorData.h) on the GPU.
+#include "TreeLod/ImpostorData.h"
+#include "TreeLod/TreeAsset.h"
+
+#include <OgreException.h>
+#include <OgreGpuProgramParams.h>
+#include <OgreHardwareBufferManager.h>
+#include <OgreImage.h>
+#include <OgreMaterialManager.h>
+#include <OgrePass.h>
+#include <OgreTechnique.h>
+#include <OgreTextureManager.h>
+
+namespace TreeLod
+{
+    namespace
+    {
+        Ogre::PixelFormat ogreFormat(GpuTextureFormat format)
+        {
+            switch (format)
+            {
+            case GpuTextureFormat::DXT1:
+                return Ogre::PF_DXT1;
+            case GpuTextureFormat::DXT5:
+                return Ogre::PF_DXT5;
+            default:
+                return Ogre::PF_BYTE_RGBA;
+            }
+        }
+
+        /// `texture` with every baked mip level as Ogre texture `name` (as TreeAsset.cpp uploads).
+        void uploadTexture(const Ogre::String& name, const Ogre::String& group, const GpuTexture& texture)
+        {
+            Ogre::Image image;
+            image.loadDynamicImage(const_cast<Ogre::uchar*>(texture.data.data()), texture.width, texture.height, 1,
+                                   ogreFormat(texture.format), false, 1, texture.mipCount - 1);
+            Ogre::TextureManager::getSingleton().loadImage(name, group, image, Ogre::TEX_TYPE_2D,
+                                                           int(texture.mipCount - 1));
+        }
+    }
+
+    const ImpostorGpu& TreeAsset::getImpostorGpu()
+    {
+        if (mImpostorGpu)
+            return *mImpostorGpu;
+        const PackageReader& package = getPackage();
+        const int index = package.findChunk(IMPOSTOR_CHUNK, 0);
+        if (index >= 0 && package.chunks()[std::size_t(index)].formatVersion != IMPOSTOR_CHUNK_FORMAT_VERSION)
+            raise(fail(mName, chunkElement(IMPOSTOR_CHUNK, 0),
+                       "format version " + std::to_string(package.chunks()[std::size_t(index)].formatVersion) +
+                           ", this build reads " + std::to_string(IMPOSTOR_CHUNK_FORMAT_VERSION) +
+                           ": bake the package again"));
+        Result<ImpostorData> decoded = decodeImpostorChunk(readChunk(IMPOSTOR_CHUNK), mName);
+        if (!decoded)
+            raise(decoded.error());
+        const ImpostorData& data = decoded.value();
+
+        auto gpu = std::make_unique<ImpostorGpu>();
+        const Ogre::String prefix = "TreeLod/" + mName + "/impostor";
+        gpu->texture = prefix + "-colour";
+        gpu->normalTexture = prefix + "-normal";
+        uploadTexture(gpu->texture, mGroup, data.colour);
+        uploadTexture(gpu->normalTexture, mGroup, data.normal);
+
+        // The quad (ImpostorData.h): x in [-halfWidth, halfWidth], y in [bottom, top], facing +Z.
+        const float w = data.halfWidth;
+        const float vertices[4][5] = {{-w, data.bottom, 0.0f, 0.0f, 1.0f},
+                                      {w, data.bottom, 0.0f, 1.0f, 1.0f},
+                                      {w, data.top, 0.0f, 1.0f, 0.0f},
+                                      {-w, data.top, 0.0f, 0.0f, 0.0f}};
+        gpu->vertexData = std::make_unique<Ogre::VertexData>();
+        Ogre::VertexData& vd = *gpu->vertexData;
+        vd.vertexCount = 4;
+        const std::size_t offset =
+            vd.vertexDeclaration->addElement(0, 0, Ogre::VET_FLOAT3, Ogre::VES_POSITION).getSize();
+        vd.vertexDeclaration->addElement(0, offset, Ogre::VET_FLOAT2, Ogre::VES_TEXTURE_COORDINATES, 0);
+        Ogre::HardwareVertexBufferSharedPtr buffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
+            sizeof(vertices[0]), 4, Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+        buffer->writeData(0, sizeof(vertices), vertices, true);
+        vd.vertexBufferBinding->setBinding(0, buffer);
+        const std::uint16_t indices[6] = {0, 1, 2, 0, 2, 3};
+        gpu->indexBuffer = Ogre::HardwareBufferManager::getSingleton().createIndexBuffer(
+            Ogre::HardwareIndexBuffer::IT_16BIT, 6, Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+        gpu->indexBuffer->writeData(0, sizeof(indices), indices, true);
+        gpu->gpuBytes = data.gpuBytes() + sizeof(vertices) + sizeof(indices);
+
+        // Materials: clones of TreeLod/Impostor(Shadowed) and of their shadow caster, the textures
+        // bound to units Colour and Normal, the alpha cutoff set.
+        auto configure = [&](const Ogre::MaterialPtr& material) {
+            material->load();
+            for (Ogre::Technique* tech : material->getTechniques())
+                for (Ogre::Pass* pass : tech->getPasses())
+                {
+                    if (Ogre::TextureUnitState* unit = pass->getTextureUnitState("Colour"))
+                        unit->setTextureName(gpu->texture);
+                    if (Ogre::TextureUnitState* unit = pass->getTextureUnitState("Normal"))
+                        unit->setTextureName(gpu->normalTexture);
+                    if (pass->hasFragmentProgram())
+                    {
+                        Ogre::GpuProgramParametersSharedPtr p = pass->getFragmentProgramParameters();
+                        p->setIgnoreMissingParams(true);
+                        p->setNamedConstant("alphaCutoff", data.alphaCutoff);
+                    }
+                }
+        };
+        auto clone = [&](const Ogre::String& base, const Ogre::String& name) {
+            Ogre::MaterialPtr parent = Ogre::MaterialManager::getSingleton().getByName(base, Ogre::RGN_DEFAULT);
+            if (!parent)
+                parent = Ogre::MaterialManager::getSingleton().getByName(base);
+            if (!parent)
+                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
+                            "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
+                            "TreeAsset '" + mName + "'");
+            Ogre::MaterialPtr material = parent->clone(name, true, mGroup);
+            configure(material);
+            return material;
+        };
+        gpu->material = prefix;
+        gpu->shadowedMaterial = prefix + "/Shadowed";
+        Ogre::MaterialPtr caster;
+        for (const Ogre::String& name : {gpu->material, gpu->shadowedMaterial})
+        {
+            Ogre::MaterialPtr material =
+                clone(name == gpu->material ? "TreeLod/Impostor" : "TreeLod/ImpostorShadowed", name);
+            Ogre::Technique* tech = material->getTechnique(0);
+            if (Ogre::MaterialPtr base = tech->getShadowCasterMaterial())
+            {
+                if (!caster)
+                    caster = clone(base->getName(), prefix + "/Caster");
+                tech->setShadowCasterMaterial(caster);
+            }
+        }
+        mImpostorGpu = std::move(gpu);
+        return *mImpostorGpu;
+    }
+}

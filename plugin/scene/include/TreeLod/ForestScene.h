@@ -1,0 +1,114 @@
+// ForestScene: a scene script (SceneScript.h) built in an Ogre SceneManager: the ground, the
+// sun and shadows, and one Forest holding every placed tree (issue 5). Used by `treelod bench`
+// and the sample browser; links TreeLodBake (scripts, the bake cache) and is not part of
+// Plugin_TreeLod.
+//
+// Lazy baking: each species' package comes from TreeAssetManager::require, so the registered
+// TreeBaker (CacheTreeBaker below, over BakeCache) bakes exactly the chunks the species'
+// techniques draw from, and reports what it built and reused.
+//
+// Technique choice: the script's ("auto" = Forest::getAutoBands(); distance bands become
+// screen-height bands for the script's camera: h_px = height * resolutionY / (2 d tan(fovY/2))),
+// or one technique for every species and distance (`treelod bench --techniques`, the browser).
+#pragma once
+
+#include "TreeLod/BakeCache.h"
+#include "TreeLod/Forest.h"
+#include "TreeLod/SceneScript.h"
+#include "TreeLod/TreeBaker.h"
+
+#include <OgreManualObject.h>
+#include <OgreSceneManager.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace TreeLod
+{
+    /// A TreeBaker over a BakeCache with the tree generator's presets registered as
+    /// "preset:NAME?seed=S&leaves=N&height=H" sources. Progress goes to `progress`; every
+    /// require() adds its BakeCacheEntry to getEntries().
+    class CacheTreeBaker : public TreeBaker
+    {
+    public:
+        explicit CacheTreeBaker(const std::string& directory = defaultBakeCacheDirectory(),
+                                ProgressCallback progress = {});
+        Ogre::String requirePackage(const Ogre::String& source, const std::vector<Ogre::String>& techniques) override;
+        const std::vector<BakeCacheEntry>& getEntries() const { return mEntries; }
+        const BakeCache& getCache() const { return mCache; }
+
+    private:
+        BakeCache mCache;
+        ProgressCallback mProgress;
+        std::vector<BakeCacheEntry> mEntries;
+    };
+
+    /// The source string of a species (its file, or "preset:NAME?seed=S&leaves=N&height=H").
+    std::string speciesSource(const SceneSpecies& species);
+
+    /// The bake technique (chunk) an Ogre-side technique draws from: mesh -> reference,
+    /// quad -> impostor, others their own name. Empty for an unknown technique.
+    std::string bakeTechniqueOf(const std::string& technique);
+
+    struct ForestSceneOptions
+    {
+        /// "" = the script's technique choice; else every species drawn with this technique alone.
+        std::string technique;
+        PlacementOptions placement;
+        Ogre::String group = "TreeLod"; ///< resource group for assets, meshes and materials
+    };
+
+    class ForestScene
+    {
+    public:
+        /// Builds under `parent` (ground mesh, Forest) and sets the scene manager's ambient light,
+        /// the sun (the light "TreeLodSun" when the scene manager has one, as OffscreenRenderer's
+        /// does, else created and owned) and texture shadows as the script says. Throws Ogre::Exception with the script's file and the species' name when
+        /// a bake or load fails.
+        ForestScene(Ogre::SceneManager& sceneManager, Ogre::SceneNode& parent, const SceneScript& script,
+                    const ForestSceneOptions& options = {});
+        ~ForestScene(); ///< destroys everything it created
+
+        const SceneScript& getScript() const { return mScript; }
+        Forest& getForest() { return *mForest; }
+        Ogre::Light& getSun() { return *mSun; }
+        const std::vector<PlacedTree>& getPlacements() const { return mPlacements; }
+        const std::vector<TreeAssetPtr>& getAssets() const { return mAssets; } ///< per species
+
+        /// Re-create the Forest's species for another technique choice ("" = the script's),
+        /// keeping the instances; bakes what the new choice needs.
+        void setTechnique(const std::string& technique);
+        const std::string& getTechnique() const { return mTechnique; }
+
+        /// Texture shadows on or off (the script's size and shadow camera setup), reaching
+        /// getShadowFarDistance() metres from the camera; the ground receives them.
+        void setShadows(bool enabled);
+        static float getShadowFarDistance();
+
+        /// The camera at frame `frame` of `frameCount` (0 = the script's frame count).
+        CameraSpec cameraAtFrame(std::uint32_t frame, std::uint32_t frameCount = 0) const;
+
+        /// GPU bytes of the drawables in use (Forest::getGpuBytes).
+        std::uint64_t getGpuBytes() const;
+
+    private:
+        void release();
+        void buildGround();
+        void buildSpecies();
+
+        Ogre::SceneManager& mSceneManager;
+        Ogre::SceneNode& mParent;
+        SceneScript mScript;
+        ForestSceneOptions mOptions;
+        std::string mTechnique;
+        std::vector<PlacedTree> mPlacements;
+        std::vector<TreeAssetPtr> mAssets;
+        Forest* mForest = nullptr;
+        Ogre::SceneNode* mForestNode = nullptr;
+        Ogre::ManualObject* mGround = nullptr;
+        Ogre::SceneNode* mGroundNode = nullptr;
+        Ogre::Light* mSun = nullptr;
+        Ogre::SceneNode* mSunNode = nullptr;
+    };
+}

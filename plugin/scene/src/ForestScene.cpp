@@ -1,0 +1,336 @@
+#include "TreeLod/ForestScene.h"
+
+#include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/TreeAssetManager.h"
+#include "TreeLod/TreeGenerator.h"
+
+#include <OgreManualObject.h>
+#include <OgreMaterialManager.h>
+#include <OgreSceneNode.h>
+#include <OgreTechnique.h>
+
+#include <glm/gtc/constants.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+
+namespace TreeLod
+{
+    namespace
+    {
+        /// "preset:NAME?seed=S&leaves=N&height=H" (every key optional) -> generateTree.
+        Result<TreeModel> generatePreset(const std::string& source, const ProgressCallback& progress)
+        {
+            const std::string body = source.substr(source.find(':') + 1);
+            const std::size_t q = body.find('?');
+            GeneratorOptions options;
+            if (!parsePreset(body.substr(0, q), options.preset))
+                return fail(source, "preset", "unknown preset '" + body.substr(0, q) +
+                                                  "' (known: oak, conifer, birch, shrub)");
+            std::string query = q == std::string::npos ? "" : body.substr(q + 1);
+            while (!query.empty())
+            {
+                const std::size_t amp = query.find('&');
+                const std::string pair = query.substr(0, amp);
+                query = amp == std::string::npos ? "" : query.substr(amp + 1);
+                const std::size_t eq = pair.find('=');
+                const std::string key = pair.substr(0, eq);
+                const std::string value = eq == std::string::npos ? "" : pair.substr(eq + 1);
+                char* end = nullptr;
+                const double number = std::strtod(value.c_str(), &end);
+                if (value.empty() || *end != '\0' || !std::isfinite(number) || number < 0.0)
+                    return fail(source, key, "'" + value + "' is not a non-negative number");
+                if (key == "seed")
+                    options.seed = std::uint32_t(number);
+                else if (key == "leaves")
+                    options.leafCount = std::uint32_t(number);
+                else if (key == "height")
+                    options.height = float(number);
+                else
+                    return fail(source, key, "unknown generator option (known: seed, leaves, height)");
+            }
+            return generateTree(options, progress);
+        }
+
+        const Ogre::String SUN_NAME = "TreeLodSun"; // OffscreenRenderer's sun, reused when present
+        constexpr float SHADOW_FAR_DISTANCE = 150.0f; // metres: shadows of the trees near the viewer
+
+        /// A linear-space grass colour for the ground (what the Lit bark shader multiplies its white texture by).
+        const Ogre::ColourValue GROUND_COLOUR(0.10f, 0.16f, 0.05f, 1.0f);
+    }
+
+    CacheTreeBaker::CacheTreeBaker(const std::string& directory, ProgressCallback progress)
+        : mCache(directory), mProgress(std::move(progress))
+    {
+        Result<void> r = mCache.addGenerator("preset", generatePreset);
+        OgreAssert(bool(r), "the preset scheme is valid");
+    }
+
+    Ogre::String CacheTreeBaker::requirePackage(const Ogre::String& source, const std::vector<Ogre::String>& techniques)
+    {
+        Result<BakeCacheEntry> entry = mCache.require(source, techniques, "", mProgress);
+        if (!entry)
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, entry.error().message(), "CacheTreeBaker::requirePackage");
+        mEntries.push_back(*entry);
+        return entry->path;
+    }
+
+    std::string speciesSource(const SceneSpecies& species)
+    {
+        if (!species.source.empty())
+            return species.source;
+        std::string out = "preset:" + species.preset + "?seed=" + std::to_string(species.seed);
+        if (species.leaves)
+            out += "&leaves=" + std::to_string(species.leaves);
+        if (species.height > 0.0f)
+        {
+            char text[32];
+            std::snprintf(text, sizeof text, "%g", double(species.height));
+            out += std::string("&height=") + text;
+        }
+        return out;
+    }
+
+    std::string bakeTechniqueOf(const std::string& technique)
+    {
+        if (technique == "mesh")
+            return "reference";
+        if (technique == "quad")
+            return "impostor";
+        if (technique == "lodf" || technique == "billboard-cloud" || technique == "classic-billboard-cloud")
+            return technique;
+        return "";
+    }
+
+    ForestScene::ForestScene(Ogre::SceneManager& sceneManager, Ogre::SceneNode& parent, const SceneScript& script,
+                             const ForestSceneOptions& options)
+        : mSceneManager(sceneManager), mParent(parent), mScript(script), mOptions(options),
+          mTechnique(options.technique)
+    {
+        mPlacements = generatePlacements(mScript, mOptions.placement);
+        if (mSceneManager.hasLight(SUN_NAME))
+            mSun = mSceneManager.getLight(SUN_NAME);
+        else
+        {
+            mSun = mSceneManager.createLight(SUN_NAME);
+            mSunNode = mSceneManager.getRootSceneNode()->createChildSceneNode();
+            mSunNode->attachObject(mSun);
+        }
+        applyLighting(mSceneManager, *mSun, sceneLighting(mScript));
+        try
+        {
+            buildGround();
+            buildSpecies();
+            setShadows(mScript.shadows.enabled);
+        }
+        catch (...)
+        {
+            release();
+            throw;
+        }
+    }
+
+    ForestScene::~ForestScene() { release(); }
+
+    void ForestScene::release()
+    {
+        if (mForest)
+        {
+            mForestNode->detachAllObjects();
+            mSceneManager.destroyMovableObject(mForest);
+            mSceneManager.destroySceneNode(mForestNode);
+            mForest = nullptr;
+        }
+        if (mGround)
+        {
+            mGroundNode->detachAllObjects();
+            mSceneManager.destroyMovableObject(mGround);
+            mSceneManager.destroySceneNode(mGroundNode);
+            mGround = nullptr;
+        }
+        if (mSunNode)
+        {
+            mSunNode->detachAllObjects();
+            mSceneManager.destroyLight(mSun);
+            mSceneManager.destroySceneNode(mSunNode);
+            mSunNode = nullptr;
+            mSun = nullptr;
+        }
+    }
+
+    void ForestScene::buildGround()
+    {
+        Ogre::MaterialManager& materials = Ogre::MaterialManager::getSingleton();
+        for (const char* suffix : {"", "Shadowed"})
+        {
+            const Ogre::String name = Ogre::String("TreeLod/Ground") + suffix;
+            if (materials.resourceExists(name, mOptions.group))
+                continue;
+            Ogre::MaterialPtr base = materials.getByName(Ogre::String("TreeLod/Bark") + suffix, mOptions.group);
+            if (!base)
+                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
+                            Ogre::String("material TreeLod/Bark") + suffix + " not found in group " + mOptions.group,
+                            "ForestScene");
+            Ogre::MaterialPtr ground = base->clone(name, true, mOptions.group);
+            ground->getTechnique(0)->getPass(0)->getFragmentProgramParameters()->setNamedConstant("baseColour",
+                                                                                                 GROUND_COLOUR);
+            ground->load();
+        }
+
+        // A grid over the square (65 x 65 vertices; heights and normals from the heightfield).
+        const SceneGround& g = mScript.ground;
+        const int cells = g.kind == SceneGround::Kind::Heightfield ? 128 : 16;
+        const float half = 0.5f * g.size, step = g.size / float(cells);
+        static int counter = 0;
+        mGround = mSceneManager.createManualObject("TreeLod/Ground/" + std::to_string(counter++));
+        mGround->setCastShadows(false);
+        mGround->begin("TreeLod/Ground", Ogre::RenderOperation::OT_TRIANGLE_LIST, mOptions.group);
+        for (int j = 0; j <= cells; ++j)
+            for (int i = 0; i <= cells; ++i)
+            {
+                const float x = -half + step * float(i), z = -half + step * float(j);
+                const float e = 0.5f * step;
+                const float dx = groundHeight(g, x + e, z) - groundHeight(g, x - e, z);
+                const float dz = groundHeight(g, x, z + e) - groundHeight(g, x, z - e);
+                const Ogre::Vector3 n = Ogre::Vector3(-dx, 2.0f * e, -dz).normalisedCopy();
+                mGround->position(x, groundHeight(g, x, z), z);
+                mGround->normal(n);
+                mGround->textureCoord(x / 4.0f, z / 4.0f);
+            }
+        for (int j = 0; j < cells; ++j)
+            for (int i = 0; i < cells; ++i)
+            {
+                const Ogre::uint32 a = Ogre::uint32(j * (cells + 1) + i), b = a + 1, c = a + Ogre::uint32(cells + 1),
+                                   d = c + 1;
+                mGround->triangle(a, c, b); // counter-clockwise seen from above (+Y)
+                mGround->triangle(b, c, d);
+            }
+        mGround->end();
+        mGroundNode = mParent.createChildSceneNode();
+        mGroundNode->attachObject(mGround);
+    }
+
+    void ForestScene::buildSpecies()
+    {
+        static int counter = 0;
+        mForest = static_cast<Forest*>(
+            mSceneManager.createMovableObject("TreeLod/Forest/" + std::to_string(counter++), ForestFactory::FACTORY_TYPE_NAME));
+        mForestNode = mParent.createChildSceneNode();
+        mForestNode->attachObject(mForest);
+
+        // Bands per species; then one bake request per distinct source with every technique its
+        // species draw (two species sharing a file share one package and one asset).
+        const float tanHalfFov = std::tan(glm::radians(mScript.camera.fovYDegrees) * 0.5f);
+        std::vector<std::vector<ForestBand>> bands(mScript.species.size());
+        std::map<std::string, std::set<std::string>> techniques; // source -> bake techniques
+        for (std::size_t s = 0; s < mScript.species.size(); ++s)
+        {
+            const SceneSpecies& species = mScript.species[s];
+            if (!mTechnique.empty())
+                bands[s] = {ForestBand{mTechnique, 0.0f}};
+            else if (species.autoTechnique)
+                bands[s] = Forest::getAutoBands();
+            else
+                for (std::size_t b = 0; b < species.bands.size(); ++b)
+                    bands[s].push_back(ForestBand{species.bands[b].technique, species.bands[b].minPixels});
+            std::set<std::string>& wanted = techniques[speciesSource(species)];
+            wanted.insert("reference");
+            for (const ForestBand& band : bands[s])
+            {
+                const std::string bake = bakeTechniqueOf(band.technique);
+                if (bake.empty())
+                    OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                                mScript.file + ": species '" + species.name + "': unknown technique '" +
+                                    band.technique + "' (known: mesh, lodf, billboard-cloud, classic-billboard-cloud, quad)",
+                                "ForestScene");
+                wanted.insert(bake);
+            }
+        }
+        std::map<std::string, TreeAssetPtr> assets;
+        for (const auto& [source, wanted] : techniques)
+        {
+            try
+            {
+                assets[source] = TreeAssetManager::getSingleton().require(
+                    source, std::vector<Ogre::String>(wanted.begin(), wanted.end()), mOptions.group);
+            }
+            catch (const Ogre::Exception& e)
+            {
+                OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, mScript.file + ": " + e.getDescription(), "ForestScene");
+            }
+        }
+
+        mAssets.clear();
+        for (std::size_t s = 0; s < mScript.species.size(); ++s)
+        {
+            const SceneSpecies& species = mScript.species[s];
+            TreeAssetPtr asset = assets[speciesSource(species)];
+            mAssets.push_back(asset);
+            // Distance bands: the screen height a tree of this asset has at that distance from the
+            // script's camera (the bench and the browser render at the script's resolution).
+            if (mTechnique.empty() && !species.autoTechnique)
+            {
+                const Ogre::AxisAlignedBox bounds = asset->getBounds();
+                const float height = float(bounds.getMaximum().y - bounds.getMinimum().y) *
+                                     0.5f * (species.scaleMin + species.scaleMax);
+                for (std::size_t b = 0; b < species.bands.size(); ++b)
+                    if (species.bands[b].maxDistance > 0.0f)
+                        bands[s][b].minHeightPixels =
+                            height * float(mScript.height) / (2.0f * species.bands[b].maxDistance * tanHalfFov);
+            }
+            try
+            {
+                mForest->addSpecies(asset, Forest::levelsForBands(*asset, bands[s]));
+            }
+            catch (const Ogre::Exception& e)
+            {
+                OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                            mScript.file + ": species '" + species.name + "': " + e.getDescription(), "ForestScene");
+            }
+        }
+
+        std::vector<ForestInstance> instances;
+        instances.reserve(mPlacements.size());
+        for (const PlacedTree& tree : mPlacements)
+            instances.push_back(ForestInstance{tree.position, tree.rotation, tree.scale, tree.species});
+        mForest->addInstances(instances);
+    }
+
+    void ForestScene::setTechnique(const std::string& technique)
+    {
+        if (mForest)
+        {
+            mForestNode->detachAllObjects();
+            mSceneManager.destroyMovableObject(mForest);
+            mSceneManager.destroySceneNode(mForestNode);
+            mForest = nullptr;
+        }
+        mTechnique = technique;
+        buildSpecies();
+    }
+
+    void ForestScene::setShadows(bool enabled)
+    {
+        const ShadowCamera camera = mScript.shadows.camera == "lispsm" ? ShadowCamera::LiSPSM : ShadowCamera::Focused;
+        applyTextureShadows(mSceneManager, *mSun, enabled, unsigned(mScript.shadows.textureSize), camera);
+        if (enabled)
+        {
+            mSceneManager.setShadowFarDistance(SHADOW_FAR_DISTANCE);
+            mSceneManager.setShadowDirectionalLightExtrusionDistance(2.0f * SHADOW_FAR_DISTANCE + 50.0f);
+        }
+        if (mGround)
+            mGround->setMaterialName(0, enabled ? "TreeLod/GroundShadowed" : "TreeLod/Ground", mOptions.group);
+    }
+
+    float ForestScene::getShadowFarDistance() { return SHADOW_FAR_DISTANCE; }
+
+    CameraSpec ForestScene::cameraAtFrame(std::uint32_t frame, std::uint32_t frameCount) const
+    {
+        return cameraAt(mScript, frameTime(mScript, frame, frameCount));
+    }
+
+    std::uint64_t ForestScene::getGpuBytes() const { return mForest ? mForest->getGpuBytes() : 0; }
+}

@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# treelod bench end to end (run by ctest under xvfb-run): single-tree.json on a short path and
+# table2.json scaled down with two tree counts. Checks that the outputs exist and agree with each
+# other (row counts, techniques, biases, tree counts, PNG plots), not the timings. A bad script
+# exits 2 naming file, line and column, and writes nothing.
+set -euo pipefail
+treelod=$1; src=$2; out=$3
+rm -rf "$out"; mkdir -p "$out"
+cache="$out/cache"
+
+fail() { echo "bench test: $*"; exit 1; }
+png() { [ -s "$1" ] && head -c 8 "$1" | od -An -tx1 | grep -q "89 50 4e 47" || fail "$1 is not a PNG"; }
+
+# 1. One tree: reference, floor and auto at two biases over 6 frames.
+"$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/single" --frames 6 --size 160x90 \
+  --techniques auto --lod-bias 1,0.5 --samples 2 --cache "$cache" -q
+for f in frames.csv summary.json frame-time.png trade.png; do [ -s "$out/single/$f" ] || fail "single/$f missing"; done
+png "$out/single/frame-time.png"; png "$out/single/trade.png"
+rows=$(($(wc -l < "$out/single/frames.csv") - 1))
+[ "$rows" = 24 ] || fail "frames.csv has $rows rows, expected (mesh + quad + auto x 2 biases) x 6 = 24"
+for t in mesh quad auto; do
+  n=$(awk -F, -v t=$t 'NR > 1 && $2 == t' "$out/single/frames.csv" | wc -l)
+  want=6; [ $t = auto ] && want=12
+  [ "$n" = "$want" ] || fail "technique $t has $n rows, expected $want"
+done
+# Every frame of one tree is timed (the reference fits the budget) and draws at least one batch.
+awk -F, 'NR > 1 && ($6 != 1 || $9 < 1 || $8 <= 0) { bad = 1; print } END { exit bad }' "$out/single/frames.csv" \
+  || fail "untimed or empty frames above"
+# Sampled frames carry FLIP for every technique; the floor's error is larger than auto's at bias 1.
+n=$(awk -F, 'NR > 1 && $13 != ""' "$out/single/frames.csv" | wc -l)
+[ "$n" = 8 ] || fail "$n frames with FLIP, expected 2 samples x 4 runs = 8"
+grep -q '"technique": "auto"' "$out/single/summary.json" || fail "summary lacks auto"
+grep -q '"speedupVsReference": [0-9]' "$out/single/summary.json" || fail "summary has no measured speedup"
+grep -q '"ratioToFloor": [0-9]' "$out/single/summary.json" || fail "summary has no ratio to the floor"
+[ "$(grep -c '"lodBias"' "$out/single/summary.json")" = 4 ] || fail "summary should have 4 results"
+# The bake cache reported what it built; a second run reuses everything.
+grep -q 'baked' "$out/single/summary.json" || fail "first run baked nothing?"
+"$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/single2" --frames 2 --size 64x36 \
+  --techniques lodf --lod-bias 1 --samples 1 --cache "$cache" -q
+grep -q '"bake"' "$out/single2/summary.json" && ! grep -q ': baked' "$out/single2/summary.json" \
+  || fail "second run rebaked"
+
+# 2. Paper 000 Table 2 scaled down: two tree counts (1 and 1 + 49 x 0.1), a trees.png plot.
+"$treelod" bench "$src/samples/scenes/table2.json" -o "$out/table2" --scale 0.1 --counts 1,50 --frames 3 \
+  --size 128x96 --techniques billboard-cloud --lod-bias 1 --samples 1 --cache "$cache" -q
+for f in frames.csv summary.json trees.png; do [ -s "$out/table2/$f" ] || fail "table2/$f missing"; done
+counts=$(awk -F, 'NR > 1 { print $1 }' "$out/table2/frames.csv" | sort -n | uniq)
+[ "$(echo $counts)" = "1 6" ] || fail "tree counts '$(echo $counts)', expected '1 6'"
+for c in $counts; do
+  n=$(awk -F, -v c=$c 'NR > 1 && $1 == c' "$out/table2/frames.csv" | wc -l)
+  [ "$n" = 9 ] || fail "$c trees: $n rows, expected 3 runs x 3 frames"
+  png "$out/table2/trade-$c.png"; png "$out/table2/frame-time-$c.png"
+  grep -q "\"trees\": $c\$" "$out/table2/summary.json" || fail "summary lacks $c trees"
+done
+
+# 3. A bad script: exit 2, file:line:column named, nothing written.
+printf '{\n  "name": "bad",\n  "frames": -3\n}\n' > "$out/bad.json"
+set +e
+"$treelod" bench "$out/bad.json" -o "$out/bad" -q 2> "$out/bad.txt"; code=$?
+set -e
+[ "$code" = 2 ] || fail "bad script: exit $code, expected 2"
+grep -q "bad.json: line" "$out/bad.txt" || { cat "$out/bad.txt"; fail "error does not name file and line"; }
+[ ! -e "$out/bad" ] || fail "bad script created its output directory"
+echo "bench test passed"

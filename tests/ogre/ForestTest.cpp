@@ -1,0 +1,1004 @@
+// Forest (issue 5) through Plugin_TreeLod: the factory, render queue group and query flags;
+// the instanced draws against the same trees as separate objects (Entity, FoliageLodTree,
+// BillboardCloudTree under SceneNodes: the test of the INSTANCED vertex programs' rotation,
+// scale and normals); the quad level; culling and level counts against ForestInstances::cull;
+// LoD at 10 km, inside a crown, with bias and frozen; texture shadows cast and received; bad
+// input; two species of one asset, one instance and 20,000 quads; levels from bands.
+//
+// The package (reference, lodf, billboard-cloud, impostor of media/oak.glb) is baked here with
+// the core bakers (few AO rays) and cached in $TREELOD_TEST_OUT/forest, keyed by this binary's
+// modification time.
+#include "OgreTestSupport.h"
+
+#include "TreeLod/BillboardCloudBaker.h"
+#include "TreeLod/BillboardCloudTree.h"
+#include "TreeLod/FoliageLodBaker.h"
+#include "TreeLod/FoliageLodTree.h"
+#include "TreeLod/Forest.h"
+#include "TreeLod/GltfImporter.h"
+#include "TreeLod/ImpostorBaker.h"
+#include "TreeLod/ImpostorData.h"
+#include "TreeLod/PackageWriter.h"
+#include "TreeLod/TreeAssetManager.h"
+
+#include <OgreEntity.h>
+#include <OgreManualObject.h>
+#include <OgreMaterialManager.h>
+#include <OgreRenderQueue.h>
+#include <OgreRenderQueueSortingGrouping.h>
+#include <OgreSceneManager.h>
+#include <OgreSceneQuery.h>
+#include <OgreSubEntity.h>
+#include <OgreTechnique.h>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <map>
+
+namespace TreeLod
+{
+    namespace
+    {
+        struct ForestTree
+        {
+            TreeModel model;
+            TreeAssetPtr asset;
+        };
+
+        std::vector<std::uint8_t> bakePackage(const TreeModel& model, const std::string& name)
+        {
+            PackageWriter writer;
+            Result<void> added = addFoliageLodChunk(writer, model, name); // and the reference
+            EXPECT_TRUE(added.ok()) << (added.ok() ? "" : added.error().message());
+            BillboardCloudOptions cloudOptions;
+            cloudOptions.aoRays = 4;
+            Result<BillboardCloudData> cloud = bakeBillboardCloud(model, cloudOptions, name);
+            EXPECT_TRUE(cloud.ok()) << (cloud.ok() ? "" : cloud.error().message());
+            if (cloud.ok())
+            {
+                EXPECT_TRUE(writer.addChunk(BILLBOARD_CLOUD_CHUNK, 0, BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION,
+                                            encodeBillboardCloudChunk(cloud.value())).ok());
+            }
+            ImpostorOptions impostorOptions;
+            impostorOptions.aoRays = 4;
+            impostorOptions.resolution = 128;
+            Result<ImpostorData> impostor = bakeImpostor(model, impostorOptions, name);
+            EXPECT_TRUE(impostor.ok()) << (impostor.ok() ? "" : impostor.error().message());
+            if (impostor.ok())
+            {
+                EXPECT_TRUE(writer.addChunk(IMPOSTOR_CHUNK, 0, IMPOSTOR_CHUNK_FORMAT_VERSION,
+                                            encodeImpostorChunk(impostor.value())).ok());
+            }
+            return writer.toBytes();
+        }
+
+        /// media/oak.glb with every chunk the Forest draws, loaded as "oak.forest-test".
+        const ForestTree& oak()
+        {
+            OgreEnvironment::renderer(); // first: the Root must outlive the asset
+            static ForestTree tree = [] {
+                ForestTree t;
+                Result<TreeModel> model = importGltf(OgreEnvironment::sourcePath("media/oak.glb"));
+                EXPECT_TRUE(model.ok()) << (model.ok() ? "" : model.error().message());
+                t.model = std::move(model.value());
+
+                const char* out = std::getenv("TREELOD_TEST_OUT");
+                const std::filesystem::path dir =
+                    (out && *out ? std::string(out) : std::string(TREELOD_BINARY_DIR) + "/test-out") + "/forest";
+                std::filesystem::create_directories(dir);
+                std::error_code error;
+                const auto stamp = std::filesystem::last_write_time("/proc/self/exe", error).time_since_epoch().count();
+                const std::filesystem::path path = dir / ("oak@" + std::to_string(error ? 0 : stamp) + ".treelod");
+                std::vector<std::uint8_t> bytes;
+                if (std::ifstream in{path, std::ios::binary})
+                    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+                if (bytes.empty())
+                {
+                    bytes = bakePackage(t.model, "oak");
+                    for (const auto& entry : std::filesystem::directory_iterator(dir)) // older builds' packages
+                        if (entry.path().filename().string().rfind("oak@", 0) == 0)
+                            std::filesystem::remove(entry.path());
+                    const std::string temp = path.string() + "." + std::to_string(::getpid()) + ".tmp";
+                    std::ofstream(temp, std::ios::binary)
+                        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+                    std::filesystem::rename(temp, path);
+                }
+                t.asset = TreeAssetManager::getSingleton().loadFromBytes("oak.forest-test", Ogre::RGN_DEFAULT, bytes);
+                return t;
+            }();
+            return tree;
+        }
+
+        const glm::vec3 BACKGROUND = LightingSpec().background;
+
+        /// A fresh Forest (through its factory) under a child of the content node, content cleared.
+        Forest* placeForest(const Ogre::NameValuePairList& params = {}, Ogre::SceneNode** node = nullptr)
+        {
+            static int serial = 0;
+            OffscreenRenderer& r = OgreEnvironment::renderer();
+            r.clearContent();
+            r.setShadows(false);
+            r.setLodBias(1.0f);
+            Ogre::MovableObject* object =
+                r.getSceneManager().createMovableObject("forest-" + std::to_string(serial++), "Forest", &params);
+            Ogre::SceneNode* parent = r.getContentNode().createChildSceneNode();
+            parent->attachObject(object);
+            if (node)
+                *node = parent;
+            return static_cast<Forest*>(object);
+        }
+
+        Ogre::Camera& ogreCamera()
+        {
+            return *OgreEnvironment::renderer().getSceneManager().getCamera("TreeLodOffscreenCamera");
+        }
+
+        ForestInstance instance(float x, float y, float z, float rotation = 0.0f, float scale = 1.0f,
+                                std::uint32_t species = 0)
+        {
+            return ForestInstance{glm::vec3(x, y, z), rotation, scale, species};
+        }
+
+        /// n x n trees `spacing` metres apart centred on the origin, rotations varied.
+        std::vector<ForestInstance> grid(int n, float spacing, std::uint32_t species = 0)
+        {
+            std::vector<ForestInstance> out;
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i)
+                    out.push_back(instance((float(i) - 0.5f * float(n - 1)) * spacing, 0.0f,
+                                           (float(j) - 0.5f * float(n - 1)) * spacing, 0.7f * float(i * n + j),
+                                           0.8f + 0.05f * float((i + 2 * j) % 8), species));
+            return out;
+        }
+
+        Image sideBySide(const std::vector<Image>& images)
+        {
+            int width = 0;
+            for (const Image& i : images)
+                width += i.width;
+            Image out(width, images.front().height, glm::vec4(0, 0, 0, 1));
+            int x0 = 0;
+            for (const Image& i : images)
+            {
+                for (int y = 0; y < i.height && y < out.height; ++y)
+                    for (int x = 0; x < i.width; ++x)
+                        out.at(x0 + x, y) = i.at(x, y);
+                x0 += i.width;
+            }
+            return out;
+        }
+
+        /// Every `factor` x `factor` block averaged (goldens of pictures rendered large).
+        Image shrink(const Image& image, int factor)
+        {
+            Image out(image.width / factor, image.height / factor);
+            for (int y = 0; y < out.height; ++y)
+                for (int x = 0; x < out.width; ++x)
+                {
+                    glm::vec4 sum(0.0f);
+                    for (int j = 0; j < factor; ++j)
+                        for (int i = 0; i < factor; ++i)
+                            sum += image.at(x * factor + i, y * factor + j);
+                    out.at(x, y) = sum / float(factor * factor);
+                }
+            return out;
+        }
+
+        double flipMean(const Image& a, const Image& b)
+        {
+            Result<FlipResult> error = flip(a, b);
+            EXPECT_TRUE(error.ok());
+            return error.ok() ? error->mean : 1.0;
+        }
+
+        double meanLuminance(const Image& image)
+        {
+            double sum = 0.0;
+            for (const glm::vec4& p : image.pixels)
+                sum += 0.2126 * p.r + 0.7152 * p.g + 0.0722 * p.b;
+            return sum / double(image.pixels.size());
+        }
+
+        /// Renderables the object queues into each (group, priority).
+        std::map<std::pair<int, int>, std::size_t> queued(Ogre::MovableObject& object)
+        {
+            Ogre::RenderQueue queue;
+            object._notifyCurrentCamera(&ogreCamera());
+            object._updateRenderQueue(&queue);
+            struct Counter : Ogre::QueuedRenderableVisitor
+            {
+                std::size_t count = 0;
+                void visit(Ogre::RenderablePass*) override { ++count; }
+                void visit(const Ogre::Pass*, Ogre::RenderableList& list) override { count += list.size(); }
+            };
+            std::map<std::pair<int, int>, std::size_t> out;
+            for (std::size_t id = 0; id < Ogre::RENDER_QUEUE_COUNT; ++id)
+                if (const auto& group = queue._getQueueGroups()[id])
+                    for (const auto& priority : group->getIterator())
+                    {
+                        Counter counter;
+                        priority.second->getSolidsBasic().acceptVisitor(
+                            &counter, Ogre::QueuedRenderableCollection::OM_PASS_GROUP);
+                        if (counter.count > 0)
+                            out[{int(id), int(priority.first)}] += counter.count;
+                    }
+            return out;
+        }
+
+        float treeHeight(const TreeModel& model) { return model.boundsMax.y - model.boundsMin.y; }
+
+        /// Perspective camera at `eye` looking at `target`.
+        CameraSpec look(const glm::vec3& eye, const glm::vec3& target, float fov = 40.0f)
+        {
+            CameraSpec spec;
+            spec.position = eye;
+            spec.target = target;
+            spec.fovYDegrees = fov;
+            spec.nearClip = 0.1f;
+            spec.farClip = 20000.0f;
+            return spec;
+        }
+
+        /// The Forest's level of every instance per species (levelCounts) as one list.
+        std::vector<std::uint32_t> flatCounts(const Forest& forest)
+        {
+            std::vector<std::uint32_t> out;
+            for (const auto& species : forest.getStats().levelCounts)
+                out.insert(out.end(), species.begin(), species.end());
+            return out;
+        }
+
+        /// Mean level index of the visible instances of species 0.
+        double meanLevel(const Forest& forest)
+        {
+            const std::vector<std::uint32_t>& counts = forest.getStats().levelCounts.at(0);
+            double sum = 0.0, n = 0.0;
+            for (std::size_t l = 0; l < counts.size(); ++l)
+            {
+                sum += double(l) * counts[l];
+                n += counts[l];
+            }
+            return n > 0.0 ? sum / n : -1.0;
+        }
+    }
+
+    TEST(Forest, factoryQueueGroupAndQueryFlags)
+    {
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        Ogre::SceneManager& sm = r.getSceneManager();
+        EXPECT_TRUE(Ogre::Root::getSingleton().hasMovableObjectFactory(ForestFactory::FACTORY_TYPE_NAME));
+
+        Ogre::NameValuePairList params{{"lodBias", "2.5"}};
+        Ogre::MovableObject* object = sm.createMovableObject("forestViaFactory", "Forest", &params);
+        ASSERT_NE(object, nullptr);
+        EXPECT_EQ(object->getMovableType(), "Forest");
+        EXPECT_FLOAT_EQ(static_cast<Forest*>(object)->getLodBias(), 2.5f);
+        EXPECT_TRUE(object->getBoundingBox().isNull()) << "no instances yet";
+        sm.destroyMovableObject(object);
+        Ogre::NameValuePairList bad{{"lodBias", "0"}};
+        try
+        {
+            sm.createMovableObject("forestBad", "Forest", &bad);
+            ADD_FAILURE() << "lodBias 0 must throw";
+        }
+        catch (const Ogre::Exception& e)
+        {
+            EXPECT_NE(e.getDescription().find("'lodBias'"), std::string::npos) << e.getDescription();
+        }
+
+        // Render queue group and priority of the object, for every part of every level.
+        Forest* forest = placeForest();
+        forest->addSpecies(tree.asset, {ForestLevel{"lodf", 0, false, 0.0f}});
+        forest->addInstances({instance(0, 0, 0), instance(20, 0, 0, 1.0f)});
+        forest->setRenderQueueGroupAndPriority(Ogre::RENDER_QUEUE_6, 42);
+        const float h = treeHeight(tree.model);
+        r.render(look(glm::vec3(10, 0.5f * h, 4 * h), glm::vec3(10, 0.5f * h, 0)), 64, 64, 1);
+        const auto counts = queued(*forest);
+        ASSERT_EQ(counts.size(), 1u);
+        EXPECT_EQ(counts.begin()->first, std::make_pair(int(Ogre::RENDER_QUEUE_6), 42));
+        EXPECT_EQ(counts.begin()->second, forest->getStats().batches) << "one renderable per (bucket, part)";
+        EXPECT_GT(counts.begin()->second, 1u) << "leaves and bark";
+
+        // Query flags: a ray through the first tree's crown finds the Forest only with a matching mask.
+        forest->setQueryFlags(0x4);
+        const glm::vec3 centre = 0.5f * (tree.model.boundsMin + tree.model.boundsMax);
+        Ogre::RaySceneQuery* query =
+            sm.createRayQuery(Ogre::Ray(Ogre::Vector3(centre.x, centre.y, 100.0f), Ogre::Vector3::NEGATIVE_UNIT_Z),
+                              0x4);
+        bool found = false;
+        for (const Ogre::RaySceneQueryResultEntry& hit : query->execute())
+            found |= hit.movable == forest;
+        EXPECT_TRUE(found);
+        query->setQueryMask(0x8);
+        for (const Ogre::RaySceneQueryResultEntry& hit : query->execute())
+            EXPECT_NE(hit.movable, forest);
+        sm.destroyQuery(query);
+
+        // Bounds: the union of the instances' spheres, in the Forest's space.
+        const Ogre::AxisAlignedBox& box = forest->getBoundingBox();
+        for (std::size_t i = 0; i < 2; ++i)
+        {
+            const glm::vec4 s = forest->getInstances().getWorldSphere(i);
+            EXPECT_TRUE(box.contains(Ogre::Vector3(s.x - s.w, s.y - s.w, s.z - s.w)));
+            EXPECT_TRUE(box.contains(Ogre::Vector3(s.x + s.w, s.y + s.w, s.z + s.w)));
+        }
+        EXPECT_FLOAT_EQ(forest->getBoundingRadius(), Ogre::Math::boundingRadiusFromAABB(box));
+        EXPECT_GT(forest->getGpuBytes(), forest->getStats().instanceBufferBytes);
+        EXPECT_GT(forest->getStats().instanceBufferBytes, 0u);
+    }
+
+    TEST(Forest, instancedDrawsMatchSeparateObjects)
+    {
+        // Three trees with different rotations and scales, the Forest's node moved and turned:
+        // the Forest's instanced draws against the same trees as separate objects under
+        // SceneNodes. Rotation direction, scale, normals (lighting) and the node transform
+        // all show in the picture.
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        Ogre::SceneManager& sm = r.getSceneManager();
+        const float h = treeHeight(tree.model);
+        const float w = std::max(tree.model.boundsMax.x - tree.model.boundsMin.x,
+                                 tree.model.boundsMax.z - tree.model.boundsMin.z);
+        const std::vector<ForestInstance> trees = {instance(-0.7f * w, 0.0f, 0.2f * w, 0.0f, 0.85f),
+                                                   instance(0.0f, 0.0f, -0.3f * w, 1.2f, 1.0f),
+                                                   instance(0.72f * w, 0.0f, 0.1f * w, -2.5f, 0.9f)};
+        const Ogre::Vector3 nodePosition(3.0f, 0.5f, -2.0f);
+        const Ogre::Quaternion nodeOrientation(Ogre::Radian(0.4f), Ogre::Vector3::UNIT_Y);
+        // Looking at the middle tree from the front, a little above; trees about 260 px tall (full
+        // bark detail in every separate object, as in the Forest's first level).
+        const Ogre::Vector3 middle = nodePosition + nodeOrientation * Ogre::Vector3(0.0f, 0.5f * h, -0.3f * w);
+        const Ogre::Vector3 eye = middle + nodeOrientation * Ogre::Vector3(0.0f, 0.25f * h, 2.0f * h);
+        const CameraSpec view = look(glm::vec3(eye.x, eye.y, eye.z), glm::vec3(middle.x, middle.y, middle.z), 36.0f);
+        const int width = 800, height = 340;
+        const FoliageLodData& lodf = tree.asset->getFoliageLod();
+        const std::uint32_t leaves = (lodf.maxLeafCount() + lodf.minLeafCount()) / 2;
+
+        struct Case
+        {
+            const char* name;
+            ForestLevel level;
+            std::function<Ogre::MovableObject*(const std::string&)> create;
+            std::function<void(Ogre::MovableObject*)> check;
+        };
+        const std::vector<Case> cases = {
+            {"mesh", ForestLevel{"mesh", 0, false, 0.0f},
+             [&](const std::string& name) {
+                 Ogre::Entity* entity = sm.createEntity(name, tree.asset->getReferenceMesh());
+                 entity->setMeshLodBias(1.0f, 0, 0); // full bark detail, as the Forest's first level
+                 return entity;
+             },
+             [](Ogre::MovableObject*) {}},
+            {"lodf", ForestLevel{"lodf", leaves, false, 0.0f},
+             [&](const std::string& name) {
+                 Ogre::NameValuePairList params{{"asset", tree.asset->getName()}, {"leaves", std::to_string(leaves)}};
+                 return sm.createMovableObject(name, FoliageLodTreeFactory::FACTORY_TYPE_NAME, &params);
+             },
+             [&](Ogre::MovableObject* object) {
+                 EXPECT_EQ(static_cast<FoliageLodTree*>(object)->getLeafCount(), leaves);
+                 EXPECT_EQ(static_cast<FoliageLodTree*>(object)->getBarkLodIndex(), 0u);
+             }},
+            {"billboard-cloud", ForestLevel{"billboard-cloud", 0, false, 0.0f},
+             [&](const std::string& name) {
+                 Ogre::NameValuePairList params{{"asset", tree.asset->getName()}, {"level", "0"}};
+                 return sm.createMovableObject(name, BillboardCloudTreeFactory::FACTORY_TYPE_NAME, &params);
+             },
+             [](Ogre::MovableObject* object) {
+                 EXPECT_EQ(static_cast<BillboardCloudTree*>(object)->getMaterialLodIndex(), 0u);
+                 EXPECT_EQ(static_cast<BillboardCloudTree*>(object)->getBarkLodIndex(), 0u);
+             }},
+            // The low-res technique of a layered level: BillboardCloudTree with list factor 0
+            // draws the low-res texture alone (its material LoD index 1).
+            {"billboard-cloud-lowres", ForestLevel{"billboard-cloud", 0, true, 0.0f},
+             [&](const std::string& name) {
+                 Ogre::NameValuePairList params{
+                     {"asset", tree.asset->getName()}, {"level", "0"}, {"listFactor", "0"}};
+                 return sm.createMovableObject(name, BillboardCloudTreeFactory::FACTORY_TYPE_NAME, &params);
+             },
+             [](Ogre::MovableObject* object) {
+                 EXPECT_EQ(static_cast<BillboardCloudTree*>(object)->getMaterialLodIndex(), 1u);
+             }},
+        };
+        std::vector<Image> strip;
+        int serial = 0;
+        for (const Case& c : cases)
+        {
+            Ogre::SceneNode* node = nullptr;
+            Forest* forest = placeForest({}, &node);
+            node->setPosition(nodePosition);
+            node->setOrientation(nodeOrientation);
+            forest->addSpecies(tree.asset, {c.level});
+            forest->addInstances(trees);
+            const Image instanced = toImage(r.render(view, width, height, 1));
+            EXPECT_EQ(forest->getStats().visibleInstances, 3u) << c.name;
+            EXPECT_EQ(forest->getStats().levelCounts.at(0).at(0), 3u) << c.name;
+
+            r.clearContent();
+            Ogre::SceneNode* parent = r.getContentNode().createChildSceneNode(nodePosition, nodeOrientation);
+            std::vector<Ogre::MovableObject*> objects;
+            for (const ForestInstance& t : trees)
+            {
+                Ogre::SceneNode* child = parent->createChildSceneNode(
+                    Ogre::Vector3(t.position.x, t.position.y, t.position.z),
+                    Ogre::Quaternion(Ogre::Radian(t.rotationY), Ogre::Vector3::UNIT_Y));
+                child->setScale(Ogre::Vector3(t.scale));
+                objects.push_back(c.create("separate-" + std::to_string(serial++)));
+                child->attachObject(objects.back());
+            }
+            const Image separate = toImage(r.render(view, width, height, 1));
+            for (Ogre::MovableObject* object : objects)
+                c.check(object);
+            const double error = flipMean(instanced, separate);
+            std::printf("%s: instanced vs separate objects FLIP %.5f, coverage %.3f\n", c.name, error,
+                        treeCoverage(instanced, BACKGROUND));
+            EXPECT_LT(error, 0.001) << c.name;
+            EXPECT_GT(treeCoverage(instanced, BACKGROUND), 0.15) << c.name;
+            strip.push_back(instanced);
+            strip.push_back(separate);
+        }
+        writePng(OgreEnvironment::outDir() + "/forest-instanced-vs-separate.png", sideBySide(strip));
+        // Golden: the four Forest pictures side by side at a fifth of the size.
+        compareWithGolden(shrink(sideBySide({strip[0], strip[2], strip[4], strip[6]}), 5), "forest-three-trees", 0.02);
+    }
+
+    TEST(Forest, quadLevelRenders)
+    {
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+        const CameraSpec view = look(glm::vec3(1.5f * h, 3.0f * h, 5.5f * h), glm::vec3(0.0f, 0.2f * h, 0.0f));
+        Forest* forest = placeForest();
+        forest->addSpecies(tree.asset, {ForestLevel{"quad", 0, false, 0.0f}});
+        forest->addInstances(grid(4, 1.3f * h));
+        const Image quads = toImage(r.render(view, 256, 192, 2));
+        EXPECT_EQ(forest->getStats().visibleInstances, 16u);
+        EXPECT_EQ(forest->getStats().batches, 1u);
+        EXPECT_EQ(forest->getStats().triangles, 32u);
+        EXPECT_GT(treeCoverage(quads, BACKGROUND), 0.1);
+        // The same trees as meshes: the quad is the tree seen from afar.
+        forest = placeForest();
+        forest->addSpecies(tree.asset, {ForestLevel{"mesh", 0, false, 0.0f}});
+        forest->addInstances(grid(4, 1.3f * h));
+        const Image meshes = toImage(r.render(view, 256, 192, 2));
+        // The quads stand where the trees stand (their look is the impostor's business,
+        // ImpostorTest): the pixels they cover overlap the polygonal trees'.
+        std::size_t both = 0, either = 0;
+        for (std::size_t i = 0; i < quads.pixels.size(); ++i)
+        {
+            const bool q = glm::length(glm::vec3(quads.pixels[i]) - BACKGROUND) > 0.02f;
+            const bool m = glm::length(glm::vec3(meshes.pixels[i]) - BACKGROUND) > 0.02f;
+            both += q && m;
+            either += q || m;
+        }
+        const double overlap = double(both) / double(std::max<std::size_t>(either, 1));
+        std::printf("quad vs mesh forest: covered pixels in common %.3f, FLIP %.4f\n", overlap,
+                    flipMean(meshes, quads));
+        EXPECT_GT(overlap, 0.6);
+        writePng(OgreEnvironment::outDir() + "/forest-quad-vs-mesh.png", sideBySide({quads, meshes}));
+        compareWithGolden(quads, "forest-quad", 0.02);
+    }
+
+    TEST(Forest, cullingAndLevelCountsMatchForestInstances)
+    {
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+        Forest* forest = placeForest();
+        forest->addSpecies(tree.asset,
+                           Forest::levelsForBands(*tree.asset, {{"billboard-cloud", 40.0f}, {"quad", 0.0f}}));
+        forest->addInstances(grid(12, 1.5f * h));
+        // Standing inside the forest, looking along -Z: the trees behind are not drawn.
+        const glm::vec3 eye(0.0f, 0.5f * h, 0.0f);
+        const CameraSpec view = look(eye, eye + glm::vec3(0.3f, -0.05f, -1.0f), 60.0f);
+        const int width = 160, height = 120;
+        r.render(view, width, height, 1);
+        const ForestStats& stats = forest->getStats();
+
+        ForestVisibility visibility;
+        ASSERT_TRUE(forest->getInstances().cull(CullCamera::fromSpec(view, float(width), float(height)), 1.0f,
+                                                visibility).ok());
+        EXPECT_EQ(stats.instances, 144u);
+        EXPECT_EQ(stats.visibleInstances, visibility.getVisibleCount());
+        EXPECT_GT(stats.visibleInstances, 10u);
+        EXPECT_LT(stats.visibleInstances, 100u) << "about half the forest is behind the camera";
+        for (const ForestBucket& bucket : visibility.getBuckets())
+            EXPECT_EQ(stats.levelCounts.at(bucket.kind).at(bucket.level), bucket.count) << "level " << bucket.level;
+        for (std::uint32_t v = 0; v < visibility.getVisibleCount(); ++v)
+        {
+            const glm::vec4 sphere = forest->getInstances().getWorldSphere(visibility.getIndices()[v]);
+            EXPECT_LT(sphere.z - sphere.w, eye.z) << "an instance behind the camera counted visible";
+        }
+        std::uint32_t levelsInUse = 0;
+        for (std::uint32_t count : flatCounts(*forest))
+            levelsInUse += count > 0;
+        EXPECT_GE(levelsInUse, 2u) << "near and far trees at different levels";
+        EXPECT_GE(stats.cullMilliseconds, 0.0);
+
+        // Looking away from the whole forest (Ogre culls the object whole): nothing visible.
+        r.render(look(glm::vec3(0.0f, 5.0f * h, 0.0f), glm::vec3(0.0f, 100.0f * h, 0.0f)), width, height, 1);
+        EXPECT_EQ(forest->getStats().visibleInstances, 0u);
+        EXPECT_EQ(forest->getStats().batches, 0u);
+        for (std::uint32_t count : flatCounts(*forest))
+            EXPECT_EQ(count, 0u);
+    }
+
+    TEST(Forest, drawsDoNotGrowWithTheInstanceCount)
+    {
+        // One instanced draw per (species, level, part) in use, whatever the number of trees:
+        // the RenderTarget's batch count for 9 and for 100 trees at one level, and for 100
+        // separate objects.
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+        const CameraSpec view = look(glm::vec3(0.0f, 9.0f * h, 14.0f * h), glm::vec3(0.0f, 0.0f, 0.0f), 50.0f);
+        std::vector<FrameTiming> frames;
+        for (const int n : {3, 10})
+        {
+            Forest* forest = placeForest();
+            forest->addSpecies(tree.asset, {ForestLevel{"billboard-cloud", 1, false, 0.0f}});
+            forest->addInstances(grid(n, 1.4f * h));
+            r.renderTimedFrame(view, 256, 192); // warm-up: buffers and programs
+            frames.push_back(r.renderTimedFrame(view, 256, 192));
+            EXPECT_EQ(forest->getStats().visibleInstances, std::uint32_t(n * n));
+            EXPECT_EQ(frames.back().triangles, forest->getStats().triangles);
+        }
+        EXPECT_EQ(frames[0].batches, frames[1].batches);
+        EXPECT_EQ(frames[1].triangles, frames[0].triangles * 100 / 9);
+
+        // 100 trees with the billboard cloud's own levels (and the bark's), against 100
+        // BillboardCloudTrees choosing theirs: the same triangles, in a few draws.
+        Forest* forest = placeForest();
+        forest->addSpecies(tree.asset, Forest::levelsForBands(*tree.asset, {{"billboard-cloud", 0.0f}}));
+        forest->addInstances(grid(10, 1.4f * h));
+        r.renderTimedFrame(view, 256, 192);
+        const FrameTiming levels = r.renderTimedFrame(view, 256, 192);
+        r.clearContent();
+        int serial = 0;
+        for (const ForestInstance& t : grid(10, 1.4f * h))
+        {
+            Ogre::SceneNode* node = r.getContentNode().createChildSceneNode(
+                Ogre::Vector3(t.position.x, t.position.y, t.position.z),
+                Ogre::Quaternion(Ogre::Radian(t.rotationY), Ogre::Vector3::UNIT_Y));
+            node->setScale(Ogre::Vector3(t.scale));
+            Ogre::NameValuePairList params{{"asset", tree.asset->getName()}};
+            node->attachObject(r.getSceneManager().createMovableObject(
+                "bcGrid" + std::to_string(serial++), BillboardCloudTreeFactory::FACTORY_TYPE_NAME, &params));
+        }
+        r.renderTimedFrame(view, 256, 192);
+        const FrameTiming separate = r.renderTimedFrame(view, 256, 192);
+        r.clearContent();
+        std::printf("billboard-cloud level 1: Forest 9 trees %zu batches %zu triangles %.1f ms, 100 trees %zu "
+                    "batches %zu triangles %.1f ms; its levels: Forest %zu batches %zu triangles %.1f ms, "
+                    "100 BillboardCloudTrees %zu batches %zu triangles %.1f ms\n",
+                    frames[0].batches, frames[0].triangles, frames[0].frameMilliseconds, frames[1].batches,
+                    frames[1].triangles, frames[1].frameMilliseconds, levels.batches, levels.triangles,
+                    levels.frameMilliseconds, separate.batches, separate.triangles, separate.frameMilliseconds);
+        // Near-equal, not equal: BillboardCloudTree measures its LoD with the cloud's radius, the
+        // Forest with the reference's (the bark's switch moves a little).
+        EXPECT_NEAR(double(levels.triangles), double(separate.triangles), 0.05 * double(separate.triangles));
+        EXPECT_GE(separate.batches, 100u);
+        EXPECT_LT(levels.batches, 12u);
+    }
+
+    TEST(Forest, levelOfDetailExtremesBiasAndFreeze)
+    {
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+        Forest* forest = placeForest();
+        const std::vector<ForestLevel> levels = Forest::levelsForBands(*tree.asset, Forest::getAutoBands());
+        forest->addSpecies(tree.asset, levels);
+        forest->addInstances(grid(5, 1.4f * h));
+        const std::size_t last = levels.size() - 1;
+
+        // 10 km away: everything at the last level (the quad), a few pixels.
+        const Image distant = toImage(r.render(look(glm::vec3(0.0f, 200.0f, 10000.0f), glm::vec3(0.0f)), 96, 96, 1));
+        EXPECT_EQ(forest->getStats().visibleInstances, 25u);
+        EXPECT_EQ(forest->getStats().levelCounts[0][last], 25u);
+        EXPECT_EQ(levels[last].technique, "quad");
+        EXPECT_LT(treeCoverage(distant, BACKGROUND), 0.01);
+
+        // Inside the middle tree's crown: no failure, leaves all around.
+        const glm::vec3 centre = 0.5f * (tree.model.boundsMin + tree.model.boundsMax);
+        const CameraSpec crown =
+            look(centre + glm::vec3(0.0f, 0.0f, 0.3f), centre + glm::vec3(0.0f, 0.0f, -5.0f), 70.0f);
+        const Image inside = toImage(r.render(crown, 96, 96, 1));
+        EXPECT_GT(treeCoverage(inside, BACKGROUND), 0.3);
+        EXPECT_GT(forest->getStats().visibleInstances, 0u);
+
+        // LoD bias raises detail: the Forest's and the camera's multiply.
+        const CameraSpec mid = look(glm::vec3(0.0f, 3.0f * h, 10.0f * h), glm::vec3(0.0f, 0.3f * h, 0.0f));
+        r.render(mid, 256, 192, 1);
+        EXPECT_EQ(forest->getStats().visibleInstances, 25u);
+        const double plain = meanLevel(*forest);
+        std::printf("25 trees, automatic bands, mid view: %u batches, %llu triangles, levels",
+                    forest->getStats().batches, (unsigned long long)forest->getStats().triangles);
+        for (std::uint32_t count : flatCounts(*forest))
+            std::printf(" %u", count);
+        std::printf("\n");
+        forest->setLodBias(8.0f);
+        r.render(mid, 256, 192, 1);
+        const double biased = meanLevel(*forest);
+        forest->setLodBias(1.0f);
+        r.setLodBias(8.0f);
+        r.render(mid, 256, 192, 1);
+        const double cameraBiased = meanLevel(*forest);
+        r.setLodBias(1.0f);
+        std::printf("mean level: bias 1 %.2f, Forest bias 8 %.2f, camera bias 8 %.2f\n", plain, biased, cameraBiased);
+        EXPECT_LT(biased, plain);
+        EXPECT_DOUBLE_EQ(cameraBiased, biased);
+
+        // Frozen LoD: levels stay while the camera moves back (every tree stays in view).
+        r.render(mid, 256, 192, 1);
+        const std::vector<std::uint32_t> before = flatCounts(*forest);
+        forest->setLodFrozen(true);
+        const CameraSpec back = look(glm::vec3(0.0f, 4.0f * h, 30.0f * h), glm::vec3(0.0f, 0.3f * h, 0.0f));
+        r.render(back, 256, 192, 1);
+        EXPECT_EQ(flatCounts(*forest), before);
+        forest->setLodFrozen(false);
+        r.render(back, 256, 192, 1);
+        EXPECT_NE(flatCounts(*forest), before) << "unfrozen, the far view drops detail";
+        EXPECT_EQ(forest->getStats().visibleInstances, 25u);
+    }
+
+    TEST(Forest, castsAndReceivesTextureShadows)
+    {
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        Ogre::SceneManager& sm = r.getSceneManager();
+        const float h = treeHeight(tree.model);
+        // A ground material receiving the sun's shadow (TreeLod/BarkShadowed, untextured).
+        Ogre::MaterialManager& materials = Ogre::MaterialManager::getSingleton();
+        for (const char* suffix : {"", "Shadowed"})
+        {
+            const Ogre::String name = Ogre::String("ForestTest/Ground") + suffix;
+            if (materials.resourceExists(name, "TreeLod"))
+                continue;
+            Ogre::MaterialPtr ground =
+                materials.getByName(Ogre::String("TreeLod/Bark") + suffix, "TreeLod")->clone(name);
+            ground->getTechnique(0)->getPass(0)->getFragmentProgramParameters()->setNamedConstant(
+                "baseColour", Ogre::ColourValue(0.45f, 0.5f, 0.3f, 1.0f));
+            ground->load();
+        }
+        auto place = [&](const std::function<void(Ogre::SceneNode&)>& trees, bool shadowed) {
+            r.clearContent();
+            Ogre::ManualObject* ground = sm.createManualObject();
+            ground->setCastShadows(false);
+            ground->begin(shadowed ? "ForestTest/GroundShadowed" : "ForestTest/Ground",
+                          Ogre::RenderOperation::OT_TRIANGLE_LIST, "TreeLod");
+            const float s = 4.0f * h;
+            for (const glm::vec2 c : {glm::vec2(-s, -s), glm::vec2(s, -s), glm::vec2(s, s), glm::vec2(-s, s)})
+            {
+                ground->position(c.x, 0.0f, c.y);
+                ground->normal(0.0f, 1.0f, 0.0f);
+                ground->textureCoord(0.0f, 0.0f);
+            }
+            ground->quad(0, 3, 2, 1); // counter-clockwise seen from above
+            ground->end();
+            r.getContentNode().createChildSceneNode()->attachObject(ground);
+            trees(*r.getContentNode().createChildSceneNode());
+        };
+        const std::vector<ForestInstance> trees = {instance(-0.6f * h, 0, 0.3f * h, 0.5f, 0.9f),
+                                                   instance(0.5f * h, 0, -0.4f * h, 2.0f, 1.1f)};
+        // The polygonal trees: the Forest's mesh level against Entities of the reference mesh
+        // with its shadow-receiving materials and full bark detail.
+        auto forestTrees = [&](Ogre::SceneNode& node) {
+            static int serial = 0;
+            auto* forest =
+                static_cast<Forest*>(sm.createMovableObject("forestShadow" + std::to_string(serial++), "Forest"));
+            forest->addSpecies(tree.asset, {ForestLevel{"mesh", 0, false, 0.0f}});
+            forest->addInstances(trees);
+            node.attachObject(forest);
+        };
+        auto separateTrees = [&](Ogre::SceneNode& node) {
+            const std::vector<Ogre::String>& plainNames = tree.asset->getMaterialNames();
+            const std::vector<Ogre::String>& shadowedNames = tree.asset->getShadowedMaterialNames();
+            for (const ForestInstance& t : trees)
+            {
+                Ogre::SceneNode* child = node.createChildSceneNode(
+                    Ogre::Vector3(t.position.x, t.position.y, t.position.z),
+                    Ogre::Quaternion(Ogre::Radian(t.rotationY), Ogre::Vector3::UNIT_Y));
+                child->setScale(Ogre::Vector3(t.scale));
+                Ogre::Entity* entity = sm.createEntity(tree.asset->getReferenceMesh());
+                entity->setMeshLodBias(1.0f, 0, 0);
+                for (unsigned i = 0; i < entity->getNumSubEntities(); ++i)
+                {
+                    Ogre::SubEntity* sub = entity->getSubEntity(i);
+                    const auto it = std::find(plainNames.begin(), plainNames.end(), sub->getMaterialName());
+                    ASSERT_NE(it, plainNames.end());
+                    sub->setMaterialName(shadowedNames[std::size_t(it - plainNames.begin())], tree.asset->getGroup());
+                }
+                child->attachObject(entity);
+            }
+        };
+        const CameraSpec view = look(glm::vec3(0.5f * h, 1.3f * h, 2.3f * h), glm::vec3(0.0f, 0.25f * h, 0.0f), 45.0f);
+        place(forestTrees, false);
+        const Image plain = toImage(r.render(view, 192, 160, 2));
+        place(forestTrees, true);
+        r.setShadows(true, 1024);
+        const Image shadowed = toImage(r.render(view, 192, 160, 2));
+        place(separateTrees, true);
+        const Image separate = toImage(r.render(view, 192, 160, 2));
+        // Billboard clouds (their own levels): the cloud's instanced casters against BillboardCloudTrees'.
+        auto forestClouds = [&](Ogre::SceneNode& node) {
+            static int serial = 0;
+            auto* forest =
+                static_cast<Forest*>(sm.createMovableObject("forestCloud" + std::to_string(serial++), "Forest"));
+            forest->addSpecies(tree.asset, Forest::levelsForBands(*tree.asset, {{"billboard-cloud", 0.0f}}));
+            forest->addInstances(trees);
+            node.attachObject(forest);
+        };
+        auto separateClouds = [&](Ogre::SceneNode& node) {
+            static int serial = 0;
+            for (const ForestInstance& t : trees)
+            {
+                Ogre::SceneNode* child = node.createChildSceneNode(
+                    Ogre::Vector3(t.position.x, t.position.y, t.position.z),
+                    Ogre::Quaternion(Ogre::Radian(t.rotationY), Ogre::Vector3::UNIT_Y));
+                child->setScale(Ogre::Vector3(t.scale));
+                Ogre::NameValuePairList params{{"asset", tree.asset->getName()}};
+                child->attachObject(sm.createMovableObject("cloudShadow" + std::to_string(serial++),
+                                                           BillboardCloudTreeFactory::FACTORY_TYPE_NAME, &params));
+            }
+        };
+        place(forestClouds, true);
+        const Image cloudForest = toImage(r.render(view, 192, 160, 2));
+        place(separateClouds, true);
+        const Image cloudSeparate = toImage(r.render(view, 192, 160, 2));
+        // LiSPSM (paper 000 §5.2): a perspective shadow camera with its own matrices culls too.
+        place(forestTrees, true);
+        r.setShadows(true, 1024, ShadowCamera::LiSPSM);
+        const Image lispsm = toImage(r.render(view, 192, 160, 2));
+        r.setShadows(false);
+        r.clearContent();
+        const double drop = meanLuminance(plain) - meanLuminance(shadowed);
+        const double error = flipMean(shadowed, separate);
+        std::printf("shadows: luminance drop %.4f, Forest vs separate Entities FLIP %.5f\n", drop, error);
+        EXPECT_GT(drop, 0.01) << "the trees' shadows must darken the ground and the crowns";
+        const double cloudError = flipMean(cloudForest, cloudSeparate);
+        std::printf("shadows: billboard-cloud Forest vs separate BillboardCloudTrees FLIP %.5f\n", cloudError);
+        EXPECT_LT(cloudError, 0.015);
+        const double dropLispsm = meanLuminance(plain) - meanLuminance(lispsm);
+        std::printf("LiSPSM: luminance drop %.4f\n", dropLispsm);
+        EXPECT_NEAR(dropLispsm, drop, 0.5 * drop);
+        // Not 0: the focused shadow camera frames the Forest's bounds (spheres), not the
+        // Entities' boxes, so the shadow texels fall differently.
+        EXPECT_LT(error, 0.015) << "instanced casters and receivers as the separate objects'";
+        writePng(OgreEnvironment::outDir() + "/forest-shadows-strip.png",
+                 sideBySide({plain, shadowed, separate, lispsm, cloudForest, cloudSeparate}));
+        compareWithGolden(shadowed, "forest-shadows", 0.02);
+    }
+
+    TEST(Forest, badInputIsRefusedAndNamed)
+    {
+        const ForestTree& tree = oak();
+        Forest* forest = placeForest();
+        forest->addSpecies(tree.asset, {ForestLevel{"quad", 0, false, 0.0f}});
+        forest->addInstances({instance(0, 0, 0)});
+        const Ogre::AxisAlignedBox bounds = forest->getBoundingBox();
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        const std::pair<std::vector<ForestInstance>, const char*> cases[] = {
+            {{instance(1, 0, 0), instance(2, 0, 0), instance(nan, 0, 0)}, "instance 2"},
+            {{instance(1, 0, 0), instance(2, 0, 0, 0.0f, 0.0f)}, "instance 1"},
+            {{instance(1, 0, 0, std::numeric_limits<float>::infinity())}, "instance 0"},
+            {{instance(1, 0, 0, 0.0f, 1.0f, 7)}, "instance 0"},
+        };
+        for (const auto& c : cases)
+        {
+            try
+            {
+                forest->addInstances(c.first);
+                ADD_FAILURE() << c.second << " must be refused";
+            }
+            catch (const Ogre::InvalidParametersException& e)
+            {
+                EXPECT_NE(e.getDescription().find(c.second), std::string::npos) << e.getDescription();
+            }
+            EXPECT_EQ(forest->getInstances().size(), 1u) << "nothing added";
+            EXPECT_EQ(forest->getBoundingBox(), bounds);
+        }
+
+        // Species: bad level lists are named, nothing is added.
+        const std::pair<std::vector<ForestLevel>, const char*> levels[] = {
+            {{}, "0 levels"},
+            {{ForestLevel{"mesh", 0, false, 10.0f}, ForestLevel{"quad", 0, false, 20.0f}}, "level 1 'quad'"},
+            {{ForestLevel{"mesh", 0, false, 10.0f}}, "level 0 'mesh'"},
+            {{ForestLevel{"trees", 0, false, 0.0f}}, "unknown technique"},
+            {{ForestLevel{"lodf", 0, true, 0.0f}}, "lowRes"},
+            {{ForestLevel{"billboard-cloud", 9, false, 0.0f}}, "cloud level 9"},
+        };
+        for (const auto& c : levels)
+        {
+            try
+            {
+                forest->addSpecies(tree.asset, c.first);
+                ADD_FAILURE() << c.second << " must be refused";
+            }
+            catch (const Ogre::Exception& e)
+            {
+                EXPECT_NE(e.getDescription().find(c.second), std::string::npos) << e.getDescription();
+            }
+            EXPECT_EQ(forest->getSpeciesCount(), 1u);
+        }
+        EXPECT_THROW(forest->setLodBias(0.0f), Ogre::InvalidParametersException);
+
+        // Bands: an unknown technique, bands out of order, a package without the chunk.
+        try
+        {
+            Forest::levelsForBands(*tree.asset, {{"lodf", 100.0f}, {"bush", 0.0f}});
+            ADD_FAILURE() << "an unknown technique must throw";
+        }
+        catch (const Ogre::Exception& e)
+        {
+            EXPECT_NE(e.getDescription().find("band 1 'bush'"), std::string::npos) << e.getDescription();
+        }
+        EXPECT_THROW(Forest::levelsForBands(*tree.asset, {{"lodf", 10.0f}, {"mesh", 20.0f}, {"quad", 0.0f}}),
+                     Ogre::InvalidParametersException);
+        EXPECT_THROW(Forest::levelsForBands(*tree.asset, {{"lodf", 10.0f}}), Ogre::InvalidParametersException);
+        PackageWriter writer;
+        ASSERT_TRUE(addReferenceChunk(writer, tree.model, "ref-only").ok());
+        TreeAssetPtr refOnly =
+            TreeAssetManager::getSingleton().loadFromBytes("ref-only.forest-test", Ogre::RGN_DEFAULT, writer.toBytes());
+        try
+        {
+            Forest::levelsForBands(*refOnly, {{"mesh", 100.0f}, {"lodf", 0.0f}});
+            ADD_FAILURE() << "a package without lodf must throw";
+        }
+        catch (const Ogre::Exception& e)
+        {
+            EXPECT_NE(e.getDescription().find("band 1 'lodf'"), std::string::npos) << e.getDescription();
+            EXPECT_NE(e.getDescription().find("--technique lodf"), std::string::npos) << e.getDescription();
+        }
+    }
+
+    TEST(Forest, sharedAssetOneInstanceAndTwentyThousandQuads)
+    {
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+
+        // Two species of one asset: each draws its own technique.
+        Forest* forest = placeForest();
+        EXPECT_EQ(forest->addSpecies(tree.asset, {ForestLevel{"lodf", 0, false, 0.0f}}), 0u);
+        EXPECT_EQ(forest->addSpecies(tree.asset, {ForestLevel{"billboard-cloud", 1, false, 0.0f}}), 1u);
+        forest->addInstances({instance(-0.6f * h, 0, 0, 0.0f, 1.0f, 0), instance(0.6f * h, 0, 0, 0.0f, 1.0f, 1)});
+        const CameraSpec pair = look(glm::vec3(0.0f, 0.5f * h, 2.5f * h), glm::vec3(0.0f, 0.5f * h, 0.0f));
+        const Image two = toImage(r.render(pair, 128, 96, 1));
+        EXPECT_EQ(forest->getStats().levelCounts, (std::vector<std::vector<std::uint32_t>>{{1u}, {1u}}));
+        EXPECT_GT(treeCoverage(two, BACKGROUND), 0.1);
+        EXPECT_EQ(forest->getAsset(0), forest->getAsset(1));
+
+        // One instance.
+        forest = placeForest();
+        forest->addSpecies(tree.asset, Forest::levelsForBands(*tree.asset, Forest::getAutoBands()));
+        forest->addInstances({instance(0, 0, 0)});
+        const Image one = toImage(r.render(pair, 96, 96, 1));
+        EXPECT_EQ(forest->getStats().visibleInstances, 1u);
+        EXPECT_GT(treeCoverage(one, BACKGROUND), 0.05);
+
+        // 20,000 quads (a 142 x 142 grid, 1.2 tree heights apart) seen from a little above the edge.
+        forest = placeForest();
+        forest->addSpecies(tree.asset, {ForestLevel{"quad", 0, false, 0.0f}});
+        forest->addInstances(grid(142, 1.2f * h));
+        const float half = 71.0f * 1.2f * h;
+        const CameraSpec over = look(glm::vec3(0.0f, 4.0f * h, half + 8.0f * h), glm::vec3(0.0f, 0.0f, 0.0f), 60.0f);
+        const auto start = std::chrono::steady_clock::now();
+        const Image many = toImage(r.render(over, 256, 160, 1));
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        const ForestStats& stats = forest->getStats();
+        std::printf("20164 quads: %u visible, %u batches, %llu triangles, cull %.3f ms, frame %.0f ms\n",
+                    stats.visibleInstances, stats.batches, (unsigned long long)stats.triangles,
+                    stats.cullMilliseconds, ms);
+        EXPECT_EQ(stats.instances, 142u * 142u);
+        EXPECT_GT(stats.visibleInstances, 10000u);
+        EXPECT_EQ(stats.batches, 1u);
+        EXPECT_EQ(stats.triangles, 2u * stats.visibleInstances);
+        EXPECT_GT(treeCoverage(many, BACKGROUND), 0.2);
+        // 24 bytes per instance on the GPU, grown by doubling; the next frame allocates nothing.
+        const std::uint64_t bytes = stats.instanceBufferBytes;
+        EXPECT_GE(bytes, 24u * stats.visibleInstances);
+        EXPECT_LE(bytes, 2u * 24u * stats.visibleInstances);
+        r.render(over, 256, 160, 1);
+        EXPECT_EQ(forest->getStats().instanceBufferBytes, bytes);
+        compareWithGolden(many, "forest-20k-quads", 0.02);
+    }
+
+    TEST(Forest, levelsForBandsFollowTheTechniquesCurves)
+    {
+        const ForestTree& tree = oak();
+        TreeAsset& asset = *tree.asset;
+        const std::vector<ForestLevel> levels = Forest::levelsForBands(asset, Forest::getAutoBands());
+        ASSERT_GE(levels.size(), 3u);
+        for (std::size_t l = 1; l < levels.size(); ++l)
+            EXPECT_LT(levels[l].minPixelCount, levels[l - 1].minPixelCount);
+        EXPECT_EQ(levels.back().minPixelCount, 0.0f);
+        EXPECT_EQ(levels.back().technique, "quad");
+        EXPECT_EQ(levels.front().technique, "lodf");
+        EXPECT_EQ(levels.front().techniqueLevel, asset.getFoliageLod().maxLeafCount());
+
+        // Band edges: a tree h_px tall has r_px = h_px * R / h, value 4 pi r_px^2.
+        const Ogre::AxisAlignedBox bounds = asset.getBounds();
+        const double radius = Ogre::Math::boundingRadiusFromAABB(bounds);
+        const double height = bounds.getMaximum().y - bounds.getMinimum().y;
+        auto value = [&](double pixels) {
+            const double r = pixels * radius / height;
+            return 4.0 * Ogre::Math::PI * r * r;
+        };
+        std::size_t lastLodf = 0, lastCloud = 0;
+        for (std::size_t l = 0; l < levels.size(); ++l)
+        {
+            if (levels[l].technique == "lodf")
+                lastLodf = l;
+            if (levels[l].technique == "billboard-cloud")
+                lastCloud = l;
+        }
+        EXPECT_NEAR(levels[lastLodf].minPixelCount, value(160.0), 1e-3 * value(160.0));
+        EXPECT_NEAR(levels[lastCloud].minPixelCount, value(24.0), 1e-3 * value(24.0));
+        // A level repeated with the same drawable: split where its bark mesh's LoD switches.
+        auto isBarkSwitch = [](const Ogre::MeshPtr& bark, Ogre::Real value) {
+            for (unsigned short i = 1; i < bark->getNumLodLevels(); ++i)
+                if (bark->getLodLevel(i).value == value)
+                    return true;
+            return false;
+        };
+        auto same = [](const ForestLevel& a, const ForestLevel& b) {
+            return a.technique == b.technique && a.techniqueLevel == b.techniqueLevel && a.lowRes == b.lowRes;
+        };
+        std::size_t barkSplits = 0;
+        // lodf: halving counts, each kept while FoliageLodTree's curve asks for more than the next.
+        for (std::size_t l = 0; l < lastLodf; ++l)
+        {
+            if (same(levels[l], levels[l + 1]))
+            {
+                EXPECT_TRUE(isBarkSwitch(asset.getBarkMesh(), levels[l].minPixelCount)) << "level " << l;
+                ++barkSplits;
+                continue;
+            }
+            EXPECT_EQ(levels[l + 1].techniqueLevel, (levels[l].techniqueLevel + 1) / 2);
+            EXPECT_FLOAT_EQ(levels[l].minPixelCount,
+                            FoliageLodTree::pixelCountForLeaves(levels[l + 1].techniqueLevel,
+                                                                FoliageLodTree::DEFAULT_PIXELS_PER_LEAF));
+        }
+        // Billboard cloud: BillboardCloudTree's switches (in the same units) inside the band.
+        const BillboardCloudGpu& gpu = asset.getBillboardCloudGpu(false);
+        const std::vector<Ogre::Real> switches =
+            BillboardCloudTree::switchPixelCounts(gpu, gpu.listFactor, float(radius));
+        for (std::size_t l = lastLodf + 1; l < lastCloud; ++l)
+        {
+            const ForestLevel& level = levels[l];
+            const ForestLevel& next = levels[l + 1];
+            if (same(level, next))
+            {
+                EXPECT_TRUE(isBarkSwitch(asset.getBarkAoMesh(false), level.minPixelCount)) << "level " << l;
+                ++barkSplits;
+            }
+            else if (next.techniqueLevel == level.techniqueLevel)
+                EXPECT_TRUE(!level.lowRes && next.lowRes) << "a layered level, then its low-res technique";
+            else
+                EXPECT_FLOAT_EQ(level.minPixelCount, switches.at(level.techniqueLevel));
+        }
+        EXPECT_GT(barkSplits, 0u) << "the bark's LoD switches inside the billboard-cloud band";
+        std::printf("auto levels of oak:");
+        for (const ForestLevel& level : levels)
+            std::printf(" %s/%u%s>=%.0f", level.technique.c_str(), level.techniqueLevel, level.lowRes ? "lowres" : "",
+                        level.minPixelCount);
+        std::printf("\n");
+
+        // A single band: the technique's own levels from the finest to 0.
+        const std::vector<ForestLevel> lodf = Forest::levelsForBands(asset, {{"lodf", 0.0f}});
+        EXPECT_EQ(lodf.back().techniqueLevel, asset.getFoliageLod().minLeafCount());
+        const std::vector<ForestLevel> mesh = Forest::levelsForBands(asset, {{"mesh", 0.0f}});
+        const Ogre::MeshPtr reference = asset.getReferenceMesh();
+        ASSERT_EQ(mesh.size(), std::size_t(reference->getNumLodLevels()));
+        for (std::size_t l = 0; l + 1 < mesh.size(); ++l)
+        {
+            EXPECT_EQ(mesh[l].technique, "mesh");
+            EXPECT_EQ(mesh[l].minPixelCount, reference->getLodLevel(std::uint16_t(l + 1)).value);
+        }
+    }
+}
