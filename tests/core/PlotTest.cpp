@@ -143,6 +143,9 @@ TEST(PlotTicks, logAxesUseDecadesWithMinorTicks)
     t = plotTicks(1.0e-8, 1.0e12, true, 8);
     EXPECT_EQ(t.labels, (std::vector<std::string>{"1e-5", "1", "1e5", "1e10"}));
     EXPECT_EQ(t.minor.size(), 21u - 4u);
+    // Once one label needs an exponent, all from 1e3 on have one.
+    EXPECT_EQ(plotTicks(2.0, 3.0e6, true, 8).labels,
+              (std::vector<std::string>{"10", "100", "1e3", "1e4", "1e5", "1e6"}));
 
     // Only one decade inside: 2 and 5 x 10^k join the labels.
     t = plotTicks(0.3, 8.0, true, 8);
@@ -354,4 +357,40 @@ TEST(Plot, deterministicAndWritesExamples)
     empty.xLabel = "x";
     empty.yLabel = "y";
     ASSERT_TRUE(writePlot(testOut("example-empty.png").string(), empty).ok());
+}
+
+// Degenerate input still gives a sane frame and a finished picture.
+TEST(Plot, oddInputsStillDrawAPlot)
+{
+    PlotSpec one; // a single point: the range opens 10% around it
+    one.series.emplace_back();
+    one.series[0].points = {{5.0, 5.0}, {5.0, 5.0}};
+    PlotFrame f = plotFrame(one);
+    EXPECT_NEAR(f.xMin, 4.5, 1e-12);
+    EXPECT_NEAR(f.xMax, 5.5, 1e-12);
+    EXPECT_FALSE(plotTicks(f.xMin, f.xMax, false).major.empty());
+
+    PlotSpec odd;
+    odd.width = 10; // clamped to 200 x 150
+    odd.height = 10;
+    odd.title = "caf\xc3\xa9 \x01";                                   // non-ASCII draws as '?'
+    odd.series.push_back({"huge", {{-1e300, 1e-300}, {1e300, 2e-300}}}); // range overflows double
+    for (int i = 0; i < 12; ++i)                                         // palette wraps, legend overflows
+        odd.series.push_back({"series " + std::to_string(i), {{0.0, double(i)}, {1.0, double(i + 1)}}});
+    odd.markers.push_back({"odd shape", {0.5, 0.5}, glm::vec3(0.0f), '?'});
+    odd.series[1].lineWidth = -3.0f;
+    // A span at the limit of double precision: no ticks rather than a hang.
+    EXPECT_TRUE(plotTicks(1e12, 1e12 + 1e-3, false).major.empty());
+    PlotSpec narrow;
+    narrow.series.emplace_back();
+    narrow.series[0].points = {{1e12, 1.0}, {std::nextafter(1e12, 2e12), 2.0}};
+    EXPECT_EQ(drawPlot(narrow).width, 960);
+    Image image = drawPlot(odd);
+    EXPECT_EQ(image.width, 200);
+    EXPECT_EQ(image.height, 150);
+    f = plotFrame(odd);
+    EXPECT_LT(f.left, f.right);
+    EXPECT_LT(f.top, f.bottom);
+    EXPECT_TRUE(std::isfinite(f.xMin) && std::isfinite(f.xMax) && f.xMin < f.xMax);
+    ASSERT_TRUE(writePlot(testOut("example-odd.png").string(), odd).ok());
 }

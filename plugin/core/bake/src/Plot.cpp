@@ -17,6 +17,7 @@ namespace TreeLod
         // bit 7 = leftmost of the 6 columns; baseline below row 10.
         constexpr int kGlyphW = 6;
         constexpr int kGlyphH = 13;
+        // clang-format off
         constexpr std::uint8_t kFont[95][kGlyphH] = {
     {0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00}, // space
     {0x00, 0x00, 0x20, 0x20, 0x20, 0x20, 0x20, 0x20, 0x20, 0x00, 0x20, 0x00, 0x00}, // !
@@ -114,6 +115,7 @@ namespace TreeLod
     {0x00, 0xc0, 0x20, 0x20, 0x20, 0x20, 0x18, 0x20, 0x20, 0x20, 0x20, 0xc0, 0x00}, // }
     {0x00, 0x00, 0x48, 0xa8, 0x90, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00}, // ~
         };
+        // clang-format on
 
         // Paul Tol's "bright" qualitative scheme (colour-blind safe), in sRGB.
         const glm::vec3 kPalette[] = {
@@ -133,6 +135,11 @@ namespace TreeLod
         constexpr int kMinorTickLen = 3; // minor tick
         constexpr int kTickGap = 4;      // tick to its label
         constexpr int kTitleScale = 2;
+
+        double lineWidthOf(const PlotSeries& s)
+        {
+            return std::isfinite(s.lineWidth) && s.lineWidth > 0.0f ? double(s.lineWidth) : 2.0;
+        }
 
         bool usable(double v, bool logScale) { return std::isfinite(v) && (!logScale || v > 0.0); }
 
@@ -156,11 +163,12 @@ namespace TreeLod
             return buffer;
         }
 
-        // "2e6", "0.001", "100": a value that is m * 10^k with an integer m.
-        std::string formatPower(double v)
+        // "2e6", "0.001", "100": a value that is m * 10^k with an integer m; with `exponents`
+        // (some label on the axis needs one) every |k| >= 3 gets one too, so the axis reads alike.
+        std::string formatPower(double v, bool exponents)
         {
             int k = floorLog10(v);
-            if (k >= -3 && k <= 4)
+            if (exponents ? std::abs(k) < 3 : k >= -3 && k <= 4)
                 return printf1("%.*f", std::max(0, -k), v);
             char buffer[64];
             std::snprintf(buffer, sizeof buffer, "%de%d", int(std::lround(v / pow10i(k))), k);
@@ -207,6 +215,8 @@ namespace TreeLod
                     double first = std::ceil(lo / step - 1e-9), last = std::floor(hi / step + 1e-9);
                     if (last - first + 1.0 > maxMajor)
                         continue;
+                    if (std::abs(first) > 1e15 || std::abs(last) > 1e15)
+                        return ticks; // the span is below double precision of the values: no ticks
                     for (double i = first; i <= last; i += 1.0)
                         ticks.major.push_back(scaled(i * m, k));
                     ticks.labels = linearLabels(ticks.major, k);
@@ -227,7 +237,10 @@ namespace TreeLod
             for (int m = 1;; m *= 10)
             {
                 auto count = [&](int e) { return int(std::floor(double(d1) / e) - std::ceil(double(d0) / e)) + 1; };
-                int s = count(m) <= maxMajor ? m : count(2 * m) <= maxMajor ? 2 * m : count(5 * m) <= maxMajor ? 5 * m : 0;
+                int s = count(m) <= maxMajor       ? m
+                        : count(2 * m) <= maxMajor ? 2 * m
+                        : count(5 * m) <= maxMajor ? 5 * m
+                                                   : 0;
                 if (s != 0 || m > d1 - d0)
                 {
                     every = s != 0 ? s : m;
@@ -255,8 +268,11 @@ namespace TreeLod
                 }
             }
             std::sort(ticks.major.begin(), ticks.major.end());
+            bool exponents = false;
             for (double v : ticks.major)
-                ticks.labels.push_back(formatPower(v));
+                exponents |= floorLog10(v) < -3 || floorLog10(v) > 4;
+            for (double v : ticks.major)
+                ticks.labels.push_back(formatPower(v, exponents));
             return ticks;
         }
 
@@ -266,8 +282,7 @@ namespace TreeLod
         {
         public:
             Coverage(int width, int height) : mWidth(width), mHeight(height), mValues(std::size_t(width) * height, 0.0f)
-            {
-            }
+            {}
 
             void clip(int x0, int y0, int x1, int y1)
             {
@@ -282,8 +297,10 @@ namespace TreeLod
                     return;
                 double half = std::max(width, 1.0) * 0.5;
                 double fade = std::min(width, 1.0);
-                int x0 = int(std::floor(std::min(a.x, b.x) - half - 1.0)), x1 = int(std::ceil(std::max(a.x, b.x) + half + 1.0));
-                int y0 = int(std::floor(std::min(a.y, b.y) - half - 1.0)), y1 = int(std::ceil(std::max(a.y, b.y) + half + 1.0));
+                int x0 = int(std::floor(std::min(a.x, b.x) - half - 1.0)),
+                    x1 = int(std::ceil(std::max(a.x, b.x) + half + 1.0));
+                int y0 = int(std::floor(std::min(a.y, b.y) - half - 1.0)),
+                    y1 = int(std::ceil(std::max(a.y, b.y) + half + 1.0));
                 glm::dvec2 ab = b - a;
                 double len2 = glm::dot(ab, ab);
                 forEach(x0, y0, x1, y1, [&](int x, int y) {
@@ -296,8 +313,8 @@ namespace TreeLod
 
             void disc(glm::dvec2 c, double radius)
             {
-                forEach(int(std::floor(c.x - radius - 1)), int(std::floor(c.y - radius - 1)), int(std::ceil(c.x + radius + 1)),
-                        int(std::ceil(c.y + radius + 1)), [&](int x, int y) {
+                forEach(int(std::floor(c.x - radius - 1)), int(std::floor(c.y - radius - 1)),
+                        int(std::ceil(c.x + radius + 1)), int(std::ceil(c.y + radius + 1)), [&](int x, int y) {
                             double d = glm::length(glm::dvec2(x + 0.5, y + 0.5) - c);
                             return float(std::clamp(radius + 0.5 - d, 0.0, 1.0));
                         });
@@ -405,7 +422,8 @@ namespace TreeLod
         int textWidth(const std::string& text, int scale = 1) { return int(text.size()) * kGlyphW * scale; }
 
         // Text with its top-left corner at (x, y); each font pixel becomes scale x scale pixels.
-        void drawText(Image& image, int x, int y, const std::string& text, int scale = 1, const glm::vec3& colour = kInk)
+        void drawText(Image& image, int x, int y, const std::string& text, int scale = 1,
+                      const glm::vec3& colour = kInk)
         {
             for (char ch : text)
             {
@@ -414,8 +432,8 @@ namespace TreeLod
                 for (int r = 0; r < kGlyphH; ++r)
                     for (int c = 0; c < kGlyphW; ++c)
                         if (rows[r] & (0x80 >> c))
-                            fillRect(image, x + c * scale, y + r * scale, x + (c + 1) * scale - 1, y + (r + 1) * scale - 1,
-                                     colour);
+                            fillRect(image, x + c * scale, y + r * scale, x + (c + 1) * scale - 1,
+                                     y + (r + 1) * scale - 1, colour);
                 x += kGlyphW * scale;
             }
         }
@@ -430,7 +448,8 @@ namespace TreeLod
                 break;
             case 's':
             {
-                glm::dvec2 p[4] = {c + glm::dvec2(-r, -r), c + glm::dvec2(r, -r), c + glm::dvec2(r, r), c + glm::dvec2(-r, r)};
+                glm::dvec2 p[4] = {c + glm::dvec2(-r, -r), c + glm::dvec2(r, -r), c + glm::dvec2(r, r),
+                                   c + glm::dvec2(-r, r)};
                 for (int i = 0; i < 4; ++i)
                     mask.segment(p[i], p[(i + 1) % 4], width);
                 break;
@@ -525,8 +544,9 @@ namespace TreeLod
                 {
                     double d = std::abs(axisPixel(ticks.major[i], lo, hi, logScale, p0, p1) -
                                         axisPixel(ticks.major[i - 1], lo, hi, logScale, p0, p1));
-                    double need = horizontal ? (textWidth(ticks.labels[i]) + textWidth(ticks.labels[i - 1])) * 0.5 + 12.0
-                                             : kGlyphH + 6.0;
+                    double need = horizontal
+                                      ? (textWidth(ticks.labels[i]) + textWidth(ticks.labels[i - 1])) * 0.5 + 12.0
+                                      : kGlyphH + 6.0;
                     fits = d >= need;
                 }
                 if (fits)
@@ -624,7 +644,8 @@ namespace TreeLod
         for (const PlotSeries& s : spec.series)
         {
             bool automatic = s.colour.r < 0.0f || s.colour.g < 0.0f || s.colour.b < 0.0f;
-            seriesColour.push_back(automatic ? kPalette[nextColour++ % kPaletteSize] : glm::clamp(s.colour, 0.0f, 1.0f));
+            seriesColour.push_back(automatic ? kPalette[nextColour++ % kPaletteSize]
+                                             : glm::clamp(s.colour, 0.0f, 1.0f));
         }
         for (const PlotRule& r : spec.rules)
         {
@@ -641,7 +662,7 @@ namespace TreeLod
         for (std::size_t i = 0; i < spec.series.size(); ++i)
         {
             const PlotSeries& s = spec.series[i];
-            double width = std::isfinite(s.lineWidth) && s.lineWidth > 0.0f ? double(s.lineWidth) : 2.0;
+            double width = lineWidthOf(s);
             glm::dvec2 previous(std::numeric_limits<double>::quiet_NaN());
             for (const glm::dvec2& p : s.points)
             {
@@ -659,13 +680,17 @@ namespace TreeLod
                 previous = q; // a skipped point leaves NaN: the next segment is not drawn
             }
             mask.flush(image, seriesColour[i]);
-            if (s.markers)
-            {
-                for (const glm::dvec2& p : s.points)
-                    if (usable(p.x, f.logX) && usable(p.y, f.logY))
-                        mask.disc(f.toPixel(p), std::max(3.0, width * 1.5));
-                mask.flush(image, seriesColour[i]);
-            }
+        }
+        for (std::size_t i = 0; i < spec.series.size(); ++i) // markers over all lines
+        {
+            const PlotSeries& s = spec.series[i];
+            if (!s.markers)
+                continue;
+            double width = lineWidthOf(s);
+            for (const glm::dvec2& p : s.points)
+                if (usable(p.x, f.logX) && usable(p.y, f.logY))
+                    mask.disc(f.toPixel(p), std::max(3.0, width * 1.5));
+            mask.flush(image, seriesColour[i]);
         }
         for (const PlotMarker& m : spec.markers)
         {
@@ -705,7 +730,8 @@ namespace TreeLod
 
         // Axis labels and title.
         if (!spec.xLabel.empty())
-            drawText(image, (L + R) / 2 - textWidth(spec.xLabel) / 2, B + kTickLen + kTickGap + kGlyphH + 8, spec.xLabel);
+            drawText(image, (L + R) / 2 - textWidth(spec.xLabel) / 2, B + kTickLen + kTickGap + kGlyphH + 8,
+                     spec.xLabel);
         if (!spec.yLabel.empty())
             drawText(image, kPad, T - kGlyphH - 8, spec.yLabel);
         if (!spec.title.empty())
@@ -735,7 +761,8 @@ namespace TreeLod
             if (!spec.rules[i].label.empty())
                 entries.push_back({&spec.rules[i].label, glm::clamp(spec.rules[i].colour, 0.0f, 1.0f), 2, i});
         constexpr int kRow = 18, kSample = 30, kInset = 8, kInner = 8;
-        int rows = std::min(int(entries.size()), std::max(0, (B - T - 2 * kInset - 2 * kInner + kRow - kGlyphH) / kRow));
+        int rows =
+            std::min(int(entries.size()), std::max(0, (B - T - 2 * kInset - 2 * kInner + kRow - kGlyphH) / kRow));
         if (rows > 0)
         {
             int textW = 0;
@@ -775,7 +802,7 @@ namespace TreeLod
                 if (e.kind == 0)
                 {
                     const PlotSeries& s = spec.series[e.index];
-                    double width = std::isfinite(s.lineWidth) && s.lineWidth > 0.0f ? double(s.lineWidth) : 2.0;
+                    double width = lineWidthOf(s);
                     if (s.lines || !s.markers)
                         mask.segment(a, b, width);
                     mask.flush(image, e.colour);

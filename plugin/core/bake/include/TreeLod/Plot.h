@@ -24,7 +24,8 @@ namespace TreeLod
         std::vector<glm::dvec2> points; ///< data, drawn in this order; may be empty
         glm::vec3 colour{-1.0f};        ///< sRGB 0..1; any negative = next colour of the palette
         bool lines = true, markers = true;
-        float lineWidth = 2.0f;         ///< pixels, > 0
+        /// Pixels (not positive or finite: 2); markers are discs of radius max(3, 1.5 x width).
+        float lineWidth = 2.0f;
     };
 
     /// One labelled point (e.g. "polygonal reference", "one-quad floor"), drawn as an outline.
@@ -64,15 +65,17 @@ namespace TreeLod
     {
         std::vector<double> major;       ///< labelled, with a grid line
         std::vector<std::string> labels; ///< one per major tick
-        std::vector<double> minor;       ///< log axes only: 2..9 x 10^k between decades
+        std::vector<double> minor;       ///< log axes only: 2..9 x 10^k, or unlabelled decades
     };
 
-    /// Ticks for the range [min, max] (min < max; on a log axis both > 0): linear axes step
-    /// by 1, 2 or 5 x 10^k with at most maxMajor ticks (at least 2 unless the range is tiny);
-    /// log axes put majors on decades (every 1, 2, 5, 10... decades), and add 2 and 5 x 10^k
-    /// as majors when fewer than two decades fall inside; a range narrower than a decade
-    /// gets linear ticks. Labels use the fewest decimals that tell neighbours apart,
-    /// exponents ("2e6") for very large or small magnitudes (log axes: outside 0.001..10000).
+    /// Ticks for the range [min, max] (min < max; on a log axis both > 0; else no ticks).
+    /// Linear: the smallest step of 1, 2 or 5 x 10^k giving at most maxMajor ticks (below 2
+    /// counts as 2); a narrow range may get just one, a span below the precision of its values none.
+    /// Log: majors on decades (every 1, 2, 5, 10... decades), plus 2 and 5 x 10^k when fewer than
+    /// two decades fall inside; a range narrower than a decade gets linear ticks.
+    /// Labels use the decimals the step needs; exponents ("2e6") when the largest linear tick is
+    /// from 1e6 or below 1e-3, and on a log axis with a tick outside 0.001..10000 for every
+    /// label from 1e3 or 1e-3 on.
     PlotTicks plotTicks(double min, double max, bool logScale, int maxMajor = 8);
 
     /// Where drawPlot puts things: the axis ranges it settled on and the plot area in
@@ -82,7 +85,7 @@ namespace TreeLod
         double xMin = 0.0, xMax = 1.0, yMin = 0.0, yMax = 1.0; ///< data units
         bool logX = false, logY = false;
         double left = 0.0, top = 0.0, right = 1.0, bottom = 1.0; ///< pixels
-        bool hasData = false; ///< any drawable series point or marker
+        bool hasData = false;                                    ///< any drawable series point or marker
 
         /// Pixel position of a data point (not clamped); NaN for a non-positive value on a log axis.
         glm::dvec2 toPixel(const glm::dvec2& p) const;
