@@ -52,7 +52,8 @@ namespace TreeLod
             double scale = 1.0;
             std::string size;         // "" = the script's resolution
             std::uint32_t samples = 4; // sampled frames for the error measures
-            double referenceBudget = 3e6;
+            double referenceBudget = 3e6;      // triangles: the reference's timed frames
+            double referenceImageBudget = 0.0; // triangles: its supersampled images; 0 = referenceBudget
             std::string cacheDirectory;
             std::string counts;       // "" = the script's counts
             bool json = false;
@@ -182,6 +183,11 @@ namespace TreeLod
             return levels;
         }
 
+        double imageBudget(const BenchArgs& args)
+        {
+            return args.referenceImageBudget > 0.0 ? args.referenceImageBudget : args.referenceBudget;
+        }
+
         std::string treesText(std::uint32_t count) { return std::to_string(count) + (count == 1 ? " tree" : " trees"); }
 
         Result<void> writeText(const std::string& path, const std::string& text)
@@ -229,6 +235,7 @@ namespace TreeLod
                             {"frames", frames},
                             {"scale", args.scale},
                             {"referenceBudgetTriangles", args.referenceBudget},
+                            {"referenceImageBudgetTriangles", imageBudget(args)},
                             {"timing", "frame_ms: wall time until a one-pixel read-back (GPU-bounded; Ogre's GL3Plus "
                                        "offers no timer queries); cpu_ms: until the commands are submitted"}};
             json bakes = json::array();
@@ -534,7 +541,7 @@ namespace TreeLod
                                 std::map<std::uint32_t, ReferenceSample>& refs = references[trees];
                                 if (technique == "mesh")
                                 {
-                                    if (record.timed)
+                                    if (double(referenceCost) <= imageBudget(args))
                                     {
                                         ReferenceSample sample;
                                         sample.image = toImage(renderer.render(camera, width, height, 2));
@@ -554,13 +561,17 @@ namespace TreeLod
                                         record.msRmse = r->combined;
                                     if (Result<MultiScaleRmseResult> r = multiScaleRmse(image, next))
                                         record.temporalNoise = r->combined;
-                                    if (f == sampled.front())
-                                        OffscreenRenderer::savePng(renderer.render(camera, width, height, 1),
-                                                                   args.output + "/frame-" + std::to_string(trees) + "-" +
-                                                                       technique + "-" + number(bias, 2) + ".png");
                                 }
-                                else if (record.skipped.empty())
-                                    record.skipped = "no reference for this frame (too costly)";
+                                else if (technique == "mesh")
+                                    record.skipped += std::string(record.skipped.empty() ? "" : "; ") +
+                                                      "reference image too costly: " + std::to_string(referenceCost) +
+                                                      " triangles > image budget " + number(imageBudget(args), 3);
+                                else
+                                    record.skipped = "no reference image for this frame (too costly)";
+                                if (f == sampled.front()) // a picture of every run
+                                    OffscreenRenderer::savePng(renderer.render(camera, width, height, 1),
+                                                               args.output + "/frame-" + std::to_string(trees) + "-" +
+                                                                   technique + "-" + number(bias, 2) + ".png");
                             }
                             run.frames.push_back(std::move(record));
                         }
@@ -600,6 +611,9 @@ namespace TreeLod
         cmd->add_option("--reference-budget", args->referenceBudget,
                         "skip reference frames that would submit more triangles than this")
             ->capture_default_str();
+        cmd->add_option("--reference-image-budget", args->referenceImageBudget,
+                        "the same for the reference's supersampled images on sampled frames (default: "
+                        "--reference-budget); images cost no timed frames, so this may be larger");
         cmd->add_option("--cache", args->cacheDirectory, "bake cache directory (default: $XDG_CACHE_HOME/treelod)");
         cmd->add_flag("--json", args->json, "also print summary.json");
         cmd->add_flag("-q,--quiet", args->quiet, "no progress");
