@@ -205,6 +205,28 @@ namespace TreeLod
             return statsOf(ms).median;
         }
 
+        /// Frames that every run of `count` trees timed; the reference's runs count only when that
+        /// leaves some (it is skipped where too costly), so the trade plot compares like with like.
+        std::vector<bool> commonTimedFrames(const std::vector<Run>& runs, std::uint32_t count)
+        {
+            for (bool withReference : {true, false})
+            {
+                std::vector<bool> common;
+                for (const Run& run : runs)
+                {
+                    if (run.count != count || (!withReference && run.technique == "mesh"))
+                        continue;
+                    if (common.empty())
+                        common.assign(run.frames.size(), true);
+                    for (std::size_t f = 0; f < run.frames.size() && f < common.size(); ++f)
+                        common[f] = common[f] && run.frames[f].timed;
+                }
+                if (std::find(common.begin(), common.end(), true) != common.end())
+                    return common;
+            }
+            return {};
+        }
+
         bool writeOutputs(const BenchArgs& args, const SceneScript& script, std::uint32_t frames, int width, int height,
                           const std::vector<Run>& runs,
                           const std::map<std::uint32_t, std::map<std::uint32_t, ReferenceSample>>& references,
@@ -321,7 +343,8 @@ namespace TreeLod
                 time.logY = true;
                 PlotSpec trade;
                 trade.title = script.name + ": error against frame time (" + treesText(count) + ")";
-                trade.xLabel = "median frame ms";
+                trade.xLabel = "median frame ms (over the frames every run timed)";
+                const std::vector<bool> common = commonTimedFrames(runs, count);
                 trade.yLabel = "mean FLIP vs supersampled reference";
                 trade.logX = true;
                 std::map<std::string, PlotSeries> curves;
@@ -331,9 +354,9 @@ namespace TreeLod
                         continue;
                     const double median = statsOf([&] {
                         std::vector<double> v;
-                        for (const FrameRecord& r : run.frames)
-                            if (r.timed)
-                                v.push_back(r.timing.frameMilliseconds);
+                        for (std::size_t f = 0; f < run.frames.size(); ++f)
+                            if (run.frames[f].timed && f < common.size() && common[f])
+                                v.push_back(run.frames[f].timing.frameMilliseconds);
                         return v;
                     }()).median;
                     std::vector<double> flips;
