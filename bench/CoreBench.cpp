@@ -8,6 +8,7 @@
 #include "TreeLod/GltfExporter.h"
 #include "TreeLod/GltfImporter.h"
 #include "TreeLod/TreeGenerator.h"
+#include "TestTrees.h"
 
 #include <benchmark/benchmark.h>
 #include <glm/gtc/constants.hpp>
@@ -28,11 +29,7 @@ namespace
         TreeModel model;
         Material bark;
         bark.name = "Bark";
-        Material leaf;
-        leaf.name = "Leaf";
-        leaf.isLeaf = true;
-        leaf.doubleSided = true;
-        model.materials = {bark, leaf};
+        model.materials = {bark, TreeLod::test::leafMaterial("Leaf")};
 
         // Trunk: 16 sides x 8 rings, 0.3 m radius, 4 m tall.
         const int sides = 16, rings = 8;
@@ -69,20 +66,7 @@ namespace
             glm::vec3 v = glm::cross(n, u);
             u *= 0.025f;
             v *= 0.025f;
-            Leaf l;
-            l.firstVertex = std::uint32_t(model.leafVertices.size());
-            l.vertexCount = 4;
-            l.firstIndex = std::uint32_t(model.leafIndices.size());
-            l.indexCount = 6;
-            l.material = 1;
-            const glm::vec3 corners[4] = {c - u - v, c + u - v, c + u + v, c - u + v};
-            const glm::vec2 uvs[4] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
-            for (int k = 0; k < 4; ++k)
-                model.leafVertices.push_back({corners[k], n, uvs[k]});
-            for (std::uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u})
-                model.leafIndices.push_back(l.firstVertex + k);
-            model.leaves.push_back(l);
-            model.updateLeafRecord(model.leaves.size() - 1);
+            TreeLod::test::addQuadLeaf(model, c, u, v, n, 1);
         }
         model.updateBounds();
         return model;

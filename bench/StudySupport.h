@@ -8,6 +8,7 @@
 #include "TreeLod/ImageMetrics.h"
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/ReferenceRenderer.h"
+#include "TreeLod/RgbaImageConversion.h"
 
 #include <algorithm>
 #include <chrono>
@@ -47,17 +48,6 @@ namespace TreeLod
     inline double secondsSince(std::chrono::steady_clock::time_point start)
     {
         return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    }
-
-    // The same conversion as toImage in tests/ogre/OgreTestSupport.h, which is test-only (it
-    // pulls in gtest); OffscreenRenderer.h must not depend on TreeLodBake's Image.
-    inline Image toImage(const RgbaImage& rgba)
-    {
-        Image image(rgba.width, rgba.height);
-        for (std::size_t i = 0; i < image.pixels.size(); ++i)
-            image.pixels[i] = glm::vec4(rgba.pixels[4 * i], rgba.pixels[4 * i + 1], rgba.pixels[4 * i + 2],
-                                        rgba.pixels[4 * i + 3]) / 255.0f;
-        return image;
     }
 
     inline double flipMean(const Image& a, const Image& b)

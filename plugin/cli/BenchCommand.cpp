@@ -381,6 +381,9 @@ namespace TreeLod
                                        : run.technique == "quad" ? "floor (one quad per tree)"
                                                                  : run.technique;
                         series.markers = false;
+                        if (std::none_of(run.frames.begin(), run.frames.end(),
+                                         [](const FrameRecord& r) { return r.timed; }))
+                            series.label += ": every frame over the triangle budget, skipped";
                         for (const FrameRecord& r : run.frames)
                             series.points.push_back(
                                 glm::dvec2(r.time, r.timed ? r.timing.frameMilliseconds : std::nan("")));

@@ -7,6 +7,7 @@
 // low-res only vs the classic cloud at equal memory.
 #include "BillboardClustering.h"
 #include "BillboardLeafTiles.h"
+#include "TestTrees.h"
 
 #include "TreeLod/BillboardCloudBaker.h"
 #include "TreeLod/BillboardCloudData.h"
@@ -50,10 +51,7 @@ namespace TreeLod
         {
             TreeModel m;
             m.name = "quads";
-            Material leaf;
-            leaf.name = "Leaves";
-            leaf.isLeaf = true;
-            leaf.doubleSided = true;
+            Material leaf = test::leafMaterial("Leaves");
             leaf.baseColour = glm::vec4(0.2f, 0.5f, 0.1f, 1.0f);
             m.materials.push_back(leaf);
             for (const LeafAt& at : leaves)
@@ -62,21 +60,7 @@ namespace TreeLod
                 const glm::vec3 u =
                     0.5f * at.size *
                     glm::normalize(glm::cross(n, std::abs(n.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0)));
-                const glm::vec3 v = glm::cross(n, u);
-                Leaf l;
-                l.firstVertex = std::uint32_t(m.leafVertices.size());
-                l.vertexCount = 4;
-                l.firstIndex = std::uint32_t(m.leafIndices.size());
-                l.indexCount = 6;
-                const glm::vec3 corners[4] = {at.centre - u - v, at.centre + u - v, at.centre + u + v,
-                                              at.centre - u + v};
-                const glm::vec2 uvs[4] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
-                for (int k = 0; k < 4; ++k)
-                    m.leafVertices.push_back({corners[k], n, uvs[k]});
-                for (std::uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u})
-                    m.leafIndices.push_back(l.firstVertex + k);
-                m.leaves.push_back(l);
-                m.updateLeafRecord(m.leaves.size() - 1);
+                test::addQuadLeaf(m, at.centre, u, glm::cross(n, u), n);
             }
             if (bark)
             {
@@ -92,24 +76,7 @@ namespace TreeLod
             return m;
         }
 
-        /// Generated oak (seed 1, 64-texel texture), cached per (leaves, height).
-        const TreeModel& generatedOak(std::uint32_t leaves, float height = 0.0f)
-        {
-            static std::map<std::pair<std::uint32_t, float>, TreeModel> cache;
-            auto it = cache.find({leaves, height});
-            if (it == cache.end())
-            {
-                GeneratorOptions options;
-                options.preset = TreePreset::Oak;
-                options.leafCount = leaves;
-                options.height = height;
-                options.textureSize = 64;
-                Result<TreeModel> m = generateTree(options);
-                EXPECT_TRUE(m.ok()) << (m.ok() ? "" : m.error().message());
-                it = cache.emplace(std::make_pair(leaves, height), m.ok() ? std::move(m).value() : TreeModel()).first;
-            }
-            return it->second;
-        }
+        using test::generatedOak;
 
         /// Options that keep a test fast: 1 AO ray, 16-texel tiles, no DXT.
         BillboardCloudOptions fastOptions()
@@ -1061,20 +1028,7 @@ namespace TreeLod
             const glm::vec3 n(0, 0, unit(rng) < 0.5f ? 1.0f : -1.0f);
             const glm::vec3 u = 0.15f * glm::vec3(std::cos(a), std::sin(a), 0.0f);
             const glm::vec3 v = 0.3f * glm::cross(n, glm::normalize(u));
-            Leaf l;
-            l.firstVertex = std::uint32_t(m.leafVertices.size());
-            l.vertexCount = 4;
-            l.firstIndex = std::uint32_t(m.leafIndices.size());
-            l.indexCount = 6;
-            l.material = leafMaterial;
-            const glm::vec3 corners[4] = {c - u - v, c + u - v, c + u + v, c - u + v};
-            const glm::vec2 uvs[4] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
-            for (int k = 0; k < 4; ++k)
-                m.leafVertices.push_back({corners[k], n, uvs[k]});
-            for (std::uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u})
-                m.leafIndices.push_back(l.firstVertex + k);
-            m.leaves.push_back(l);
-            m.updateLeafRecord(m.leaves.size() - 1);
+            test::addQuadLeaf(m, c, u, v, n, leafMaterial);
         }
         m.updateBounds();
         BillboardCloudOptions options = fastOptions();

@@ -8,6 +8,7 @@
 #include "TreeLod/Package.h"
 #include "TreeLod/PackageWriter.h"
 #include "TreeLod/TreeGenerator.h"
+#include "TestTrees.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -48,33 +49,13 @@ namespace TreeLod
             for (const LeafAt& l : leaves)
                 leafMaterials = std::max(leafMaterials, l.material + 1);
             for (std::uint32_t k = 0; k < leafMaterials; ++k)
-            {
-                Material leaf;
-                leaf.name = "Leaves " + std::to_string(k);
-                leaf.isLeaf = true;
-                leaf.doubleSided = true;
-                m.materials.push_back(leaf);
-            }
+                m.materials.push_back(test::leafMaterial("Leaves " + std::to_string(k)));
             for (const LeafAt& at : leaves)
             {
                 const glm::vec3 n = glm::normalize(at.normal);
                 const glm::vec3 u =
                     0.5f * at.size * glm::normalize(glm::cross(n, std::abs(n.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0)));
-                const glm::vec3 v = glm::cross(n, u);
-                Leaf l;
-                l.firstVertex = std::uint32_t(m.leafVertices.size());
-                l.vertexCount = 4;
-                l.firstIndex = std::uint32_t(m.leafIndices.size());
-                l.indexCount = 6;
-                l.material = at.material;
-                const glm::vec3 corners[4] = {at.centre - u - v, at.centre + u - v, at.centre + u + v, at.centre - u + v};
-                const glm::vec2 uvs[4] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
-                for (int k = 0; k < 4; ++k)
-                    m.leafVertices.push_back({corners[k], n, uvs[k]});
-                for (std::uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u})
-                    m.leafIndices.push_back(l.firstVertex + k);
-                m.leaves.push_back(l);
-                m.updateLeafRecord(m.leaves.size() - 1);
+                test::addQuadLeaf(m, at.centre, u, glm::cross(n, u), n, at.material);
             }
             if (bark)
             {

@@ -11,6 +11,7 @@
 #include "TreeLod/Package.h"
 #include "TreeLod/PackageWriter.h"
 #include "TreeLod/TreeGenerator.h"
+#include "TestTrees.h"
 
 #include <gtest/gtest.h>
 #include <squish.h>
@@ -26,22 +27,7 @@ namespace TreeLod
 {
     namespace
     {
-        const TreeModel& generatedOak(std::uint32_t leaves, float height = 0.0f)
-        {
-            static std::map<std::pair<std::uint32_t, float>, TreeModel> cache;
-            auto it = cache.find({leaves, height});
-            if (it == cache.end())
-            {
-                GeneratorOptions options;
-                options.leafCount = leaves;
-                options.height = height;
-                options.textureSize = 64;
-                Result<TreeModel> m = generateTree(options);
-                EXPECT_TRUE(m.ok()) << (m.ok() ? "" : m.error().message());
-                it = cache.emplace(std::make_pair(leaves, height), m.ok() ? std::move(m).value() : TreeModel()).first;
-            }
-            return it->second;
-        }
+        using test::generatedOak;
 
         /// Small and uncompressed, so that texels can be read back.
         ImpostorOptions fastOptions()
@@ -67,28 +53,14 @@ namespace TreeLod
         {
             TreeModel m;
             m.name = "one leaf";
-            Material leaf;
-            leaf.name = "Leaves";
-            leaf.isLeaf = true;
-            leaf.doubleSided = true;
+            Material leaf = test::leafMaterial("Leaves");
             leaf.baseColour = glm::vec4(0.2f, 0.5f, 0.1f, 1.0f);
             leaf.backColour = glm::vec3(0.6f, 0.5f, 0.1f);
             m.materials.push_back(leaf);
             const glm::vec3 n = glm::normalize(normal);
             const glm::vec3 u = 0.5f * size * (std::abs(n.x) > 0.9f ? glm::vec3(0, 0, -n.x) : glm::vec3(n.z, 0, 0));
             const glm::vec3 v(0.0f, 0.5f * size, 0.0f);
-            Leaf l;
-            l.firstVertex = 0;
-            l.vertexCount = 4;
-            l.firstIndex = 0;
-            l.indexCount = 6;
-            const glm::vec3 corners[4] = {centre - u - v, centre + u - v, centre + u + v, centre - u + v};
-            const glm::vec2 uvs[4] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
-            for (int k = 0; k < 4; ++k)
-                m.leafVertices.push_back({corners[k], n, uvs[k]});
-            m.leafIndices = {0, 1, 2, 0, 2, 3};
-            m.leaves.push_back(l);
-            m.updateLeafRecord(0);
+            test::addQuadLeaf(m, centre, u, v, n);
             m.updateBounds();
             return m;
         }

@@ -41,17 +41,6 @@ namespace TreeLod
             TreeAssetPtr asset;
         };
 
-        std::string cachePath(const std::string& name)
-        {
-            const char* out = std::getenv("TREELOD_TEST_OUT");
-            const std::string dir = (out && *out ? std::string(out) : std::string(TREELOD_BINARY_DIR) + "/test-out") +
-                                    "/billboardcloud";
-            std::filesystem::create_directories(dir);
-            std::error_code error;
-            const auto stamp = std::filesystem::last_write_time("/proc/self/exe", error).time_since_epoch().count();
-            return dir + "/" + name + "@" + std::to_string(error ? 0 : stamp) + ".treelod";
-        }
-
         /// `model` baked with the reference, billboard-cloud and (withClassic) classic chunks,
         /// loaded as asset "<name>.bc-test"; the package bytes are cached on disk.
         TreeAssetPtr bake(const TreeModel& model, const std::string& name, bool withClassic)
@@ -60,12 +49,7 @@ namespace TreeLod
             const std::string assetName = name + ".bc-test";
             if (TreeAssetPtr existing = TreeAssetManager::getSingleton().getByName(assetName, Ogre::RGN_DEFAULT))
                 return existing;
-            const std::string path = cachePath(name);
-            std::vector<std::uint8_t> bytes;
-            if (std::ifstream in{path, std::ios::binary})
-                bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-            if (bytes.empty())
-            {
+            const std::vector<std::uint8_t> bytes = cachedPackage("billboardcloud", name, [&] {
                 PackageWriter writer;
                 Result<void> added = addReferenceChunk(writer, model, name);
                 EXPECT_TRUE(added.ok()) << (added.ok() ? "" : added.error().message());
@@ -74,7 +58,7 @@ namespace TreeLod
                 Result<BillboardCloudData> cloud = bakeBillboardCloud(model, options, name);
                 EXPECT_TRUE(cloud.ok()) << (cloud.ok() ? "" : cloud.error().message());
                 if (!cloud.ok())
-                    return {};
+                    return std::vector<std::uint8_t>();
                 EXPECT_TRUE(writer.addChunk(BILLBOARD_CLOUD_CHUNK, 0, BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION,
                                             encodeBillboardCloudChunk(cloud.value())).ok());
                 if (withClassic)
@@ -92,17 +76,10 @@ namespace TreeLod
                         EXPECT_TRUE(added.ok());
                     }
                 }
-                bytes = writer.toBytes();
-                // Packages of older builds of this binary go.
-                for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(path).parent_path()))
-                    if (entry.path().filename().string().rfind(name + "@", 0) == 0 &&
-                        entry.path().extension() == ".treelod")
-                        std::filesystem::remove(entry.path());
-                const std::string temp = path + "." + std::to_string(::getpid()) + ".tmp"; // ctest -j: one per process
-                std::ofstream(temp, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
-                                                            std::streamsize(bytes.size()));
-                std::filesystem::rename(temp, path);
-            }
+                return writer.toBytes();
+            });
+            if (bytes.empty())
+                return {};
             return TreeAssetManager::getSingleton().loadFromBytes(assetName, Ogre::RGN_DEFAULT, bytes);
         }
 
@@ -176,39 +153,6 @@ namespace TreeLod
             const float distance = height * float(imageHeight) / (2.0f * pixels * std::tan(glm::radians(0.5f * fov)));
             return CameraSpec::framing(model.boundsMin, model.boundsMax, 30.0f, 10.0f,
                                        distance * std::sin(glm::radians(0.5f * fov)) / radius, fov);
-        }
-
-        double meanLuminance(const Image& image)
-        {
-            double sum = 0.0;
-            for (const glm::vec4& p : image.pixels)
-                sum += 0.2126 * p.r + 0.7152 * p.g + 0.0722 * p.b;
-            return sum / double(image.pixels.size());
-        }
-
-        /// Images side by side (for the files left in test-out/ogre to look at).
-        Image sideBySide(const std::vector<Image>& images)
-        {
-            int width = 0;
-            for (const Image& i : images)
-                width += i.width;
-            Image out(width, images.front().height, glm::vec4(0, 0, 0, 1));
-            int x0 = 0;
-            for (const Image& i : images)
-            {
-                for (int y = 0; y < i.height && y < out.height; ++y)
-                    for (int x = 0; x < i.width; ++x)
-                        out.pixels[std::size_t(y) * out.width + x0 + x] = i.pixels[std::size_t(y) * i.width + x];
-                x0 += i.width;
-            }
-            return out;
-        }
-
-        double flipMean(const Image& a, const Image& b)
-        {
-            Result<FlipResult> error = flip(a, b);
-            EXPECT_TRUE(error.ok());
-            return error.ok() ? error->mean : 1.0;
         }
 
         const glm::vec3 BACKGROUND = LightingSpec().background;
@@ -333,18 +277,10 @@ namespace TreeLod
         EXPECT_EQ(elsewhere, 0u);
 
         // Query flags: a ray through the crown finds the tree only with a matching mask.
-        tree->setQueryFlags(0x4);
         const glm::vec3 centre = 0.5f * (oak.model.boundsMin + oak.model.boundsMax);
-        Ogre::Ray ray(Ogre::Vector3(centre.x, centre.y, centre.z + 100.0f), Ogre::Vector3::NEGATIVE_UNIT_Z);
-        Ogre::RaySceneQuery* query = r.getSceneManager().createRayQuery(ray, 0x4);
-        bool found = false;
-        for (const Ogre::RaySceneQueryResultEntry& hit : query->execute())
-            found |= hit.movable == tree;
-        EXPECT_TRUE(found);
-        query->setQueryMask(0x8);
-        for (const Ogre::RaySceneQueryResultEntry& hit : query->execute())
-            EXPECT_NE(hit.movable, tree);
-        r.getSceneManager().destroyQuery(query);
+        expectRayQueryHonoursFlags(
+            r.getSceneManager(), tree,
+            Ogre::Ray(Ogre::Vector3(centre.x, centre.y, centre.z + 100.0f), Ogre::Vector3::NEGATIVE_UNIT_Z));
     }
 
     TEST(BillboardCloudTree, levelFollowsPixelCountBiasAndDistance)

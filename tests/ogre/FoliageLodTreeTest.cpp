@@ -72,14 +72,6 @@ namespace TreeLod
             EXPECT_TRUE(CameraSpec::parse(text, model.boundsMin, model.boundsMax, spec, error)) << error;
             return spec;
         }
-
-        double meanLuminance(const Image& image)
-        {
-            double sum = 0.0;
-            for (const glm::vec4& p : image.pixels)
-                sum += 0.2126 * p.r + 0.7152 * p.g + 0.0722 * p.b;
-            return sum / double(image.pixels.size());
-        }
     }
 
     TEST(FoliageLodTree, registeredAsTechniqueAndFactory)

@@ -50,6 +50,19 @@ namespace TreeLod
             TreeAssetPtr asset;
         };
 
+        /// `baked`, encoded by `encode`, added as chunk `chunk` level 0; when baking failed, a
+        /// test failure naming the error.
+        template <typename T, typename Encode>
+        void addBakedChunk(PackageWriter& writer, const char* chunk, std::uint32_t version, const Result<T>& baked,
+                           Encode encode)
+        {
+            EXPECT_TRUE(baked.ok()) << (baked.ok() ? "" : baked.error().message());
+            if (baked.ok())
+            {
+                EXPECT_TRUE(writer.addChunk(chunk, 0, version, encode(baked.value())).ok()) << chunk;
+            }
+        }
+
         std::vector<std::uint8_t> bakePackage(const TreeModel& model, const std::string& name)
         {
             PackageWriter writer;
@@ -57,23 +70,13 @@ namespace TreeLod
             EXPECT_TRUE(added.ok()) << (added.ok() ? "" : added.error().message());
             BillboardCloudOptions cloudOptions;
             cloudOptions.aoRays = 4;
-            Result<BillboardCloudData> cloud = bakeBillboardCloud(model, cloudOptions, name);
-            EXPECT_TRUE(cloud.ok()) << (cloud.ok() ? "" : cloud.error().message());
-            if (cloud.ok())
-            {
-                EXPECT_TRUE(writer.addChunk(BILLBOARD_CLOUD_CHUNK, 0, BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION,
-                                            encodeBillboardCloudChunk(cloud.value())).ok());
-            }
+            addBakedChunk(writer, BILLBOARD_CLOUD_CHUNK, BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION,
+                          bakeBillboardCloud(model, cloudOptions, name), encodeBillboardCloudChunk);
             ImpostorOptions impostorOptions;
             impostorOptions.aoRays = 4;
             impostorOptions.resolution = 128;
-            Result<ImpostorData> impostor = bakeImpostor(model, impostorOptions, name);
-            EXPECT_TRUE(impostor.ok()) << (impostor.ok() ? "" : impostor.error().message());
-            if (impostor.ok())
-            {
-                EXPECT_TRUE(writer.addChunk(IMPOSTOR_CHUNK, 0, IMPOSTOR_CHUNK_FORMAT_VERSION,
-                                            encodeImpostorChunk(impostor.value())).ok());
-            }
+            addBakedChunk(writer, IMPOSTOR_CHUNK, IMPOSTOR_CHUNK_FORMAT_VERSION,
+                          bakeImpostor(model, impostorOptions, name), encodeImpostorChunk);
             return writer.toBytes();
         }
 
@@ -86,28 +89,8 @@ namespace TreeLod
                 Result<TreeModel> model = importGltf(OgreEnvironment::sourcePath("media/oak.glb"));
                 EXPECT_TRUE(model.ok()) << (model.ok() ? "" : model.error().message());
                 t.model = std::move(model.value());
-
-                const char* out = std::getenv("TREELOD_TEST_OUT");
-                const std::filesystem::path dir =
-                    (out && *out ? std::string(out) : std::string(TREELOD_BINARY_DIR) + "/test-out") + "/forest";
-                std::filesystem::create_directories(dir);
-                std::error_code error;
-                const auto stamp = std::filesystem::last_write_time("/proc/self/exe", error).time_since_epoch().count();
-                const std::filesystem::path path = dir / ("oak@" + std::to_string(error ? 0 : stamp) + ".treelod");
-                std::vector<std::uint8_t> bytes;
-                if (std::ifstream in{path, std::ios::binary})
-                    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-                if (bytes.empty())
-                {
-                    bytes = bakePackage(t.model, "oak");
-                    for (const auto& entry : std::filesystem::directory_iterator(dir)) // older builds' packages
-                        if (entry.path().filename().string().rfind("oak@", 0) == 0)
-                            std::filesystem::remove(entry.path());
-                    const std::string temp = path.string() + "." + std::to_string(::getpid()) + ".tmp";
-                    std::ofstream(temp, std::ios::binary)
-                        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-                    std::filesystem::rename(temp, path);
-                }
+                const std::vector<std::uint8_t> bytes =
+                    cachedPackage("forest", "oak", [&] { return bakePackage(t.model, "oak"); });
                 t.asset = TreeAssetManager::getSingleton().loadFromBytes("oak.forest-test", Ogre::RGN_DEFAULT, bytes);
                 return t;
             }();
@@ -156,21 +139,14 @@ namespace TreeLod
             return out;
         }
 
-        Image sideBySide(const std::vector<Image>& images)
+        /// A child of `parent` placed, turned and scaled as `t` (a Forest instance as a separate object).
+        Ogre::SceneNode* instanceNode(Ogre::SceneNode& parent, const ForestInstance& t)
         {
-            int width = 0;
-            for (const Image& i : images)
-                width += i.width;
-            Image out(width, images.front().height, glm::vec4(0, 0, 0, 1));
-            int x0 = 0;
-            for (const Image& i : images)
-            {
-                for (int y = 0; y < i.height && y < out.height; ++y)
-                    for (int x = 0; x < i.width; ++x)
-                        out.at(x0 + x, y) = i.at(x, y);
-                x0 += i.width;
-            }
-            return out;
+            Ogre::SceneNode* node = parent.createChildSceneNode(
+                Ogre::Vector3(t.position.x, t.position.y, t.position.z),
+                Ogre::Quaternion(Ogre::Radian(t.rotationY), Ogre::Vector3::UNIT_Y));
+            node->setScale(Ogre::Vector3(t.scale));
+            return node;
         }
 
         /// Every `factor` x `factor` block averaged (goldens of pictures rendered large).
@@ -187,21 +163,6 @@ namespace TreeLod
                     out.at(x, y) = sum / float(factor * factor);
                 }
             return out;
-        }
-
-        double flipMean(const Image& a, const Image& b)
-        {
-            Result<FlipResult> error = flip(a, b);
-            EXPECT_TRUE(error.ok());
-            return error.ok() ? error->mean : 1.0;
-        }
-
-        double meanLuminance(const Image& image)
-        {
-            double sum = 0.0;
-            for (const glm::vec4& p : image.pixels)
-                sum += 0.2126 * p.r + 0.7152 * p.g + 0.0722 * p.b;
-            return sum / double(image.pixels.size());
         }
 
         /// Renderables the object queues into each (group, priority).
@@ -306,19 +267,9 @@ namespace TreeLod
         EXPECT_GT(counts.begin()->second, 1u) << "leaves and bark";
 
         // Query flags: a ray through the first tree's crown finds the Forest only with a matching mask.
-        forest->setQueryFlags(0x4);
         const glm::vec3 centre = 0.5f * (tree.model.boundsMin + tree.model.boundsMax);
-        Ogre::RaySceneQuery* query =
-            sm.createRayQuery(Ogre::Ray(Ogre::Vector3(centre.x, centre.y, 100.0f), Ogre::Vector3::NEGATIVE_UNIT_Z),
-                              0x4);
-        bool found = false;
-        for (const Ogre::RaySceneQueryResultEntry& hit : query->execute())
-            found |= hit.movable == forest;
-        EXPECT_TRUE(found);
-        query->setQueryMask(0x8);
-        for (const Ogre::RaySceneQueryResultEntry& hit : query->execute())
-            EXPECT_NE(hit.movable, forest);
-        sm.destroyQuery(query);
+        expectRayQueryHonoursFlags(
+            sm, forest, Ogre::Ray(Ogre::Vector3(centre.x, centre.y, 100.0f), Ogre::Vector3::NEGATIVE_UNIT_Z));
 
         // Bounds: the union of the instances' spheres, in the Forest's space.
         const Ogre::AxisAlignedBox& box = forest->getBoundingBox();
@@ -423,10 +374,7 @@ namespace TreeLod
             std::vector<Ogre::MovableObject*> objects;
             for (const ForestInstance& t : trees)
             {
-                Ogre::SceneNode* child = parent->createChildSceneNode(
-                    Ogre::Vector3(t.position.x, t.position.y, t.position.z),
-                    Ogre::Quaternion(Ogre::Radian(t.rotationY), Ogre::Vector3::UNIT_Y));
-                child->setScale(Ogre::Vector3(t.scale));
+                Ogre::SceneNode* child = instanceNode(*parent, t);
                 objects.push_back(c.create("separate-" + std::to_string(serial++)));
                 child->attachObject(objects.back());
             }
@@ -561,10 +509,7 @@ namespace TreeLod
         int serial = 0;
         for (const ForestInstance& t : grid(10, 1.4f * h))
         {
-            Ogre::SceneNode* node = r.getContentNode().createChildSceneNode(
-                Ogre::Vector3(t.position.x, t.position.y, t.position.z),
-                Ogre::Quaternion(Ogre::Radian(t.rotationY), Ogre::Vector3::UNIT_Y));
-            node->setScale(Ogre::Vector3(t.scale));
+            Ogre::SceneNode* node = instanceNode(r.getContentNode(), t);
             Ogre::NameValuePairList params{{"asset", tree.asset->getName()}};
             node->attachObject(r.getSceneManager().createMovableObject(
                 "bcGrid" + std::to_string(serial++), BillboardCloudTreeFactory::FACTORY_TYPE_NAME, &params));
@@ -687,23 +632,24 @@ namespace TreeLod
                                                    instance(0.5f * h, 0, -0.4f * h, 2.0f, 1.1f)};
         // The polygonal trees: the Forest's mesh level against Entities of the reference mesh
         // with its shadow-receiving materials and full bark detail.
-        auto forestTrees = [&](Ogre::SceneNode& node) {
-            static int serial = 0;
-            auto* forest =
-                static_cast<Forest*>(sm.createMovableObject("forestShadow" + std::to_string(serial++), "Forest"));
-            forest->addSpecies(tree.asset, {ForestLevel{"mesh", 0, false, 0.0f}});
-            forest->addInstances(trees);
-            node.attachObject(forest);
+        // A Forest of `trees` drawn with `levels`.
+        auto forestOf = [&](const std::vector<ForestLevel>& levels) {
+            return [&, levels](Ogre::SceneNode& node) {
+                static int serial = 0;
+                auto* forest =
+                    static_cast<Forest*>(sm.createMovableObject("forestShadow" + std::to_string(serial++), "Forest"));
+                forest->addSpecies(tree.asset, levels);
+                forest->addInstances(trees);
+                node.attachObject(forest);
+            };
         };
+        const auto forestTrees = forestOf({ForestLevel{"mesh", 0, false, 0.0f}});
         auto separateTrees = [&](Ogre::SceneNode& node) {
             const std::vector<Ogre::String>& plainNames = tree.asset->getMaterialNames();
             const std::vector<Ogre::String>& shadowedNames = tree.asset->getShadowedMaterialNames();
             for (const ForestInstance& t : trees)
             {
-                Ogre::SceneNode* child = node.createChildSceneNode(
-                    Ogre::Vector3(t.position.x, t.position.y, t.position.z),
-                    Ogre::Quaternion(Ogre::Radian(t.rotationY), Ogre::Vector3::UNIT_Y));
-                child->setScale(Ogre::Vector3(t.scale));
+                Ogre::SceneNode* child = instanceNode(node, t);
                 Ogre::Entity* entity = sm.createEntity(tree.asset->getReferenceMesh());
                 entity->setMeshLodBias(1.0f, 0, 0);
                 for (unsigned i = 0; i < entity->getNumSubEntities(); ++i)
@@ -725,22 +671,12 @@ namespace TreeLod
         place(separateTrees, true);
         const Image separate = toImage(r.render(view, 192, 160, 2));
         // Billboard clouds (their own levels): the cloud's instanced casters against BillboardCloudTrees'.
-        auto forestClouds = [&](Ogre::SceneNode& node) {
-            static int serial = 0;
-            auto* forest =
-                static_cast<Forest*>(sm.createMovableObject("forestCloud" + std::to_string(serial++), "Forest"));
-            forest->addSpecies(tree.asset, Forest::levelsForBands(*tree.asset, {{"billboard-cloud", 0.0f}}));
-            forest->addInstances(trees);
-            node.attachObject(forest);
-        };
+        const auto forestClouds = forestOf(Forest::levelsForBands(*tree.asset, {{"billboard-cloud", 0.0f}}));
         auto separateClouds = [&](Ogre::SceneNode& node) {
             static int serial = 0;
             for (const ForestInstance& t : trees)
             {
-                Ogre::SceneNode* child = node.createChildSceneNode(
-                    Ogre::Vector3(t.position.x, t.position.y, t.position.z),
-                    Ogre::Quaternion(Ogre::Radian(t.rotationY), Ogre::Vector3::UNIT_Y));
-                child->setScale(Ogre::Vector3(t.scale));
+                Ogre::SceneNode* child = instanceNode(node, t);
                 Ogre::NameValuePairList params{{"asset", tree.asset->getName()}};
                 child->attachObject(sm.createMovableObject("cloudShadow" + std::to_string(serial++),
                                                            BillboardCloudTreeFactory::FACTORY_TYPE_NAME, &params));

@@ -184,30 +184,6 @@ namespace TreeLod
 
         const glm::vec3 BACKGROUND = LightingSpec().background; // sRGB, as the images store it
 
-        double flipMean(const Image& a, const Image& b)
-        {
-            Result<FlipResult> error = flip(a, b);
-            EXPECT_TRUE(error.ok());
-            return error.ok() ? error->mean : 1.0;
-        }
-
-        Image sideBySide(const std::vector<Image>& images)
-        {
-            int width = 0;
-            for (const Image& i : images)
-                width += i.width;
-            Image out(width, images.front().height, glm::vec4(0, 0, 0, 1));
-            int x0 = 0;
-            for (const Image& i : images)
-            {
-                for (int y = 0; y < i.height && y < out.height; ++y)
-                    for (int x = 0; x < i.width; ++x)
-                        out.at(x0 + x, y) = i.at(x, y);
-                x0 += i.width;
-            }
-            return out;
-        }
-
         /// From azimuth `degrees` (0 = from +Z), 5 degrees up, the tree filling the view.
         CameraSpec view(const TreeModel& m, float degrees, float distanceFactor = 1.0f)
         {

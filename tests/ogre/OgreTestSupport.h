@@ -5,13 +5,25 @@
 #include "TreeLod/Image.h"
 #include "TreeLod/ImageMetrics.h"
 #include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/RgbaImageConversion.h"
+
+#include <OgreMovableObject.h>
+#include <OgreSceneManager.h>
+#include <OgreSceneQuery.h>
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace TreeLod
 {
@@ -42,18 +54,94 @@ namespace TreeLod
         }
     };
 
+    /// `images` left to right on black, as tall as the first (for the pictures left in
+    /// test-out/ogre to look at).
+    inline Image sideBySide(const std::vector<Image>& images)
+    {
+        int width = 0;
+        for (const Image& i : images)
+            width += i.width;
+        Image out(width, images.front().height, glm::vec4(0, 0, 0, 1));
+        int x0 = 0;
+        for (const Image& i : images)
+        {
+            for (int y = 0; y < i.height && y < out.height; ++y)
+                for (int x = 0; x < i.width; ++x)
+                    out.at(x0 + x, y) = i.at(x, y);
+            x0 += i.width;
+        }
+        return out;
+    }
+
+    /// Mean FLIP error of `b` against `a`; 1 (and a test failure) when FLIP fails.
+    inline double flipMean(const Image& a, const Image& b)
+    {
+        Result<FlipResult> error = flip(a, b);
+        EXPECT_TRUE(error.ok());
+        return error.ok() ? error->mean : 1.0;
+    }
+
+    /// Mean Rec. 709 luminance of the stored (sRGB) values.
+    inline double meanLuminance(const Image& image)
+    {
+        double sum = 0.0;
+        for (const glm::vec4& p : image.pixels)
+            sum += 0.2126 * p.r + 0.7152 * p.g + 0.0722 * p.b;
+        return sum / double(image.pixels.size());
+    }
+
+    /// Package bytes cached on disk as $TREELOD_TEST_OUT/<folder>/<name>@<stamp>.treelod, the
+    /// stamp the test binary's modification time: read when there, else made by `bake` and
+    /// written (through a per-process temp file: ctest -j), the packages of older builds of the
+    /// binary removed. Empty bytes from `bake` are returned and not cached.
+    inline std::vector<std::uint8_t> cachedPackage(const std::string& folder, const std::string& name,
+                                                   const std::function<std::vector<std::uint8_t>()>& bake)
+    {
+        const char* out = std::getenv("TREELOD_TEST_OUT");
+        const std::filesystem::path dir =
+            (out && *out ? std::string(out) : std::string(TREELOD_BINARY_DIR) + "/test-out") + "/" + folder;
+        std::filesystem::create_directories(dir);
+        std::error_code error;
+        const auto stamp = std::filesystem::last_write_time("/proc/self/exe", error).time_since_epoch().count();
+        const std::filesystem::path path = dir / (name + "@" + std::to_string(error ? 0 : stamp) + ".treelod");
+        std::vector<std::uint8_t> bytes;
+        if (std::ifstream in{path, std::ios::binary})
+            bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        if (!bytes.empty())
+            return bytes;
+        bytes = bake();
+        if (bytes.empty())
+            return bytes;
+        for (const auto& entry : std::filesystem::directory_iterator(dir))
+            if (entry.path().filename().string().rfind(name + "@", 0) == 0 && entry.path().extension() == ".treelod")
+                std::filesystem::remove(entry.path());
+        const std::string temp = path.string() + "." + std::to_string(::getpid()) + ".tmp";
+        std::ofstream(temp, std::ios::binary)
+            .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        std::filesystem::rename(temp, path);
+        return bytes;
+    }
+
+    /// Query flags: with flags 0x4, `object` is found by a ray query along `ray` with mask 0x4
+    /// and not with mask 0x8.
+    inline void expectRayQueryHonoursFlags(Ogre::SceneManager& sm, Ogre::MovableObject* object, const Ogre::Ray& ray)
+    {
+        object->setQueryFlags(0x4);
+        Ogre::RaySceneQuery* query = sm.createRayQuery(ray, 0x4);
+        bool found = false;
+        for (const Ogre::RaySceneQueryResultEntry& hit : query->execute())
+            found |= hit.movable == object;
+        EXPECT_TRUE(found);
+        query->setQueryMask(0x8);
+        for (const Ogre::RaySceneQueryResultEntry& hit : query->execute())
+            EXPECT_NE(hit.movable, object);
+        sm.destroyQuery(query);
+    }
+
     // Golden images: each render is compared with tests/golden/NAME.png by FLIP (mean below
     // the bound stated per test); with TREELOD_GOLDEN=update the goldens are rewritten
     // instead (then open them and look before committing). On a failure the render and the
     // FLIP heat map are left in build/test-out/ogre/ for inspection.
-    inline Image toImage(const RgbaImage& rgba)
-    {
-        Image image(rgba.width, rgba.height);
-        for (std::size_t i = 0; i < image.pixels.size(); ++i)
-            image.pixels[i] = glm::vec4(rgba.pixels[4 * i], rgba.pixels[4 * i + 1], rgba.pixels[4 * i + 2],
-                                        rgba.pixels[4 * i + 3]) / 255.0f;
-        return image;
-    }
 
     /// Fraction of pixels that differ from the background colour: a black, empty or
     /// background-only picture cannot pass a golden test.

@@ -56,7 +56,15 @@ namespace TreeLod
 
         const char* const KNOWN_TECHNIQUES = "mesh, lodf, billboard-cloud, classic-billboard-cloud, quad";
 
-        bool parseTechnique(const Ogre::String& name, Technique& out)
+        bool isCloud(Technique t) { return t == Technique::BillboardCloud || t == Technique::ClassicBillboardCloud; }
+
+        [[noreturn]] void invalid(const Ogre::String& text, const char* source)
+        {
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, text, source);
+        }
+
+        /// The technique named `name`; throws "<element>unknown technique (known: ...)" from `source`.
+        Technique parseTechnique(const Ogre::String& name, const Ogre::String& element, const char* source)
         {
             static const std::pair<const char*, Technique> names[] = {
                 {"mesh", Technique::Mesh},
@@ -66,18 +74,8 @@ namespace TreeLod
                 {"quad", Technique::Quad}};
             for (const auto& n : names)
                 if (name == n.first)
-                {
-                    out = n.second;
-                    return true;
-                }
-            return false;
-        }
-
-        bool isCloud(Technique t) { return t == Technique::BillboardCloud || t == Technique::ClassicBillboardCloud; }
-
-        [[noreturn]] void invalid(const Ogre::String& text, const char* source)
-        {
-            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, text, source);
+                    return n.second;
+            invalid(element + "unknown technique (known: " + KNOWN_TECHNIQUES + ")", source);
         }
 
         /// Radius of the asset's reference sphere: the units of ForestLevel::minPixelCount (Forest.h).
@@ -401,9 +399,7 @@ namespace TreeLod
         {
             const ForestBand& band = bands[b];
             const Ogre::String element = label + "band " + std::to_string(b) + " '" + band.technique + "': ";
-            Technique technique;
-            if (!parseTechnique(band.technique, technique))
-                invalid(element + "unknown technique (known: " + KNOWN_TECHNIQUES + ")", source);
+            const Technique technique = parseTechnique(band.technique, element, source);
             const bool last = b + 1 == bands.size();
             if (last && band.minHeightPixels != 0.0f)
                 invalid(element + "the last band must reach 0 pixels, not " + std::to_string(band.minHeightPixels),
@@ -477,9 +473,7 @@ namespace TreeLod
                                                                   Ogre::Real upperPixelCount,
                                                                   Ogre::AxisAlignedBox& drawnBox)
     {
-        Technique technique;
-        if (!parseTechnique(level.technique, technique))
-            invalid("unknown technique (known: " + Ogre::String(KNOWN_TECHNIQUES) + ")", "Forest");
+        const Technique technique = parseTechnique(level.technique, "", "Forest");
         const Ogre::String& group = asset.getGroup();
         std::vector<std::unique_ptr<Part>> parts;
         auto addPart = [&](Ogre::VertexData* vertices, const Ogre::String& material, const Ogre::String& shadowed) {
@@ -616,9 +610,7 @@ namespace TreeLod
         {
             const ForestLevel& level = levels[l];
             const Ogre::String element = label + "level " + std::to_string(l) + " '" + level.technique + "': ";
-            Technique technique;
-            if (!parseTechnique(level.technique, technique))
-                invalid(element + "unknown technique (known: " + KNOWN_TECHNIQUES + ")", source);
+            const Technique technique = parseTechnique(level.technique, element, source);
             const bool last = l + 1 == levels.size();
             if (!std::isfinite(level.minPixelCount) || level.minPixelCount < 0.0f ||
                 (l > 0 && !(level.minPixelCount < levels[l - 1].minPixelCount)) ||

@@ -1,5 +1,6 @@
 #include "TreeLod/TreeAsset.h"
 
+#include "TreeAssetSupport.h"
 #include "TreeLod/FoliageLodState.h"
 #include "TreeLod/TreeMeshBuilder.h"
 
@@ -22,48 +23,6 @@
 
 namespace TreeLod
 {
-    namespace
-    {
-        /// A clone of TreeLod's material `base` named `name` in `group`; throws naming `base` when
-        /// TreeLod's materials are not in a resource group.
-        Ogre::MaterialPtr cloneBaseMaterial(const Ogre::String& base, const Ogre::String& name,
-                                            const Ogre::String& group)
-        {
-            Ogre::MaterialPtr parent = Ogre::MaterialManager::getSingleton().getByName(base, Ogre::RGN_DEFAULT);
-            if (!parent)
-                parent = Ogre::MaterialManager::getSingleton().getByName(base);
-            if (!parent)
-                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
-                            "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
-                            "TreeAsset");
-            return parent->clone(name, true, group);
-        }
-
-        Ogre::PixelFormat ogreFormat(GpuTextureFormat format)
-        {
-            switch (format)
-            {
-            case GpuTextureFormat::DXT1:
-                return Ogre::PF_DXT1;
-            case GpuTextureFormat::DXT5:
-                return Ogre::PF_DXT5;
-            default:
-                return Ogre::PF_BYTE_RGBA;
-            }
-        }
-
-        /// Upload `bytes` (level 0 then its mips, tightly packed) as texture `name`.
-        void uploadTexture(const Ogre::String& name, const Ogre::String& group, const std::uint8_t* bytes,
-                           std::uint32_t width, std::uint32_t height, Ogre::PixelFormat format, std::uint32_t mips)
-        {
-            Ogre::Image image;
-            image.loadDynamicImage(const_cast<Ogre::uchar*>(bytes), width, height, 1, format, false, 1,
-                                   mips > 0 ? mips - 1 : 0);
-            Ogre::TextureManager::getSingleton().loadImage(name, group, image, Ogre::TEX_TYPE_2D,
-                                                           int(mips > 0 ? mips - 1 : 0));
-        }
-    }
-
     TreeAsset::TreeAsset(Ogre::ResourceManager* creator, const Ogre::String& name, Ogre::ResourceHandle handle,
                          const Ogre::String& group, bool isManual, Ogre::ManualResourceLoader* loader)
         : Ogre::Resource(creator, name, handle, group, isManual, loader)
@@ -251,7 +210,7 @@ namespace TreeLod
                 continue;
             }
             const Ogre::String name = prefix + std::to_string(i) + suffix;
-            Ogre::MaterialPtr mat = cloneBaseMaterial(src.isLeaf ? leafBase : barkBase, name, mGroup);
+            Ogre::MaterialPtr mat = cloneBaseMaterial(src.isLeaf ? leafBase : barkBase, name, mGroup, mName);
             const Ogre::String texture = src.texture >= 0 ? mTextureNames[std::size_t(src.texture)] : "TreeLodWhite.png";
             glm::vec3 back = src.backColour == glm::vec3(0.0f) ? glm::vec3(src.baseColour) : src.backColour;
 
@@ -405,8 +364,7 @@ namespace TreeLod
               std::make_pair("low-res", &data.lowRes)})
         {
             const Ogre::String name = prefix + t.first;
-            uploadTexture(name, mGroup, t.second->data.data(), t.second->width, t.second->height,
-                          ogreFormat(t.second->format), t.second->mipCount);
+            uploadTexture(name, mGroup, *t.second);
             gpu->textures.push_back(name);
         }
 
@@ -517,7 +475,7 @@ namespace TreeLod
                 }
         };
         auto clone = [&](const Ogre::String& base, const Ogre::String& name) {
-            Ogre::MaterialPtr material = cloneBaseMaterial(base, name, mGroup);
+            Ogre::MaterialPtr material = cloneBaseMaterial(base, name, mGroup, mName);
             configure(material);
             gpu.materials.push_back(name);
             return material;

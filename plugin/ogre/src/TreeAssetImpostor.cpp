@@ -1,4 +1,5 @@
 // TreeAsset::getImpostorGpu: the one-quad impostor (chunk "impostor", ImpostorData.h) on the GPU.
+#include "TreeAssetSupport.h"
 #include "TreeLod/ImpostorData.h"
 #include "TreeLod/TreeAsset.h"
 
@@ -13,32 +14,6 @@
 
 namespace TreeLod
 {
-    namespace
-    {
-        Ogre::PixelFormat ogreFormat(GpuTextureFormat format)
-        {
-            switch (format)
-            {
-            case GpuTextureFormat::DXT1:
-                return Ogre::PF_DXT1;
-            case GpuTextureFormat::DXT5:
-                return Ogre::PF_DXT5;
-            default:
-                return Ogre::PF_BYTE_RGBA;
-            }
-        }
-
-        /// `texture` with every baked mip level as Ogre texture `name` (as TreeAsset.cpp uploads).
-        void uploadTexture(const Ogre::String& name, const Ogre::String& group, const GpuTexture& texture)
-        {
-            Ogre::Image image;
-            image.loadDynamicImage(const_cast<Ogre::uchar*>(texture.data.data()), texture.width, texture.height, 1,
-                                   ogreFormat(texture.format), false, 1, texture.mipCount - 1);
-            Ogre::TextureManager::getSingleton().loadImage(name, group, image, Ogre::TEX_TYPE_2D,
-                                                           int(texture.mipCount - 1));
-        }
-    }
-
     const ImpostorGpu& TreeAsset::getImpostorGpu()
     {
         if (mImpostorGpu)
@@ -104,14 +79,7 @@ namespace TreeLod
                 }
         };
         auto clone = [&](const Ogre::String& base, const Ogre::String& name) {
-            Ogre::MaterialPtr parent = Ogre::MaterialManager::getSingleton().getByName(base, Ogre::RGN_DEFAULT);
-            if (!parent)
-                parent = Ogre::MaterialManager::getSingleton().getByName(base);
-            if (!parent)
-                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
-                            "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
-                            "TreeAsset '" + mName + "'");
-            Ogre::MaterialPtr material = parent->clone(name, true, mGroup);
+            Ogre::MaterialPtr material = cloneBaseMaterial(base, name, mGroup, mName);
             configure(material);
             return material;
         };

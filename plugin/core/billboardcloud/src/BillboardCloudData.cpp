@@ -536,14 +536,7 @@ namespace TreeLod
         r.align(ALIGN);
         if (const std::uint8_t* p = r.ok() ? r.take(barkCount) : nullptr)
             data.barkAo.assign(p, p + barkCount);
-        if (!r.ok())
-            return r.error();
-        if (r.remaining() != 0)
-            return fail(label, name, std::to_string(r.remaining()) + " trailing bytes");
-        Result<void> valid = data.validate(label);
-        if (!valid)
-            return valid.error();
-        return data;
+        return finishDecode(r, label, name, std::move(data));
     }
 
     // ---- BillboardCloudSampler: the fragment shader's addressing (§4.2, §5) ------------------

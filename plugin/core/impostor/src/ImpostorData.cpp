@@ -91,11 +91,6 @@ namespace TreeLod
         if (!r.ok() || !readGpuTexture(r, name + ", colour texture", data.colour) ||
             !readGpuTexture(r, name + ", normal texture", data.normal))
             return r.error();
-        if (r.remaining() != 0)
-            return fail(label, name, std::to_string(r.remaining()) + " trailing bytes");
-        Result<void> valid = data.validate(label);
-        if (!valid)
-            return valid.error();
-        return data;
+        return finishDecode(r, label, name, std::move(data));
     }
 }

@@ -153,4 +153,19 @@ namespace TreeLod
         bool mFailed = false;
         Error mError;
     };
+
+    /// The end of a chunk decoder: `r`'s error; "N trailing bytes" (file `file`, element
+    /// `element`) when `r` has not read every byte; the error of `data.validate(file)`; else `data`.
+    template <typename T>
+    Result<T> finishDecode(const ByteReader& r, const std::string& file, const std::string& element, T data)
+    {
+        if (!r.ok())
+            return r.error();
+        if (r.remaining() != 0)
+            return fail(file, element, std::to_string(r.remaining()) + " trailing bytes");
+        Result<void> valid = data.validate(file);
+        if (!valid)
+            return valid.error();
+        return Result<T>(std::move(data));
+    }
 }

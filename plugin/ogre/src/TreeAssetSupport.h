@@ -1,0 +1,64 @@
+// TreeAssetSupport: what TreeAsset.cpp and TreeAssetImpostor.cpp both need to put a package's
+// textures and materials on the GPU (internal to the Ogre plugin, not installed).
+#pragma once
+
+#include "TreeLod/ModelChunk.h"
+
+#include <OgreException.h>
+#include <OgreImage.h>
+#include <OgreMaterial.h>
+#include <OgreMaterialManager.h>
+#include <OgreTextureManager.h>
+
+#include <cstdint>
+
+namespace TreeLod
+{
+    /// The Ogre pixel format of a baked texture: DXT1, DXT5, else RGBA8.
+    inline Ogre::PixelFormat ogreFormat(GpuTextureFormat format)
+    {
+        switch (format)
+        {
+        case GpuTextureFormat::DXT1:
+            return Ogre::PF_DXT1;
+        case GpuTextureFormat::DXT5:
+            return Ogre::PF_DXT5;
+        default:
+            return Ogre::PF_BYTE_RGBA;
+        }
+    }
+
+    /// Upload `bytes` (level 0 then its mips, tightly packed; `mips` levels, 0 read as 1) as
+    /// texture `name` in `group`.
+    inline void uploadTexture(const Ogre::String& name, const Ogre::String& group, const std::uint8_t* bytes,
+                              std::uint32_t width, std::uint32_t height, Ogre::PixelFormat format, std::uint32_t mips)
+    {
+        Ogre::Image image;
+        image.loadDynamicImage(const_cast<Ogre::uchar*>(bytes), width, height, 1, format, false, 1,
+                               mips > 0 ? mips - 1 : 0);
+        Ogre::TextureManager::getSingleton().loadImage(name, group, image, Ogre::TEX_TYPE_2D,
+                                                       int(mips > 0 ? mips - 1 : 0));
+    }
+
+    /// Upload `texture` with every baked mip level, in its own format, as texture `name` in `group`.
+    inline void uploadTexture(const Ogre::String& name, const Ogre::String& group, const GpuTexture& texture)
+    {
+        uploadTexture(name, group, texture.data.data(), texture.width, texture.height, ogreFormat(texture.format),
+                      texture.mipCount);
+    }
+
+    /// A clone of TreeLod's material `base` named `name` in `group`; throws naming `base` (and the
+    /// asset `assetName`) when TreeLod's materials are not in a resource group.
+    inline Ogre::MaterialPtr cloneBaseMaterial(const Ogre::String& base, const Ogre::String& name,
+                                               const Ogre::String& group, const Ogre::String& assetName)
+    {
+        Ogre::MaterialPtr parent = Ogre::MaterialManager::getSingleton().getByName(base, Ogre::RGN_DEFAULT);
+        if (!parent)
+            parent = Ogre::MaterialManager::getSingleton().getByName(base);
+        if (!parent)
+            OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
+                        "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
+                        "TreeAsset '" + assetName + "'");
+        return parent->clone(name, true, group);
+    }
+}

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# The sample browser on the default scene (samples/scenes/single-tree.json): install what is
+# missing (apt), build treelod_browser, then run it in a window when $DISPLAY is set, else headless
+# under xvfb-run, writing its screenshots into out/browser. Extra arguments go to the browser
+# (treelod_browser --help), e.g. `samples/browser.sh --scene samples/scenes/plaza-290.json`.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${TREELOD_BUILD_DIR:-$root/build}
+out=${TREELOD_BROWSER_OUT:-$root/out/browser}
+"$root/.ci/deps.sh"
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DTREELOD_BUILD_TESTS=OFF -DTREELOD_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build "$build" -j"$(nproc)" --target treelod_browser
+export XDG_CACHE_HOME=${XDG_CACHE_HOME:-$build/cache}
+args=("$@")
+[[ " $* " == *" --scene "* ]] || args+=(--scene "$root/samples/scenes/single-tree.json")
+if [ -n "${DISPLAY:-}" ]; then
+  exec "$build/bin/treelod_browser" "${args[@]}"
+fi
+xvfb-run -a -s "-screen 0 1280x1024x24" "$build/bin/treelod_browser" --headless --screenshots "$out" "${args[@]}"
+echo
+echo "No display: ran the browser headless; its screenshots are in $out:"
+ls -1 "$out"/*.png

@@ -1,0 +1,204 @@
+#include "ForestSample.h"
+
+#include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/TechniqueRegistry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace TreeLod
+{
+    const char* const ForestSample::SCRIPT_TECHNIQUE = "scene script";
+
+    ForestSample::ForestSample(Ogre::Root& root, SceneScript script) : mRoot(root), mScript(std::move(script))
+    {
+        mShadows = mScript.shadows.enabled;
+        const LightingSpec lighting = sceneLighting(mScript);
+        mBackground = Ogre::ColourValue(lighting.background.r, lighting.background.g, lighting.background.b);
+    }
+
+    ForestSample::~ForestSample()
+    {
+        detach();
+        mScene.reset();
+        if (mSceneManager)
+            mRoot.destroySceneManager(mSceneManager);
+    }
+
+    std::string ForestSample::getTitle() const { return "Forest: " + mScript.name; }
+
+    std::string ForestSample::getDescription() const
+    {
+        const std::size_t trees = mScene ? mScene->getPlacements().size() : 0;
+        char text[160];
+        std::snprintf(text, sizeof text, "\n\n%zu %s of %zu species, a %.0f s camera path. Space plays or pauses it; "
+                      "paused, drag to look and move with WASD.",
+                      trees, trees == 1 ? "tree" : "trees", mScript.species.size(), pathEnd() - pathStart());
+        return mScript.description + text;
+    }
+
+    double ForestSample::pathStart() const { return mScript.camera.keyframes.front().time; }
+    double ForestSample::pathEnd() const { return mScript.camera.keyframes.back().time; }
+
+    float ForestSample::getCameraSpeed() const { return std::clamp(mScript.ground.size / 60.0f, 2.0f, 100.0f); }
+
+    void ForestSample::build(const ProgressCallback& progress)
+    {
+        if (mSceneManager)
+            return;
+        report(progress, "forest: building " + mScript.name, 0.0f);
+        mSceneManager = mRoot.createSceneManager();
+        mScene = std::make_unique<ForestScene>(*mSceneManager, *mSceneManager->getRootSceneNode(), mScript);
+        mCamera = mSceneManager->createCamera("TreeLod/Browser/ForestCamera");
+        mCameraNode = mSceneManager->getRootSceneNode()->createChildSceneNode();
+        mCameraNode->attachObject(mCamera);
+        mPathTime = pathStart();
+        applyCameraSpec(*mCamera, *mCameraNode, cameraAt(mScript, mPathTime));
+        setShadows(mShadows);
+        report(progress, "forest: building " + mScript.name, 1.0f);
+    }
+
+    void ForestSample::renderThumbnail(Ogre::RenderTarget& target)
+    {
+        // The middle of the camera path: the first keyframe may stand inside a crown.
+        Ogre::Viewport* vp = addViewport(target, mCamera, 0, {0, 0, int(target.getWidth()), int(target.getHeight())});
+        vp->setBackgroundColour(mBackground);
+        vp->setOverlaysEnabled(false);
+        applyCameraSpec(*mCamera, *mCameraNode, cameraAt(mScript, 0.5 * (pathStart() + pathEnd())));
+        target.update();
+        target.removeViewport(vp->getZOrder());
+        applyCameraSpec(*mCamera, *mCameraNode, cameraAt(mScript, mPathTime));
+    }
+
+    void ForestSample::attach(Ogre::RenderTarget& target, const PixelRect& area, int firstZOrder)
+    {
+        detach();
+        mTarget = &target;
+        mViewport = addViewport(target, mCamera, firstZOrder, area);
+        mViewport->setBackgroundColour(mBackground);
+        mViewport->setOverlaysEnabled(false);
+        mViewport->setShadowsEnabled(true);
+    }
+
+    void ForestSample::detach()
+    {
+        if (mTarget && mViewport)
+            mTarget->removeViewport(mViewport->getZOrder());
+        mViewport = nullptr;
+        mTarget = nullptr;
+    }
+
+    void ForestSample::frame(double seconds)
+    {
+        if (!mPlaying)
+            return;
+        const double length = pathEnd() - pathStart();
+        mPathTime += seconds;
+        if (mPathTime > pathEnd())
+            mPathTime = length > 0.0 ? pathStart() + std::fmod(mPathTime - pathStart(), length) : pathStart();
+        applyCameraSpec(*mCamera, *mCameraNode, cameraAt(mScript, mPathTime));
+    }
+
+    void ForestSample::setScreenshotView(unsigned index, unsigned count)
+    {
+        mPlaying = false;
+        mPathTime = frameTime(mScript, index, count);
+        applyCameraSpec(*mCamera, *mCameraNode, cameraAt(mScript, mPathTime));
+    }
+
+    std::vector<std::string> ForestSample::getTechniques() const
+    {
+        std::vector<std::string> names{SCRIPT_TECHNIQUE};
+        for (const TechniqueInfo& info : TechniqueRegistry::getSingleton().getTechniques())
+            names.push_back(info.name);
+        names.push_back("quad"); // the Forest's one-quad impostor (Forest.h), not a registry technique
+        return names;
+    }
+
+    std::string ForestSample::getTechnique() const
+    {
+        return mScene->getTechnique().empty() ? std::string(SCRIPT_TECHNIQUE) : mScene->getTechnique();
+    }
+
+    void ForestSample::setTechnique(const std::string& technique)
+    {
+        const bool frozen = isLodFrozen();
+        mScene->setTechnique(technique == SCRIPT_TECHNIQUE ? "" : technique);
+        mScene->getForest().setLodFrozen(frozen);
+    }
+
+    void ForestSample::setLodBias(float bias)
+    {
+        mLodBias = bias;
+        mCamera->setLodBias(bias);
+    }
+
+    void ForestSample::setShadows(bool enabled)
+    {
+        mShadows = enabled;
+        mScene->setShadows(enabled);
+    }
+
+    void ForestSample::setWireframe(bool enabled)
+    {
+        mWireframe = enabled;
+        mCamera->setPolygonMode(enabled ? Ogre::PM_WIREFRAME : Ogre::PM_SOLID);
+    }
+
+    bool ForestSample::isLodFrozen() const { return mScene->getForest().isLodFrozen(); }
+
+    void ForestSample::setLodFrozen(bool frozen) { mScene->getForest().setLodFrozen(frozen); }
+
+    std::vector<std::pair<std::string, std::string>> ForestSample::getStats()
+    {
+        const ForestStats& s = mScene->getForest().getStats();
+        char cull[32];
+        std::snprintf(cull, sizeof cull, "%.2f ms", s.cullMilliseconds);
+        std::vector<std::pair<std::string, std::string>> stats;
+        stats.emplace_back("Trees shown", formatCount(s.visibleInstances) + " of " + formatCount(s.instances));
+        stats.emplace_back("Batches (frame)", std::to_string(mCamera->_getNumRenderedBatches()));
+        stats.emplace_back("Triangles (frame)", formatCount(mCamera->_getNumRenderedFaces()));
+        stats.emplace_back("Forest draws", std::to_string(s.batches));
+        stats.emplace_back("GPU memory", formatBytes(mScene->getGpuBytes()));
+        stats.emplace_back("Cull + LoD", cull);
+        return stats;
+    }
+
+    std::vector<std::string> ForestSample::getLevelHistogram()
+    {
+        constexpr int CELLS = 8;
+        const Forest& forest = mScene->getForest();
+        const ForestStats& s = forest.getStats();
+        std::uint32_t most = 1; // bars relative to the fullest level
+        for (const std::vector<std::uint32_t>& counts : s.levelCounts)
+            for (std::uint32_t count : counts)
+                most = std::max(most, count);
+        std::vector<std::string> lines;
+        for (std::size_t species = 0; species < s.levelCounts.size(); ++species)
+        {
+            const std::vector<ForestLevel>& levels = forest.getLevels(std::uint32_t(species));
+            for (std::size_t level = 0; level < s.levelCounts[species].size() && level < levels.size(); ++level)
+            {
+                const std::uint32_t count = s.levelCounts[species][level];
+                if (count == 0)
+                    continue;
+                // "oak L2 cloud 1 low": species, Forest level, what it draws (Forest.h).
+                const ForestLevel& l = levels[level];
+                std::string what = l.technique;
+                if (l.technique == "lodf")
+                    what += " " + (l.techniqueLevel ? formatCount(l.techniqueLevel) : std::string("all"));
+                else if (l.technique == "billboard-cloud")
+                    what = "cloud " + std::to_string(l.techniqueLevel) + (l.lowRes ? " low" : "");
+                else if (l.technique == "classic-billboard-cloud")
+                    what = "classic " + std::to_string(l.techniqueLevel);
+                lines.push_back(mScript.species[species].name + " L" + std::to_string(level) + " " + what + " " +
+                                textBar(double(count) / double(most), CELLS) + " " +
+                                std::to_string(count));
+            }
+        }
+        if (lines.empty())
+            lines.push_back("(no tree in view)");
+        return lines;
+    }
+}

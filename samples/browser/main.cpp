@@ -1,0 +1,59 @@
+// treelod_browser: TreeLod's sample browser (see TreeLodBrowser.h and --help).
+#include "BrowserOptions.h"
+#include "TreeLodBrowser.h"
+
+#include "TreeLod/SceneScript.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+
+int main(int argc, char** argv)
+{
+    using namespace TreeLod;
+    const char* source = std::getenv("TREELOD_SOURCE_DIR");
+    BrowserOptionsResult parsed = parseBrowserOptions(argc, argv, source && *source ? source : TREELOD_SOURCE_DIR);
+    if (!parsed.run)
+    {
+        (parsed.exitCode == 0 ? std::cout : std::cerr) << parsed.message << std::endl;
+        return parsed.exitCode;
+    }
+    const BrowserOptions& options = parsed.options;
+    Result<SceneScript> script = loadSceneScript(options.scene);
+    if (!script)
+    {
+        std::cerr << "treelod_browser: " << script.error().message() << std::endl;
+        return 2;
+    }
+    // Debian's OGRE is GLX only: say so before Ogre half-starts.
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display)
+    {
+        std::cerr << "treelod_browser: no X display (DISPLAY is not set): run under "
+                     "xvfb-run -a -s \"-screen 0 1280x1024x24\" treelod_browser --headless ..."
+                  << std::endl;
+        return 1;
+    }
+    TreeLodBrowser browser(options, *script);
+    int code = 0;
+    try
+    {
+        browser.initApp();
+        if (options.headless)
+            browser.writeScreenshots();
+        else
+            browser.getRoot()->startRendering();
+    }
+    catch (const Ogre::Exception& e)
+    {
+        std::cerr << "treelod_browser: " << e.getDescription() << std::endl;
+        code = 1;
+    }
+    catch (const std::exception& e)
+    {
+        std::cerr << "treelod_browser: " << e.what() << std::endl;
+        code = 1;
+    }
+    browser.closeApp();
+    return code;
+}

@@ -1,0 +1,75 @@
+// Test trees built in code, shared by the core tests and the core bench: the generated oak
+// (cached per leaf count and height) and leaves as the generator builds them.
+#pragma once
+
+#include "TreeLod/TreeGenerator.h"
+#include "TreeLod/TreeModel.h"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace TreeLod
+{
+    namespace test
+    {
+        /// The generated oak (seed 1, 64-texel texture) with `leaves` leaves, `height` metres tall
+        /// (0: the preset's height), built once per (leaves, height); throws std::runtime_error
+        /// with the generator's message when it fails (gtest reports it as the test's failure).
+        inline const TreeModel& generatedOak(std::uint32_t leaves, float height = 0.0f)
+        {
+            static std::map<std::pair<std::uint32_t, float>, TreeModel> cache;
+            auto it = cache.find({leaves, height});
+            if (it == cache.end())
+            {
+                GeneratorOptions options;
+                options.preset = TreePreset::Oak;
+                options.leafCount = leaves;
+                options.height = height;
+                options.textureSize = 64;
+                Result<TreeModel> m = generateTree(options);
+                if (!m)
+                    throw std::runtime_error(m.error().message());
+                it = cache.emplace(std::make_pair(leaves, height), std::move(m).value()).first;
+            }
+            return it->second;
+        }
+
+        /// A double-sided, untextured leaf material named `name` (base colour and back colour
+        /// left for the caller).
+        inline Material leafMaterial(const std::string& name)
+        {
+            Material leaf;
+            leaf.name = name;
+            leaf.isLeaf = true;
+            leaf.doubleSided = true;
+            return leaf;
+        }
+
+        /// Append one leaf quad as the generator builds it: corners centre -+u -+v, normal `n`,
+        /// UVs over the whole texture, 4 own vertices, 2 triangles, material `material`; its leaf
+        /// record (centre, normal, area, UV box) updated.
+        inline void addQuadLeaf(TreeModel& m, const glm::vec3& centre, const glm::vec3& u, const glm::vec3& v,
+                                const glm::vec3& n, std::uint32_t material = 0)
+        {
+            Leaf l;
+            l.firstVertex = std::uint32_t(m.leafVertices.size());
+            l.vertexCount = 4;
+            l.firstIndex = std::uint32_t(m.leafIndices.size());
+            l.indexCount = 6;
+            l.material = material;
+            const glm::vec3 corners[4] = {centre - u - v, centre + u - v, centre + u + v, centre - u + v};
+            const glm::vec2 uvs[4] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+            for (int k = 0; k < 4; ++k)
+                m.leafVertices.push_back({corners[k], n, uvs[k]});
+            for (std::uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u})
+                m.leafIndices.push_back(l.firstVertex + k);
+            m.leaves.push_back(l);
+            m.updateLeafRecord(m.leaves.size() - 1);
+        }
+    }
+}
