@@ -200,13 +200,6 @@ namespace TreeLod
             for (std::uint32_t& v : *array)
                 v = r.u32();
         }
-        if (!r.ok())
-            return r.error();
-        if (r.remaining() != 0)
-            return fail(label, r.element(), std::to_string(r.remaining()) + " trailing bytes");
-        Result<void> valid = data.validate(label);
-        if (!valid)
-            return valid.error();
-        return data;
+        return finishDecode(r, label, r.element(), std::move(data));
     }
 }
