@@ -1,16 +1,21 @@
 // treelod bench SCENE.json -o DIR [--techniques a,b] [--lod-bias 1,0.5,0.25] [--frames N] [--scale S]
 //
-// Scripted scene benchmark (issue 5): the scene's camera path rendered headless for each
-// technique and LoD bias, with the polygonal reference ("mesh") and the one-quad-per-tree floor
-// ("quad") in the same run. Per frame: CPU time (until the frame's commands are submitted),
-// frame time bounded by a one-pixel read-back (Ogre's GL3Plus render system offers no timer
-// queries, so the GPU time is the glFinish-bounded wall time), batches, triangles, instances
-// per level. On sampled frames: the polygonal reference supersampled 2x2, and against it FLIP
-// and multi-scale RMSE (paper 001 §4), and temporal noise: the multi-scale RMSE between the
-// frame and the next frame of the path (paper 001 §5, Fig. 13), for the reference too.
-// A reference frame whose triangle count would exceed --reference-budget is skipped and said
-// so, never estimated. Writes DIR/frames.csv, DIR/summary.json and PNG plots (frame time along
-// the path, paper 001 Fig. 11; the speed/accuracy trade over the LoD biases).
+// Scripted scene benchmark (issues 5 and 7): the scene's camera path rendered headless for each
+// technique and LoD bias, with the polygonal reference ("mesh") and three floors in the same run:
+// the Forest's one-quad level ("quad"), one plain Ogre Entity per tree ("entities": what Ogre users
+// pay today) and every tree's quad merged into a few static batches ("merged-quads": the cheapest
+// possible drawing). The bench bakes what the runs draw (BakeCache), writes the package list and
+// runs treelod_frames, which renders and times the frames and links no baker (DESIGN.md, "Runtime
+// vs bake"); then it compares the frames treelod_frames saved. Per frame: CPU time (until the
+// frame's commands are submitted), frame time bounded by a one-pixel read-back (Ogre's GL3Plus
+// render system offers no timer queries, so the GPU time is the glFinish-bounded wall time),
+// batches, triangles, instances per level, bytes uploaded. On sampled frames: the polygonal
+// reference supersampled 2x2, and against it FLIP and multi-scale RMSE (paper 001 §4), and
+// temporal noise: the multi-scale RMSE between the frame and the next frame of the path (paper 001
+// §5, Fig. 13), for the reference too. A reference frame whose triangle count would exceed
+// --reference-budget is skipped and said so, never estimated. Writes DIR/frames.csv,
+// DIR/summary.json and PNG plots (frame time along the path, paper 001 Fig. 11; the speed/accuracy
+// trade over the LoD biases with the reference and the floors marked).
 #include "CliSupport.h"
 #include "Commands.h"
 
@@ -32,10 +37,16 @@
 
 #ifdef TREELOD_WITH_OGRE
 #include "TreeLod/AtomicFile.h"
+#include "TreeLod/CacheTreeBaker.h"
 #include "TreeLod/ForestScene.h"
+#include "TreeLod/Image.h"
 #include "TreeLod/OffscreenRenderer.h"
-#include "TreeLod/RgbaImageConversion.h"
-#include "TreeLod/TreeAssetManager.h"
+
+#include <cerrno>
+#include <cstring>
+
+#include <sys/wait.h>
+#include <unistd.h>
 #endif
 
 namespace TreeLod
@@ -56,6 +67,8 @@ namespace TreeLod
             double referenceImageBudget = 0.0; // triangles: its supersampled images; 0 = referenceBudget
             std::string cacheDirectory;
             std::string counts;       // "" = the script's counts
+            bool bakeOnly = false;    // bake, write packages.json, print the treelod_frames command
+            std::string framesFrom;   // "" = run treelod_frames here; else read its output from this directory
             bool json = false;
             bool quiet = false;
         };
@@ -112,6 +125,7 @@ namespace TreeLod
             FrameTiming timing;
             std::uint32_t visible = 0;
             std::vector<std::uint32_t> levels; ///< visible instances per level index, all species summed
+            std::uint64_t uploadedBytes = 0;   ///< levels made resident in this frame (Forest upload budget)
             double flip = NAN, msRmse = NAN, temporalNoise = NAN;
         };
 
@@ -122,9 +136,31 @@ namespace TreeLod
             std::string technique;
             float lodBias = 1.0f;
             std::vector<FrameRecord> frames;
-            std::uint64_t assetBytes = 0;
+            std::uint64_t assetBytes = 0;    ///< GPU bytes of what the run drew
+            std::uint64_t instanceBytes = 0; ///< the Forest's instance store on the CPU
+            double rssMiB = NAN, peakRssMiB = NAN; ///< treelod_frames' resident memory after the run
             double bakeSeconds = 0.0;
+            std::string skipped;   ///< the whole run (e.g. too many entities)
+            bool hasPicture = false;
         };
+
+        /// Runs that stand for something every technique is compared with, and what the plots call them.
+        const std::vector<std::pair<std::string, std::string>>& comparisonRuns()
+        {
+            static const std::vector<std::pair<std::string, std::string>> runs = {
+                {"mesh", "polygonal reference (mesh, 1 spp)"},
+                {"quad", "floor: the Forest's one-quad level"},
+                {"entities", "floor: one Ogre entity per tree (a quad)"},
+                {"merged-quads", "floor: quads merged into a few batches"}};
+            return runs;
+        }
+        bool isComparisonRun(const std::string& technique)
+        {
+            for (const auto& [name, label] : comparisonRuns())
+                if (name == technique)
+                    return true;
+            return false;
+        }
 
         /// The reference on a sampled frame: supersampled image and its temporal noise.
         struct ReferenceSample
@@ -148,39 +184,6 @@ namespace TreeLod
             char text[64];
             std::snprintf(text, sizeof text, "%.*g", digits + 2, v);
             return text;
-        }
-
-        /// Triangles the polygonal reference would submit from `camera`: visible trees times
-        /// their reference triangle counts (an exact count of what would be drawn, not a guess
-        /// at time: the budget is in triangles).
-        std::uint64_t referenceTriangles(ForestScene& scene, const CameraSpec& camera, int width, int height)
-        {
-            Forest& forest = scene.getForest();
-            ForestVisibility visibility;
-            const CullCamera cull = CullCamera::fromSpec(camera, float(width), float(height));
-            if (!forest.getInstances().cull(cull, 1.0f, visibility))
-                return 0;
-            std::uint64_t triangles = 0;
-            for (const ForestBucket& bucket : visibility.getBuckets())
-            {
-                const ReferenceChunk& reference = forest.getAsset(bucket.kind)->getReference();
-                triangles += std::uint64_t(bucket.count) *
-                             (reference.model.barkIndices.size() + reference.model.leafIndices.size()) / 3;
-            }
-            return triangles;
-        }
-
-        std::vector<std::uint32_t> levelHistogram(const Forest& forest)
-        {
-            std::vector<std::uint32_t> levels;
-            for (const std::vector<std::uint32_t>& species : forest.getStats().levelCounts)
-            {
-                if (levels.size() < species.size())
-                    levels.resize(species.size(), 0);
-                for (std::size_t l = 0; l < species.size(); ++l)
-                    levels[l] += species[l];
-            }
-            return levels;
         }
 
         double imageBudget(const BenchArgs& args)
@@ -214,7 +217,7 @@ namespace TreeLod
                 std::vector<bool> common;
                 for (const Run& run : runs)
                 {
-                    if (run.count != count || (!withReference && run.technique == "mesh"))
+                    if (run.count != count || run.frames.empty() || (!withReference && run.technique == "mesh"))
                         continue;
                     if (common.empty())
                         common.assign(run.frames.size(), true);
@@ -234,7 +237,7 @@ namespace TreeLod
         {
             // frames.csv: one row per run and frame.
             std::string csv = "trees,technique,lod_bias,frame,time_s,timed,cpu_ms,frame_ms,batches,triangles,visible,"
-                              "instances_per_level,flip,ms_rmse,temporal_noise,skipped\n";
+                              "instances_per_level,flip,ms_rmse,temporal_noise,skipped,uploaded_bytes\n";
             for (const Run& run : runs)
                 for (const FrameRecord& r : run.frames)
                     csv += std::to_string(run.count) + "," + run.technique + "," + number(run.lodBias, 3) + "," +
@@ -245,7 +248,7 @@ namespace TreeLod
                            (r.timed ? std::to_string(r.timing.triangles) : "") + "," +
                            (r.timed ? std::to_string(r.visible) : "") + "," + levelsText(r.levels) + "," +
                            number(r.flip) + "," + number(r.msRmse) + "," + number(r.temporalNoise) + ",\"" +
-                           r.skipped + "\"\n";
+                           r.skipped + "\"," + (r.timed ? std::to_string(r.uploadedBytes) : "") + "\n";
             if (Result<void> w = writeText(args.output + "/frames.csv", csv); !w)
                 return printError(w.error()), false;
 
@@ -268,20 +271,25 @@ namespace TreeLod
             for (const Run& run : runs)
             {
                 const Run* reference = nullptr;
-                const Run* floor = nullptr;
                 for (const Run& other : runs)
                     if (other.count == run.count && other.technique == "mesh")
                         reference = &other;
-                    else if (other.count == run.count && other.technique == "quad")
-                        floor = &other;
                 std::vector<double> frameMs, cpuMs, flips, rmse, noise, refNoise;
                 std::vector<std::string> skipped;
+                if (!run.skipped.empty())
+                    skipped.push_back(run.skipped);
+                json worst = nullptr;
+                std::uint64_t maxUploaded = 0;
                 for (const FrameRecord& r : run.frames)
                 {
                     if (r.timed)
                     {
                         frameMs.push_back(r.timing.frameMilliseconds);
                         cpuMs.push_back(r.timing.cpuMilliseconds);
+                        if (worst.is_null() || r.timing.frameMilliseconds > worst["frameMs"].get<double>())
+                            worst = {{"frame", r.frame}, {"time", r.time}, {"frameMs", r.timing.frameMilliseconds},
+                                     {"uploadedBytes", r.uploadedBytes}};
+                        maxUploaded = std::max(maxUploaded, r.uploadedBytes);
                     }
                     flips.push_back(r.flip);
                     rmse.push_back(r.msRmse);
@@ -293,25 +301,32 @@ namespace TreeLod
                     for (const auto& [frame, sample] : it->second)
                         refNoise.push_back(sample.temporalNoise);
                 const Stats flipStats = statsOf(flips);
+                const Stats frameStats = statsOf(frameMs);
                 const double techniqueOnShared = reference ? medianOver(run, reference) : NAN;
                 const double referenceOnShared = reference ? medianOver(*reference, &run) : NAN;
-                const double ownMedian = statsOf(frameMs).median;
-                const double floorMedian = floor ? statsOf([&] {
-                    std::vector<double> v;
-                    for (const FrameRecord& r : floor->frames)
-                        if (r.timed)
-                            v.push_back(r.timing.frameMilliseconds);
-                    return v;
-                }()).median
-                                                 : NAN;
                 auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+                // Ratios of medians measured in this run (the floors' own medians over their timed frames).
+                json ratios = json::object();
+                for (const auto& [floor, label] : comparisonRuns())
+                    if (floor != "mesh")
+                        for (const Run& other : runs)
+                            if (other.count == run.count && other.technique == floor)
+                                ratios[floor] = num(frameStats.median / medianOver(other, nullptr));
                 results.push_back({{"trees", run.count},
                                    {"technique", run.technique},
                                    {"lodBias", run.lodBias},
-                                   {"frameMs", toJson(statsOf(frameMs))},
+                                   {"frameMs", toJson(frameStats)},
+                                   {"p95OverMedian", num(frameStats.p95 / frameStats.median)},
+                                   {"worstFrame", worst},
                                    {"cpuMs", toJson(statsOf(cpuMs))},
                                    {"speedupVsReference", num(referenceOnShared / techniqueOnShared)},
-                                   {"ratioToFloor", num(ownMedian / floorMedian)},
+                                   {"ratioToFloor", ratios.contains("quad") ? ratios["quad"] : json(nullptr)},
+                                   {"ratioToFloors", ratios},
+                                   {"maxUploadedBytesPerFrame", maxUploaded},
+                                   {"instanceBytes", run.instanceBytes},
+                                   {"instanceBytesPerTree", num(run.count ? double(run.instanceBytes) / run.count : NAN)},
+                                   {"rssMiB", num(run.rssMiB)},
+                                   {"peakRssMiB", num(run.peakRssMiB)},
                                    {"flip", {{"mean", num(flipStats.mean)}, {"max", num(flipStats.max)},
                                              {"samples", flipStats.count}}},
                                    {"msRmse", num(statsOf(rmse).mean)},
@@ -363,23 +378,28 @@ namespace TreeLod
                     for (const FrameRecord& r : run.frames)
                         flips.push_back(r.flip);
                     const double meanFlip = statsOf(flips).mean;
-                    if (run.technique == "mesh" || run.technique == "quad")
-                        trade.markers.push_back(PlotMarker{run.technique == "mesh" ? "polygonal reference (mesh, 1 spp)"
-                                                                                   : "floor: one quad per tree",
-                                                           glm::dvec2(median, meanFlip), glm::vec3(0.0f),
-                                                           run.technique == "mesh" ? 'o' : 's'});
+                    if (isComparisonRun(run.technique))
+                    {
+                        static const char shapes[] = {'o', 's', '^', 'x'};
+                        for (std::size_t c = 0; c < comparisonRuns().size(); ++c)
+                            if (comparisonRuns()[c].first == run.technique)
+                                trade.markers.push_back(PlotMarker{comparisonRuns()[c].second,
+                                                                   glm::dvec2(median, meanFlip), glm::vec3(0.0f),
+                                                                   shapes[c]});
+                    }
                     else
                     {
                         PlotSeries& curve = curves[run.technique];
                         curve.label = run.technique + " (LoD bias " + args.lodBiases + ")";
                         curve.points.push_back(glm::dvec2(median, meanFlip));
                     }
-                    if (run.lodBias == 1.0f || run.technique == "mesh" || run.technique == "quad")
+                    if (run.lodBias == 1.0f || isComparisonRun(run.technique))
                     {
                         PlotSeries series;
-                        series.label = run.technique == "mesh"   ? "polygonal reference (mesh)"
-                                       : run.technique == "quad" ? "floor (one quad per tree)"
-                                                                 : run.technique;
+                        series.label = run.technique;
+                        for (const auto& [name, text] : comparisonRuns())
+                            if (name == run.technique)
+                                series.label = text;
                         series.markers = false;
                         if (std::none_of(run.frames.begin(), run.frames.end(),
                                          [](const FrameRecord& r) { return r.timed; }))
@@ -420,12 +440,139 @@ namespace TreeLod
             return true;
         }
 
+        /// treelod_frames: $TREELOD_FRAMES, else beside this executable.
+        std::string framesExecutable()
+        {
+            if (const char* env = std::getenv("TREELOD_FRAMES"); env && *env)
+                return env;
+            std::error_code ec;
+            const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+            return (ec ? std::filesystem::path("treelod_frames") : self.parent_path() / "treelod_frames").string();
+        }
+
+        /// Run `argv` and wait; its exit code, or -1 when it could not start or died of a signal.
+        int runProcess(const std::vector<std::string>& argv)
+        {
+            std::vector<char*> args;
+            for (const std::string& a : argv)
+                args.push_back(const_cast<char*>(a.c_str()));
+            args.push_back(nullptr);
+            const pid_t pid = fork();
+            if (pid < 0)
+                return -1;
+            if (pid == 0)
+            {
+                execv(args[0], args.data());
+                std::fprintf(stderr, "treelod: bench: cannot run %s: %s\n", args[0], std::strerror(errno));
+                _exit(127);
+            }
+            int status = 0;
+            while (waitpid(pid, &status, 0) < 0)
+                if (errno != EINTR)
+                    return -1;
+            return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        }
+
+        /// The runs treelod_frames timed (DIR/timings.json), with the image metrics of their sampled
+        /// frames computed here from the PNGs it saved; each run's first picture is copied to `output`.
+        Result<std::vector<Run>> readRuns(const std::string& directory, const std::string& output,
+                                          std::map<std::uint32_t, std::map<std::uint32_t, ReferenceSample>>& references)
+        {
+            const std::string path = directory + "/timings.json";
+            std::ifstream in(path);
+            nlohmann::json timings = nlohmann::json::parse(in, nullptr, false);
+            if (timings.is_discarded() || !timings.contains("runs"))
+                return fail(path, "", "not the timings treelod_frames writes");
+            auto load = [&](const std::string& stem) -> Result<Image> {
+                return readImage(directory + "/images/" + stem + ".png");
+            };
+            std::vector<Run> runs;
+            for (const nlohmann::json& r : timings["runs"])
+            {
+                Run run;
+                run.count = r.value("trees", 0u);
+                run.technique = r.value("technique", "");
+                run.lodBias = r.value("lodBias", 1.0f);
+                run.assetBytes = r.value("gpuBytes", std::uint64_t(0));
+                run.instanceBytes = r.value("instanceBytes", std::uint64_t(0));
+                run.rssMiB = r.value("rssMiB", NAN);
+                run.peakRssMiB = r.value("peakRssMiB", NAN);
+                run.skipped = r.value("skipped", "");
+                for (const nlohmann::json& f : r["frames"])
+                {
+                    FrameRecord record;
+                    record.frame = f.value("frame", 0u);
+                    record.time = f.value("time", 0.0);
+                    record.skipped = f.value("skipped", "");
+                    record.timed = f.contains("frameMs");
+                    if (record.timed)
+                    {
+                        record.timing.cpuMilliseconds = f["cpuMs"];
+                        record.timing.frameMilliseconds = f["frameMs"];
+                        record.timing.batches = f["batches"];
+                        record.timing.triangles = f["triangles"];
+                        record.visible = f.value("visible", 0u);
+                        record.levels = f.value("levels", std::vector<std::uint32_t>{});
+                        record.uploadedBytes = f.value("uploadedBytes", std::uint64_t(0));
+                    }
+                    std::map<std::uint32_t, ReferenceSample>& refs = references[run.count];
+                    if (f.contains("referenceImage"))
+                    {
+                        const std::string stem = f["referenceImage"];
+                        Result<Image> image = load(stem), next = load(stem + "-next");
+                        if (!image)
+                            return image.error();
+                        if (!next)
+                            return next.error();
+                        ReferenceSample sample;
+                        sample.image = std::move(*image);
+                        if (Result<MultiScaleRmseResult> m = multiScaleRmse(sample.image, *next))
+                            sample.temporalNoise = m->combined;
+                        refs[record.frame] = std::move(sample);
+                    }
+                    if (f.contains("image"))
+                    {
+                        const std::string stem = f["image"];
+                        if (auto it = refs.find(record.frame); it != refs.end())
+                        {
+                            Result<Image> image = load(stem), next = load(stem + "-next");
+                            if (!image)
+                                return image.error();
+                            if (!next)
+                                return next.error();
+                            if (Result<FlipResult> m = flip(it->second.image, *image))
+                                record.flip = m->mean;
+                            if (Result<MultiScaleRmseResult> m = multiScaleRmse(it->second.image, *image))
+                                record.msRmse = m->combined;
+                            if (Result<MultiScaleRmseResult> m = multiScaleRmse(*image, *next))
+                                record.temporalNoise = m->combined;
+                        }
+                        else
+                            record.skipped += std::string(record.skipped.empty() ? "" : "; ") +
+                                              "no reference image for this frame (too costly)";
+                        if (run.frames.empty() || !run.hasPicture) // a picture of every run
+                        {
+                            std::error_code ec;
+                            std::filesystem::copy_file(directory + "/images/" + stem + ".png",
+                                                       output + "/frame-" + std::to_string(run.count) + "-" +
+                                                           run.technique + "-" + number(run.lodBias, 2) + ".png",
+                                                       std::filesystem::copy_options::overwrite_existing, ec);
+                            run.hasPicture = !ec;
+                        }
+                    }
+                    run.frames.push_back(std::move(record));
+                }
+                runs.push_back(std::move(run));
+            }
+            return runs;
+        }
+
         int runBench(const BenchArgs& args)
         {
-            Result<SceneScript> loaded = loadSceneScript(args.scene);
+            Result<SceneScript> loaded = loadSceneScript(args.scene, readGreyImage);
             if (!loaded)
                 return printError(loaded.error());
-            SceneScript script = *loaded;
+            const SceneScript& script = *loaded;
             if (!(args.scale > 0.0) || !std::isfinite(args.scale))
                 return printError(fail("", "--scale", "must be a positive number"));
             int width = script.width, height = script.height;
@@ -433,35 +580,24 @@ namespace TreeLod
                                        height <= 0 || width > 16384 || height > 16384))
                 return printError(fail("", "--size", "'" + args.size + "' is not WxH with 1..16384"));
             const std::uint32_t frames = args.frames ? args.frames : script.frames;
-            std::vector<float> biases;
             for (const std::string& b : splitList(args.lodBiases))
             {
                 char* end = nullptr;
                 const double v = std::strtod(b.c_str(), &end);
                 if (*end != '\0' || !(v > 0.0) || !std::isfinite(v))
                     return printError(fail("", "--lod-bias", "'" + b + "' is not a positive number"));
-                biases.push_back(float(v));
             }
-            if (biases.empty())
+            if (splitList(args.lodBiases).empty())
                 return printError(fail("", "--lod-bias", "needs at least one value"));
-            std::vector<std::string> techniques = splitList(args.techniques);
-            for (const std::string& t : techniques)
+            // Every run draws from these: the reference, the floors, then the techniques.
+            std::vector<std::string> drawn = {"mesh", "quad"};
+            for (const std::string& t : splitList(args.techniques))
+            {
                 if (t != "auto" && bakeTechniqueOf(t).empty())
                     return printError(fail("", "--techniques",
-                                           "unknown technique '" + t +
-                                               "' (known: auto, mesh, lodf, billboard-cloud, classic-billboard-cloud, quad)"));
-            techniques.erase(std::remove_if(techniques.begin(), techniques.end(),
-                                            [](const std::string& t) { return t == "mesh" || t == "quad"; }),
-                             techniques.end());
-            std::vector<std::uint32_t> counts = script.counts;
-            if (!args.counts.empty())
-            {
-                counts.clear();
-                for (const std::string& c : splitList(args.counts))
-                    counts.push_back(std::uint32_t(std::strtoul(c.c_str(), nullptr, 10)));
+                                           "unknown technique '" + t + "' (known: auto, " + knownSceneTechniques() + ")"));
+                drawn.push_back(t == "auto" ? "" : t);
             }
-            if (counts.empty())
-                counts.push_back(0); // as the script places them
             if (args.samples == 0 || frames == 0)
                 return printError(fail("", "--frames/--samples", "must be >= 1"));
 
@@ -470,145 +606,66 @@ namespace TreeLod
             if (ec)
                 return printError(fail(args.output, "", "cannot create the output directory: " + ec.message()));
 
+            // Bake what the runs draw, once per distinct source; treelod_frames reads the list.
             ProgressCallback progress = makeProgress(args.quiet);
-            OffscreenRenderer renderer;
-            renderer.setLighting(sceneLighting(script));
             CacheTreeBaker baker(args.cacheDirectory.empty() ? defaultBakeCacheDirectory() : args.cacheDirectory,
                                  progress);
-            TreeAssetManager::getSingleton().setBaker(&baker);
-            struct BakerReset
+            double bakeSeconds = 0.0;
+            try
             {
-                ~BakerReset() { TreeAssetManager::getSingleton().setBaker(nullptr); }
-            } bakerReset;
-
-            // Sampled frames: evenly along the path (never the last: its successor is the temporal pair).
-            std::vector<std::uint32_t> sampled;
-            const std::uint32_t samples = std::min(args.samples, std::max<std::uint32_t>(1, frames - 1));
-            for (std::uint32_t i = 0; i < samples; ++i)
-                sampled.push_back(frames <= 1 ? 0 : std::uint32_t((std::uint64_t(i) * 2 + 1) * (frames - 1) / (2 * samples)));
-            auto isSampled = [&](std::uint32_t f) { return std::find(sampled.begin(), sampled.end(), f) != sampled.end(); };
-            // The temporal pair: the next frame at the script's own frame rate (not --frames'), so
-            // temporal noise does not depend on how much the bench thins the path out.
-            const double nativeStep =
-                script.frames > 1 ? frameTime(script, 1, script.frames) - frameTime(script, 0, script.frames) : 0.0;
-            auto nextCamera = [&](std::uint32_t f) { return cameraAt(script, frameTime(script, f, frames) + nativeStep); };
-
-            std::vector<Run> runs;
-            std::map<std::uint32_t, std::map<std::uint32_t, ReferenceSample>> references; // trees -> frame ->
-
-            for (std::uint32_t count : counts)
-            {
-                ForestSceneOptions options;
-                options.placement.totalCount = count;
-                options.placement.scale = args.scale;
-                std::vector<std::pair<std::string, std::vector<float>>> plan = {{"mesh", {1.0f}}, {"quad", {1.0f}}};
-                for (const std::string& t : techniques)
-                    plan.push_back({t, biases});
-                for (const auto& [technique, runBiases] : plan)
+                for (const auto& [source, techniques] : scenePackages(script, drawn))
                 {
-                    const std::size_t entriesBefore = baker.getEntries().size();
-                    options.technique = technique == "auto" ? "" : technique;
-                    std::unique_ptr<ForestScene> scene;
-                    try
-                    {
-                        scene = std::make_unique<ForestScene>(renderer.getSceneManager(), renderer.getContentNode(),
-                                                              script, options);
-                    }
-                    catch (const Ogre::Exception& e)
-                    {
-                        return printError(fail(args.scene, "technique " + technique, e.getDescription()));
-                    }
-                    if (script.shadows.enabled)
-                        renderer.setShadowFarDistance(ForestScene::getShadowFarDistance());
-                    const std::uint32_t trees = std::uint32_t(scene->getPlacements().size());
-                    double bakeSeconds = 0.0;
-                    for (std::size_t e = entriesBefore; e < baker.getEntries().size(); ++e)
-                    {
-                        bakeSeconds += baker.getEntries()[e].bakeSeconds;
-                        if (!args.quiet)
-                            std::fprintf(stderr, "%s\n", baker.getEntries()[e].describe().c_str());
-                    }
-                    for (float bias : runBiases)
-                    {
-                        // Untimed warm-up along the path: GL3Plus links each program on first use,
-                        // which would otherwise land in the first frame that shows a level.
-                        renderer.setLodBias(bias);
-                        for (std::uint32_t w = 0; w < std::min<std::uint32_t>(frames, 4); ++w)
-                            renderer.renderTimedFrame(scene->cameraAtFrame(w * (frames - 1) / 3, frames), width, height);
-                        Run run;
-                        run.count = trees;
-                        run.technique = technique;
-                        run.lodBias = bias;
-                        run.bakeSeconds = bakeSeconds;
-                        renderer.setLodBias(bias);
-                        const std::string label = technique + " bias " + number(bias, 2) + " (" + treesText(trees) + ")";
-                        for (std::uint32_t f = 0; f < frames; ++f)
-                        {
-                            progress(label, float(f) / float(frames));
-                            FrameRecord record;
-                            record.frame = f;
-                            record.time = frameTime(script, f, frames);
-                            const CameraSpec camera = scene->cameraAtFrame(f, frames);
-                            std::uint64_t referenceCost = 0;
-                            if (technique == "mesh")
-                                referenceCost = referenceTriangles(*scene, camera, width, height);
-                            if (technique == "mesh" && double(referenceCost) > args.referenceBudget)
-                                record.skipped = "reference too costly: " + std::to_string(referenceCost) +
-                                                 " triangles > budget " + number(args.referenceBudget, 3);
-                            else
-                            {
-                                record.timing = renderer.renderTimedFrame(camera, width, height);
-                                record.timed = true;
-                                record.visible = scene->getForest().getStats().visibleInstances;
-                                record.levels = levelHistogram(scene->getForest());
-                            }
-                            if (isSampled(f))
-                            {
-                                std::map<std::uint32_t, ReferenceSample>& refs = references[trees];
-                                if (technique == "mesh")
-                                {
-                                    if (double(referenceCost) <= imageBudget(args))
-                                    {
-                                        ReferenceSample sample;
-                                        sample.image = toImage(renderer.render(camera, width, height, 2));
-                                        const Image next = toImage(renderer.render(nextCamera(f), width, height, 2));
-                                        if (Result<MultiScaleRmseResult> r = multiScaleRmse(sample.image, next))
-                                            sample.temporalNoise = r->combined;
-                                        refs[f] = std::move(sample);
-                                    }
-                                }
-                                if (refs.count(f))
-                                {
-                                    const Image image = toImage(renderer.render(camera, width, height, 1));
-                                    const Image next = toImage(renderer.render(nextCamera(f), width, height, 1));
-                                    if (Result<FlipResult> r = flip(refs[f].image, image))
-                                        record.flip = r->mean;
-                                    if (Result<MultiScaleRmseResult> r = multiScaleRmse(refs[f].image, image))
-                                        record.msRmse = r->combined;
-                                    if (Result<MultiScaleRmseResult> r = multiScaleRmse(image, next))
-                                        record.temporalNoise = r->combined;
-                                }
-                                else if (technique == "mesh")
-                                    record.skipped += std::string(record.skipped.empty() ? "" : "; ") +
-                                                      "reference image too costly: " + std::to_string(referenceCost) +
-                                                      " triangles > image budget " + number(imageBudget(args), 3);
-                                else
-                                    record.skipped = "no reference image for this frame (too costly)";
-                                if (f == sampled.front()) // a picture of every run
-                                    OffscreenRenderer::savePng(renderer.render(camera, width, height, 1),
-                                                               args.output + "/frame-" + std::to_string(trees) + "-" +
-                                                                   technique + "-" + number(bias, 2) + ".png");
-                            }
-                            run.frames.push_back(std::move(record));
-                        }
-                        progress(label, 1.0f);
-                        run.assetBytes = scene->getGpuBytes();
-                        runs.push_back(std::move(run));
-                    }
-                    scene.reset();
+                    baker.requirePackage(source, techniques);
+                    bakeSeconds += baker.getEntries().back().bakeSeconds;
+                    if (!args.quiet)
+                        std::fprintf(stderr, "%s\n", baker.getEntries().back().describe().c_str());
                 }
             }
-            return writeOutputs(args, script, frames, width, height, runs, references, baker) ? EXIT_OK : EXIT_FAILURE_RUN;
+            catch (const Ogre::Exception& e)
+            {
+                return printError(fail(args.scene, "species", e.getDescription()));
+            }
+            const std::string packageList = args.output + "/packages.json";
+            if (Result<void> w = baker.writePackageList(packageList); !w)
+                return printError(w.error());
+
+            std::vector<std::string> command = {framesExecutable(), args.scene, "--packages", packageList, "-o",
+                                                args.output, "--techniques", args.techniques, "--lod-bias",
+                                                args.lodBiases, "--samples", std::to_string(args.samples),
+                                                "--reference-budget", number(args.referenceBudget, 6),
+                                                "--reference-image-budget", number(imageBudget(args), 6),
+                                                "--scale", number(args.scale, 8), "--size",
+                                                std::to_string(width) + "x" + std::to_string(height), "--frames",
+                                                std::to_string(frames)};
+            if (!args.counts.empty())
+                command.insert(command.end(), {"--counts", args.counts});
+            if (args.quiet)
+                command.push_back("-q");
+            if (args.bakeOnly)
+            {
+                // For a GPU machine (../shared/gpu/README.md): run this there, bring DIR back, then
+                // `treelod bench ... --frames-from DIR` here computes the image metrics and the plots.
+                std::string line;
+                for (const std::string& a : command)
+                    line += (line.empty() ? "" : " ") + ("'" + a + "'");
+                std::printf("%s\n", line.c_str());
+                return EXIT_OK;
+            }
+            if (args.framesFrom.empty())
+                if (const int code = runProcess(command); code != 0)
+                {
+                    std::fprintf(stderr, "treelod: bench: %s failed (exit %d)\n", command[0].c_str(), code);
+                    return code == EXIT_BAD_INPUT ? EXIT_BAD_INPUT : EXIT_FAILURE_RUN;
+                }
+
+            std::map<std::uint32_t, std::map<std::uint32_t, ReferenceSample>> references; // trees -> frame ->
+            Result<std::vector<Run>> runs = readRuns(args.framesFrom.empty() ? args.output : args.framesFrom, args.output, references);
+            if (!runs)
+                return printError(runs.error());
+            for (Run& run : *runs)
+                run.bakeSeconds = bakeSeconds;
+            return writeOutputs(args, script, frames, width, height, *runs, references, baker) ? EXIT_OK
+                                                                                               : EXIT_FAILURE_RUN;
         }
 #endif
     }
@@ -641,6 +698,10 @@ namespace TreeLod
                         "the same for the reference's supersampled images on sampled frames (default: "
                         "--reference-budget); images cost no timed frames, so this may be larger");
         cmd->add_option("--cache", args->cacheDirectory, "bake cache directory (default: $XDG_CACHE_HOME/treelod)");
+        cmd->add_flag("--bake-only", args->bakeOnly,
+                      "bake and write DIR/packages.json, print the treelod_frames command (to run on a GPU machine)");
+        cmd->add_option("--frames-from", args->framesFrom,
+                        "read treelod_frames' output (timings.json, images/) from this directory instead of running it");
         cmd->add_flag("--json", args->json, "also print summary.json");
         cmd->add_flag("-q,--quiet", args->quiet, "no progress");
         cmd->callback([args] {

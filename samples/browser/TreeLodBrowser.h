@@ -15,12 +15,13 @@
 // folder, the TreeLod plugin installed in-process, TreeLod's materials from
 // $TREELOD_MATERIALS_DIR or the source tree (group "TreeLod"), the trays' media from OGRE's
 // SdkTrays.zip ("Essential"), RTSS for the trays only (the scene viewports use TreeLod's own
-// shaders). Lazy baking through CacheTreeBaker (ForestScene.h) registered with the
+// shaders). Lazy baking through CacheTreeBaker (CacheTreeBaker.h) registered with the
 // TreeAssetManager; what it built and reused is printed.
 #pragma once
 
 #include "BrowserOptions.h"
 #include "BrowserSample.h"
+#include "TreeLod/CacheTreeBaker.h"
 #include "TreeLod/ForestScene.h"
 #include "TreeLod/SceneScript.h"
 

@@ -2,6 +2,7 @@
 #include "BrowserOptions.h"
 #include "TreeLodBrowser.h"
 
+#include "TreeLod/Image.h" // readGreyImage: heightfields
 #include "TreeLod/SceneScript.h"
 
 #include <cstdio>
@@ -19,7 +20,7 @@ int main(int argc, char** argv)
         return parsed.exitCode;
     }
     const BrowserOptions& options = parsed.options;
-    Result<SceneScript> script = loadSceneScript(options.scene);
+    Result<SceneScript> script = loadSceneScript(options.scene, readGreyImage);
     if (!script)
     {
         std::cerr << "treelod_browser: " << script.error().message() << std::endl;

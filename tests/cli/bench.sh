@@ -11,14 +11,14 @@ cache="$out/cache"
 fail() { echo "bench test: $*"; exit 1; }
 png() { [ -s "$1" ] && head -c 8 "$1" | od -An -tx1 | grep -q "89 50 4e 47" || fail "$1 is not a PNG"; }
 
-# 1. One tree: reference, floor and auto at two biases over 6 frames.
+# 1. One tree: reference, the three floors and auto at two biases over 6 frames.
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/single" --frames 6 --size 160x90 \
   --techniques auto --lod-bias 1,0.5 --samples 2 --cache "$cache" -q
 for f in frames.csv summary.json frame-time.png trade.png; do [ -s "$out/single/$f" ] || fail "single/$f missing"; done
 png "$out/single/frame-time.png"; png "$out/single/trade.png"
 rows=$(($(wc -l < "$out/single/frames.csv") - 1))
-[ "$rows" = 24 ] || fail "frames.csv has $rows rows, expected (mesh + quad + auto x 2 biases) x 6 = 24"
-for t in mesh quad auto; do
+[ "$rows" = 36 ] || fail "frames.csv has $rows rows, expected (mesh + 3 floors + auto x 2 biases) x 6 = 36"
+for t in mesh quad entities merged-quads auto; do
   n=$(awk -F, -v t=$t 'NR > 1 && $2 == t' "$out/single/frames.csv" | wc -l)
   want=6; [ $t = auto ] && want=12
   [ "$n" = "$want" ] || fail "technique $t has $n rows, expected $want"
@@ -28,11 +28,18 @@ awk -F, 'NR > 1 && ($6 != 1 || $9 < 1 || $8 <= 0) { bad = 1; print } END { exit 
   || fail "untimed or empty frames above"
 # Sampled frames carry FLIP for every technique; the floor's error is larger than auto's at bias 1.
 n=$(awk -F, 'NR > 1 && $13 != ""' "$out/single/frames.csv" | wc -l)
-[ "$n" = 8 ] || fail "$n frames with FLIP, expected 2 samples x 4 runs = 8"
+[ "$n" = 12 ] || fail "$n frames with FLIP, expected 2 samples x 6 runs = 12"
 grep -q '"technique": "auto"' "$out/single/summary.json" || fail "summary lacks auto"
 grep -q '"speedupVsReference": [0-9]' "$out/single/summary.json" || fail "summary has no measured speedup"
 grep -q '"ratioToFloor": [0-9]' "$out/single/summary.json" || fail "summary has no ratio to the floor"
-[ "$(grep -c '"lodBias"' "$out/single/summary.json")" = 4 ] || fail "summary should have 4 results"
+[ "$(grep -c '"lodBias"' "$out/single/summary.json")" = 6 ] || fail "summary should have 6 results"
+# The frames came from treelod_frames (which links no baker) through the package list.
+for f in packages.json timings.json; do [ -s "$out/single/$f" ] || fail "single/$f missing"; done
+grep -q '"format": "treelod-package-list"' "$out/single/packages.json" || fail "packages.json is not a package list"
+for floor in quad entities merged-quads; do
+  grep -q "\"$floor\": [0-9]" "$out/single/summary.json" || fail "summary has no ratio to the $floor floor"
+done
+grep -q '"worstFrame": {' "$out/single/summary.json" || fail "summary does not record the worst frame"
 # The bake cache reported what it built; a second run reuses everything.
 grep -q 'baked' "$out/single/summary.json" || fail "first run baked nothing?"
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/single2" --frames 2 --size 64x36 \
@@ -48,9 +55,9 @@ counts=$(awk -F, 'NR > 1 { print $1 }' "$out/table2/frames.csv" | sort -n | uniq
 [ "$(echo $counts)" = "1 6" ] || fail "tree counts '$(echo $counts)', expected '1 6'"
 for c in $counts; do
   n=$(awk -F, -v c=$c 'NR > 1 && $1 == c' "$out/table2/frames.csv" | wc -l)
-  [ "$n" = 9 ] || fail "$c trees: $n rows, expected 3 runs x 3 frames"
+  [ "$n" = 15 ] || fail "$c trees: $n rows, expected 5 runs x 3 frames"
   png "$out/table2/trade-$c.png"; png "$out/table2/frame-time-$c.png"
-  grep -q "\"trees\": $c\$" "$out/table2/summary.json" || fail "summary lacks $c trees"
+  grep -Eq "\"trees\": $c,?\$" "$out/table2/summary.json" || fail "summary lacks $c trees"
 done
 
 # 3. A bad script: exit 2, file:line:column named, nothing written.

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 
 namespace TreeLod
 {
@@ -89,7 +90,8 @@ namespace TreeLod
 
     TEST(SceneScript, shippedScenesParse)
     {
-        for (const char* name : {"single-tree.json", "table2.json", "flythrough-10k.json", "plaza-290.json"})
+        for (const char* name : {"single-tree.json", "table2.json", "flythrough-10k.json", "plaza-290.json",
+                                 "forest-100k.json"})
         {
             Result<SceneScript> s = loadSceneScript(scenePath(name));
             ASSERT_TRUE(s.ok()) << s.error().message();
@@ -127,7 +129,8 @@ namespace TreeLod
     {
         // Splines overshoot: a walk at 1.7 m must not dip under the ground, and a low camera must
         // not pass through a trunk (the flythrough's glade and track keep trees off its path).
-        for (const char* name : {"single-tree.json", "table2.json", "flythrough-10k.json", "plaza-290.json"})
+        for (const char* name : {"single-tree.json", "table2.json", "flythrough-10k.json", "plaza-290.json",
+                                 "forest-100k.json"})
         {
             Result<SceneScript> s = loadSceneScript(scenePath(name));
             ASSERT_TRUE(s.ok()) << s.error().message();
@@ -439,7 +442,7 @@ namespace TreeLod
         std::string text = replaced(MINIMAL, "{\"kind\": \"plane\", \"size\": 100}",
                                     "{\"kind\": \"heightfield\", \"size\": 100, \"image\": \"ramp.png\", "
                                     "\"heightScale\": 30}");
-        Result<SceneScript> r = parseSceneScript(text, "test.json", dir.string());
+        Result<SceneScript> r = parseSceneScript(text, "test.json", dir.string(), readGreyImage);
         ASSERT_TRUE(r.ok()) << r.error().message();
         ASSERT_EQ(r->ground.heightsWidth, 4);
         ASSERT_EQ(r->ground.heightsHeight, 3);
@@ -461,6 +464,20 @@ namespace TreeLod
 
         std::string message = errorOf(replaced(text, "ramp.png", "missing.png"));
         EXPECT_NE(message.find("key /ground/image"), std::string::npos) << message;
+        // No reader injected (the default): the script says where and why.
+        Result<SceneScript> unread = parseSceneScript(text, "test.json", dir.string());
+        ASSERT_FALSE(unread.ok());
+        message = unread.error().message();
+        EXPECT_EQ(message.rfind("test.json: " + positionOf(text, "\"image\"") + ", key /ground/image: ", 0), 0u)
+            << message;
+        EXPECT_NE(message.find("no image reader given ("), std::string::npos) << message;
+        // A reader's values outside [0, 1] are refused, not turned into heights.
+        GreyImageReader wild = [](const std::string&) {
+            return Result<GreyImage>(GreyImage{2, 2, {0.0f, 0.5f, 2.0f, 1.0f}});
+        };
+        Result<SceneScript> wrong = parseSceneScript(text, "test.json", dir.string(), wild);
+        ASSERT_FALSE(wrong.ok());
+        EXPECT_NE(wrong.error().message().find("outside [0, 1]: 2"), std::string::npos) << wrong.error().message();
     }
 
     // samples/scenes/README.md: azimuth 0 is the +Z side, 90 the +X side; elevation above the horizon.
@@ -482,5 +499,226 @@ namespace TreeLod
         ASSERT_TRUE(r.ok()) << r.error().message();
         EXPECT_NEAR(sceneLighting(*r).sunDirection.x, 0.0f, 1e-6f);
         EXPECT_NEAR(sceneLighting(*r).sunDirection.z, std::sqrt(3.0f) / 2.0f, 1e-6f);
+    }
+
+    namespace
+    {
+        std::filesystem::path testDir(const std::string& name)
+        {
+            const char* env = std::getenv("TREELOD_TEST_OUT");
+            std::filesystem::path dir =
+                std::filesystem::path(env && *env ? env : TREELOD_BINARY_DIR "/test-out") / "scene" / name;
+            std::filesystem::create_directories(dir);
+            return dir;
+        }
+
+        /// MINIMAL with species a (oak) and b (birch, scale 2) placed from `file` next to the script.
+        std::string withInstanceFile(const std::string& file = "trees.csv")
+        {
+            std::string text = replaced(MINIMAL, "\"techniques\": \"auto\"}",
+                                        "\"techniques\": \"auto\"}, {\"name\": \"b\", \"source\": \"preset:birch\", "
+                                        "\"techniques\": \"auto\", \"scale\": 2}");
+            return replaced(text, "{\"species\": \"a\", \"random\": {\"seed\": 1, \"count\": 10, \"area\": {\"rect\": [-10, -10, 10, 10]}}}",
+                            "{\"species\": [\"a\", \"b\"], \"file\": \"" + file + "\"}");
+        }
+
+        /// Writes `csv` as trees.csv beside a script placing it; the parse result.
+        Result<SceneScript> parseWithCsv(const std::string& name, const std::string& csv)
+        {
+            std::filesystem::path dir = testDir(name);
+            std::ofstream(dir / "trees.csv", std::ios::binary) << csv;
+            return parseSceneScript(withInstanceFile(), "test.json", dir.string());
+        }
+    }
+
+    TEST(SceneScript, explicitScaleZeroIsRefusedAtItsPosition)
+    {
+        for (const char* scale : {"0", "-1"})
+        {
+            std::string text = replaced(MINIMAL, "\"random\": {\"seed\": 1, \"count\": 10, \"area\": {\"rect\": [-10, -10, 10, 10]}}",
+                                        std::string("\"positions\": [[1, 2, 0, 1], [3, 4, 90, ") + scale + "]]");
+            std::string message = errorOf(text);
+            std::string expected = "test.json: " + positionOf(text, std::string(scale) + "]]") +
+                                   ", key /placements/0/positions/1/3: must be > 0";
+            EXPECT_EQ(message.rfind(expected, 0), 0u) << "expected '" << expected << "' in\n" << message;
+        }
+    }
+
+    TEST(SceneScript, instanceFileGivesSpeciesRotationScaleAndHeight)
+    {
+        const std::string csv = "# trees of the test\n"
+                                "x, z, species, rotation, scale, y\n"
+                                "\n"
+                                "1.5,-2,b,90,0.5,3\n"
+                                "# a comment between rows\n"
+                                "-4,5.25,a,-45,2,-1.5\r\n"
+                                "+10,1e1,b,0,1e0,0\n";
+        Result<SceneScript> r = parseWithCsv("csv-full", csv);
+        ASSERT_TRUE(r.ok()) << r.error().message();
+        ASSERT_EQ(r->placements.size(), 1u);
+        EXPECT_FALSE(r->placements[0].random);
+        EXPECT_NE(r->placements[0].file.find("trees.csv"), std::string::npos);
+        std::vector<PlacedTree> trees = generatePlacements(*r);
+        ASSERT_EQ(trees.size(), 3u);
+        EXPECT_EQ(trees[0].species, 1u);
+        EXPECT_EQ(trees[0].position, glm::vec3(1.5f, 3.0f, -2.0f));
+        EXPECT_NEAR(trees[0].rotation, 3.14159265f / 2.0f, 1e-6f);
+        EXPECT_EQ(trees[0].scale, 0.5f); // the file's scale, not the species' [2, 2]
+        EXPECT_EQ(trees[1].species, 0u);
+        EXPECT_EQ(trees[1].position, glm::vec3(-4.0f, -1.5f, 5.25f));
+        EXPECT_NEAR(trees[1].rotation, -3.14159265f / 4.0f, 1e-6f);
+        EXPECT_EQ(trees[2].position, glm::vec3(10.0f, 0.0f, 10.0f));
+
+        // Optional columns left out: the placement's first species, no rotation, scale 1, on the ground.
+        r = parseWithCsv("csv-minimal", "z,x\n7,8\n-7,-8\n");
+        ASSERT_TRUE(r.ok()) << r.error().message();
+        trees = generatePlacements(*r);
+        ASSERT_EQ(trees.size(), 2u);
+        EXPECT_EQ(trees[0].species, 0u);
+        EXPECT_EQ(trees[0].position, glm::vec3(8.0f, 0.0f, 7.0f));
+        EXPECT_EQ(trees[0].rotation, 0.0f);
+        EXPECT_EQ(trees[0].scale, 1.0f);
+    }
+
+    TEST(SceneScript, instanceFileFollowsTheExplicitPlacementRules)
+    {
+        // A file placement is explicit: kept under --scale, first in a count sweep.
+        std::string csv = "x,z\n";
+        for (int i = 0; i < 20; ++i)
+            csv += std::to_string(i) + ",0\n";
+        std::filesystem::path dir = testDir("csv-rules");
+        std::ofstream(dir / "trees.csv") << csv;
+        std::string text = replaced(withInstanceFile(), "{\"species\": [\"a\", \"b\"], \"file\": \"trees.csv\"}",
+                                    "{\"species\": [\"a\", \"b\"], \"file\": \"trees.csv\"}, {\"species\": \"a\", "
+                                    "\"random\": {\"seed\": 1, \"count\": 100, \"area\": {\"rect\": [-40, 10, 40, 40]}}}");
+        Result<SceneScript> r = parseSceneScript(text, "test.json", dir.string());
+        ASSERT_TRUE(r.ok()) << r.error().message();
+        EXPECT_EQ(generatePlacements(*r).size(), 120u);
+        PlacementOptions thin;
+        thin.scale = 0.1;
+        std::vector<PlacedTree> thinned = generatePlacements(*r, thin);
+        ASSERT_EQ(thinned.size(), 20u + 10u);
+        EXPECT_EQ(thinned[19].position, glm::vec3(19.0f, 0.0f, 0.0f));
+        PlacementOptions few;
+        few.totalCount = 5;
+        std::vector<PlacedTree> five = generatePlacements(*r, few);
+        ASSERT_EQ(five.size(), 5u);
+        EXPECT_EQ(five[4].position, glm::vec3(4.0f, 0.0f, 0.0f));
+    }
+
+    TEST(SceneScript, instanceFileErrorsNameFileLineColumnAndReason)
+    {
+        struct Case
+        {
+            std::string csv;
+            std::string expected; ///< after "trees.csv: "
+        };
+        const std::string header = "x,z,species,rotation,scale\n# comment\n1,2,a,0,1\n";
+        const std::vector<Case> cases = {
+            {header + "1,2,a,0,0\n", "line 4, column scale: 0 must be finite and > 0"},
+            {header + "1,2,a,0,-2\n", "line 4, column scale: -2 must be finite and > 0"},
+            {header + "1,2,a,0,NaN\n", "line 4, column scale: NaN must be finite and > 0"},
+            {header + "nan,2,a,0,1\n", "line 4, column x: nan must be finite and on the ground (|x| <= 50)"},
+            {header + "1,inf,a,0,1\n", "line 4, column z: inf must be finite"},
+            {header + "1,-inf,a,0,1\n", "line 4, column z: -inf must be finite"},
+            {header + "1,2,a,1e999,1\n", "line 4, column rotation: 1e999 must be finite degrees in [-360, 360]"},
+            {header + "1,2,a,0,1e999\n", "line 4, column scale: 1e999 must be finite and > 0"},
+            {header + "1,2,a,0,2000\n", "line 4, column scale: 2000 must be <= 1000"},
+            {header + "60,2,a,0,1\n", "line 4, column x: 60 must be finite and on the ground (|x| <= 50)"},
+            {header + "1,2,pine,0,1\n", "line 4, column species: unknown species 'pine' (this placement's: a, b)"},
+            {header + "1,2,a,0\n", "line 4: expected 5 columns (x, z, species, rotation, scale), got 4"},
+            {header + "1,2,a,0,1,5\n", "line 4: expected 5 columns (x, z, species, rotation, scale), got 6"},
+            {header + "1,two,a,0,1\n", "line 4, column z: 'two' is not a number"},
+            {header + "1,2,a,,1\n", "line 4, column rotation: '' is not a number"},
+            {header + "1,2,a,0,1 m\n", "line 4, column scale: '1 m' is not a number"},
+            {"# header next\nx,z,height\n1,2,3\n", "line 2: unknown column 'height'"},
+            {"x,species\n1,a\n", "line 1: the header lacks the column z"},
+            {"x,z,x\n1,2,3\n", "line 1: column 'x' named twice"},
+            {"# nothing\n\n", "line 2: no header line"},
+            {"x,z\n", "line 1: no trees"},
+        };
+        for (const Case& c : cases)
+        {
+            Result<SceneScript> r = parseWithCsv("csv-errors", c.csv);
+            ASSERT_FALSE(r.ok()) << c.csv;
+            const std::string message = r.error().message();
+            const std::size_t at = message.find("trees.csv: ");
+            EXPECT_NE(at, std::string::npos) << message;
+            EXPECT_EQ(message.substr(at + 11, c.expected.size()), c.expected) << c.csv << "\n" << message;
+        }
+        // The file itself missing: an error at the script's key.
+        std::filesystem::path dir = testDir("csv-missing");
+        std::filesystem::remove(dir / "absent.csv");
+        const std::string text = withInstanceFile("absent.csv");
+        Result<SceneScript> r = parseSceneScript(text, "test.json", dir.string());
+        ASSERT_FALSE(r.ok());
+        EXPECT_EQ(r.error().message().rfind("test.json: " + positionOf(text, "\"file\"") +
+                                                ", key /placements/0/file: no such file: ",
+                                            0),
+                  0u)
+            << r.error().message();
+        // One of positions, random or file.
+        std::string both = replaced(text, "\"file\": \"absent.csv\"", "\"file\": \"absent.csv\", \"positions\": [[0, 0]]");
+        EXPECT_NE(errorOf(both).find("key /placements/0/file: a placement has one of positions, random or file"),
+                  std::string::npos)
+            << errorOf(both);
+    }
+
+    TEST(SceneScript, twoSpeciesSharingOneAssetFileLoad)
+    {
+        std::string text = replaced(MINIMAL, "{\"name\": \"a\", \"source\": \"preset:oak\", \"techniques\": \"auto\"}",
+                                    "{\"name\": \"a\", \"source\": \"../../media/oak.glb\", \"techniques\": \"auto\"}, "
+                                    "{\"name\": \"big\", \"source\": \"../../media/oak.glb\", \"techniques\": \"auto\", "
+                                    "\"scale\": [1.5, 2]}");
+        text = replaced(text, "{\"species\": \"a\", \"random\"", "{\"species\": [\"a\", \"big\"], \"random\"");
+        Result<SceneScript> r = parseSceneScript(text, "test.json", scenePath(""));
+        ASSERT_TRUE(r.ok()) << r.error().message();
+        ASSERT_EQ(r->species.size(), 2u);
+        EXPECT_EQ(r->species[0].source, r->species[1].source);
+        EXPECT_EQ(r->species[1].scaleMin, 1.5f);
+        std::vector<PlacedTree> trees = generatePlacements(*r);
+        ASSERT_EQ(trees.size(), 10u);
+        for (const PlacedTree& t : trees)
+            EXPECT_TRUE(t.species == 0 ? t.scale == 1.0f : t.scale >= 1.5f && t.scale <= 2.0f);
+    }
+
+    TEST(SceneScript, forest100kPlacesItsTreesAndLandsTheCameraAtWalkingHeight)
+    {
+        Result<SceneScript> s = loadSceneScript(scenePath("forest-100k.json"));
+        ASSERT_TRUE(s.ok()) << s.error().message();
+        std::vector<PlacedTree> trees = generatePlacements(*s);
+        EXPECT_EQ(trees.size(), 100000u);
+        std::vector<std::size_t> perSpecies(s->species.size(), 0);
+        glm::vec2 lo(1e9f), hi(-1e9f);
+        for (const PlacedTree& t : trees)
+        {
+            ++perSpecies[t.species];
+            lo = glm::min(lo, glm::vec2(t.position.x, t.position.z));
+            hi = glm::max(hi, glm::vec2(t.position.x, t.position.z));
+        }
+        EXPECT_GE(s->species.size(), 2u);
+        for (std::size_t n : perSpecies)
+            EXPECT_GT(n, 10000u);
+        const double km2 = double(hi.x - lo.x) * double(hi.y - lo.y) / 1e6;
+        EXPECT_TRUE(km2 > 8.0 && km2 < 12.0) << km2; // about 10 km²
+        EXPECT_EQ(s->width, 1920);
+        EXPECT_EQ(s->height, 1080);
+
+        PlacementOptions thin;
+        thin.scale = 0.01;
+        const std::size_t thinned = generatePlacements(*s, thin).size();
+        EXPECT_TRUE(thinned >= 900 && thinned <= 1100) << thinned;
+
+        // From the overview (most of the forest in view) down to walking height.
+        double highest = 0.0, lowest = 1e9;
+        for (std::uint32_t f = 0; f < s->frames; ++f)
+        {
+            CameraSpec cam = cameraAt(*s, frameTime(*s, f));
+            highest = std::max(highest, double(cam.position.y));
+            lowest = std::min(lowest, double(cam.position.y));
+        }
+        EXPECT_GE(highest, 1500.0);
+        EXPECT_LT(lowest, 2.0);
+        EXPECT_GT(double(s->camera.farClip), highest * 2.0); // the far side of the forest from the overview
     }
 }

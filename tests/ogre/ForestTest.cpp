@@ -19,6 +19,7 @@
 #include "TreeLod/ImpostorBaker.h"
 #include "TreeLod/ImpostorData.h"
 #include "TreeLod/PackageWriter.h"
+#include "TreeLod/QuadFloors.h"
 #include "TreeLod/TreeAssetManager.h"
 
 #include <OgreEntity.h>
@@ -935,6 +936,72 @@ namespace TreeLod
         {
             EXPECT_EQ(mesh[l].technique, "mesh");
             EXPECT_EQ(mesh[l].minPixelCount, reference->getLodLevel(std::uint16_t(l + 1)).value);
+        }
+    }
+
+    // The bench's floors (QuadFloors.h) draw the Forest's quad level as plain Ogre objects: one
+    // entity per tree, and merged static batches. Same impostor, same program: the same picture.
+    TEST(Forest, quadFloorsDrawWhatTheQuadLevelDraws)
+    {
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+        const CameraSpec view = look(glm::vec3(1.5f * h, 3.0f * h, 5.5f * h), glm::vec3(0.0f, 0.2f * h, 0.0f));
+        const std::vector<ForestInstance> trees = grid(4, 1.3f * h);
+        Forest* forest = placeForest();
+        forest->addSpecies(tree.asset, {ForestLevel{"quad", 0, false, 0.0f}});
+        forest->addInstances(trees);
+        const Image quads = toImage(r.render(view, 256, 192, 1));
+        r.clearContent();
+        Ogre::SceneManager& sm = r.getSceneManager();
+        Image entities, merged;
+        {
+            EntityFloor floor(sm, r.getContentNode(), {tree.asset}, trees);
+            EXPECT_EQ(floor.getEntityCount(), trees.size());
+            entities = toImage(r.render(view, 256, 192, 1));
+        }
+        {
+            MergedQuadFloor floor(sm, r.getContentNode(), {tree.asset}, trees);
+            EXPECT_EQ(floor.getBatchCount(), 1u);
+            EXPECT_GT(floor.getGpuBytes(), trees.size() * 4 * 44);
+            merged = toImage(r.render(view, 256, 192, 1));
+        }
+        writePng(OgreEnvironment::outDir() + "/forest-quad-floors.png", sideBySide({quads, entities, merged}));
+        EXPECT_GT(treeCoverage(merged, BACKGROUND), 0.1);
+        const double flipEntities = flipMean(quads, entities), flipMerged = flipMean(quads, merged);
+        std::printf("quad level vs floors: FLIP entities %.5f, merged quads %.5f\n", flipEntities, flipMerged);
+        EXPECT_LE(flipEntities, 0.002);
+        EXPECT_LE(flipMerged, 0.002);
+        compareWithGolden(merged, "forest-quad-merged", 0.02);
+
+        // Batches: two species, more trees than a batch holds; none; an asset without the impostor.
+        const std::vector<ForestInstance> many = grid(100, 1.3f * h); // 10,000 trees, species 0
+        std::vector<ForestInstance> two = many;
+        for (std::size_t i = 0; i < two.size(); i += 2)
+            two[i].kind = 1;
+        {
+            MergedQuadFloor floor(sm, r.getContentNode(), {tree.asset, tree.asset}, two);
+            EXPECT_EQ(floor.getBatchCount(), 2u * ((5000 + MergedQuadFloor::BATCH_TREES - 1) / MergedQuadFloor::BATCH_TREES));
+        }
+        {
+            MergedQuadFloor none(sm, r.getContentNode(), {tree.asset}, {});
+            EXPECT_EQ(none.getBatchCount(), 0u);
+            EntityFloor noEntities(sm, r.getContentNode(), {tree.asset}, {});
+            EXPECT_EQ(noEntities.getEntityCount(), 0u);
+        }
+        EXPECT_THROW(MergedQuadFloor(sm, r.getContentNode(), {tree.asset}, two), Ogre::Exception); // kind 1 unknown
+        PackageWriter writer;
+        ASSERT_TRUE(addFoliageLodChunk(writer, tree.model, "bare").ok());
+        TreeAssetPtr bare = TreeAssetManager::getSingleton().loadFromBytes("bare.floor-test", Ogre::RGN_DEFAULT,
+                                                                           writer.toBytes());
+        try
+        {
+            EntityFloor floor(sm, r.getContentNode(), {bare}, trees);
+            ADD_FAILURE() << "an asset without impostor was accepted";
+        }
+        catch (const Ogre::Exception& e)
+        {
+            EXPECT_NE(e.getDescription().find("bare.floor-test"), std::string::npos) << e.getDescription();
         }
     }
 }

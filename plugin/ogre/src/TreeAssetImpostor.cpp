@@ -39,6 +39,9 @@ namespace TreeLod
 
         // The quad (ImpostorData.h): x in [-halfWidth, halfWidth], y in [bottom, top], facing +Z.
         const float w = data.halfWidth;
+        gpu->halfWidth = w;
+        gpu->bottom = data.bottom;
+        gpu->top = data.top;
         const float vertices[4][5] = {{-w, data.bottom, 0.0f, 0.0f, 1.0f},
                                       {w, data.bottom, 0.0f, 1.0f, 1.0f},
                                       {w, data.top, 0.0f, 1.0f, 0.0f},

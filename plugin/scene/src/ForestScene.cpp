@@ -2,7 +2,6 @@
 
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/TreeAssetManager.h"
-#include "TreeLod/TreeGenerator.h"
 
 #include <OgreManualObject.h>
 #include <OgreMaterialManager.h>
@@ -21,61 +20,39 @@ namespace TreeLod
 {
     namespace
     {
-        /// "preset:NAME?seed=S&leaves=N&height=H" (every key optional) -> generateTree.
-        Result<TreeModel> generatePreset(const std::string& source, const ProgressCallback& progress)
-        {
-            const std::string body = source.substr(source.find(':') + 1);
-            const std::size_t q = body.find('?');
-            GeneratorOptions options;
-            if (!parsePreset(body.substr(0, q), options.preset))
-                return fail(source, "preset", "unknown preset '" + body.substr(0, q) +
-                                                  "' (known: oak, conifer, birch, shrub)");
-            std::string query = q == std::string::npos ? "" : body.substr(q + 1);
-            while (!query.empty())
-            {
-                const std::size_t amp = query.find('&');
-                const std::string pair = query.substr(0, amp);
-                query = amp == std::string::npos ? "" : query.substr(amp + 1);
-                const std::size_t eq = pair.find('=');
-                const std::string key = pair.substr(0, eq);
-                const std::string value = eq == std::string::npos ? "" : pair.substr(eq + 1);
-                char* end = nullptr;
-                const double number = std::strtod(value.c_str(), &end);
-                if (value.empty() || *end != '\0' || !std::isfinite(number) || number < 0.0)
-                    return fail(source, key, "'" + value + "' is not a non-negative number");
-                if (key == "seed")
-                    options.seed = std::uint32_t(number);
-                else if (key == "leaves")
-                    options.leafCount = std::uint32_t(number);
-                else if (key == "height")
-                    options.height = float(number);
-                else
-                    return fail(source, key, "unknown generator option (known: seed, leaves, height)");
-            }
-            return generateTree(options, progress);
-        }
-
         const Ogre::String SUN_NAME = "TreeLodSun"; // OffscreenRenderer's sun, reused when present
         constexpr float SHADOW_FAR_DISTANCE = 150.0f; // metres: shadows of the trees near the viewer
 
         /// A linear-space grass colour for the ground (what the Lit bark shader multiplies its white texture by).
         const Ogre::ColourValue GROUND_COLOUR(0.10f, 0.16f, 0.05f, 1.0f);
-    }
 
-    CacheTreeBaker::CacheTreeBaker(const std::string& directory, ProgressCallback progress)
-        : mCache(directory), mProgress(std::move(progress))
-    {
-        Result<void> r = mCache.addGenerator("preset", generatePreset);
-        OgreAssert(bool(r), "the preset scheme is valid");
-    }
-
-    Ogre::String CacheTreeBaker::requirePackage(const Ogre::String& source, const std::vector<Ogre::String>& techniques)
-    {
-        Result<BakeCacheEntry> entry = mCache.require(source, techniques, "", mProgress);
-        if (!entry)
-            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, entry.error().message(), "CacheTreeBaker::requirePackage");
-        mEntries.push_back(*entry);
-        return entry->path;
+        /// A species' bands for a technique choice ("" = the script's), distance bands still
+        /// open (minHeightPixels 0: ForestScene converts them with the asset's height), and the
+        /// bake techniques they draw from, "reference" included. Throws on an unknown technique.
+        std::vector<ForestBand> speciesBands(const SceneScript& script, const SceneSpecies& species,
+                                             const std::string& technique, std::set<std::string>& bake)
+        {
+            std::vector<ForestBand> bands;
+            if (!technique.empty())
+                bands = {ForestBand{technique, 0.0f}};
+            else if (species.autoTechnique)
+                bands = Forest::getAutoBands();
+            else
+                for (const TechniqueBand& band : species.bands)
+                    bands.push_back(ForestBand{band.technique, band.minPixels});
+            bake.insert("reference");
+            for (const ForestBand& band : bands)
+            {
+                const std::string name = bakeTechniqueOf(band.technique);
+                if (name.empty())
+                    OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                                script.file + ": species '" + species.name + "': unknown technique '" +
+                                    band.technique + "' (known: " + knownSceneTechniques() + ")",
+                                "ForestScene");
+                bake.insert(name);
+            }
+            return bands;
+        }
     }
 
     std::string speciesSource(const SceneSpecies& species)
@@ -98,11 +75,31 @@ namespace TreeLod
     {
         if (technique == "mesh")
             return "reference";
-        if (technique == "quad")
+        if (technique == "quad" || isQuadFloor(technique))
             return "impostor";
         if (technique == "lodf" || technique == "billboard-cloud" || technique == "classic-billboard-cloud")
             return technique;
         return "";
+    }
+
+    bool isQuadFloor(const std::string& technique) { return technique == "entities" || technique == "merged-quads"; }
+
+    std::string knownSceneTechniques()
+    {
+        return "mesh, lodf, billboard-cloud, classic-billboard-cloud, quad, entities, merged-quads";
+    }
+
+    std::map<std::string, std::vector<std::string>> scenePackages(const SceneScript& script,
+                                                                  const std::vector<std::string>& techniques)
+    {
+        std::map<std::string, std::set<std::string>> wanted;
+        for (const std::string& technique : techniques)
+            for (const SceneSpecies& species : script.species)
+                speciesBands(script, species, technique, wanted[speciesSource(species)]);
+        std::map<std::string, std::vector<std::string>> packages;
+        for (const auto& [source, bake] : wanted)
+            packages[source] = std::vector<std::string>(bake.begin(), bake.end());
+        return packages;
     }
 
     ForestScene::ForestScene(Ogre::SceneManager& sceneManager, Ogre::SceneNode& parent, const SceneScript& script,
@@ -137,13 +134,7 @@ namespace TreeLod
 
     void ForestScene::release()
     {
-        if (mForest)
-        {
-            mForestNode->detachAllObjects();
-            mSceneManager.destroyMovableObject(mForest);
-            mSceneManager.destroySceneNode(mForestNode);
-            mForest = nullptr;
-        }
+        destroyForest();
         if (mGround)
         {
             mGroundNode->detachAllObjects();
@@ -227,28 +218,7 @@ namespace TreeLod
         std::vector<std::vector<ForestBand>> bands(mScript.species.size());
         std::map<std::string, std::set<std::string>> techniques; // source -> bake techniques
         for (std::size_t s = 0; s < mScript.species.size(); ++s)
-        {
-            const SceneSpecies& species = mScript.species[s];
-            if (!mTechnique.empty())
-                bands[s] = {ForestBand{mTechnique, 0.0f}};
-            else if (species.autoTechnique)
-                bands[s] = Forest::getAutoBands();
-            else
-                for (std::size_t b = 0; b < species.bands.size(); ++b)
-                    bands[s].push_back(ForestBand{species.bands[b].technique, species.bands[b].minPixels});
-            std::set<std::string>& wanted = techniques[speciesSource(species)];
-            wanted.insert("reference");
-            for (const ForestBand& band : bands[s])
-            {
-                const std::string bake = bakeTechniqueOf(band.technique);
-                if (bake.empty())
-                    OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
-                                mScript.file + ": species '" + species.name + "': unknown technique '" +
-                                    band.technique + "' (known: mesh, lodf, billboard-cloud, classic-billboard-cloud, quad)",
-                                "ForestScene");
-                wanted.insert(bake);
-            }
-        }
+            bands[s] = speciesBands(mScript, mScript.species[s], mTechnique, techniques[speciesSource(mScript.species[s])]);
         std::map<std::string, TreeAssetPtr> assets;
         for (const auto& [source, wanted] : techniques)
         {
@@ -281,6 +251,8 @@ namespace TreeLod
                         bands[s][b].minHeightPixels =
                             height * float(mScript.height) / (2.0f * species.bands[b].maxDistance * tanHalfFov);
             }
+            if (isQuadFloor(mTechnique))
+                continue; // drawn by the floor below, not the Forest
             try
             {
                 mForest->addSpecies(asset, Forest::levelsForBands(*asset, bands[s]));
@@ -296,11 +268,18 @@ namespace TreeLod
         instances.reserve(mPlacements.size());
         for (const PlacedTree& tree : mPlacements)
             instances.push_back(ForestInstance{tree.position, tree.rotation, tree.scale, tree.species});
-        mForest->addInstances(instances);
+        if (mTechnique == "entities")
+            mEntityFloor = std::make_unique<EntityFloor>(mSceneManager, *mForestNode, mAssets, instances);
+        else if (mTechnique == "merged-quads")
+            mMergedQuadFloor = std::make_unique<MergedQuadFloor>(mSceneManager, *mForestNode, mAssets, instances);
+        else
+            mForest->addInstances(instances);
     }
 
-    void ForestScene::setTechnique(const std::string& technique)
+    void ForestScene::destroyForest()
     {
+        mEntityFloor.reset();
+        mMergedQuadFloor.reset();
         if (mForest)
         {
             mForestNode->detachAllObjects();
@@ -308,6 +287,11 @@ namespace TreeLod
             mSceneManager.destroySceneNode(mForestNode);
             mForest = nullptr;
         }
+    }
+
+    void ForestScene::setTechnique(const std::string& technique)
+    {
+        destroyForest();
         mTechnique = technique;
         buildSpecies();
     }
@@ -332,5 +316,12 @@ namespace TreeLod
         return cameraAt(mScript, frameTime(mScript, frame, frameCount));
     }
 
-    std::uint64_t ForestScene::getGpuBytes() const { return mForest ? mForest->getGpuBytes() : 0; }
+    std::uint64_t ForestScene::getGpuBytes() const
+    {
+        if (mEntityFloor)
+            return mEntityFloor->getGpuBytes();
+        if (mMergedQuadFloor)
+            return mMergedQuadFloor->getGpuBytes();
+        return mForest ? mForest->getGpuBytes() : 0;
+    }
 }

@@ -71,6 +71,20 @@ namespace TreeLod
         return image;
     }
 
+    Result<GreyImage> readGreyImage(const std::string& path)
+    {
+        Result<Image> image = readImage(path);
+        if (!image)
+            return image.error();
+        GreyImage grey;
+        grey.width = image->width;
+        grey.height = image->height;
+        grey.values.reserve(image->pixels.size());
+        for (const glm::vec4& p : image->pixels)
+            grey.values.push_back(std::clamp(p.r, 0.0f, 1.0f));
+        return grey;
+    }
+
     Result<void> writePng(const std::string& path, const Image& image)
     {
         if (image.width <= 0 || image.height <= 0 ||

@@ -113,6 +113,16 @@ namespace TreeLod
                mTransforms.capacity() * sizeof(float);
     }
 
+    std::size_t ForestInstances::getMemoryBytes() const
+    {
+        std::size_t bytes = 0;
+        for (const std::vector<float>* a : {&mX, &mY, &mZ, &mRotation, &mScale, &mCosScale, &mSinScale, &mSphereX,
+                                            &mSphereY, &mSphereZ, &mSphereR})
+            bytes += a->capacity() * sizeof(float);
+        return bytes + (mKind.capacity() + mHandleOfSlot.capacity() + mSlotOfHandle.capacity() +
+                        mFreeHandles.capacity()) * sizeof(std::uint32_t);
+    }
+
     // ---- kinds -----------------------------------------------------------------------------------
 
     Result<std::uint32_t> ForestInstances::addKind(const ForestKind& kind)

@@ -79,6 +79,8 @@ namespace TreeLod
         Ogre::String shadowedMaterial; ///< receives texture shadows
         Ogre::String texture;          ///< colour and coverage (unit 0)
         Ogre::String normalTexture;    ///< normal and ambient occlusion (unit 1)
+        float halfWidth = 0.0f;        ///< the quad: x in [-halfWidth, halfWidth] (metres)
+        float bottom = 0.0f, top = 0.0f; ///< y in [bottom, top] (metres)
         std::uint64_t gpuBytes = 0;    ///< textures + vertices + indices
     };
 

@@ -1,59 +1,61 @@
 // ForestScene: a scene script (SceneScript.h) built in an Ogre SceneManager: the ground, the
-// sun and shadows, and one Forest holding every placed tree (issue 5). Used by `treelod bench`
-// and the sample browser; links TreeLodBake (scripts, the bake cache) and is not part of
-// Plugin_TreeLod.
+// sun and shadows, and one Forest holding every placed tree (issue 5). Used by treelod_frames,
+// `treelod bench` and the sample browser. In TreeLodScene, which links the runtime side only
+// (Plugin_TreeLod, TreeLodOffscreen, TreeLodScript; DESIGN.md, "Runtime vs bake").
 //
-// Lazy baking: each species' package comes from TreeAssetManager::require, so the registered
-// TreeBaker (CacheTreeBaker below, over BakeCache) bakes exactly the chunks the species'
-// techniques draw from, and reports what it built and reused.
+// Packages: each species' package comes from TreeAssetManager::require, so the registered
+// TreeBaker supplies exactly the chunks the species' techniques draw from: CacheTreeBaker
+// (CacheTreeBaker.h, TreeLodSceneBake) bakes them, PackageListBaker (PackageListBaker.h) looks
+// them up in the list a bake wrote.
 //
 // Technique choice: the script's ("auto" = Forest::getAutoBands(); distance bands become
 // screen-height bands for the script's camera: h_px = height * resolutionY / (2 d tan(fovY/2))),
 // or one technique for every species and distance (`treelod bench --techniques`, the browser).
 #pragma once
 
-#include "TreeLod/BakeCache.h"
 #include "TreeLod/Forest.h"
+#include "TreeLod/OgreGreyImage.h"
+#include "TreeLod/QuadFloors.h" // readGreyImageOgre: loadSceneScript's reader on this side
 #include "TreeLod/SceneScript.h"
-#include "TreeLod/TreeBaker.h"
+#include "TreeLod/TreeAsset.h"
 
 #include <OgreManualObject.h>
 #include <OgreSceneManager.h>
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 namespace TreeLod
 {
-    /// A TreeBaker over a BakeCache with the tree generator's presets registered as
-    /// "preset:NAME?seed=S&leaves=N&height=H" sources. Progress goes to `progress`; every
-    /// require() adds its BakeCacheEntry to getEntries().
-    class CacheTreeBaker : public TreeBaker
-    {
-    public:
-        explicit CacheTreeBaker(const std::string& directory = defaultBakeCacheDirectory(),
-                                ProgressCallback progress = {});
-        Ogre::String requirePackage(const Ogre::String& source, const std::vector<Ogre::String>& techniques) override;
-        const std::vector<BakeCacheEntry>& getEntries() const { return mEntries; }
-        const BakeCache& getCache() const { return mCache; }
-
-    private:
-        BakeCache mCache;
-        ProgressCallback mProgress;
-        std::vector<BakeCacheEntry> mEntries;
-    };
-
     /// The source string of a species (its file, or "preset:NAME?seed=S&leaves=N&height=H").
     std::string speciesSource(const SceneSpecies& species);
 
     /// The bake technique (chunk) an Ogre-side technique draws from: mesh -> reference,
-    /// quad -> impostor, others their own name. Empty for an unknown technique.
+    /// quad, entities, merged-quads -> impostor, others their own name. Empty for an unknown technique.
     std::string bakeTechniqueOf(const std::string& technique);
+
+    /// The speed floors drawn without the Forest (QuadFloors.h): "entities" (one Ogre Entity per
+    /// tree) and "merged-quads" (every tree's quad in a few static batches).
+    bool isQuadFloor(const std::string& technique);
+
+    /// The techniques bakeTechniqueOf knows, for messages: "mesh, lodf, billboard-cloud, ...".
+    std::string knownSceneTechniques();
+
+    /// The packages that drawing `script` needs: per species source, the sorted bake techniques
+    /// ("reference" always) of every choice in `techniques` (each as ForestSceneOptions::technique:
+    /// "" = the script's own choice). What a ForestScene of each choice requires through the
+    /// TreeBaker, so a program can bake it all first (`treelod bench`). Throws Ogre::Exception
+    /// naming the script and the species for an unknown technique.
+    std::map<std::string, std::vector<std::string>> scenePackages(const SceneScript& script,
+                                                                  const std::vector<std::string>& techniques);
 
     struct ForestSceneOptions
     {
-        /// "" = the script's technique choice; else every species drawn with this technique alone.
+        /// "" = the script's technique choice; else every species drawn with this technique alone;
+        /// "entities" / "merged-quads": a speed floor (QuadFloors.h) instead of the Forest, whose
+        /// getForest() then holds no species.
         std::string technique;
         PlacementOptions placement;
         Ogre::String group = "TreeLod"; ///< resource group for assets, meshes and materials
@@ -94,6 +96,7 @@ namespace TreeLod
 
     private:
         void release();
+        void destroyForest(); ///< the Forest and any floor
         void buildGround();
         void buildSpecies();
 
@@ -105,6 +108,8 @@ namespace TreeLod
         std::vector<PlacedTree> mPlacements;
         std::vector<TreeAssetPtr> mAssets;
         Forest* mForest = nullptr;
+        std::unique_ptr<EntityFloor> mEntityFloor;
+        std::unique_ptr<MergedQuadFloor> mMergedQuadFloor;
         Ogre::SceneNode* mForestNode = nullptr;
         Ogre::ManualObject* mGround = nullptr;
         Ogre::SceneNode* mGroundNode = nullptr;

@@ -3,6 +3,7 @@
 // rows run top to bottom, pixels are interleaved RGBA.
 #pragma once
 
+#include "TreeLod/GreyImage.h"
 #include "TreeLod/Result.h"
 
 #include <glm/glm.hpp>
@@ -35,6 +36,10 @@ namespace TreeLod
     /// Read a PNG (or any format OpenImageIO knows) as RGBA in [0, 1]; grey and RGB get
     /// alpha 1, palette images keep their tRNS alpha.
     Result<Image> readImage(const std::string& path);
+
+    /// readImage's red channel, clamped to [0, 1] (16-bit and float files keep their precision):
+    /// the GreyImageReader of the bake side (scene scripts' heightfields, SceneScript.h).
+    Result<GreyImage> readGreyImage(const std::string& path);
 
     /// Write an 8-bit RGBA PNG atomically (values clamped to [0, 1]).
     Result<void> writePng(const std::string& path, const Image& image);

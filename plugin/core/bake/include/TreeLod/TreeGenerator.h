@@ -35,26 +35,13 @@
 #include "TreeLod/Progress.h"
 #include "TreeLod/Result.h"
 #include "TreeLod/TreeModel.h"
+#include "TreeLod/TreePreset.h" // TreePreset, presetName, parsePreset
 
 #include <cstdint>
 #include <string>
 
 namespace TreeLod
 {
-    enum class TreePreset
-    {
-        Oak,     ///< broadleaf, decurrent, broad rounded crown (also "broadleaf")
-        Conifer, ///< excurrent, conical, near-horizontal whorled branches, needle sprays
-        Birch,   ///< slender white trunk, narrow crown, pendulous twigs
-        Shrub    ///< many stems from the ground, low rounded bush
-    };
-
-    /// "oak", "conifer", "birch", "shrub".
-    const char* presetName(TreePreset preset);
-
-    /// Accepts the names above (case-sensitive) and "broadleaf" as Oak. False otherwise.
-    bool parsePreset(const std::string& name, TreePreset& out);
-
     struct GeneratorOptions
     {
         TreePreset preset = TreePreset::Oak;

@@ -181,6 +181,9 @@ namespace TreeLod
         Result<void> remove(ForestHandle handle);
         void clear();
         void reserve(std::size_t count);
+        /// Bytes the store holds for its instances (every per-instance array's capacity, handle maps
+        /// included; kinds not counted): what grows with the instance count.
+        std::size_t getMemoryBytes() const;
 
         std::size_t size() const { return mKind.size(); }
         bool contains(ForestHandle handle) const;

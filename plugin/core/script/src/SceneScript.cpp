@@ -1,5 +1,6 @@
 // SceneScript: parsing (nlohmann::json for values, a position scan for line/column of
-// every key), placements (uniform and Thomas-clustered) and the camera path.
+// every key), instance files (CSV, std::from_chars), placements (uniform and Thomas-clustered)
+// and the camera path.
 //
 // This work is based on:
 //   M. Thomas, "A generalization of Poisson's binomial limit for use in ecology",
@@ -11,14 +12,16 @@
 #include "TreeLod/SceneScript.h"
 
 #include "TreeLod/AtomicFile.h"
-#include "TreeLod/Image.h"
-#include "TreeLod/TreeGenerator.h"
+#include "TreeLod/TreePreset.h"
 
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <charconv>
+#include <cstdlib>
 #include <cmath>
 #include <filesystem>
+#include <string_view>
 #include <map>
 #include <random>
 #include <sstream>
@@ -42,6 +45,12 @@ namespace TreeLod
         {
             throw ScriptError{pointer, reason};
         }
+
+        /// Internal only: an instance file's error, already naming the CSV file, line and column.
+        struct InstanceFileError
+        {
+            Error error;
+        };
 
         std::string child(const std::string& pointer, const std::string& key)
         {
@@ -321,7 +330,8 @@ namespace TreeLod
             return p.lexically_normal().string();
         }
 
-        SceneGround readGround(const Json& j, const std::string& pointer, const std::string& baseDir)
+        SceneGround readGround(const Json& j, const std::string& pointer, const std::string& baseDir,
+                               const GreyImageReader& readImage)
         {
             allowKeys(j, pointer, {"kind", "size", "image", "heightScale"});
             SceneGround g;
@@ -340,15 +350,24 @@ namespace TreeLod
             g.heightScale = float(number(need(j, pointer, "heightScale"), child(pointer, "heightScale"), 0.0, 1e4));
             std::string imagePointer = child(pointer, "image");
             g.image = resolvePath(baseDir, text(need(j, pointer, "image"), imagePointer));
-            Result<Image> image = readImage(g.image);
+            if (!readImage)
+                bad(imagePointer, "no image reader given (the program reading this script passes readGreyImage "
+                                  "or readGreyImageOgre to loadSceneScript)");
+            Result<GreyImage> image = readImage(g.image);
             if (!image)
                 bad(imagePointer, image.error().message());
             if (image->width < 2 || image->height < 2)
                 bad(imagePointer, "heightfield image must be at least 2 x 2 pixels");
+            if (image->values.size() != std::size_t(image->width) * std::size_t(image->height))
+                bad(imagePointer, "the image reader returned " + std::to_string(image->values.size()) +
+                                      " values for " + std::to_string(image->width) + " x " +
+                                      std::to_string(image->height) + " pixels");
+            for (float v : image->values)
+                if (!(v >= 0.0f && v <= 1.0f))
+                    bad(imagePointer, "the image reader returned a grey value outside [0, 1]: " + formatNumber(v));
             g.heightsWidth = image->width;
             g.heightsHeight = image->height;
-            for (const glm::vec4& p : image->pixels)
-                g.heights.push_back(p.r);
+            g.heights = std::move(image->values);
             return g;
         }
 
@@ -364,7 +383,7 @@ namespace TreeLod
                 s.preset = source.substr(7);
                 TreePreset preset;
                 if (!parsePreset(s.preset, preset))
-                    bad(sourcePointer, "unknown preset '" + s.preset + "' (expected oak, conifer, birch, shrub)");
+                    bad(sourcePointer, "unknown preset '" + s.preset + "' (expected " + presetNames() + ")");
                 if (const Json* v = find(j, "seed"))
                     s.seed = std::uint32_t(integer(*v, child(pointer, "seed"), 0, 0xffffffffll));
                 if (const Json* v = find(j, "leaves"))
@@ -520,9 +539,182 @@ namespace TreeLod
             return double(hi.x - lo.x) * double(hi.y - lo.y) * double(free) / (double(n) * n);
         }
 
-        ScenePlacement readPlacement(const Json& j, const std::string& pointer, const SceneScript& script)
+        // ---- instance files (a placement's "file") -------------------------------------------
+
+        /// A number of an instance file: the whole field (a leading '+' allowed), finite.
+        /// Overflow (1e999) and "nan" / "inf" read as not finite; false when it is no number.
+        bool csvNumber(std::string_view field, double& out)
         {
-            allowKeys(j, pointer, {"species", "positions", "random"});
+            const char* begin = field.data();
+            const char* end = begin + field.size();
+            if (begin != end && *begin == '+')
+                ++begin;
+            auto [ptr, ec] = std::from_chars(begin, end, out);
+            if (ptr != end || begin == end || ec == std::errc::invalid_argument)
+                return false;
+            if (ec == std::errc::result_out_of_range) // strtod tells overflow (inf) from underflow (0)
+                out = std::strtod(std::string(begin, end).c_str(), nullptr);
+            return true;
+        }
+
+        std::string_view trimmed(std::string_view s)
+        {
+            while (!s.empty() && (s.front() == ' ' || s.front() == '\t'))
+                s.remove_prefix(1);
+            while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
+                s.remove_suffix(1);
+            return s;
+        }
+
+        /// Reads the CSV at `path` into the placement's explicit trees (samples/scenes/README.md,
+        /// "Instance files"). Throws InstanceFileError naming the file, line and column.
+        void readInstanceFile(const std::string& path, ScenePlacement& p, const SceneScript& script)
+        {
+            enum Column { X, Z, SPECIES, ROTATION, SCALE, Y, COLUMN_COUNT };
+            static const char* const NAMES[COLUMN_COUNT] = {"x", "z", "species", "rotation", "scale", "y"};
+            auto failAt = [&](std::size_t line, const std::string& column, const std::string& reason) {
+                throw InstanceFileError{fail(path, "line " + std::to_string(line) +
+                                                       (column.empty() ? "" : ", column " + column), reason)};
+            };
+            Result<std::vector<std::uint8_t>> bytes = readFile(path);
+            if (!bytes)
+                throw InstanceFileError{bytes.error()};
+            std::string_view text(reinterpret_cast<const char*>(bytes->data()), bytes->size());
+            if (text.substr(0, 3) == "\xEF\xBB\xBF") // a UTF-8 byte order mark
+                text.remove_prefix(3);
+
+            const double half = 0.5 * script.ground.size;
+            std::vector<Column> columns; // per field of a row
+            bool hasSpecies = false, hasY = false;
+            std::string columnList;      // "x, z, scale" for messages
+            std::string speciesList;     // "oak, pine" for messages
+            for (std::uint32_t s : p.species)
+                speciesList += (speciesList.empty() ? "" : ", ") + script.species[s].name;
+            std::size_t at = 0, line = 0;
+            std::string_view fields[COLUMN_COUNT + 1];
+            while (at < text.size())
+            {
+                std::size_t end = text.find('\n', at);
+                if (end == std::string_view::npos)
+                    end = text.size();
+                const std::string_view row = trimmed(text.substr(at, end - at));
+                at = end + 1;
+                ++line;
+                if (row.empty() || row.front() == '#')
+                    continue;
+                // Split at commas: more fields than columns is an error either way.
+                std::size_t count = 0;
+                for (std::size_t start = 0;;)
+                {
+                    const std::size_t comma = row.find(',', start);
+                    const std::string_view field =
+                        trimmed(row.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+                    if (count <= COLUMN_COUNT)
+                        fields[count] = field;
+                    ++count;
+                    if (comma == std::string_view::npos)
+                        break;
+                    start = comma + 1;
+                }
+                if (columns.empty()) // the header
+                {
+                    bool seen[COLUMN_COUNT] = {};
+                    for (std::size_t i = 0; i < count; ++i)
+                    {
+                        if (i >= COLUMN_COUNT)
+                            failAt(line, "", "more columns than x, z, species, rotation, scale, y");
+                        const auto known = std::find(std::begin(NAMES), std::end(NAMES), fields[i]);
+                        if (known == std::end(NAMES))
+                            failAt(line, "", "unknown column '" + std::string(fields[i]) +
+                                                 "' (expected x, z and any of species, rotation, scale, y)");
+                        const Column c = Column(known - std::begin(NAMES));
+                        if (seen[c])
+                            failAt(line, "", "column '" + std::string(fields[i]) + "' named twice");
+                        seen[c] = true;
+                        columns.push_back(c);
+                        columnList += (columnList.empty() ? "" : ", ") + std::string(fields[i]);
+                    }
+                    for (Column c : {X, Z})
+                        if (!seen[c])
+                            failAt(line, "", std::string("the header lacks the column ") + NAMES[c] +
+                                                 " (first line: column names, e.g. x,z,species,rotation,scale)");
+                    hasSpecies = seen[SPECIES];
+                    hasY = seen[Y];
+                    continue;
+                }
+                if (count != columns.size())
+                    failAt(line, "", "expected " + std::to_string(columns.size()) + " columns (" + columnList +
+                                         "), got " + std::to_string(count));
+                if (p.positions.size() >= MAX_TREES)
+                    failAt(line, "", "more than " + std::to_string(MAX_TREES) + " trees");
+                glm::vec4 tree(0.0f, 0.0f, 0.0f, 1.0f);
+                std::uint32_t species = p.species[0];
+                float y = NAN;
+                for (std::size_t i = 0; i < count; ++i)
+                {
+                    const std::string_view f = fields[i];
+                    const char* name = NAMES[columns[i]];
+                    if (columns[i] == SPECIES)
+                    {
+                        auto known = std::find_if(p.species.begin(), p.species.end(), [&](std::uint32_t s) {
+                            return script.species[s].name == f;
+                        });
+                        if (known == p.species.end())
+                            failAt(line, name, "unknown species '" + std::string(f) + "' (this placement's: " +
+                                                   speciesList + ")");
+                        species = *known;
+                        continue;
+                    }
+                    double v = 0.0;
+                    if (!csvNumber(f, v))
+                        failAt(line, name, "'" + std::string(f) + "' is not a number");
+                    const std::string shown(f);
+                    switch (columns[i])
+                    {
+                    case X:
+                    case Z:
+                        if (!std::isfinite(v) || std::abs(v) > half)
+                            failAt(line, name, shown + " must be finite and on the ground (|" + name + "| <= " +
+                                                   formatNumber(half) + ")");
+                        (columns[i] == X ? tree.x : tree.y) = float(v);
+                        break;
+                    case ROTATION:
+                        if (!std::isfinite(v) || std::abs(v) > 360.0)
+                            failAt(line, name, shown + " must be finite degrees in [-360, 360]");
+                        tree.z = float(v * PI / 180.0);
+                        break;
+                    case SCALE:
+                        if (!std::isfinite(v) || !(v > 0.0))
+                            failAt(line, name, shown + " must be finite and > 0");
+                        if (v > 1e3)
+                            failAt(line, name, shown + " must be <= 1000");
+                        tree.w = float(v);
+                        break;
+                    case Y:
+                        if (!std::isfinite(v) || std::abs(v) > 1e6)
+                            failAt(line, name, shown + " must be finite metres in [-1e6, 1e6]");
+                        y = float(v);
+                        break;
+                    default:
+                        break;
+                    }
+                }
+                p.positions.push_back(tree);
+                if (hasSpecies)
+                    p.positionSpecies.push_back(species);
+                if (hasY)
+                    p.positionY.push_back(y);
+            }
+            if (columns.empty())
+                failAt(line, "", "no header line (the first line names the columns, e.g. x,z,species,rotation,scale)");
+            if (p.positions.empty())
+                failAt(line, "", "no trees (rows after the header)");
+        }
+
+        ScenePlacement readPlacement(const Json& j, const std::string& pointer, const SceneScript& script,
+                                     const std::string& baseDir)
+        {
+            allowKeys(j, pointer, {"species", "positions", "random", "file"});
             ScenePlacement p;
             std::string speciesPointer = child(pointer, "species");
             const Json& species = need(j, pointer, "species");
@@ -547,11 +739,22 @@ namespace TreeLod
 
             const Json* positions = find(j, "positions");
             const Json* random = find(j, "random");
-            if (!positions && !random)
-                bad(child(pointer, "positions"), "missing required key (positions or random)");
-            if (positions && random)
-                bad(child(pointer, "random"), "a placement has positions or random, not both");
+            const Json* file = find(j, "file");
+            if (!positions && !random && !file)
+                bad(child(pointer, "positions"), "missing required key (positions, random or file)");
+            if (int(positions != nullptr) + int(random != nullptr) + int(file != nullptr) > 1)
+                bad(child(pointer, file ? "file" : "random"), "a placement has one of positions, random or file");
             const double half = 0.5 * script.ground.size;
+            if (file)
+            {
+                const std::string fp = child(pointer, "file");
+                p.file = resolvePath(baseDir, text(*file, fp));
+                std::error_code ec;
+                if (!std::filesystem::is_regular_file(p.file, ec))
+                    bad(fp, "no such file: " + p.file);
+                readInstanceFile(p.file, p, script);
+                return p;
+            }
             if (positions)
             {
                 std::string pp = child(pointer, "positions");
@@ -715,7 +918,7 @@ namespace TreeLod
             return c;
         }
 
-        SceneScript readScript(const Json& root, const std::string& baseDir)
+        SceneScript readScript(const Json& root, const std::string& baseDir, const GreyImageReader& readImage)
         {
             allowKeys(root, "", {"name", "description", "ground", "species", "placements", "sun", "shadows",
                                  "camera", "resolution", "frames", "counts"});
@@ -723,7 +926,7 @@ namespace TreeLod
             s.name = text(need(root, "", "name"), "/name");
             if (const Json* v = find(root, "description"))
                 s.description = text(*v, "/description", true);
-            s.ground = readGround(need(root, "", "ground"), "/ground", baseDir);
+            s.ground = readGround(need(root, "", "ground"), "/ground", baseDir, readImage);
 
             const Json& species = need(root, "", "species");
             expectArray(species, "/species", 1);
@@ -741,7 +944,7 @@ namespace TreeLod
             bool anyRandom = false;
             for (std::size_t i = 0; i < placements.size(); ++i)
             {
-                s.placements.push_back(readPlacement(placements[i], child("/placements", i), s));
+                s.placements.push_back(readPlacement(placements[i], child("/placements", i), s, baseDir));
                 explicitTrees += s.placements.back().positions.size();
                 anyRandom = anyRandom || s.placements.back().random;
             }
@@ -904,7 +1107,8 @@ namespace TreeLod
         return float(PI * (double(radius) * radius - double(innerRadius) * innerRadius));
     }
 
-    Result<SceneScript> parseSceneScript(const std::string& text, const std::string& label, const std::string& baseDir)
+    Result<SceneScript> parseSceneScript(const std::string& text, const std::string& label, const std::string& baseDir,
+                                         const GreyImageReader& readImage)
     {
         Json root;
         try
@@ -924,9 +1128,13 @@ namespace TreeLod
         try
         {
             scan.run();
-            SceneScript script = readScript(root, baseDir);
+            SceneScript script = readScript(root, baseDir, readImage);
             script.file = label;
             return script;
+        }
+        catch (const InstanceFileError& e)
+        {
+            return e.error;
         }
         catch (const ScriptError& e)
         {
@@ -939,13 +1147,13 @@ namespace TreeLod
         }
     }
 
-    Result<SceneScript> loadSceneScript(const std::string& path)
+    Result<SceneScript> loadSceneScript(const std::string& path, const GreyImageReader& readImage)
     {
         Result<std::vector<std::uint8_t>> bytes = readFile(path);
         if (!bytes)
             return bytes.error();
         return parseSceneScript(std::string(bytes->begin(), bytes->end()), path,
-                                std::filesystem::path(path).parent_path().string());
+                                std::filesystem::path(path).parent_path().string(), readImage);
     }
 
     float groundHeight(const SceneGround& ground, float x, float z)
@@ -1018,8 +1226,11 @@ namespace TreeLod
                     for (std::size_t k = 0; k < counts[i]; ++k)
                     {
                         const glm::vec4& e = p.positions[k];
-                        trees.push_back({p.species[0], glm::vec3(e.x, groundHeight(script.ground, e.x, e.y), e.y),
-                                         e.z, e.w});
+                        const float y = p.positionY.empty() || std::isnan(p.positionY[k])
+                                            ? groundHeight(script.ground, e.x, e.y)
+                                            : p.positionY[k];
+                        trees.push_back({p.positionSpecies.empty() ? p.species[0] : p.positionSpecies[k],
+                                         glm::vec3(e.x, y, e.y), e.z, e.w});
                     }
                     continue;
                 }

@@ -1,0 +1,403 @@
+// treelod_frames SCENE.json --packages LIST -o DIR [--techniques] [--lod-bias] [--frames] [--scale] [--counts]
+//                [--size] [--samples] [--reference-budget] [--reference-image-budget] [--entity-limit]
+//                [--skip-comparisons] [-q]
+//
+// The program that renders and times the frames of `treelod bench` (issue 7): it links OGRE and the
+// runtime only (Plugin_TreeLod, TreeLodOffscreen, TreeLodScene, TreeLodScript, TreeLodRuntime), never
+// TreeLodBake (DESIGN.md, "Runtime vs bake"), so it fits the GPU bundle of ../shared/gpu/README.md.
+// It bakes nothing: packages come from the list `treelod bench` writes after baking them
+// (PackageListBaker). `treelod bench` runs it and then computes the image metrics from the frames it
+// saved; on a GPU machine run it directly with the same options and the bench's package list.
+//
+// Runs per tree count: the polygonal reference ("mesh"), the floors ("quad": the Forest's one-quad
+// level; "entities": one Ogre Entity per tree; "merged-quads": all quads merged into a few static
+// batches), then every technique at every LoD bias. Writes DIR/timings.json (per run: per frame
+// CPU ms, frame ms (bounded by a one-pixel read-back), batches, triangles, visible trees, trees per
+// level, bytes uploaded, pending levels; run totals: GPU bytes, instance bytes, resident memory) and,
+// on sampled frames, PNGs under DIR/images: the reference supersampled 2x2 and every run at one
+// sample per pixel, each with the next frame at the script's frame rate (temporal noise).
+#include "CliSupport.h"
+
+#include "TreeLod/AtomicFile.h"
+#include "TreeLod/ForestScene.h"
+#include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/PackageListBaker.h"
+#include "TreeLod/SceneScript.h"
+#include "TreeLod/TreeAssetManager.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace TreeLod
+{
+    namespace
+    {
+        struct FramesArgs
+        {
+            std::string scene;
+            std::string packages;
+            std::string output;
+            std::string techniques = "auto,lodf,billboard-cloud";
+            std::string lodBiases = "1,0.5,0.25";
+            std::uint32_t frames = 0; // 0 = the script's
+            double scale = 1.0;
+            std::string size;
+            std::uint32_t samples = 4;
+            double referenceBudget = 3e6;
+            double referenceImageBudget = 0.0;
+            std::string counts;
+            std::uint64_t entityLimit = 200000;
+            bool skipComparisons = false; // only the techniques: no reference, no floors (memory of one scene)
+            bool quiet = false;
+        };
+
+        std::vector<std::string> splitList(const std::string& text)
+        {
+            std::vector<std::string> out;
+            std::stringstream in(text);
+            std::string item;
+            while (std::getline(in, item, ','))
+                if (!item.empty())
+                    out.push_back(item);
+            return out;
+        }
+
+        /// Resident and peak resident memory of this process in MiB (/proc/self/status), NaN elsewhere.
+        std::pair<double, double> residentMiB()
+        {
+            std::ifstream in("/proc/self/status");
+            std::string line;
+            double rss = NAN, peak = NAN;
+            while (std::getline(in, line))
+            {
+                if (line.rfind("VmRSS:", 0) == 0)
+                    rss = std::strtod(line.c_str() + 6, nullptr) / 1024.0;
+                else if (line.rfind("VmHWM:", 0) == 0)
+                    peak = std::strtod(line.c_str() + 6, nullptr) / 1024.0;
+            }
+            return {rss, peak};
+        }
+
+        /// Triangles the polygonal reference would submit from `camera`: visible trees times their
+        /// reference triangle counts (exact, not a guess at time: the budget is in triangles).
+        std::uint64_t referenceTriangles(ForestScene& scene, const CameraSpec& camera, int width, int height)
+        {
+            Forest& forest = scene.getForest();
+            ForestVisibility visibility;
+            const CullCamera cull = CullCamera::fromSpec(camera, float(width), float(height));
+            if (!forest.getInstances().cull(cull, 1.0f, visibility))
+                return 0;
+            std::uint64_t triangles = 0;
+            for (const ForestBucket& bucket : visibility.getBuckets())
+            {
+                const ReferenceChunk& reference = forest.getAsset(bucket.kind)->getReference();
+                triangles += std::uint64_t(bucket.count) *
+                             (reference.model.barkIndices.size() + reference.model.leafIndices.size()) / 3;
+            }
+            return triangles;
+        }
+
+        std::vector<std::uint32_t> levelHistogram(const Forest& forest)
+        {
+            std::vector<std::uint32_t> levels;
+            for (const std::vector<std::uint32_t>& species : forest.getStats().levelCounts)
+            {
+                if (levels.size() < species.size())
+                    levels.resize(species.size(), 0);
+                for (std::size_t l = 0; l < species.size(); ++l)
+                    levels[l] += species[l];
+            }
+            return levels;
+        }
+
+        std::string biasText(float bias)
+        {
+            char text[32];
+            std::snprintf(text, sizeof text, "%g", double(bias));
+            return text;
+        }
+
+        /// The file name stem of a run's sampled frame (the bench reads the same names).
+        std::string imageStem(std::uint32_t trees, const std::string& technique, float bias, std::uint32_t frame)
+        {
+            return std::to_string(trees) + "-" + technique + "-" + biasText(bias) + "-" + std::to_string(frame);
+        }
+
+        bool isFloor(const std::string& technique) { return technique == "entities" || technique == "merged-quads"; }
+
+        int runFrames(const FramesArgs& args)
+        {
+            // The renderer first: readGreyImageOgre (heightfields) needs Ogre's image codecs.
+            OffscreenRenderer renderer;
+            Result<SceneScript> loaded = loadSceneScript(args.scene, readGreyImageOgre);
+            if (!loaded)
+                return printError(loaded.error());
+            const SceneScript& script = *loaded;
+            if (!(args.scale > 0.0) || !std::isfinite(args.scale))
+                return printError(fail("", "--scale", "must be a positive number"));
+            int width = script.width, height = script.height;
+            if (!args.size.empty() && (std::sscanf(args.size.c_str(), "%dx%d", &width, &height) != 2 || width <= 0 ||
+                                       height <= 0 || width > 16384 || height > 16384))
+                return printError(fail("", "--size", "'" + args.size + "' is not WxH with 1..16384"));
+            const std::uint32_t frames = args.frames ? args.frames : script.frames;
+            if (args.samples == 0 || frames == 0)
+                return printError(fail("", "--frames/--samples", "must be >= 1"));
+            std::vector<float> biases;
+            for (const std::string& b : splitList(args.lodBiases))
+            {
+                char* end = nullptr;
+                const double v = std::strtod(b.c_str(), &end);
+                if (*end != '\0' || !(v > 0.0) || !std::isfinite(v))
+                    return printError(fail("", "--lod-bias", "'" + b + "' is not a positive number"));
+                biases.push_back(float(v));
+            }
+            if (biases.empty())
+                return printError(fail("", "--lod-bias", "needs at least one value"));
+            std::vector<std::string> techniques;
+            for (const std::string& t : splitList(args.techniques))
+            {
+                if (t != "auto" && bakeTechniqueOf(t).empty())
+                    return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: " +
+                                                                   knownSceneTechniques() + ")"));
+                if (t != "mesh" && t != "quad" && !isFloor(t))
+                    techniques.push_back(t);
+            }
+            std::vector<std::uint32_t> counts = script.counts;
+            if (!args.counts.empty())
+            {
+                counts.clear();
+                for (const std::string& c : splitList(args.counts))
+                {
+                    char* end = nullptr;
+                    const unsigned long v = std::strtoul(c.c_str(), &end, 10);
+                    if (*end != '\0' || v == 0 || v > 0xFFFFFFFFul)
+                        return printError(fail("", "--counts", "'" + c + "' is not a tree count >= 1"));
+                    counts.push_back(std::uint32_t(v));
+                }
+            }
+            if (counts.empty())
+                counts.push_back(0); // as the script places them
+            const double imageBudget = args.referenceImageBudget > 0.0 ? args.referenceImageBudget : args.referenceBudget;
+
+            std::error_code ec;
+            std::filesystem::create_directories(args.output + "/images", ec);
+            if (ec)
+                return printError(fail(args.output, "", "cannot create the output directory: " + ec.message()));
+
+            ProgressCallback progress = makeProgress(args.quiet);
+            renderer.setLighting(sceneLighting(script));
+            PackageListBaker packages(args.packages);
+            TreeAssetManager::getSingleton().setBaker(&packages);
+            struct BakerReset
+            {
+                ~BakerReset() { TreeAssetManager::getSingleton().setBaker(nullptr); }
+            } bakerReset;
+
+            // Sampled frames: evenly along the path (never the last: its successor is the temporal pair).
+            std::vector<std::uint32_t> sampled;
+            const std::uint32_t samples = std::min(args.samples, std::max<std::uint32_t>(1, frames - 1));
+            for (std::uint32_t i = 0; i < samples; ++i)
+                sampled.push_back(frames <= 1 ? 0
+                                              : std::uint32_t((std::uint64_t(i) * 2 + 1) * (frames - 1) / (2 * samples)));
+            auto isSampled = [&](std::uint32_t f) { return std::find(sampled.begin(), sampled.end(), f) != sampled.end(); };
+            // The temporal pair: the next frame at the script's own frame rate (not --frames'), so
+            // temporal noise does not depend on how much the bench thins the path out.
+            const double nativeStep =
+                script.frames > 1 ? frameTime(script, 1, script.frames) - frameTime(script, 0, script.frames) : 0.0;
+            auto nextCamera = [&](std::uint32_t f) { return cameraAt(script, frameTime(script, f, frames) + nativeStep); };
+            auto save = [&](const RgbaImage& image, const std::string& stem) {
+                OffscreenRenderer::savePng(image, args.output + "/images/" + stem + ".png");
+            };
+
+            using nlohmann::json;
+            json runsJson = json::array();
+            for (std::uint32_t count : counts)
+            {
+                ForestSceneOptions options;
+                options.placement.totalCount = count;
+                options.placement.scale = args.scale;
+                std::vector<std::pair<std::string, std::vector<float>>> plan;
+                if (!args.skipComparisons)
+                    plan = {{"mesh", {1.0f}}, {"quad", {1.0f}}, {"entities", {1.0f}}, {"merged-quads", {1.0f}}};
+                for (const std::string& t : techniques)
+                    plan.push_back({t, biases});
+                for (const auto& [technique, runBiases] : plan)
+                {
+                    options.technique = technique == "auto" ? "" : technique;
+                    const std::uint32_t placed = std::uint32_t(generatePlacements(script, options.placement).size());
+                    if (technique == "entities" && placed > args.entityLimit)
+                    {
+                        json run = {{"trees", placed}, {"technique", technique}, {"lodBias", 1.0},
+                                    {"skipped", std::to_string(placed) + " entities > --entity-limit " +
+                                                    std::to_string(args.entityLimit)},
+                                    {"frames", json::array()}};
+                        runsJson.push_back(run);
+                        continue;
+                    }
+                    const auto buildStart = std::chrono::steady_clock::now();
+                    std::unique_ptr<ForestScene> scene;
+                    try
+                    {
+                        scene = std::make_unique<ForestScene>(renderer.getSceneManager(), renderer.getContentNode(),
+                                                              script, options);
+                    }
+                    catch (const Ogre::Exception& e)
+                    {
+                        return printError(fail(args.scene, "technique " + technique, e.getDescription()));
+                    }
+                    const double buildSeconds =
+                        std::chrono::duration<double>(std::chrono::steady_clock::now() - buildStart).count();
+                    if (script.shadows.enabled)
+                        renderer.setShadowFarDistance(ForestScene::getShadowFarDistance());
+                    const std::uint32_t trees = std::uint32_t(scene->getPlacements().size());
+                    for (float bias : runBiases)
+                    {
+                        // Untimed warm-up along the path: GL3Plus links each program on first use, which would
+                        // otherwise land in the first frame that shows a level. Levels the warm-up does not see
+                        // become resident during the timed frames, within the upload budget (worst frame).
+                        renderer.setLodBias(bias);
+                        for (std::uint32_t w = 0; w < std::min<std::uint32_t>(frames, 4); ++w)
+                            renderer.renderTimedFrame(scene->cameraAtFrame(w * (frames - 1) / 3, frames), width, height);
+                        json run = {{"trees", trees}, {"technique", technique}, {"lodBias", bias},
+                                    {"buildSeconds", buildSeconds}};
+                        json frameRows = json::array();
+                        const std::string label = technique + " bias " + biasText(bias) + " (" + std::to_string(trees) +
+                                                  (trees == 1 ? " tree)" : " trees)");
+                        for (std::uint32_t f = 0; f < frames; ++f)
+                        {
+                            progress(label, float(f) / float(frames));
+                            json row = {{"frame", f}, {"time", frameTime(script, f, frames)}};
+                            const CameraSpec camera = scene->cameraAtFrame(f, frames);
+                            std::uint64_t referenceCost = 0;
+                            if (technique == "mesh")
+                                referenceCost = referenceTriangles(*scene, camera, width, height);
+                            std::string skipped;
+                            if (technique == "mesh" && double(referenceCost) > args.referenceBudget)
+                                skipped = "reference too costly: " + std::to_string(referenceCost) +
+                                          " triangles > budget " + std::to_string(std::uint64_t(args.referenceBudget));
+                            else
+                            {
+                                const FrameTiming timing = renderer.renderTimedFrame(camera, width, height);
+                                const ForestStats& stats = scene->getForest().getStats();
+                                row["cpuMs"] = timing.cpuMilliseconds;
+                                row["frameMs"] = timing.frameMilliseconds;
+                                row["batches"] = timing.batches;
+                                row["triangles"] = timing.triangles;
+                                if (!isFloor(technique))
+                                {
+                                    row["visible"] = stats.visibleInstances;
+                                    row["levels"] = levelHistogram(scene->getForest());
+                                    row["cullMs"] = stats.cullMilliseconds;
+                                }
+                            }
+                            if (isSampled(f))
+                            {
+                                const std::string stem = imageStem(trees, technique, bias, f);
+                                if (technique == "mesh")
+                                {
+                                    if (double(referenceCost) <= imageBudget)
+                                    {
+                                        save(renderer.render(camera, width, height, 2), stem + "-ref");
+                                        save(renderer.render(nextCamera(f), width, height, 2), stem + "-ref-next");
+                                        row["referenceImage"] = stem + "-ref";
+                                    }
+                                    else
+                                        skipped += std::string(skipped.empty() ? "" : "; ") +
+                                                   "reference image too costly: " + std::to_string(referenceCost) +
+                                                   " triangles > image budget " +
+                                                   std::to_string(std::uint64_t(imageBudget));
+                                }
+                                if (technique != "mesh" || double(referenceCost) <= imageBudget)
+                                {
+                                    save(renderer.render(camera, width, height, 1), stem);
+                                    save(renderer.render(nextCamera(f), width, height, 1), stem + "-next");
+                                    row["image"] = stem;
+                                }
+                            }
+                            if (!skipped.empty())
+                                row["skipped"] = skipped;
+                            frameRows.push_back(std::move(row));
+                        }
+                        progress(label, 1.0f);
+                        const auto [rss, peak] = residentMiB();
+                        run["frames"] = std::move(frameRows);
+                        run["gpuBytes"] = scene->getGpuBytes();
+                        run["instanceBytes"] = scene->getForest().getInstances().getMemoryBytes();
+                        run["rssMiB"] = rss;
+                        run["peakRssMiB"] = peak;
+                        runsJson.push_back(std::move(run));
+                    }
+                    scene.reset();
+                }
+            }
+            json out = {{"scene", script.name},
+                        {"file", script.file},
+                        {"resolution", {width, height}},
+                        {"frames", frames},
+                        {"sampled", sampled},
+                        {"scale", args.scale},
+                        {"renderer", renderer.getRoot().getRenderSystem()->getName()},
+                        {"runs", std::move(runsJson)}};
+            const std::string text = out.dump(1) + "\n";
+            if (Result<void> w = writeFileAtomic(args.output + "/timings.json",
+                                                 std::vector<std::uint8_t>(text.begin(), text.end()));
+                !w)
+                return printError(w.error());
+            return EXIT_OK;
+        }
+    }
+}
+
+int main(int argc, char** argv)
+{
+    using namespace TreeLod;
+    FramesArgs args;
+    CLI::App app{"treelod_frames: render and time a scene script's camera path (the frames of `treelod bench`; "
+                 "links OGRE and the TreeLod runtime only)"};
+    app.add_option("scene", args.scene, "scene script (samples/scenes/*.json)")->required();
+    app.add_option("--packages", args.packages, "package list written by `treelod bench` (packages.json)")->required();
+    app.add_option("-o,--output", args.output, "output directory (timings.json, images/)")->required();
+    app.add_option("--techniques", args.techniques,
+                   "techniques besides the reference (mesh) and the floors (quad, entities, merged-quads)")
+        ->capture_default_str();
+    app.add_option("--lod-bias", args.lodBiases, "comma-separated LoD biases")->capture_default_str();
+    app.add_option("--frames", args.frames, "frames along the path (default: the script's)");
+    app.add_option("--scale", args.scale, "tree count factor of random placements")->capture_default_str();
+    app.add_option("--counts", args.counts, "comma-separated total tree counts (default: the script's)");
+    app.add_option("--size", args.size, "WxH (default: the script's resolution)");
+    app.add_option("--samples", args.samples, "frames saved as images for the error measures")->capture_default_str();
+    app.add_option("--reference-budget", args.referenceBudget, "skip reference frames over this many triangles")
+        ->capture_default_str();
+    app.add_option("--reference-image-budget", args.referenceImageBudget,
+                   "the same for the reference's supersampled images (default: --reference-budget)");
+    app.add_option("--entity-limit", args.entityLimit, "skip the entities floor above this many trees")
+        ->capture_default_str();
+    app.add_flag("--skip-comparisons", args.skipComparisons,
+                 "run only --techniques: no reference, no floors (e.g. to read one scene's resident memory)");
+    app.add_flag("-q,--quiet", args.quiet, "no progress");
+    try
+    {
+        app.parse(argc, argv);
+    }
+    catch (const CLI::ParseError& e)
+    {
+        const int rc = app.exit(e);
+        return rc == 0 ? 0 : EXIT_BAD_INPUT;
+    }
+    try
+    {
+        return runFrames(args);
+    }
+    catch (const Ogre::Exception& e)
+    {
+        std::fprintf(stderr, "treelod_frames: %s\n", e.getDescription().c_str());
+        return EXIT_FAILURE_RUN;
+    }
+}
