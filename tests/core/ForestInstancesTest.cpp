@@ -668,4 +668,61 @@ namespace TreeLod
         EXPECT_EQ(forest.size(), 0u);
         EXPECT_FALSE(forest.contains(handles[0]));
     }
+
+    // Issue 7: a million instances (no index overflow, memory linear at <= 32 bytes each), every
+    // tree at one spot, and the camera 10 km away.
+    TEST(ForestInstances, aMillionInstancesThirtyTwoBytesEach)
+    {
+        std::mt19937 rng(17);
+        ForestInstances forest;
+        addKinds(forest);
+        std::vector<ForestInstance> instances = randomInstances(rng, 1000000, 5000.0f, forest.getKindCount());
+        ASSERT_TRUE(forest.add(instances));
+        ASSERT_EQ(forest.size(), 1000000u);
+        const double perInstance = double(forest.getMemoryBytes()) / double(forest.size());
+        std::printf("1 M instances: %.1f bytes each\n", perInstance);
+        EXPECT_LE(perInstance, 32.0);
+        ForestInstances small;
+        addKinds(small);
+        ASSERT_TRUE(small.add(randomInstances(rng, 10000, 5000.0f, small.getKindCount())));
+        EXPECT_NEAR(double(small.getMemoryBytes()) / 10000.0, perInstance, 0.1 * perInstance); // linear
+        // The last instance reads back (indices past 2^16, 2^20 are fine).
+        const ForestInstance last = forest.getAt(999999);
+        EXPECT_NEAR(last.position.x, instances.back().position.x, 1e-3f);
+        EXPECT_NEAR(last.scale, instances.back().scale, 1e-5f * instances.back().scale);
+        EXPECT_NEAR(std::cos(last.rotationY), std::cos(instances.back().rotationY), 1e-5f);
+        EXPECT_NEAR(std::sin(last.rotationY), std::sin(instances.back().rotationY), 1e-5f);
+        // An overview sees all of them; each is in exactly one bucket; a second cull allocates nothing.
+        const TestCamera c{glm::lookAt(glm::vec3(0, 30000, 1), glm::vec3(0, 0, 0), glm::vec3(0, 1, 0)),
+                           glm::perspective(glm::radians(40.0f), 1.0f, 10.0f, 40000.0f), 1024, 1024};
+        const CullCamera camera = CullCamera::fromMatrices(c.view, c.projection, c.width, c.height);
+        ForestVisibility vis;
+        ASSERT_TRUE(forest.cull(camera, 1.0f, vis));
+        EXPECT_EQ(vis.getVisibleCount(), 1000000u);
+        std::uint64_t total = 0;
+        for (const ForestBucket& b : vis.getBuckets())
+            total += b.count;
+        EXPECT_EQ(total, 1000000u);
+        const std::size_t capacity = vis.getCapacityBytes();
+        ASSERT_TRUE(forest.cull(camera, 1.0f, vis));
+        EXPECT_EQ(vis.getCapacityBytes(), capacity);
+        // Every tree at one spot.
+        ForestInstances stacked;
+        addKinds(stacked);
+        std::vector<ForestInstance> same(5000, ForestInstance{glm::vec3(3.0f, 0.0f, -2.0f), 0.5f, 1.0f, 0});
+        ASSERT_TRUE(stacked.add(same));
+        ASSERT_TRUE(stacked.cull(camera, 1.0f, vis));
+        EXPECT_EQ(vis.getVisibleCount(), 5000u);
+        // ... of every kind, seen from 10 km: all at each kind's last level.
+        for (std::size_t i = 0; i < same.size(); ++i)
+            same[i].kind = std::uint32_t(i % stacked.getKindCount());
+        stacked.clear();
+        ASSERT_TRUE(stacked.add(same));
+        const TestCamera far{glm::lookAt(glm::vec3(3, 10, 10000), glm::vec3(3, 0, -2), glm::vec3(0, 1, 0)),
+                             glm::perspective(glm::radians(60.0f), 1.0f, 1.0f, 30000.0f), 1024, 1024};
+        ASSERT_TRUE(stacked.cull(CullCamera::fromMatrices(far.view, far.projection, far.width, far.height), 1.0f, vis));
+        EXPECT_EQ(vis.getVisibleCount(), 5000u);
+        for (const ForestBucket& b : vis.getBuckets())
+            EXPECT_EQ(b.count, b.level + 1 == stacked.getLevelCount(b.kind) ? 1250u : 0u) << b.kind << "/" << b.level;
+    }
 }

@@ -116,8 +116,7 @@ namespace TreeLod
     std::size_t ForestInstances::getMemoryBytes() const
     {
         std::size_t bytes = 0;
-        for (const std::vector<float>* a : {&mX, &mY, &mZ, &mRotation, &mScale, &mCosScale, &mSinScale, &mSphereX,
-                                            &mSphereY, &mSphereZ, &mSphereR})
+        for (const std::vector<float>* a : {&mX, &mY, &mZ, &mCosScale, &mSinScale})
             bytes += a->capacity() * sizeof(float);
         return bytes + (mKind.capacity() + mHandleOfSlot.capacity() + mSlotOfHandle.capacity() +
                         mFreeHandles.capacity()) * sizeof(std::uint32_t);
@@ -196,21 +195,16 @@ namespace TreeLod
         mX[slot] = instance.position.x;
         mY[slot] = instance.position.y;
         mZ[slot] = instance.position.z;
-        mRotation[slot] = instance.rotationY;
-        mScale[slot] = s;
         mCosScale[slot] = cs;
         mSinScale[slot] = ss;
-        // World centre = position + (R * s) * local centre, R about +Y (see the transform rows).
-        mSphereX[slot] = instance.position.x + cs * c.x + ss * c.z;
-        mSphereY[slot] = instance.position.y + s * c.y;
-        mSphereZ[slot] = instance.position.z - ss * c.x + cs * c.z;
-        mSphereR[slot] = s * kind.boundsRadius;
         mKind[slot] = instance.kind;
+        (void)kind;
+        (void)c;
     }
 
-    std::array<std::vector<float>*, 11> ForestInstances::floatArrays()
+    std::array<std::vector<float>*, 5> ForestInstances::floatArrays()
     {
-        return {&mX, &mY, &mZ, &mRotation, &mScale, &mCosScale, &mSinScale, &mSphereX, &mSphereY, &mSphereZ, &mSphereR};
+        return {&mX, &mY, &mZ, &mCosScale, &mSinScale};
     }
 
     ForestHandle ForestInstances::takeHandle()
@@ -314,6 +308,7 @@ namespace TreeLod
             a->reserve(count);
         mKind.reserve(count);
         mHandleOfSlot.reserve(count);
+        mSlotOfHandle.reserve(std::max(count, mSlotOfHandle.size()));
     }
 
     bool ForestInstances::contains(ForestHandle handle) const
@@ -325,15 +320,21 @@ namespace TreeLod
     {
         ForestInstance instance;
         instance.position = glm::vec3(mX[index], mY[index], mZ[index]);
-        instance.rotationY = mRotation[index];
-        instance.scale = mScale[index];
+        // Derived from scale * (cos, sin): the rotation comes back in (-pi, pi], both to float rounding.
+        instance.rotationY = std::atan2(mSinScale[index], mCosScale[index]);
+        instance.scale = std::hypot(mCosScale[index], mSinScale[index]);
         instance.kind = mKind[index];
         return instance;
     }
 
     glm::vec4 ForestInstances::getWorldSphere(std::size_t index) const
     {
-        return glm::vec4(mSphereX[index], mSphereY[index], mSphereZ[index], mSphereR[index]);
+        // World centre = position + (R * s) * local centre, R about +Y (see the transform rows).
+        const ForestKind& kind = mKinds[mKind[index]];
+        const glm::vec3& c = kind.boundsCentre;
+        const float cs = mCosScale[index], ss = mSinScale[index], s = std::sqrt(cs * cs + ss * ss);
+        return glm::vec4(mX[index] + cs * c.x + ss * c.z, mY[index] + s * c.y, mZ[index] - ss * c.x + cs * c.z,
+                         s * kind.boundsRadius);
     }
 
     // ---- level of detail -------------------------------------------------------------------------
@@ -344,7 +345,7 @@ namespace TreeLod
         const float dx = mX[index] - camera.lodPosition.x, dy = mY[index] - camera.lodPosition.y,
                     dz = mZ[index] - camera.lodPosition.z;
         const bool distance = mKindDistance[mKind[index]] != 0;
-        const float key = lodKey(dx * dx + dy * dy + dz * dz, mSphereR[index], distance, c);
+        const float key = lodKey(dx * dx + dy * dy + dz * dz, getWorldSphere(index).w, distance, c);
         return distance ? -key : key;
     }
 
@@ -383,10 +384,14 @@ namespace TreeLod
                 pl[p][k] = camera.planes[p][k];
         const LodConstants c = lodConstants(camera, lodBias);
         const glm::vec3 eye = camera.lodPosition;
-        const float* sx = mSphereX.data();
-        const float* sy = mSphereY.data();
-        const float* sz = mSphereZ.data();
-        const float* sr = mSphereR.data();
+        // Kinds' local spheres, copied out: the world sphere is made per instance (4 floats less stored).
+        std::array<glm::vec4, 64> localSpheres;
+        const bool fewKinds = mKinds.size() <= localSpheres.size();
+        if (fewKinds)
+            for (std::size_t k = 0; k < mKinds.size(); ++k)
+                localSpheres[k] = glm::vec4(mKinds[k].boundsCentre, mKinds[k].boundsRadius);
+        const float* cosScale = mCosScale.data();
+        const float* sinScale = mSinScale.data();
         const float* px = mX.data();
         const float* py = mY.data();
         const float* pz = mZ.data();
@@ -400,15 +405,19 @@ namespace TreeLod
         std::uint32_t visibleCount = 0;
         for (std::size_t i = 0; i < n; ++i)
         {
-            const float x = sx[i], y = sy[i], z = sz[i], negR = -sr[i];
+            const std::uint32_t kind = kinds[i];
+            const glm::vec4 local = fewKinds ? localSpheres[kind]
+                                             : glm::vec4(mKinds[kind].boundsCentre, mKinds[kind].boundsRadius);
+            const float cs = cosScale[i], ss = sinScale[i], s = std::sqrt(cs * cs + ss * ss);
+            const float x = px[i] + cs * local.x + ss * local.z, y = py[i] + s * local.y,
+                        z = pz[i] - ss * local.x + cs * local.z, r = s * local.w, negR = -r;
             bool inside = true;
             for (int p = 0; p < 6; ++p)
                 inside &= pl[p][0] * x + pl[p][1] * y + pl[p][2] * z + pl[p][3] >= negR;
             if (!inside)
                 continue;
-            const std::uint32_t kind = kinds[i];
             const float dx = px[i] - eye.x, dy = py[i] - eye.y, dz = pz[i] - eye.z;
-            const float key = lodKey(dx * dx + dy * dy + dz * dz, sr[i], kindDistance[kind] != 0, c);
+            const float key = lodKey(dx * dx + dy * dy + dz * dz, r, kindDistance[kind] != 0, c);
             const std::uint32_t bucket = kindFirst[kind] + levelForKey(tables + kind * MAX_THRESHOLDS, key);
             visible[visibleCount] = std::uint32_t(i);
             visibleBucket[visibleCount] = bucket;
@@ -434,9 +443,6 @@ namespace TreeLod
         }
         std::uint32_t* indices = out.mIndices.data();
         float* transforms = out.mTransforms.data();
-        const float* cosScale = mCosScale.data();
-        const float* sinScale = mSinScale.data();
-        const float* scale = mScale.data();
         for (std::uint32_t j = 0; j < visibleCount; ++j)
         {
             const std::uint32_t i = visible[j];
@@ -445,7 +451,7 @@ namespace TreeLod
             float* m = transforms + ForestVisibility::TRANSFORM_FLOATS * slot;
             const float cs = cosScale[i], ss = sinScale[i];
             m[0] = cs, m[1] = 0.0f, m[2] = ss, m[3] = px[i];
-            m[4] = 0.0f, m[5] = scale[i], m[6] = 0.0f, m[7] = py[i];
+            m[4] = 0.0f, m[5] = std::sqrt(cs * cs + ss * ss), m[6] = 0.0f, m[7] = py[i];
             m[8] = -ss, m[9] = 0.0f, m[10] = cs, m[11] = pz[i];
         }
         out.mVisibleCount = visibleCount;

@@ -1,8 +1,11 @@
 // ForestInstances: the Forest's packed instance data (issue 5, "Forest"), and its per-frame
 // culling and level-of-detail selection in one tight loop, without Ogre.
 //
-// Storage is structure-of-arrays: per instance its position, rotation about +Y, uniform scale
-// and kind; a kind is one (asset, technique) pair with its local bounding sphere and LoD table.
+// Storage is structure-of-arrays: per instance its position, scale * (cos, sin) of its rotation
+// about +Y and kind, 32 bytes with the handle maps (issue 7: <= 32 B per instance); scale,
+// rotation and the world bounding sphere are derived from them (get() returns the rotation in
+// (-pi, pi] and both to float rounding). A kind is one (asset, technique) pair with its local
+// bounding sphere and LoD table.
 // Each frame `cull` tests every instance's world bounding sphere against the six frustum
 // planes, picks the visible ones' level from their kind's table, and counting-sorts them into
 // buckets (kind, level) with one packed 3x4 world matrix per instance, ready to be copied into
@@ -210,7 +213,7 @@ namespace TreeLod
     private:
         std::string check(const ForestInstance& instance) const; ///< "" or the reason it is refused
         ForestHandle takeHandle();
-        std::array<std::vector<float>*, 11> floatArrays(); ///< every per-instance float array
+        std::array<std::vector<float>*, 5> floatArrays(); ///< every per-instance float array
         void write(std::size_t slot, const ForestInstance& instance);
         void push(const ForestInstance& instance, ForestHandle handle);
 
@@ -223,11 +226,10 @@ namespace TreeLod
         std::vector<float> mKindTable;
         std::uint32_t mBucketCount = 0;
 
-        // instances (structure of arrays, dense)
+        // instances (structure of arrays, dense): 32 bytes each with the handle maps (issue 7);
+        // scale, rotation and the world sphere are derived from these where needed
         std::vector<float> mX, mY, mZ;             // position
-        std::vector<float> mRotation, mScale;
         std::vector<float> mCosScale, mSinScale;   // scale * cos / sin of the rotation
-        std::vector<float> mSphereX, mSphereY, mSphereZ, mSphereR; // world bounding sphere
         std::vector<std::uint32_t> mKind;
         std::vector<ForestHandle> mHandleOfSlot;
 
