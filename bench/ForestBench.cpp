@@ -7,7 +7,9 @@
 // 1920 x 1080 viewport, fov 60 degrees. Cameras (the argument):
 //   0 ground:   2 m above the centre, far clip 5 km (a walk through the forest);
 //   1 overview: 1.5 km above a corner looking at the centre, far clip 20 km (most are visible:
-//               the fill pass writes a matrix for each).
+//               the fill pass writes a matrix for each);
+//   2 random:   64 cameras (seed 2), one per iteration in turn: anywhere over the square, 2 m to
+//               1.5 km high, any heading, pitch 0 to -60 degrees, far clip 5-20 km (issue 7).
 // Counters: visible (instances drawn per frame); items = instances culled and selected.
 // Run: build/bin/treelod_core_bench --benchmark_filter=Forest --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 #include "TreeLod/ForestInstances.h"
@@ -90,15 +92,36 @@ namespace
             view = glm::lookAt(glm::vec3(-kHalfExtent, 1500.0f, -kHalfExtent), glm::vec3(0.0f), glm::vec3(0, 1, 0));
             projection = glm::perspective(glm::radians(60.0f), width / height, 1.0f, 20000.0f);
         }
-        const CullCamera camera = CullCamera::fromMatrices(view, projection, width, height);
-        ForestVisibility visibility;
-        if (Result<void> r = forest->cull(camera, 1.0f, visibility); !r) // warm-up: arrays reach their size
+        std::vector<CullCamera> cameras = {CullCamera::fromMatrices(view, projection, width, height)};
+        if (state.range(0) == 2)
         {
-            state.SkipWithError(r.error().message().c_str());
-            return;
+            cameras.clear();
+            std::mt19937 rng(2);
+            std::uniform_real_distribution<float> u(0.0f, 1.0f);
+            for (int c = 0; c < 64; ++c)
+            {
+                const glm::vec3 eye(kHalfExtent * (2.0f * u(rng) - 1.0f), 2.0f + 1498.0f * u(rng) * u(rng),
+                                    kHalfExtent * (2.0f * u(rng) - 1.0f));
+                const float heading = 6.2831853f * u(rng), pitch = -1.0471976f * u(rng);
+                const glm::vec3 forward(std::cos(pitch) * std::sin(heading), std::sin(pitch),
+                                        std::cos(pitch) * std::cos(heading));
+                cameras.push_back(CullCamera::fromMatrices(
+                    glm::lookAt(eye, eye + forward, glm::vec3(0, 1, 0)),
+                    glm::perspective(glm::radians(60.0f), width / height, 0.1f, 5000.0f + 15000.0f * u(rng)), width,
+                    height));
+            }
         }
+        ForestVisibility visibility;
+        for (const CullCamera& camera : cameras) // warm-up: arrays reach their size
+            if (Result<void> r = forest->cull(camera, 1.0f, visibility); !r)
+            {
+                state.SkipWithError(r.error().message().c_str());
+                return;
+            }
+        std::size_t next = 0;
         for (auto _ : state)
         {
+            const CullCamera& camera = cameras[next++ % cameras.size()];
             Result<void> r = forest->cull(camera, 1.0f, visibility);
             benchmark::DoNotOptimize(r);
             benchmark::DoNotOptimize(visibility.getTransforms());
@@ -109,4 +132,4 @@ namespace
     }
 }
 
-BENCHMARK(BM_ForestCullAndSelect)->ArgName("camera")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ForestCullAndSelect)->ArgName("camera")->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);

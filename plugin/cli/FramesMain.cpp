@@ -166,8 +166,8 @@ namespace TreeLod
                 if (t != "auto" && bakeTechniqueOf(t).empty())
                     return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: " +
                                                                    knownSceneTechniques() + ")"));
-                if (t != "mesh" && t != "quad" && !isFloor(t))
-                    techniques.push_back(t);
+                if (args.skipComparisons || (t != "mesh" && t != "quad" && !isFloor(t)))
+                    techniques.push_back(t); // otherwise run once below, with the comparisons
             }
             std::vector<std::uint32_t> counts = script.counts;
             if (!args.counts.empty())

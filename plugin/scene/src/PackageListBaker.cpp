@@ -96,11 +96,16 @@ namespace TreeLod
     Ogre::String PackageListBaker::requirePackage(const Ogre::String& source,
                                                   const std::vector<Ogre::String>& techniques)
     {
+        // The request's file path is the caller's (relative to the working directory); the list's
+        // entries are relative to the list's folder (resolve()).
+        const std::string wanted = source.rfind("preset:", 0) == 0
+                                       ? source
+                                       : std::filesystem::absolute(source).lexically_normal().string();
         std::vector<std::string> missing = techniques; // of the entry that lacks the fewest
         bool listed = false;
         for (const Entry& e : mEntries)
         {
-            if (e.source != resolve(mPath, source))
+            if (e.source != wanted)
                 continue;
             listed = true;
             std::vector<std::string> lacks;
