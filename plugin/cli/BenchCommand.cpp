@@ -73,17 +73,6 @@ namespace TreeLod
             bool quiet = false;
         };
 
-        std::vector<std::string> splitList(const std::string& text)
-        {
-            std::vector<std::string> out;
-            std::stringstream in(text);
-            std::string item;
-            while (std::getline(in, item, ','))
-                if (!item.empty())
-                    out.push_back(item);
-            return out;
-        }
-
         struct Stats
         {
             double mean = NAN, median = NAN, p95 = NAN, max = NAN;
@@ -576,19 +565,11 @@ namespace TreeLod
             if (!(args.scale > 0.0) || !std::isfinite(args.scale))
                 return printError(fail("", "--scale", "must be a positive number"));
             int width = script.width, height = script.height;
-            if (!args.size.empty() && (std::sscanf(args.size.c_str(), "%dx%d", &width, &height) != 2 || width <= 0 ||
-                                       height <= 0 || width > 16384 || height > 16384))
-                return printError(fail("", "--size", "'" + args.size + "' is not WxH with 1..16384"));
+            if (Result<void> size = parseSize(args.size, width, height); !size)
+                return printError(size.error());
             const std::uint32_t frames = args.frames ? args.frames : script.frames;
-            for (const std::string& b : splitList(args.lodBiases))
-            {
-                char* end = nullptr;
-                const double v = std::strtod(b.c_str(), &end);
-                if (*end != '\0' || !(v > 0.0) || !std::isfinite(v))
-                    return printError(fail("", "--lod-bias", "'" + b + "' is not a positive number"));
-            }
-            if (splitList(args.lodBiases).empty())
-                return printError(fail("", "--lod-bias", "needs at least one value"));
+            if (Result<std::vector<float>> biases = parseLodBiases(args.lodBiases); !biases)
+                return printError(biases.error());
             // Every run draws from these: the reference, the floors, then the techniques.
             std::vector<std::string> drawn = {"mesh", "quad"};
             for (const std::string& t : splitList(args.techniques))

@@ -1,7 +1,10 @@
 #include "CliSupport.h"
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
+#include <sstream>
 
 #include <unistd.h>
 
@@ -65,5 +68,45 @@ namespace TreeLod
             state->step = step;
             state->shown = percent;
         };
+    }
+
+    std::vector<std::string> splitList(const std::string& text)
+    {
+        std::vector<std::string> out;
+        std::stringstream in(text);
+        std::string item;
+        while (std::getline(in, item, ','))
+            if (!item.empty())
+                out.push_back(item);
+        return out;
+    }
+
+    Result<void> parseSize(const std::string& text, int& width, int& height)
+    {
+        if (text.empty())
+            return {};
+        int w = 0, h = 0;
+        char tail = 0;
+        if (std::sscanf(text.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w <= 0 || h <= 0 || w > 16384 || h > 16384)
+            return fail("", "--size", "'" + text + "' is not WxH with 1..16384");
+        width = w;
+        height = h;
+        return {};
+    }
+
+    Result<std::vector<float>> parseLodBiases(const std::string& text)
+    {
+        std::vector<float> biases;
+        for (const std::string& b : splitList(text))
+        {
+            char* end = nullptr;
+            const double v = std::strtod(b.c_str(), &end);
+            if (*end != '\0' || !(v > 0.0) || !std::isfinite(v))
+                return fail("", "--lod-bias", "'" + b + "' is not a positive number");
+            biases.push_back(float(v));
+        }
+        if (biases.empty())
+            return fail("", "--lod-bias", "needs at least one value");
+        return biases;
     }
 }

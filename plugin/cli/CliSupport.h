@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace TreeLod
 {
@@ -22,6 +23,15 @@ namespace TreeLod
     /// A progress callback that draws a bar on a terminal (stderr) and prints one plain
     /// line per step otherwise. `quiet` gives an empty callback.
     ProgressCallback makeProgress(bool quiet = false);
+
+    /// Comma-separated items, empty ones dropped.
+    std::vector<std::string> splitList(const std::string& text);
+
+    /// `--size WxH` (each 1..16384) into width and height; "" leaves them as they are.
+    Result<void> parseSize(const std::string& text, int& width, int& height);
+
+    /// `--lod-bias`: comma-separated finite numbers > 0, at least one.
+    Result<std::vector<float>> parseLodBiases(const std::string& text);
 
     /// Set the exit code a subcommand callback produced (CLI11 callbacks return void).
     void setExitCode(int code);

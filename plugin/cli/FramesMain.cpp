@@ -58,17 +58,6 @@ namespace TreeLod
             bool quiet = false;
         };
 
-        std::vector<std::string> splitList(const std::string& text)
-        {
-            std::vector<std::string> out;
-            std::stringstream in(text);
-            std::string item;
-            while (std::getline(in, item, ','))
-                if (!item.empty())
-                    out.push_back(item);
-            return out;
-        }
-
         /// Resident and peak resident memory of this process in MiB (/proc/self/status), NaN elsewhere.
         std::pair<double, double> residentMiB()
         {
@@ -143,23 +132,15 @@ namespace TreeLod
             if (!(args.scale > 0.0) || !std::isfinite(args.scale))
                 return printError(fail("", "--scale", "must be a positive number"));
             int width = script.width, height = script.height;
-            if (!args.size.empty() && (std::sscanf(args.size.c_str(), "%dx%d", &width, &height) != 2 || width <= 0 ||
-                                       height <= 0 || width > 16384 || height > 16384))
-                return printError(fail("", "--size", "'" + args.size + "' is not WxH with 1..16384"));
+            if (Result<void> size = parseSize(args.size, width, height); !size)
+                return printError(size.error());
             const std::uint32_t frames = args.frames ? args.frames : script.frames;
             if (args.samples == 0 || frames == 0)
                 return printError(fail("", "--frames/--samples", "must be >= 1"));
-            std::vector<float> biases;
-            for (const std::string& b : splitList(args.lodBiases))
-            {
-                char* end = nullptr;
-                const double v = std::strtod(b.c_str(), &end);
-                if (*end != '\0' || !(v > 0.0) || !std::isfinite(v))
-                    return printError(fail("", "--lod-bias", "'" + b + "' is not a positive number"));
-                biases.push_back(float(v));
-            }
-            if (biases.empty())
-                return printError(fail("", "--lod-bias", "needs at least one value"));
+            Result<std::vector<float>> parsedBiases = parseLodBiases(args.lodBiases);
+            if (!parsedBiases)
+                return printError(parsedBiases.error());
+            const std::vector<float>& biases = *parsedBiases;
             std::vector<std::string> techniques;
             for (const std::string& t : splitList(args.techniques))
             {

@@ -43,16 +43,11 @@ namespace TreeLod
             bool verbose = false;
         };
 
-        bool parseSize(const std::string& text, int& w, int& h)
-        {
-            return std::sscanf(text.c_str(), "%dx%d", &w, &h) == 2 && w > 0 && h > 0 && w <= 16384 && h <= 16384;
-        }
-
         int runRender(const RenderArgs& args)
         {
             int width = 0, height = 0;
-            if (!parseSize(args.size, width, height))
-                return printError(fail("", "--size", "'" + args.size + "' is not WxH with 1..16384"));
+            if (Result<void> size = parseSize(args.size.empty() ? "x" : args.size, width, height); !size)
+                return printError(size.error());
             if (args.supersample < 1 || args.supersample > 8)
                 return printError(fail("", "--supersample", "must be 1..8 samples per axis"));
             if (!(args.lodBias > 0.0f))
