@@ -65,7 +65,12 @@ namespace
                 i.scale = 1.0f + 0.3f * u(rng);
                 i.kind = std::uint32_t(rng() % 4);
             }
-            if (Result<std::vector<ForestHandle>> r = forest.add(instances); !r)
+            // In the Forest's order (Forest::addInstances): blocks are compact, culling skips them.
+            const std::vector<std::uint32_t> order = ForestInstances::spatialOrder(instances);
+            std::vector<ForestInstance> sorted(instances.size());
+            for (std::size_t i = 0; i < order.size(); ++i)
+                sorted[i] = instances[order[i]];
+            if (Result<std::vector<ForestHandle>> r = forest.add(sorted); !r)
                 out.second = r.error().message();
             return out;
         }();

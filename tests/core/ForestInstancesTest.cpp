@@ -725,4 +725,57 @@ namespace TreeLod
         for (const ForestBucket& b : vis.getBuckets())
             EXPECT_EQ(b.count, b.level + 1 == stacked.getLevelCount(b.kind) ? 1250u : 0u) << b.kind << "/" << b.level;
     }
+
+    // Blocks (issue 7): a store in spatial order, whose culling skips whole blocks, sees exactly
+    // what the per-instance test of a store in input order sees, camera after camera; removals and
+    // updates keep the block boxes conservative.
+    TEST(ForestInstances, blocksSkipNothingVisible)
+    {
+        std::mt19937 rng(23);
+        ForestInstances plain, blocked;
+        addKinds(plain);
+        addKinds(blocked);
+        std::vector<ForestInstance> instances = randomInstances(rng, 20000, 3000.0f, plain.getKindCount());
+        for (ForestInstance& i : instances)
+            i.scale = std::min(i.scale, 3.0f); // trees, not towers: blocks stay small
+        const std::vector<std::uint32_t> order = ForestInstances::spatialOrder(instances);
+        ASSERT_EQ(order.size(), instances.size());
+        std::vector<ForestInstance> sorted;
+        for (std::uint32_t i : order)
+            sorted.push_back(instances[i]);
+        ASSERT_TRUE(plain.add(instances));
+        Result<std::vector<ForestHandle>> handles = blocked.add(sorted);
+        ASSERT_TRUE(handles);
+        // Move a few and remove a few in the blocked store (and the same in the plain one).
+        for (int k = 0; k < 200; ++k)
+        {
+            const std::size_t s = std::size_t(rng() % sorted.size());
+            ForestInstance moved = sorted[s];
+            moved.position.x = -moved.position.x;
+            ASSERT_TRUE(blocked.update((*handles)[s], moved));
+            ASSERT_TRUE(plain.update(order[s], moved)); // plain handles are input indices
+        }
+        for (int k = 0; k < 100; ++k)
+        {
+            const std::size_t s = std::size_t(rng() % sorted.size());
+            if (!blocked.contains((*handles)[s]))
+                continue;
+            ASSERT_TRUE(blocked.remove((*handles)[s]));
+            ASSERT_TRUE(plain.remove(order[s]));
+        }
+        ForestVisibility a, b;
+        std::size_t seen = 0;
+        for (int cam = 0; cam < 60; ++cam)
+        {
+            const TestCamera c = randomCamera(rng, 3000.0f, cam % 5 == 0);
+            const CullCamera camera = CullCamera::fromMatrices(c.view, c.projection, c.width, c.height);
+            ASSERT_TRUE(plain.cull(camera, 1.0f, a));
+            ASSERT_TRUE(blocked.cull(camera, 1.0f, b));
+            ASSERT_EQ(a.getVisibleCount(), b.getVisibleCount()) << "camera " << cam;
+            for (std::size_t k = 0; k < a.getBucketCount(); ++k)
+                EXPECT_EQ(a.getBucket(k).count, b.getBucket(k).count) << "camera " << cam << " bucket " << k;
+            seen += b.getVisibleCount();
+        }
+        EXPECT_GT(seen, 10000u);
+    }
 }

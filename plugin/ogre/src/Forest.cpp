@@ -674,11 +674,22 @@ namespace TreeLod
 
     std::vector<ForestHandle> Forest::addInstances(const std::vector<ForestInstance>& instances)
     {
-        Result<std::vector<ForestHandle>> handles = mInstances.add(instances);
+        // Added along a Z-order curve so that culling skips whole blocks (ForestInstances.h); the
+        // handles come back in the caller's order, and errors name the caller's index.
+        if (Result<void> valid = mInstances.validate(instances); !valid)
+            invalid("Forest '" + mName + "': " + valid.error().message(), "Forest::addInstances");
+        const std::vector<std::uint32_t> order = ForestInstances::spatialOrder(instances);
+        std::vector<ForestInstance> sorted(instances.size());
+        for (std::size_t i = 0; i < order.size(); ++i)
+            sorted[i] = instances[order[i]];
+        Result<std::vector<ForestHandle>> handles = mInstances.add(sorted);
         if (!handles)
             invalid("Forest '" + mName + "': " + handles.error().message(), "Forest::addInstances");
+        std::vector<ForestHandle> out(instances.size());
+        for (std::size_t i = 0; i < order.size(); ++i)
+            out[order[i]] = (*handles)[i];
         updateBounds();
-        return std::move(handles.value());
+        return out;
     }
 
     void Forest::updateBounds()

@@ -118,8 +118,8 @@ namespace TreeLod
         std::size_t bytes = 0;
         for (const std::vector<float>* a : {&mX, &mY, &mZ, &mCosScale, &mSinScale})
             bytes += a->capacity() * sizeof(float);
-        return bytes + (mKind.capacity() + mHandleOfSlot.capacity() + mSlotOfHandle.capacity() +
-                        mFreeHandles.capacity()) * sizeof(std::uint32_t);
+        return bytes + mKind.capacity() * sizeof(std::uint16_t) + mBlockBounds.capacity() * sizeof(float) +
+               (mHandleOfSlot.capacity() + mSlotOfHandle.capacity() + mFreeHandles.capacity()) * sizeof(std::uint32_t);
     }
 
     // ---- kinds -----------------------------------------------------------------------------------
@@ -131,6 +131,8 @@ namespace TreeLod
             return fail("", element, "bounding sphere centre " + text(kind.boundsCentre) + " is not finite");
         if (!std::isfinite(kind.boundsRadius) || !(kind.boundsRadius > 0.0f))
             return fail("", element, "bounding radius " + text(kind.boundsRadius) + " is not finite and > 0");
+        if (mKinds.size() >= MAX_KINDS)
+            return fail("", element, "more than " + std::to_string(MAX_KINDS) + " kinds");
         if (kind.thresholds.size() > MAX_THRESHOLDS)
             return fail("", element, std::to_string(kind.thresholds.size()) + " LoD thresholds (at most " +
                                          std::to_string(MAX_THRESHOLDS) + ")");
@@ -197,9 +199,10 @@ namespace TreeLod
         mZ[slot] = instance.position.z;
         mCosScale[slot] = cs;
         mSinScale[slot] = ss;
-        mKind[slot] = instance.kind;
+        mKind[slot] = std::uint16_t(instance.kind);
         (void)kind;
         (void)c;
+        growBlock(slot);
     }
 
     std::array<std::vector<float>*, 5> ForestInstances::floatArrays()
@@ -222,6 +225,8 @@ namespace TreeLod
         for (std::vector<float>* a : floatArrays())
             a->push_back(0.0f);
         mKind.push_back(0);
+        if (slot % BLOCK_SIZE == 0) // a new block, empty
+            mBlockBounds.insert(mBlockBounds.end(), {FLT_MAX, FLT_MAX, FLT_MAX, -FLT_MAX, -FLT_MAX, -FLT_MAX});
         mHandleOfSlot.push_back(handle);
         if (handle >= mSlotOfHandle.size())
             mSlotOfHandle.resize(std::size_t(handle) + 1, INVALID_SLOT);
@@ -239,7 +244,7 @@ namespace TreeLod
         return handle;
     }
 
-    Result<std::vector<ForestHandle>> ForestInstances::add(const std::vector<ForestInstance>& instances)
+    Result<void> ForestInstances::validate(const std::vector<ForestInstance>& instances) const
     {
         for (std::size_t i = 0; i < instances.size(); ++i)
         {
@@ -247,6 +252,13 @@ namespace TreeLod
             if (!reason.empty())
                 return fail("", "instance " + std::to_string(i), reason);
         }
+        return {};
+    }
+
+    Result<std::vector<ForestHandle>> ForestInstances::add(const std::vector<ForestInstance>& instances)
+    {
+        if (Result<void> valid = validate(instances); !valid)
+            return valid.error();
         reserve(size() + instances.size());
         std::vector<ForestHandle> handles;
         handles.reserve(instances.size());
@@ -283,6 +295,11 @@ namespace TreeLod
         }
         mKind[slot] = mKind[last];
         mKind.pop_back();
+        // Block bounds only grow (still conservative); the emptied last block goes.
+        if (slot != last)
+            growBlock(slot);
+        if (last % BLOCK_SIZE == 0)
+            mBlockBounds.resize(mBlockBounds.size() - 6);
         const ForestHandle moved = mHandleOfSlot[last];
         mHandleOfSlot[slot] = moved;
         mHandleOfSlot.pop_back();
@@ -297,6 +314,7 @@ namespace TreeLod
         for (std::vector<float>* a : floatArrays())
             a->clear();
         mKind.clear();
+        mBlockBounds.clear();
         mHandleOfSlot.clear();
         mSlotOfHandle.clear();
         mFreeHandles.clear();
@@ -307,6 +325,7 @@ namespace TreeLod
         for (std::vector<float>* a : floatArrays())
             a->reserve(count);
         mKind.reserve(count);
+        mBlockBounds.reserve(6 * ((count + BLOCK_SIZE - 1) / BLOCK_SIZE));
         mHandleOfSlot.reserve(count);
         mSlotOfHandle.reserve(std::max(count, mSlotOfHandle.size()));
     }
@@ -325,6 +344,51 @@ namespace TreeLod
         instance.scale = std::hypot(mCosScale[index], mSinScale[index]);
         instance.kind = mKind[index];
         return instance;
+    }
+
+    void ForestInstances::growBlock(std::size_t slot)
+    {
+        const glm::vec4 sphere = getWorldSphere(slot);
+        float* b = mBlockBounds.data() + 6 * (slot / BLOCK_SIZE);
+        for (int k = 0; k < 3; ++k)
+        {
+            b[k] = std::min(b[k], sphere[k] - sphere.w);
+            b[3 + k] = std::max(b[3 + k], sphere[k] + sphere.w);
+        }
+    }
+
+    std::vector<std::uint32_t> ForestInstances::spatialOrder(const std::vector<ForestInstance>& instances)
+    {
+        // Z-order (Morton) of a 1024 x 1024 grid over the instances' x-z extent.
+        glm::vec2 lo(FLT_MAX), hi(-FLT_MAX);
+        for (const ForestInstance& i : instances)
+            if (std::isfinite(i.position.x) && std::isfinite(i.position.z))
+            {
+                lo = glm::min(lo, glm::vec2(i.position.x, i.position.z));
+                hi = glm::max(hi, glm::vec2(i.position.x, i.position.z));
+            }
+        const glm::vec2 scale = 1023.0f / glm::max(hi - lo, glm::vec2(1e-6f));
+        auto spread = [](std::uint32_t v) {
+            v &= 0x3FF;
+            v = (v | (v << 8)) & 0x00FF00FF;
+            v = (v | (v << 4)) & 0x0F0F0F0F;
+            v = (v | (v << 2)) & 0x33333333;
+            return (v | (v << 1)) & 0x55555555;
+        };
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> keyed(instances.size());
+        for (std::size_t i = 0; i < instances.size(); ++i)
+        {
+            const glm::vec2 p(instances[i].position.x, instances[i].position.z);
+            const glm::vec2 g = glm::clamp((p - lo) * scale, glm::vec2(0.0f), glm::vec2(1023.0f));
+            const bool finiteXz = std::isfinite(g.x) && std::isfinite(g.y);
+            keyed[i] = {finiteXz ? spread(std::uint32_t(g.x)) | (spread(std::uint32_t(g.y)) << 1) : 0u,
+                        std::uint32_t(i)};
+        }
+        std::sort(keyed.begin(), keyed.end());
+        std::vector<std::uint32_t> order(instances.size());
+        for (std::size_t i = 0; i < keyed.size(); ++i)
+            order[i] = keyed[i].second;
+        return order;
     }
 
     glm::vec4 ForestInstances::getWorldSphere(std::size_t index) const
@@ -395,7 +459,7 @@ namespace TreeLod
         const float* px = mX.data();
         const float* py = mY.data();
         const float* pz = mZ.data();
-        const std::uint32_t* kinds = mKind.data();
+        const std::uint16_t* kinds = mKind.data();
         const std::uint8_t* kindDistance = mKindDistance.data();
         const std::uint32_t* kindFirst = mKindFirstBucket.data();
         const float* tables = mKindTable.data();
@@ -403,7 +467,26 @@ namespace TreeLod
         std::uint32_t* visibleBucket = out.mVisibleBucket.data();
         std::uint32_t* counts = out.mCursor.data();
         std::uint32_t visibleCount = 0;
-        for (std::size_t i = 0; i < n; ++i)
+        const float* blocks = mBlockBounds.data();
+        for (std::size_t block = 0, begin = 0; begin < n; ++block, begin += BLOCK_SIZE)
+        {
+            // A block whose box is outside one plane is skipped whole; one inside every plane needs
+            // no per-instance test (its spheres' centres are all inside).
+            const float* b = blocks + 6 * block;
+            bool outside = false, inside = true;
+            for (int p = 0; p < 6; ++p)
+            {
+                const float farthest = pl[p][3] + pl[p][0] * b[pl[p][0] >= 0.0f ? 3 : 0] +
+                                       pl[p][1] * b[pl[p][1] >= 0.0f ? 4 : 1] + pl[p][2] * b[pl[p][2] >= 0.0f ? 5 : 2];
+                const float nearest = pl[p][3] + pl[p][0] * b[pl[p][0] >= 0.0f ? 0 : 3] +
+                                      pl[p][1] * b[pl[p][1] >= 0.0f ? 1 : 4] + pl[p][2] * b[pl[p][2] >= 0.0f ? 2 : 5];
+                outside |= farthest < 0.0f;
+                inside &= nearest >= 0.0f;
+            }
+            if (outside)
+                continue;
+            const std::size_t end = std::min(n, begin + BLOCK_SIZE);
+            for (std::size_t i = begin; i < end; ++i)
         {
             const std::uint32_t kind = kinds[i];
             const glm::vec4 local = fewKinds ? localSpheres[kind]
@@ -411,10 +494,11 @@ namespace TreeLod
             const float cs = cosScale[i], ss = sinScale[i], s = std::sqrt(cs * cs + ss * ss);
             const float x = px[i] + cs * local.x + ss * local.z, y = py[i] + s * local.y,
                         z = pz[i] - ss * local.x + cs * local.z, r = s * local.w, negR = -r;
-            bool inside = true;
-            for (int p = 0; p < 6; ++p)
-                inside &= pl[p][0] * x + pl[p][1] * y + pl[p][2] * z + pl[p][3] >= negR;
+            bool visibleSphere = true;
             if (!inside)
+                for (int p = 0; p < 6; ++p)
+                    visibleSphere &= pl[p][0] * x + pl[p][1] * y + pl[p][2] * z + pl[p][3] >= negR;
+            if (!visibleSphere)
                 continue;
             const float dx = px[i] - eye.x, dy = py[i] - eye.y, dz = pz[i] - eye.z;
             const float key = lodKey(dx * dx + dy * dy + dz * dz, r, kindDistance[kind] != 0, c);
@@ -423,6 +507,7 @@ namespace TreeLod
             visibleBucket[visibleCount] = bucket;
             ++counts[bucket];
             ++visibleCount;
+        }
         }
 
         // Prefix sums: bucket ranges; counts become fill cursors.

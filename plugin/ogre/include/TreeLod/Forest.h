@@ -129,7 +129,9 @@ namespace TreeLod
         ForestInstances& getInstances() { return mInstances; }
         const ForestInstances& getInstances() const { return mInstances; }
         /// Add instances all or nothing; throws Ogre::InvalidParametersException with
-        /// ForestInstances' message (instance index and reason). Updates the bounds.
+        /// ForestInstances' message (instance index and reason). Updates the bounds. Stored along
+        /// ForestInstances::spatialOrder (dense indices differ from the input's; handles are in
+        /// the input's order), so that culling skips whole blocks.
         std::vector<ForestHandle> addInstances(const std::vector<ForestInstance>& instances);
         /// Recompute the local bounds after changing instances through getInstances().
         void updateBounds();

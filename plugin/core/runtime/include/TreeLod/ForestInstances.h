@@ -2,7 +2,8 @@
 // culling and level-of-detail selection in one tight loop, without Ogre.
 //
 // Storage is structure-of-arrays: per instance its position, scale * (cos, sin) of its rotation
-// about +Y and kind, 32 bytes with the handle maps (issue 7: <= 32 B per instance); scale,
+// about +Y and kind (16 bits), 30 bytes with the handle maps, plus a box per block of 256
+// instances (issue 7: <= 32 B per instance); scale,
 // rotation and the world bounding sphere are derived from them (get() returns the rotation in
 // (-pi, pi] and both to float rounding). A kind is one (asset, technique) pair with its local
 // bounding sphere and LoD table.
@@ -157,6 +158,15 @@ namespace TreeLod
     {
     public:
         static constexpr std::size_t MAX_THRESHOLDS = 15; ///< at most 16 levels per kind
+        static constexpr std::size_t MAX_KINDS = 65535;   ///< kinds are stored in 16 bits
+        /// Dense instances [k * BLOCK_SIZE, (k + 1) * BLOCK_SIZE) share a conservative world box;
+        /// cull skips a block outside the frustum whole and tests no instance of a block inside it.
+        static constexpr std::size_t BLOCK_SIZE = 256;
+
+        /// An order of `instances` (indices) along a Z-order curve over their x-z extent: added in
+        /// that order, blocks are compact patches and culling skips what is out of view (the
+        /// Forest adds in this order). Non-finite positions go first (add() refuses them).
+        static std::vector<std::uint32_t> spatialOrder(const std::vector<ForestInstance>& instances);
 
         /// Add a kind; returns its index. Kinds are never removed.
         Result<std::uint32_t> addKind(const ForestKind& kind);
@@ -176,6 +186,8 @@ namespace TreeLod
         /// Add one instance. Error (element "instance N", N the index it would get) on a
         /// non-finite value, scale <= 0 or an unknown kind; nothing is added then.
         Result<ForestHandle> add(const ForestInstance& instance);
+        /// The check add() makes, without adding: the error names the instance by its index.
+        Result<void> validate(const std::vector<ForestInstance>& instances) const;
         /// Add many: all or nothing; the error names the instance by its index in `instances`.
         Result<std::vector<ForestHandle>> add(const std::vector<ForestInstance>& instances);
         /// Replace an instance's data; same checks as add.
@@ -216,6 +228,7 @@ namespace TreeLod
         std::array<std::vector<float>*, 5> floatArrays(); ///< every per-instance float array
         void write(std::size_t slot, const ForestInstance& instance);
         void push(const ForestInstance& instance, ForestHandle handle);
+        void growBlock(std::size_t slot); ///< merge the instance's world sphere into its block's box
 
         // kinds
         std::vector<ForestKind> mKinds;
@@ -230,7 +243,8 @@ namespace TreeLod
         // scale, rotation and the world sphere are derived from these where needed
         std::vector<float> mX, mY, mZ;             // position
         std::vector<float> mCosScale, mSinScale;   // scale * cos / sin of the rotation
-        std::vector<std::uint32_t> mKind;
+        std::vector<std::uint16_t> mKind;
+        std::vector<float> mBlockBounds;           // per block: min xyz, max xyz (only grow until clear)
         std::vector<ForestHandle> mHandleOfSlot;
 
         // handles
