@@ -18,6 +18,7 @@
 #include <OgrePixelCountLodStrategy.h>
 #include <OgrePass.h>
 #include <OgreRenderQueue.h>
+#include <OgreRoot.h>
 #include <OgreSceneManager.h>
 #include <OgreSceneNode.h>
 #include <OgreSubMesh.h>
@@ -44,6 +45,7 @@ namespace TreeLod
         constexpr std::size_t MIN_INSTANCE_CAPACITY = 16;
         constexpr std::size_t MAX_LEVELS = ForestInstances::MAX_THRESHOLDS + 1;
         constexpr Ogre::Real NO_UPPER = std::numeric_limits<Ogre::Real>::max();
+        constexpr std::uint32_t NO_LEVEL = std::numeric_limits<std::uint32_t>::max();
 
         enum class Technique
         {
@@ -109,7 +111,7 @@ namespace TreeLod
             switch (technique)
             {
             case Technique::Mesh:
-                asset.getReferenceMesh();
+                asset.getReference();
                 add(0, false, 0.0f, NO_UPPER);
                 break;
             case Technique::Quad:
@@ -146,7 +148,7 @@ namespace TreeLod
                 // The switches BillboardCloudTree makes (§6), in the reference sphere's units; a
                 // layered level splits where its material LoD turns to the low-res technique (§5.1).
                 const bool classic = technique == Technique::ClassicBillboardCloud;
-                const BillboardCloudGpu& gpu = asset.getBillboardCloudGpu(classic);
+                const BillboardCloudGpu& gpu = asset.getBillboardCloudLayout(classic);
                 const float radius = float(referenceRadius(asset));
                 const std::vector<Ogre::Real> switches =
                     BillboardCloudTree::switchPixelCounts(gpu, gpu.listFactor, radius);
@@ -172,15 +174,12 @@ namespace TreeLod
 
             // Bark: split where the drawn mesh's own LoD levels switch (MeshLodGenerator levels,
             // pixel-count values), so that a level's bark level (the one of its largest value,
-            // Forest::buildParts) is the one each of its trees would pick alone.
+            // Forest::buildParts) is the one each of its trees would pick alone. The reference,
+            // bark and bark-AO meshes share those levels (the generator runs on the bark alone,
+            // with the same options: TreeMeshBuilder.h), so the plain bark mesh plans them all.
             Ogre::MeshPtr bark;
-            const bool hasBark = !asset.getReference().model.barkIndices.empty();
-            if (technique == Technique::Mesh)
-                bark = asset.getReferenceMesh();
-            else if (technique == Technique::Lodf && hasBark)
+            if (technique != Technique::Quad && !asset.getReference().model.barkIndices.empty())
                 bark = asset.getBarkMesh();
-            else if (isCloud(technique) && hasBark)
-                bark = asset.getBarkAoMesh(technique == Technique::ClassicBillboardCloud);
             if (!bark || bark->getLodStrategy() != Ogre::AbsolutePixelCountLodStrategy::getSingletonPtr())
                 return spans;
             std::vector<Span> split;
@@ -248,11 +247,21 @@ namespace TreeLod
         float listFactor = 0.0f;            ///< the cloud's shader LoD factor (paper 000 §5.1)
     };
 
+    /// Where a level's drawables are (Forest.h, "Residency").
+    enum class Forest::Residency : std::uint8_t
+    {
+        Absent,   ///< not built; its trees draw the next resident level
+        Queued,   ///< asked for, waiting in mUploadQueue
+        Resident, ///< parts built and uploaded
+        Failed    ///< building threw (logged); its trees keep drawing the fallback
+    };
+
     struct Forest::Species
     {
         TreeAssetPtr asset;
         std::vector<ForestLevel> levels;
-        std::vector<std::vector<std::unique_ptr<Part>>> parts; ///< per level
+        std::vector<std::vector<std::unique_ptr<Part>>> parts; ///< per level; empty until resident
+        std::vector<Residency> residency;                     ///< per level
     };
 
     /// One instanced draw of one camera: a Part with that camera's instance buffer of its bucket.
@@ -317,7 +326,8 @@ namespace TreeLod
     {
         Ogre::HardwareVertexBufferSharedPtr buffer;
         std::size_t capacity = 0; ///< instances
-        std::vector<std::unique_ptr<Batch>> batches; ///< one per part of the bucket's level
+        std::uint32_t drawnLevel = NO_LEVEL; ///< the level whose parts `batches` draw
+        std::vector<std::unique_ptr<Batch>> batches; ///< one per part of the drawn level
     };
 
     struct Forest::CameraState
@@ -470,8 +480,7 @@ namespace TreeLod
     }
 
     std::vector<std::unique_ptr<Forest::Part>> Forest::buildParts(TreeAsset& asset, const ForestLevel& level,
-                                                                  Ogre::Real upperPixelCount,
-                                                                  Ogre::AxisAlignedBox& drawnBox)
+                                                                  Ogre::Real upperPixelCount)
     {
         const Technique technique = parseTechnique(level.technique, "", "Forest");
         const Ogre::String& group = asset.getGroup();
@@ -560,7 +569,6 @@ namespace TreeLod
                     part->cloud = true;
                     part->listFactor = gpu.listFactor;
                 }
-                drawnBox.merge(gpu.bounds);
             }
             if (hasBark)
                 addMesh(asset.getBarkAoMesh(classic), asset.getBarkAoMaterialNames(false),
@@ -605,6 +613,10 @@ namespace TreeLod
         auto species = std::make_unique<Species>();
         species->asset = asset;
         species->levels = levels;
+        species->parts.resize(levels.size());
+        species->residency.assign(levels.size(), Residency::Absent);
+        // Planned from decoded chunks only (nothing uploaded but the bark mesh levelsForBands
+        // plans with); each level's drawables are built when its trees first need them.
         Ogre::AxisAlignedBox drawn = asset->getBounds();
         for (std::size_t l = 0; l < levels.size(); ++l)
         {
@@ -620,22 +632,42 @@ namespace TreeLod
                         source);
             try
             {
-                if (isCloud(technique))
-                {
-                    const BillboardCloudGpu& gpu =
-                        asset->getBillboardCloudGpu(technique == Technique::ClassicBillboardCloud);
-                    if (level.techniqueLevel >= std::max<std::size_t>(gpu.levels.size(), 1))
-                        invalid("cloud level " + std::to_string(level.techniqueLevel) + " does not exist (" +
-                                    std::to_string(gpu.levels.size()) + " levels)",
-                                source);
-                    if (level.lowRes && !(level.techniqueLevel < gpu.levels.size() &&
-                                          gpu.levels[level.techniqueLevel].layered))
-                        invalid("lowRes on a cloud level that is not layered", source);
-                }
-                else if (level.lowRes)
+                if (!isCloud(technique) && level.lowRes)
                     invalid("lowRes is for billboard-cloud levels only", source);
-                species->parts.push_back(
-                    buildParts(*asset, level, l == 0 ? NO_UPPER : levels[l - 1].minPixelCount, drawn));
+                switch (technique)
+                {
+                case Technique::Mesh:
+                    asset->getReference();
+                    break;
+                case Technique::Lodf:
+                    asset->getFoliageLod(); // decoded and checked against the reference
+                    break;
+                case Technique::Quad:
+                    asset->getImpostorGpu(); // one quad: always resident, the fallback of last resort
+                    break;
+                case Technique::BillboardCloud:
+                case Technique::ClassicBillboardCloud:
+                {
+                    const BillboardCloudGpu& layout =
+                        asset->getBillboardCloudLayout(technique == Technique::ClassicBillboardCloud);
+                    if (level.techniqueLevel >= std::max<std::size_t>(layout.levels.size(), 1))
+                        invalid("cloud level " + std::to_string(level.techniqueLevel) + " does not exist (" +
+                                    std::to_string(layout.levels.size()) + " levels)",
+                                source);
+                    if (level.lowRes && !(level.techniqueLevel < layout.levels.size() &&
+                                          layout.levels[level.techniqueLevel].layered))
+                        invalid("lowRes on a cloud level that is not layered", source);
+                    if (level.techniqueLevel < layout.levels.size())
+                        drawn.merge(layout.bounds);
+                    break;
+                }
+                }
+                // The last level is the fallback of every other: resident from the start.
+                if (last)
+                {
+                    species->parts[l] = buildParts(*asset, level, l == 0 ? NO_UPPER : levels[l - 1].minPixelCount);
+                    species->residency[l] = Residency::Resident;
+                }
             }
             catch (const Ogre::Exception& e)
             {
@@ -725,7 +757,9 @@ namespace TreeLod
         return mManager && mManager->isShadowTechniqueTextureBased() && mManager->isShadowTechniqueIntegrated();
     }
 
-    std::uint64_t Forest::getGpuBytes() const
+    std::uint64_t Forest::getGpuBytes() const { return drawableBytes() + mInstanceBufferBytes; }
+
+    std::uint64_t Forest::drawableBytes() const
     {
         std::set<const void*> seen;
         std::uint64_t bytes = 0;
@@ -749,7 +783,89 @@ namespace TreeLod
                                             if (const Ogre::TexturePtr& texture = unit->_getTexturePtr())
                                                 once(texture.get(), textureBytes(*texture));
                 }
-        return bytes + mInstanceBufferBytes;
+        return bytes;
+    }
+
+    // ---- residency (Forest.h) ---------------------------------------------------------------------
+
+    void Forest::setUploadBudget(std::uint64_t bytesPerFrame) { mUploadBudget = bytesPerFrame; }
+
+    bool Forest::isResident(std::uint32_t species, std::uint32_t level) const
+    {
+        return mSpecies.at(species)->residency.at(level) == Residency::Resident;
+    }
+
+    std::uint32_t Forest::getDrawnLevel(std::uint32_t species, std::uint32_t level) const
+    {
+        // The nearest resident level, coarser first: the last level always is (addSpecies).
+        const std::vector<Residency>& residency = mSpecies.at(species)->residency;
+        for (std::size_t l = level; l < residency.size(); ++l)
+            if (residency[l] == Residency::Resident)
+                return std::uint32_t(l);
+        for (std::size_t l = std::min<std::size_t>(level, residency.size()); l-- > 0;)
+            if (residency[l] == Residency::Resident)
+                return std::uint32_t(l);
+        return level;
+    }
+
+    std::uint64_t Forest::makeResident(std::uint32_t s, std::uint32_t l)
+    {
+        Species& species = *mSpecies[s];
+        if (species.residency[l] == Residency::Resident || species.residency[l] == Residency::Failed)
+            return 0;
+        const std::uint64_t before = drawableBytes();
+        try
+        {
+            species.parts[l] =
+                buildParts(*species.asset, species.levels[l], l == 0 ? NO_UPPER : species.levels[l - 1].minPixelCount);
+            species.residency[l] = Residency::Resident;
+        }
+        catch (const Ogre::Exception& e)
+        {
+            // Not fatal mid-frame: the level's trees keep drawing their fallback.
+            species.parts[l].clear();
+            species.residency[l] = Residency::Failed;
+            Ogre::LogManager::getSingleton().logError(
+                "Forest '" + mName + "' species " + std::to_string(s) + " level " + std::to_string(l) + " '" +
+                species.levels[l].technique + "': " + e.getDescription() + " (its trees draw level " +
+                std::to_string(getDrawnLevel(s, l)) + ")");
+        }
+        return drawableBytes() - before;
+    }
+
+    void Forest::makeAllResident()
+    {
+        for (std::uint32_t s = 0; s < mSpecies.size(); ++s)
+            for (std::uint32_t l = 0; l < mSpecies[s]->levels.size(); ++l)
+                makeResident(s, l);
+        mUploadQueue.clear();
+        mStats.pendingLevels = 0;
+    }
+
+    unsigned long Forest::currentFrame()
+    {
+        return Ogre::Root::getSingletonPtr() ? Ogre::Root::getSingleton().getNextFrameNumber() : 0;
+    }
+
+    void Forest::serviceUploads()
+    {
+        const unsigned long frame = currentFrame();
+        if (frame != mUploadFrame)
+        {
+            mUploadFrame = frame;
+            mStats.uploadedBytes = 0;
+            mStats.uploadedLevels = 0;
+        }
+        // In the order asked for, until this frame's bytes reach the budget (a level larger than
+        // the whole budget goes alone in its frame: a level is not split).
+        while (!mUploadQueue.empty() && (mUploadBudget == 0 || mStats.uploadedBytes < mUploadBudget))
+        {
+            const auto [s, l] = mUploadQueue.front();
+            mUploadQueue.pop_front();
+            mStats.uploadedBytes += makeResident(s, l);
+            ++mStats.uploadedLevels;
+        }
+        mStats.pendingLevels = std::uint32_t(mUploadQueue.size());
     }
 
     void Forest::_notifyManager(Ogre::SceneManager* manager)
@@ -765,6 +881,12 @@ namespace TreeLod
 
     void Forest::clearFrameStats()
     {
+        if (currentFrame() != mUploadFrame)
+        {
+            mStats.uploadedBytes = 0;
+            mStats.uploadedLevels = 0;
+        }
+        mStats.fallbackInstances = 0;
         mStats.instances = std::uint32_t(mInstances.size());
         mStats.visibleInstances = 0;
         mStats.batches = 0;
@@ -784,9 +906,19 @@ namespace TreeLod
     {
         const ForestBucket& bucket = state.visibility.getBucket(b);
         BucketState& slot = *state.buckets[b];
-        if (slot.batches.empty())
-            for (const std::unique_ptr<Part>& part : mSpecies[bucket.kind]->parts[bucket.level])
+        const std::uint32_t drawn = getDrawnLevel(bucket.kind, bucket.level);
+        if (slot.drawnLevel != drawn)
+        {
+            // First use, or the bucket's own level (or a nearer fallback) became resident.
+            slot.batches.clear();
+            for (const std::unique_ptr<Part>& part : mSpecies[bucket.kind]->parts[drawn])
+            {
                 slot.batches.push_back(std::make_unique<Batch>(*this, *part));
+                if (slot.buffer)
+                    slot.batches.back()->setInstanceBuffer(slot.buffer);
+            }
+            slot.drawnLevel = drawn;
+        }
         if (bucket.count > slot.capacity)
         {
             // Grown by doubling, never shrunk: steady frames allocate nothing.
@@ -863,8 +995,23 @@ namespace TreeLod
             return;
         }
 
+        // Residency: ask for the levels this camera needs, then build within this frame's budget;
+        // until built, a level's trees draw the nearest resident level (getDrawnLevel).
+        for (std::uint32_t b = 0; b < state.visibility.getBucketCount(); ++b)
+        {
+            const ForestBucket& bucket = state.visibility.getBucket(b);
+            Residency& residency = mSpecies[bucket.kind]->residency[bucket.level];
+            if (bucket.count > 0 && residency == Residency::Absent)
+            {
+                residency = Residency::Queued;
+                mUploadQueue.emplace_back(bucket.kind, bucket.level);
+            }
+        }
+        serviceUploads();
+
         std::uint32_t batches = 0;
         std::uint64_t triangles = 0;
+        std::uint32_t fallbacks = 0;
         const Ogre::Vector4 cloudParams(0.0f, 1.0f, 0.0f, 0.0f);
         for (std::uint32_t b = 0; b < state.visibility.getBucketCount(); ++b)
         {
@@ -874,6 +1021,8 @@ namespace TreeLod
             if (bucket.count == 0)
                 continue;
             fillBucket(state, b);
+            if (state.buckets[b]->drawnLevel != bucket.level)
+                fallbacks += bucket.count;
             for (const std::unique_ptr<Batch>& batch : state.buckets[b]->batches)
             {
                 batch->mInstanceCount = bucket.count;
@@ -896,6 +1045,7 @@ namespace TreeLod
             mStats.batches = batches;
             mStats.triangles = triangles;
             mStats.cullMilliseconds = cullMs;
+            mStats.fallbackInstances = fallbacks;
         }
         mStats.instanceBufferBytes = mInstanceBufferBytes;
     }

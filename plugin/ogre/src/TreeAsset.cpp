@@ -80,6 +80,8 @@ namespace TreeLod
         }
         for (std::unique_ptr<BillboardCloudData>& data : mBillboardClouds)
             data.reset();
+        for (std::unique_ptr<BillboardCloudGpu>& layout : mBillboardCloudLayouts)
+            layout.reset();
         if (mImpostorGpu)
         {
             const ImpostorGpu& gpu = *mImpostorGpu;
@@ -320,6 +322,38 @@ namespace TreeLod
         return *slot;
     }
 
+    const BillboardCloudGpu& TreeAsset::getBillboardCloudLayout(bool classic)
+    {
+        std::unique_ptr<BillboardCloudGpu>& slot = mBillboardCloudLayouts[classic ? 1 : 0];
+        if (slot)
+            return *slot;
+        const BillboardCloudData& data = getBillboardCloud(classic);
+        auto layout = std::make_unique<BillboardCloudGpu>();
+        layout->listFactor = data.listFactor;
+        layout->bounds = getBounds();
+        layout->bounds.merge(Ogre::AxisAlignedBox(data.boundsMin.x, data.boundsMin.y, data.boundsMin.z,
+                                                  data.boundsMax.x, data.boundsMax.y, data.boundsMax.z));
+        for (const Billboard& b : data.billboards)
+            for (const glm::vec3& c : {b.origin, b.origin + b.axisU, b.origin + b.axisV, b.origin + b.axisU + b.axisV})
+                layout->bounds.merge(Ogre::Vector3(c.x, c.y, c.z));
+        layout->radius = Ogre::Math::boundingRadiusFromAABB(layout->bounds);
+        // §6: all levels' quads in one buffer, a range of the index buffer per level.
+        for (const BillboardCloudLevel& l : data.levels)
+        {
+            BillboardCloudGpu::Level level;
+            level.indexStart = std::size_t(l.firstBillboard) * 6;
+            level.indexCount = std::size_t(l.billboardCount) * 6;
+            level.layered = l.layered;
+            level.cellSize = l.cellSize;
+            if (l.layered)
+                level.lowResPixelCount =
+                    billboardCloudPixelCount(1.0f, l.cellSize, float(layout->radius), data.listFactor);
+            layout->levels.push_back(level);
+        }
+        slot = std::move(layout);
+        return *slot;
+    }
+
     const BillboardCloudGpu& TreeAsset::getBillboardCloudGpu(bool classic)
     {
         std::unique_ptr<BillboardCloudGpu>& slot = mBillboardCloudGpus[classic ? 1 : 0];
@@ -328,15 +362,12 @@ namespace TreeLod
         const BillboardCloudData& data = getBillboardCloud(classic);
         const Ogre::String prefix =
             "TreeLod/" + mName + "/" + (classic ? CLASSIC_BILLBOARD_CLOUD_CHUNK : BILLBOARD_CLOUD_CHUNK) + "/";
+        const BillboardCloudGpu& layout = getBillboardCloudLayout(classic);
         auto gpu = std::make_unique<BillboardCloudGpu>();
-        gpu->listFactor = data.listFactor;
-        gpu->bounds = getBounds();
-        gpu->bounds.merge(Ogre::AxisAlignedBox(data.boundsMin.x, data.boundsMin.y, data.boundsMin.z, data.boundsMax.x,
-                                               data.boundsMax.y, data.boundsMax.z));
-        for (const Billboard& b : data.billboards)
-            for (const glm::vec3& c : {b.origin, b.origin + b.axisU, b.origin + b.axisV, b.origin + b.axisU + b.axisV})
-                gpu->bounds.merge(Ogre::Vector3(c.x, c.y, c.z));
-        gpu->radius = Ogre::Math::boundingRadiusFromAABB(gpu->bounds);
+        gpu->listFactor = layout.listFactor;
+        gpu->bounds = layout.bounds;
+        gpu->radius = layout.radius;
+        gpu->levels = layout.levels;
 
         // §6 atlases: integer texel fetches only (no mips; filtering unused). The Lists and AO
         // atlases are padded with zero texels past the last entry.
@@ -421,18 +452,6 @@ namespace TreeLod
                 std::vector<std::uint16_t> narrow(indices.begin(), indices.end());
                 gpu->indexBuffer->writeData(0, narrow.size() * 2, narrow.data(), true);
             }
-        }
-        for (const BillboardCloudLevel& l : data.levels)
-        {
-            BillboardCloudGpu::Level level;
-            level.indexStart = std::size_t(l.firstBillboard) * 6;
-            level.indexCount = std::size_t(l.billboardCount) * 6;
-            level.layered = l.layered;
-            level.cellSize = l.cellSize;
-            if (l.layered)
-                level.lowResPixelCount =
-                    billboardCloudPixelCount(1.0f, l.cellSize, float(gpu->radius), data.listFactor);
-            gpu->levels.push_back(level);
         }
         createBillboardCloudMaterials(*gpu, data, prefix);
         slot = std::move(gpu);

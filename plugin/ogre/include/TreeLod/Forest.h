@@ -49,6 +49,16 @@
 //   in code from the plain program: same source, defines + INSTANCED=1, shared by every
 //   Forest); the clones are the Forest's and go with it. The quad's materials are instanced
 //   already and used as they are.
+// - Residency (issue 7, "model only what a scene requires"; no stall when a level first shows):
+//   addSpecies plans every level from decoded chunks (BillboardCloudGpu layouts, LoDF leaf
+//   counts; the bark mesh that levelsForBands plans with is the one upload there) and builds
+//   the last level only, the fallback of every other. A level's drawables (asset buffers and
+//   textures, instanced materials) are built the first time a camera sees trees at it; queued
+//   levels are built in the order asked for, in _updateRenderQueue, while this Root frame's
+//   bytes are below setUploadBudget (0 = no limit). Trees whose level is not resident yet draw
+//   getDrawnLevel, the nearest resident level, coarser first. A level that fails to build is
+//   logged and keeps its fallback. Uploads run on the render thread (GL): the budget bounds
+//   them per frame. Levels are never evicted while the Forest lives.
 // - ForestStats describe the last viewer camera (one whose LoD camera is itself, outside shadow
 //   texture rendering); they are cleared before each viewer's visibility pass, so a viewer that
 //   does not see the Forest's bounds reports nothing visible. Cameras without a viewport (area
@@ -61,6 +71,8 @@
 #include <OgreMaterial.h>
 #include <OgreMovableObject.h>
 
+#include <deque>
+#include <limits>
 #include <map>
 #include <memory>
 #include <vector>
@@ -96,6 +108,13 @@ namespace TreeLod
         std::vector<std::vector<std::uint32_t>> levelCounts;
         double cullMilliseconds = 0.0;        ///< ForestInstances::cull of the viewer's camera
         std::uint64_t instanceBufferBytes = 0; ///< instance vertex buffers, all cameras
+        /// Residency, this Root frame (all cameras): GPU bytes the Forest started drawing from
+        /// (buffers and textures of the levels built, each counted once; see "Residency").
+        std::uint64_t uploadedBytes = 0;
+        std::uint32_t uploadedLevels = 0;     ///< levels built this frame
+        std::uint32_t pendingLevels = 0;      ///< levels asked for and waiting for a later frame
+        /// Visible instances of the viewer drawn at a fallback level (theirs not resident yet).
+        std::uint32_t fallbackInstances = 0;
     };
 
     class Forest : public Ogre::MovableObject
@@ -145,8 +164,19 @@ namespace TreeLod
 
         const ForestStats& getStats() const { return mStats; }
         /// GPU bytes of the assets' drawables in use (vertex and index buffers and textures, all
-        /// mips, of every level's parts, each counted once) plus the instance buffers.
+        /// mips, of every resident level's parts, each counted once) plus the instance buffers.
         std::uint64_t getGpuBytes() const;
+
+        /// Bytes the levels built in one Root frame may upload (0, the default: no limit, every
+        /// level is built in the frame that first needs it). See "Residency".
+        void setUploadBudget(std::uint64_t bytesPerFrame);
+        std::uint64_t getUploadBudget() const { return mUploadBudget; }
+        /// Build every level of every species now (preloading, outside the frame loop).
+        void makeAllResident();
+        bool isResident(std::uint32_t species, std::uint32_t level) const;
+        /// The level drawn for trees at `level`: itself when resident, else the nearest resident
+        /// level, coarser first (the last level always is).
+        std::uint32_t getDrawnLevel(std::uint32_t species, std::uint32_t level) const;
 
         // MovableObject
         const Ogre::String& getMovableType() const override;
@@ -159,6 +189,7 @@ namespace TreeLod
 
     private:
         struct Part;
+        enum class Residency : std::uint8_t;
         struct Species;
         class Batch;
         struct BucketState;
@@ -167,7 +198,14 @@ namespace TreeLod
 
         /// The parts `level` of `asset` draws (instanced materials made on the way).
         std::vector<std::unique_ptr<Part>> buildParts(TreeAsset& asset, const ForestLevel& level,
-                                                      Ogre::Real upperPixelCount, Ogre::AxisAlignedBox& drawnBox);
+                                                      Ogre::Real upperPixelCount);
+        /// Build level `level` of species `species` (no-op when resident or failed); returns the
+        /// GPU bytes the Forest draws from that it did not before.
+        std::uint64_t makeResident(std::uint32_t species, std::uint32_t level);
+        /// Build queued levels within this frame's budget.
+        void serviceUploads();
+        static unsigned long currentFrame();
+        std::uint64_t drawableBytes() const; ///< getGpuBytes without the instance buffers
         /// This Forest's instanced clone of material `name` (and of its shadow casters).
         Ogre::MaterialPtr instancedMaterial(const Ogre::String& name, const Ogre::String& group);
         bool useShadowedMaterials() const;
@@ -188,6 +226,9 @@ namespace TreeLod
         bool mLodFrozen = false;
         ForestStats mStats;
         std::uint64_t mInstanceBufferBytes = 0;
+        std::uint64_t mUploadBudget = 0;
+        std::deque<std::pair<std::uint32_t, std::uint32_t>> mUploadQueue; ///< (species, level), FIFO
+        unsigned long mUploadFrame = std::numeric_limits<unsigned long>::max(); ///< of mStats' upload counts
         std::unique_ptr<ViewerListener> mViewerListener; ///< registered with mManager
     };
 

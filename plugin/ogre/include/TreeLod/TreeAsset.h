@@ -131,7 +131,11 @@ namespace TreeLod
         /// The billboard cloud of chunk "billboard-cloud", or "classic-billboard-cloud" when
         /// `classic` (decoded on first call, its bark AO checked against the reference).
         const BillboardCloudData& getBillboardCloud(bool classic);
-        /// Its GPU resources (built on first call).
+        /// Its levels (index ranges, layered, cell sizes, low-res switch), bounds, radius and list
+        /// factor, from the decoded chunk alone: nothing is uploaded (buffers, textures and
+        /// materials empty). What the Forest plans levels and culls with before it draws them.
+        const BillboardCloudGpu& getBillboardCloudLayout(bool classic);
+        /// Its GPU resources (built on first call; the layout's fields as getBillboardCloudLayout).
         const BillboardCloudGpu& getBillboardCloudGpu(bool classic);
         /// The bark mesh with the cloud's bark AO as a vertex colour, "<asset>/bark-ao/<chunk>",
         /// with MeshLodGenerator levels and TreeLod/BarkAo materials (paper 000 §5.2, §6).
@@ -187,6 +191,7 @@ namespace TreeLod
         std::vector<Ogre::String> mMaterialNames;
         std::vector<Ogre::String> mTextureNames;
         std::unique_ptr<BillboardCloudData> mBillboardClouds[2];  ///< [classic]
+        std::unique_ptr<BillboardCloudGpu> mBillboardCloudLayouts[2]; ///< [classic]
         std::unique_ptr<BillboardCloudGpu> mBillboardCloudGpus[2]; ///< [classic]
         std::unique_ptr<ImpostorGpu> mImpostorGpu;
         Ogre::MeshPtr mBarkAoMeshes[2];                            ///< [classic]
