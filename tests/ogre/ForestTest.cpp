@@ -1004,4 +1004,92 @@ namespace TreeLod
             EXPECT_NE(e.getDescription().find("bare.floor-test"), std::string::npos) << e.getDescription();
         }
     }
+
+    TEST(Forest, levelsBecomeResidentWithinTheUploadBudget)
+    {
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+        const std::vector<ForestLevel> levels = Forest::levelsForBands(*tree.asset, Forest::getAutoBands());
+        const std::uint32_t last = std::uint32_t(levels.size() - 1);
+        const std::vector<ForestInstance> trees = grid(5, 1.4f * h);
+        // Near trees at lodf, farther ones at cloud levels: several levels in one view.
+        const CameraSpec view = look(glm::vec3(0.0f, 1.2f * h, 4.5f * h), glm::vec3(0.0f, 0.4f * h, -2.0f * h));
+
+        // addSpecies builds the last level only (the fallback); 10 km away nothing more is built.
+        Forest* lazy = placeForest();
+        lazy->addSpecies(tree.asset, levels);
+        lazy->addInstances(trees);
+        EXPECT_TRUE(lazy->isResident(0, last));
+        for (std::uint32_t l = 0; l < last; ++l)
+        {
+            EXPECT_FALSE(lazy->isResident(0, l)) << "level " << l;
+            EXPECT_EQ(lazy->getDrawnLevel(0, l), last);
+        }
+        const std::uint64_t planned = lazy->getGpuBytes();
+        r.render(look(glm::vec3(0.0f, 200.0f, 10000.0f), glm::vec3(0.0f)), 96, 96, 1);
+        EXPECT_EQ(lazy->getStats().uploadedLevels, 0u);
+        EXPECT_EQ(lazy->getGpuBytes() - lazy->getStats().instanceBufferBytes, planned) << "a far view uploads nothing";
+
+        // A budget of one byte: one level per frame; meanwhile the trees draw their fallback.
+        lazy->setUploadBudget(1);
+        const Image first = toImage(r.render(view, 256, 192, 1));
+        const ForestStats firstStats = lazy->getStats();
+        EXPECT_EQ(firstStats.uploadedLevels, 1u);
+        EXPECT_GT(firstStats.uploadedBytes, 0u);
+        EXPECT_GT(firstStats.pendingLevels, 0u);
+        EXPECT_GT(firstStats.fallbackInstances, 0u);
+        EXPECT_GT(firstStats.visibleInstances, 15u);
+        EXPECT_GT(treeCoverage(first, BACKGROUND), 0.1) << "the fallback draws every tree";
+        std::uint32_t frames = 1, pending = firstStats.pendingLevels;
+        std::uint64_t maxUploaded = firstStats.uploadedBytes;
+        while (lazy->getStats().pendingLevels > 0 && frames < 40)
+        {
+            r.render(view, 256, 192, 1);
+            ++frames;
+            EXPECT_LE(lazy->getStats().uploadedLevels, 1u);
+            EXPECT_LT(lazy->getStats().pendingLevels, pending + 1);
+            pending = lazy->getStats().pendingLevels;
+            maxUploaded = std::max(maxUploaded, lazy->getStats().uploadedBytes);
+        }
+        const Image converged = toImage(r.render(view, 256, 192, 1));
+        const ForestStats done = lazy->getStats();
+        EXPECT_EQ(done.pendingLevels, 0u);
+        EXPECT_EQ(done.fallbackInstances, 0u);
+        EXPECT_EQ(done.uploadedLevels, 0u);
+        std::uint32_t used = 0, resident = 0;
+        for (std::uint32_t l = 0; l < levels.size(); ++l)
+        {
+            used += done.levelCounts[0][l] > 0 ? 1 : 0;
+            resident += lazy->isResident(0, l) ? 1 : 0;
+        }
+        std::printf("upload budget 1 B: %u levels in view became resident over %u frames (largest frame %.2f MB, "
+                    "%u of %zu levels resident; %.2f MB planned, %.2f MB after)\n",
+                    used, frames, double(maxUploaded) / 1e6, resident, levels.size(), double(planned) / 1e6,
+                    double(lazy->getGpuBytes()) / 1e6);
+        EXPECT_GE(used, 3u) << "the view should show several levels";
+        EXPECT_LT(resident, std::uint32_t(levels.size())) << "levels never seen stay unbuilt";
+        EXPECT_GT(lazy->getGpuBytes(), planned);
+
+        // No budget: a fresh Forest builds what the view needs in its first frame, same picture.
+        Forest* eager = placeForest();
+        eager->addSpecies(tree.asset, levels);
+        eager->addInstances(trees);
+        const Image unlimited = toImage(r.render(view, 256, 192, 1));
+        EXPECT_EQ(eager->getStats().pendingLevels, 0u);
+        EXPECT_EQ(eager->getStats().fallbackInstances, 0u);
+        EXPECT_EQ(eager->getStats().uploadedLevels, used);
+        const double flipConverged = flipMean(unlimited, converged), flipFirst = flipMean(unlimited, first);
+        std::printf("FLIP against the unlimited first frame: budget's first frame %.4f, converged %.5f\n", flipFirst,
+                    flipConverged);
+        EXPECT_LT(flipConverged, 0.002);
+        EXPECT_GT(flipFirst, 0.01) << "the first frame drew fallbacks, it should differ";
+        compareWithGolden(sideBySide({first, converged}), "forest-residency", 0.03);
+
+        // Preloading builds every level.
+        eager->makeAllResident();
+        for (std::uint32_t l = 0; l < levels.size(); ++l)
+            EXPECT_TRUE(eager->isResident(0, l)) << "level " << l;
+        EXPECT_EQ(eager->getStats().pendingLevels, 0u);
+    }
 }
