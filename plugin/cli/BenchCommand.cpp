@@ -9,7 +9,8 @@
 // vs bake"); then it compares the frames treelod_frames saved. Per frame: CPU time (until the
 // frame's commands are submitted), frame time bounded by a one-pixel read-back (Ogre's GL3Plus
 // render system offers no timer queries, so the GPU time is the glFinish-bounded wall time),
-// batches, triangles, instances per level, bytes uploaded. On sampled frames: the polygonal
+// batches, triangles, instances per level, bytes of Forest levels built in the frame (at most
+// --upload-budget plus one level). On sampled frames: the polygonal
 // reference supersampled 2x2, and against it FLIP and multi-scale RMSE (paper 001 §4), and
 // temporal noise: the multi-scale RMSE between the frame and the next frame of the path (paper 001
 // §5, Fig. 13), for the reference too. A reference frame whose triangle count would exceed
@@ -67,6 +68,7 @@ namespace TreeLod
             double referenceImageBudget = 0.0; // triangles: its supersampled images; 0 = referenceBudget
             std::string cacheDirectory;
             std::string counts;       // "" = the script's counts
+            std::uint64_t uploadBudget = 8000000; // bytes of Forest levels built per frame (0 = no limit)
             bool bakeOnly = false;    // bake, write packages.json, print the treelod_frames command
             std::string framesFrom;   // "" = run treelod_frames here; else read its output from this directory
             bool json = false;
@@ -617,7 +619,8 @@ namespace TreeLod
                                                 "--reference-image-budget", number(imageBudget(args), 6),
                                                 "--scale", number(args.scale, 8), "--size",
                                                 std::to_string(width) + "x" + std::to_string(height), "--frames",
-                                                std::to_string(frames)};
+                                                std::to_string(frames), "--upload-budget",
+                                                std::to_string(args.uploadBudget)};
             if (!args.counts.empty())
                 command.insert(command.end(), {"--counts", args.counts});
             if (args.quiet)
@@ -678,6 +681,9 @@ namespace TreeLod
         cmd->add_option("--reference-image-budget", args->referenceImageBudget,
                         "the same for the reference's supersampled images on sampled frames (default: "
                         "--reference-budget); images cost no timed frames, so this may be larger");
+        cmd->add_option("--upload-budget", args->uploadBudget,
+                        "bytes of Forest levels built per frame (0 = no limit); levels waiting draw a coarser one")
+            ->capture_default_str();
         cmd->add_option("--cache", args->cacheDirectory, "bake cache directory (default: $XDG_CACHE_HOME/treelod)");
         cmd->add_flag("--bake-only", args->bakeOnly,
                       "bake and write DIR/packages.json, print the treelod_frames command (to run on a GPU machine)");

@@ -1,6 +1,6 @@
 // treelod_frames SCENE.json --packages LIST -o DIR [--techniques] [--lod-bias] [--frames] [--scale] [--counts]
 //                [--size] [--samples] [--reference-budget] [--reference-image-budget] [--entity-limit]
-//                [--skip-comparisons] [-q]
+//                [--upload-budget] [--skip-comparisons] [-q]
 //
 // The program that renders and times the frames of `treelod bench` (issue 7): it links OGRE and the
 // runtime only (Plugin_TreeLod, TreeLodOffscreen, TreeLodScene, TreeLodScript, TreeLodRuntime), never
@@ -54,6 +54,7 @@ namespace TreeLod
             double referenceImageBudget = 0.0;
             std::string counts;
             std::uint64_t entityLimit = 200000;
+            std::uint64_t uploadBudget = 8000000; // bytes per frame (Forest::setUploadBudget; 0 = no limit)
             bool skipComparisons = false; // only the techniques: no reference, no floors (memory of one scene)
             bool quiet = false;
         };
@@ -204,6 +205,7 @@ namespace TreeLod
                 ForestSceneOptions options;
                 options.placement.totalCount = count;
                 options.placement.scale = args.scale;
+                options.uploadBudget = args.uploadBudget;
                 std::vector<std::pair<std::string, std::vector<float>>> plan;
                 if (!args.skipComparisons)
                     plan = {{"mesh", {1.0f}}, {"quad", {1.0f}}, {"entities", {1.0f}}, {"merged-quads", {1.0f}}};
@@ -276,6 +278,9 @@ namespace TreeLod
                                     row["visible"] = stats.visibleInstances;
                                     row["levels"] = levelHistogram(scene->getForest());
                                     row["cullMs"] = stats.cullMilliseconds;
+                                    row["uploadedBytes"] = stats.uploadedBytes;
+                                    row["pendingLevels"] = stats.pendingLevels;
+                                    row["fallbackTrees"] = stats.fallbackInstances;
                                 }
                             }
                             if (isSampled(f))
@@ -359,6 +364,9 @@ int main(int argc, char** argv)
     app.add_option("--reference-image-budget", args.referenceImageBudget,
                    "the same for the reference's supersampled images (default: --reference-budget)");
     app.add_option("--entity-limit", args.entityLimit, "skip the entities floor above this many trees")
+        ->capture_default_str();
+    app.add_option("--upload-budget", args.uploadBudget,
+                   "bytes of Forest levels built per frame (0 = no limit); levels waiting draw a coarser one")
         ->capture_default_str();
     app.add_flag("--skip-comparisons", args.skipComparisons,
                  "run only --techniques: no reference, no floors (e.g. to read one scene's resident memory)");

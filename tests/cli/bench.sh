@@ -13,7 +13,7 @@ png() { [ -s "$1" ] && head -c 8 "$1" | od -An -tx1 | grep -q "89 50 4e 47" || f
 
 # 1. One tree: reference, the three floors and auto at two biases over 6 frames.
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/single" --frames 6 --size 160x90 \
-  --techniques auto --lod-bias 1,0.5 --samples 2 --cache "$cache" -q
+  --techniques auto --lod-bias 1,0.5 --samples 2 --upload-budget 1 --cache "$cache" -q
 for f in frames.csv summary.json frame-time.png trade.png; do [ -s "$out/single/$f" ] || fail "single/$f missing"; done
 png "$out/single/frame-time.png"; png "$out/single/trade.png"
 rows=$(($(wc -l < "$out/single/frames.csv") - 1))
@@ -40,6 +40,12 @@ for floor in quad entities merged-quads; do
   grep -q "\"$floor\": [0-9]" "$out/single/summary.json" || fail "summary has no ratio to the $floor floor"
 done
 grep -q '"worstFrame": {' "$out/single/summary.json" || fail "summary does not record the worst frame"
+# Levels are built when first seen, one per frame under a 1-byte budget: some timed frame of auto
+# uploads, and every timed frame says how much.
+awk -F, 'NR > 1 && $6 == 1 && $NF !~ /^[0-9]+$/ { bad = 1; print } END { exit bad }' "$out/single/frames.csv" \
+  || fail "timed frames without uploaded bytes above"
+awk -F, 'NR > 1 && $2 == "auto" && $NF > 0 { n++ } END { exit !(n > 0) }' "$out/single/frames.csv" \
+  || fail "auto built no level during the timed frames"
 # The bake cache reported what it built; a second run reuses everything.
 grep -q 'baked' "$out/single/summary.json" || fail "first run baked nothing?"
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/single2" --frames 2 --size 64x36 \

@@ -211,6 +211,7 @@ namespace TreeLod
             mSceneManager.createMovableObject("TreeLod/Forest/" + std::to_string(counter++), ForestFactory::FACTORY_TYPE_NAME));
         mForestNode = mParent.createChildSceneNode();
         mForestNode->attachObject(mForest);
+        mForest->setUploadBudget(mOptions.uploadBudget);
 
         // Bands per species; then one bake request per distinct source with every technique its
         // species draw (two species sharing a file share one package and one asset).

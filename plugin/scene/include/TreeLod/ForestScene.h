@@ -58,6 +58,9 @@ namespace TreeLod
         /// getForest() then holds no species.
         std::string technique;
         PlacementOptions placement;
+        /// Forest::setUploadBudget: bytes of levels built per frame (0 = no limit: every level the
+        /// first frame needs is built in it).
+        std::uint64_t uploadBudget = 0;
         Ogre::String group = "TreeLod"; ///< resource group for assets, meshes and materials
     };
 
