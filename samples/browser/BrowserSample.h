@@ -64,6 +64,9 @@ namespace TreeLod
         virtual bool isLodFrozen() const = 0;
         virtual void setLodFrozen(bool frozen) = 0;
         /// A camera path to play (the forest's scene script); false: play/pause is hidden.
+        /// Nothing is still arriving (a technique's bakes, Forest levels within the upload
+        /// budget): what the next frame shows is complete. Screenshots wait for it.
+        virtual bool isSettled() const { return true; }
         virtual bool hasCameraPath() const { return false; }
         virtual bool isPlaying() const { return false; }
         virtual void setPlaying(bool) {}

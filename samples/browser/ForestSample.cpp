@@ -3,6 +3,8 @@
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/TechniqueRegistry.h"
 
+#include <OgreLogManager.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +12,8 @@
 namespace TreeLod
 {
     const char* const ForestSample::SCRIPT_TECHNIQUE = "scene script";
+    /// Bytes of Forest levels built per frame: a level first seen never stalls the browser by more.
+    constexpr std::uint64_t UPLOAD_BUDGET = 8000000;
 
     ForestSample::ForestSample(Ogre::Root& root, SceneScript script) : mRoot(root), mScript(std::move(script))
     {
@@ -49,7 +53,9 @@ namespace TreeLod
             return;
         report(progress, "forest: building " + mScript.name, 0.0f);
         mSceneManager = mRoot.createSceneManager();
-        mScene = std::make_unique<ForestScene>(*mSceneManager, *mSceneManager->getRootSceneNode(), mScript);
+        ForestSceneOptions options;
+        options.uploadBudget = UPLOAD_BUDGET;
+        mScene = std::make_unique<ForestScene>(*mSceneManager, *mSceneManager->getRootSceneNode(), mScript, options);
         mCamera = mSceneManager->createCamera("TreeLod/Browser/ForestCamera");
         mCameraNode = mSceneManager->getRootSceneNode()->createChildSceneNode();
         mCameraNode->attachObject(mCamera);
@@ -91,6 +97,18 @@ namespace TreeLod
 
     void ForestSample::frame(double seconds)
     {
+        // A technique switch bakes on worker threads; the Forest keeps drawing the current one.
+        try
+        {
+            const bool frozen = isLodFrozen();
+            if (mScene->update())
+                mScene->getForest().setLodFrozen(frozen);
+        }
+        catch (const Ogre::Exception& e)
+        {
+            mBakeError = e.getDescription();
+            Ogre::LogManager::getSingleton().logError(mBakeError);
+        }
         if (!mPlaying)
             return;
         const double length = pathEnd() - pathStart();
@@ -118,14 +136,15 @@ namespace TreeLod
 
     std::string ForestSample::getTechnique() const
     {
-        return mScene->getTechnique().empty() ? std::string(SCRIPT_TECHNIQUE) : mScene->getTechnique();
+        // The one asked for while its bakes run (the menu keeps showing the choice).
+        const std::string& technique = mScene->isTechniquePending() ? mScene->getPendingTechnique() : mScene->getTechnique();
+        return technique.empty() ? std::string(SCRIPT_TECHNIQUE) : technique;
     }
 
     void ForestSample::setTechnique(const std::string& technique)
     {
-        const bool frozen = isLodFrozen();
-        mScene->setTechnique(technique == SCRIPT_TECHNIQUE ? "" : technique);
-        mScene->getForest().setLodFrozen(frozen);
+        mBakeError.clear();
+        mScene->requestTechnique(technique == SCRIPT_TECHNIQUE ? "" : technique);
     }
 
     void ForestSample::setLodBias(float bias)
@@ -146,6 +165,11 @@ namespace TreeLod
         mCamera->setPolygonMode(enabled ? Ogre::PM_WIREFRAME : Ogre::PM_SOLID);
     }
 
+    bool ForestSample::isSettled() const
+    {
+        return !mScene->isTechniquePending() && mScene->getForest().getStats().pendingLevels == 0;
+    }
+
     bool ForestSample::isLodFrozen() const { return mScene->getForest().isLodFrozen(); }
 
     void ForestSample::setLodFrozen(bool frozen) { mScene->getForest().setLodFrozen(frozen); }
@@ -162,6 +186,16 @@ namespace TreeLod
         stats.emplace_back("Forest draws", std::to_string(s.batches));
         stats.emplace_back("GPU memory", formatBytes(mScene->getGpuBytes()));
         stats.emplace_back("Cull + LoD", cull);
+        if (s.pendingLevels > 0 || s.fallbackInstances > 0)
+            stats.emplace_back("Levels uploading", std::to_string(s.pendingLevels) + " (" +
+                                                       formatCount(s.fallbackInstances) + " trees at a fallback)");
+        if (mScene->isTechniquePending())
+            stats.emplace_back("Baking", getTechnique() + " (drawing " +
+                                             (mScene->getTechnique().empty() ? std::string(SCRIPT_TECHNIQUE)
+                                                                             : mScene->getTechnique()) +
+                                             " meanwhile)");
+        if (!mBakeError.empty())
+            stats.emplace_back("Bake failed", mBakeError);
         return stats;
     }
 

@@ -46,6 +46,7 @@ namespace TreeLod
         bool isLodFrozen() const override;
         void setLodFrozen(bool frozen) override;
         bool hasCameraPath() const override { return true; }
+        bool isSettled() const override;
         bool isPlaying() const override { return mPlaying; }
         void setPlaying(bool playing) override { mPlaying = playing; }
         void setScreenshotView(unsigned index, unsigned count) override;
@@ -69,6 +70,7 @@ namespace TreeLod
         Ogre::ColourValue mBackground;
         double mPathTime = 0.0; ///< seconds along the camera path
         bool mPlaying = true;
+        std::string mBakeError; ///< the last technique switch's failed bake, shown in the stats
         float mLodBias = 1.0f;
         bool mShadows = false;
         bool mWireframe = false;

@@ -596,7 +596,10 @@ namespace TreeLod
         fs::create_directories(mOptions.screenshots);
         std::vector<std::string> written;
         auto shoot = [&](const std::string& name) {
-            // Two frames: the stats panel shows what the frame before measured.
+            // Until nothing is arriving (bakes, levels within the upload budget), then two frames:
+            // the stats panel shows what the frame before measured.
+            for (int f = 0; f < 200 && mCurrent >= 0 && !mSamples[std::size_t(mCurrent)]->isSettled(); ++f)
+                mRoot->renderOneFrame();
             mRoot->renderOneFrame();
             mRoot->renderOneFrame();
             const std::string path = (fs::path(mOptions.screenshots) / name).string();

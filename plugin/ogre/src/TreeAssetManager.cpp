@@ -3,6 +3,8 @@
 #include <OgreException.h>
 #include <OgreResourceGroupManager.h>
 
+#include <algorithm>
+#include <chrono>
 #include <fstream>
 #include <iterator>
 
@@ -22,6 +24,8 @@ namespace TreeLod
 
     TreeAssetManager::~TreeAssetManager()
     {
+        for (const std::shared_future<Ogre::String>& bake : mBakes)
+            bake.wait();
         Ogre::ResourceGroupManager::getSingleton()._unregisterResourceManager(mResourceType);
     }
 
@@ -51,14 +55,67 @@ namespace TreeLod
         return asset;
     }
 
-    TreeAssetPtr TreeAssetManager::require(const Ogre::String& source, const std::vector<Ogre::String>& techniques,
-                                           const Ogre::String& group)
+    TreeBaker& TreeAssetManager::baker(const Ogre::String& source) const
     {
         if (!mBaker)
             OGRE_EXCEPT(Ogre::Exception::ERR_INVALID_STATE,
                         "'" + source + "': no baker registered (TreeAssetManager::setBaker), cannot bake on demand",
                         "TreeAssetManager::require");
-        const Ogre::String path = mBaker->requirePackage(source, techniques);
+        return *mBaker;
+    }
+
+    TreeAssetPtr TreeAssetManager::require(const Ogre::String& source, const std::vector<Ogre::String>& techniques,
+                                           const Ogre::String& group)
+    {
+        TreeBaker& registered = baker(source);
+        Ogre::String path;
+        {
+            std::lock_guard<std::mutex> lock(mBakeMutex);
+            path = registered.requirePackage(source, techniques);
+        }
+        return loadBaked(source, techniques, path, group);
+    }
+
+    std::shared_ptr<TreeAssetRequest> TreeAssetManager::requireAsync(const Ogre::String& source,
+                                                                     const std::vector<Ogre::String>& techniques,
+                                                                     const Ogre::String& group)
+    {
+        TreeBaker* registered = &baker(source);
+        auto request = std::make_shared<TreeAssetRequest>();
+        request->mSource = source;
+        request->mGroup = group;
+        request->mTechniques = techniques;
+        std::mutex* mutex = &mBakeMutex;
+        request->mPath = std::async(std::launch::async, [registered, mutex, source, techniques] {
+                             std::lock_guard<std::mutex> lock(*mutex);
+                             return registered->requirePackage(source, techniques);
+                         }).share();
+        // Kept here too: the last copy of an async future waits in its destructor, so a dropped
+        // request must not hold it. Ended bakes are forgotten.
+        mBakes.erase(std::remove_if(mBakes.begin(), mBakes.end(),
+                                    [](const std::shared_future<Ogre::String>& f) {
+                                        return f.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+                                    }),
+                     mBakes.end());
+        mBakes.push_back(request->mPath);
+        return request;
+    }
+
+    bool TreeAssetRequest::isReady() const
+    {
+        return mPath.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+    }
+
+    TreeAssetPtr TreeAssetRequest::get()
+    {
+        if (!mAsset)
+            mAsset = TreeAssetManager::getSingleton().loadBaked(mSource, mTechniques, mPath.get(), mGroup);
+        return mAsset;
+    }
+
+    TreeAssetPtr TreeAssetManager::loadBaked(const Ogre::String& source, const std::vector<Ogre::String>& techniques,
+                                             const Ogre::String& path, const Ogre::String& group)
+    {
         const Ogre::String name = path.substr(path.find_last_of('/') + 1);
         if (TreeAssetPtr existing = getByName(name, group))
         {

@@ -297,6 +297,44 @@ namespace TreeLod
         buildSpecies();
     }
 
+    void ForestScene::requestTechnique(const std::string& technique)
+    {
+        std::vector<std::shared_ptr<TreeAssetRequest>> bakes;
+        for (const auto& [source, techniques] : scenePackages(mScript, {technique}))
+            bakes.push_back(TreeAssetManager::getSingleton().requireAsync(
+                source, std::vector<Ogre::String>(techniques.begin(), techniques.end()), mOptions.group));
+        mPendingBakes = std::move(bakes);
+        mPendingTechnique = technique;
+        mPendingRequested = true;
+    }
+
+    bool ForestScene::update()
+    {
+        if (!mPendingRequested)
+            return false;
+        for (const std::shared_ptr<TreeAssetRequest>& bake : mPendingBakes)
+            if (!bake->isReady())
+                return false;
+        mPendingRequested = false;
+        const std::vector<std::shared_ptr<TreeAssetRequest>> bakes = std::move(mPendingBakes);
+        mPendingBakes.clear();
+        for (const std::shared_ptr<TreeAssetRequest>& bake : bakes)
+        {
+            try
+            {
+                bake->get(); // the baker's error, if any; the package is loaded
+            }
+            catch (const Ogre::Exception& e)
+            {
+                OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                            mScript.file + ": technique '" + mPendingTechnique + "': " + e.getDescription(),
+                            "ForestScene::update");
+            }
+        }
+        setTechnique(mPendingTechnique); // its require() calls find the packages baked
+        return true;
+    }
+
     void ForestScene::setShadows(bool enabled)
     {
         const ShadowCamera camera = mScript.shadows.camera == "lispsm" ? ShadowCamera::LiSPSM : ShadowCamera::Focused;

@@ -1,6 +1,12 @@
 // TreeAssetManager: the ResourceManager for TreeAsset ("TreeAsset", *.treelod).
 // Packages are found through resource groups like meshes:
 //   TreeAssetManager::getSingleton().load("oak.treelod", "General")
+//
+// Baking off the frame path (issue 7): requireAsync runs the registered TreeBaker on a worker
+// thread and returns at once; the render thread polls TreeAssetRequest::isReady() and then get()s
+// the asset (loading the package: header and chunk table only, TreeAsset.h). Bakes run one at a
+// time (require() waits for a running one); the baker must not call Ogre's render-thread APIs
+// (CacheTreeBaker does not) and must outlive them: the manager's destructor waits for them.
 #pragma once
 
 #include "TreeLod/TreeAsset.h"
@@ -9,8 +15,32 @@
 #include <OgreResourceManager.h>
 #include <OgreSingleton.h>
 
+#include <future>
+#include <memory>
+#include <mutex>
+
 namespace TreeLod
 {
+    /// A bake TreeAssetManager::requireAsync started. Dropping it does not wait for the bake.
+    class TreeAssetRequest
+    {
+    public:
+        const Ogre::String& getSource() const { return mSource; }
+        /// The bake has ended (the package is there, or the bake failed).
+        bool isReady() const;
+        /// On the render thread: the asset, loaded from the baked package (waits for the bake
+        /// when it has not ended). Throws what the baker threw, naming the source, or the loader's
+        /// error; every call returns the same asset or throws the same error.
+        TreeAssetPtr get();
+
+    private:
+        friend class TreeAssetManager;
+        Ogre::String mSource, mGroup;
+        std::vector<Ogre::String> mTechniques;
+        std::shared_future<Ogre::String> mPath; ///< the baker's answer
+        TreeAssetPtr mAsset;
+    };
+
     class TreeAssetManager : public Ogre::ResourceManager, public Ogre::Singleton<TreeAssetManager>
     {
     public:
@@ -36,6 +66,11 @@ namespace TreeLod
         /// no baker is registered, else what the baker or the loader throws.
         TreeAssetPtr require(const Ogre::String& source, const std::vector<Ogre::String>& techniques,
                              const Ogre::String& group);
+        /// require() with the bake on a worker thread (see the file comment). Throws
+        /// Ogre::InvalidStateException at once when no baker is registered.
+        std::shared_ptr<TreeAssetRequest> requireAsync(const Ogre::String& source,
+                                                       const std::vector<Ogre::String>& techniques,
+                                                       const Ogre::String& group);
 
         static TreeAssetManager& getSingleton();
         static TreeAssetManager* getSingletonPtr();
@@ -46,6 +81,14 @@ namespace TreeLod
                                    const Ogre::NameValuePairList* params) override;
 
     private:
+        friend class TreeAssetRequest;
+        TreeBaker& baker(const Ogre::String& source) const; ///< throws when none is registered
+        /// The asset of package `path` baked for `source` (reused when it holds `techniques`).
+        TreeAssetPtr loadBaked(const Ogre::String& source, const std::vector<Ogre::String>& techniques,
+                               const Ogre::String& path, const Ogre::String& group);
+
         TreeBaker* mBaker = nullptr;
+        std::mutex mBakeMutex; ///< one bake at a time
+        std::vector<std::shared_future<Ogre::String>> mBakes; ///< running or ended; waited for at destruction
     };
 }

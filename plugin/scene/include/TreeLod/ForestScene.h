@@ -18,6 +18,7 @@
 #include "TreeLod/QuadFloors.h" // readGreyImageOgre: loadSceneScript's reader on this side
 #include "TreeLod/SceneScript.h"
 #include "TreeLod/TreeAsset.h"
+#include "TreeLod/TreeAssetManager.h"
 
 #include <OgreManualObject.h>
 #include <OgreSceneManager.h>
@@ -85,6 +86,16 @@ namespace TreeLod
         /// keeping the instances; bakes what the new choice needs.
         void setTechnique(const std::string& technique);
         const std::string& getTechnique() const { return mTechnique; }
+        /// setTechnique without waiting for bakes: they run on worker threads
+        /// (TreeAssetManager::requireAsync) while the current choice keeps drawing, and update()
+        /// switches once they have ended. A later request replaces an earlier one.
+        void requestTechnique(const std::string& technique);
+        /// Once per frame: switches to the requested technique when its bakes have ended; true when
+        /// it did. Throws Ogre::Exception naming the script and the source when a bake failed (the
+        /// request is dropped, the current choice stays).
+        bool update();
+        bool isTechniquePending() const { return mPendingRequested; }
+        const std::string& getPendingTechnique() const { return mPendingTechnique; }
 
         /// Texture shadows on or off (the script's size and shadow camera setup), reaching
         /// getShadowFarDistance() metres from the camera; the ground receives them.
@@ -108,6 +119,9 @@ namespace TreeLod
         SceneScript mScript;
         ForestSceneOptions mOptions;
         std::string mTechnique;
+        bool mPendingRequested = false;
+        std::string mPendingTechnique;
+        std::vector<std::shared_ptr<TreeAssetRequest>> mPendingBakes;
         std::vector<PlacedTree> mPlacements;
         std::vector<TreeAssetPtr> mAssets;
         Forest* mForest = nullptr;
