@@ -1,6 +1,6 @@
 // treelod_frames SCENE.json --packages LIST -o DIR [--techniques] [--lod-bias] [--frames] [--scale] [--counts]
 //                [--size] [--samples] [--reference-budget] [--reference-image-budget] [--entity-limit]
-//                [--upload-budget] [--skip-comparisons] [-q]
+//                [--upload-budget] [--preload] [--skip-comparisons] [-q]
 //
 // The program that renders and times the frames of `treelod bench` (issue 7): it links OGRE and the
 // runtime only (Plugin_TreeLod, TreeLodOffscreen, TreeLodScene, TreeLodScript, TreeLodRuntime), never
@@ -55,6 +55,7 @@ namespace TreeLod
             std::string counts;
             std::uint64_t entityLimit = 200000;
             std::uint64_t uploadBudget = 8000000; // bytes per frame (Forest::setUploadBudget; 0 = no limit)
+            bool preload = false;         // every Forest level built before the frames (no uploads timed)
             bool skipComparisons = false; // only the techniques: no reference, no floors (memory of one scene)
             bool quiet = false;
         };
@@ -235,6 +236,8 @@ namespace TreeLod
                     {
                         return printError(fail(args.scene, "technique " + technique, e.getDescription()));
                     }
+                    if (args.preload)
+                        scene->getForest().makeAllResident();
                     const double buildSeconds =
                         std::chrono::duration<double>(std::chrono::steady_clock::now() - buildStart).count();
                     if (script.shadows.enabled)
@@ -368,6 +371,8 @@ int main(int argc, char** argv)
     app.add_option("--upload-budget", args.uploadBudget,
                    "bytes of Forest levels built per frame (0 = no limit); levels waiting draw a coarser one")
         ->capture_default_str();
+    app.add_flag("--preload", args.preload,
+                 "build every Forest level before the frames (Forest::makeAllResident: nothing uploaded while timing)");
     app.add_flag("--skip-comparisons", args.skipComparisons,
                  "run only --techniques: no reference, no floors (e.g. to read one scene's resident memory)");
     app.add_flag("-q,--quiet", args.quiet, "no progress");

@@ -46,6 +46,11 @@ awk -F, 'NR > 1 && $6 == 1 && $NF !~ /^[0-9]+$/ { bad = 1; print } END { exit ba
   || fail "timed frames without uploaded bytes above"
 awk -F, 'NR > 1 && $2 == "auto" && $NF > 0 { n++ } END { exit !(n > 0) }' "$out/single/frames.csv" \
   || fail "auto built no level during the timed frames"
+# treelod_frames --preload builds every level first: no timed frame uploads.
+"$(dirname "$treelod")/treelod_frames" "$src/samples/scenes/single-tree.json" --packages "$out/single/packages.json" \
+  -o "$out/preload" --skip-comparisons --techniques auto --lod-bias 1 --frames 6 --size 160x90 --samples 1 --preload -q
+grep -q '"uploadedBytes": 0' "$out/preload/timings.json" || fail "preloaded frames record no uploaded bytes"
+! grep -Eq '"uploadedBytes": [1-9]' "$out/preload/timings.json" || fail "a preloaded frame uploaded"
 # The bake cache reported what it built; a second run reuses everything.
 grep -q 'baked' "$out/single/summary.json" || fail "first run baked nothing?"
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/single2" --frames 2 --size 64x36 \
