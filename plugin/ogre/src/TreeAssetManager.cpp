@@ -55,6 +55,14 @@ namespace TreeLod
         return asset;
     }
 
+    void TreeAssetManager::setBaker(TreeBaker* baker)
+    {
+        for (const std::shared_future<Ogre::String>& bake : mBakes)
+            bake.wait();
+        mBakes.clear();
+        mBaker = baker;
+    }
+
     TreeBaker& TreeAssetManager::baker(const Ogre::String& source) const
     {
         if (!mBaker)

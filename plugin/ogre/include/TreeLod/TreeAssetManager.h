@@ -6,7 +6,7 @@
 // thread and returns at once; the render thread polls TreeAssetRequest::isReady() and then get()s
 // the asset (loading the package: header and chunk table only, TreeAsset.h). Bakes run one at a
 // time (require() waits for a running one); the baker must not call Ogre's render-thread APIs
-// (CacheTreeBaker does not) and must outlive them: the manager's destructor waits for them.
+// (CacheTreeBaker does not) and must outlive them: setBaker and the destructor wait for them.
 #pragma once
 
 #include "TreeLod/TreeAsset.h"
@@ -56,8 +56,9 @@ namespace TreeLod
         TreeAssetPtr loadFromBytes(const Ogre::String& name, const Ogre::String& group,
                                    std::vector<std::uint8_t> packageBytes);
 
-        /// The baker require() asks (not owned; nullptr = none). See TreeBaker.h.
-        void setBaker(TreeBaker* baker) { mBaker = baker; }
+        /// The baker require() asks (not owned; nullptr = none). See TreeBaker.h. Waits for the
+        /// bakes requireAsync started, so the previous baker may be destroyed once this returns.
+        void setBaker(TreeBaker* baker);
         TreeBaker* getBaker() const { return mBaker; }
 
         /// Lazy baking: the asset for `source` holding the chunks of `techniques`, baked by the
