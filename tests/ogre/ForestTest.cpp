@@ -1092,4 +1092,57 @@ namespace TreeLod
             EXPECT_TRUE(eager->isResident(0, l)) << "level " << l;
         EXPECT_EQ(eager->getStats().pendingLevels, 0u);
     }
+
+    TEST(Forest, cameraStatesGoWithTheirCameras)
+    {
+        // Every camera that renders the Forest gets instance buffers; a destroyed camera's go
+        // with it (50 short-lived cameras leave nothing behind), and a Forest destroyed before a
+        // camera it saw leaves that camera no dangling listener.
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        Ogre::SceneManager& manager = r.getSceneManager();
+        const float h = treeHeight(tree.model);
+        const CameraSpec view = look(glm::vec3(0.0f, 4.0f * h, 9.0f * h), glm::vec3(0.0f, 0.0f, 0.0f), 50.0f);
+        Forest* forest = placeForest();
+        forest->addSpecies(tree.asset, {ForestLevel{"quad", 0, false, 0.0f}});
+        forest->addInstances(grid(6, 1.4f * h));
+        const Image before = toImage(r.render(view, 96, 72, 1));
+        const std::uint64_t viewerBytes = forest->getGpuBytes();
+        ASSERT_GT(forest->getStats().instanceBufferBytes, 0u);
+
+        Ogre::SceneNode* holder = manager.getRootSceneNode()->createChildSceneNode(
+            Ogre::Vector3(0.0f, 2.0f * h, 12.0f * h));
+        holder->lookAt(Ogre::Vector3::ZERO, Ogre::Node::TS_WORLD);
+        auto renderWith = [&](Ogre::Camera* camera) {
+            Ogre::RenderQueue queue;
+            forest->_notifyCurrentCamera(camera);
+            forest->_updateRenderQueue(&queue);
+        };
+        for (int i = 0; i < 50; ++i)
+        {
+            Ogre::Camera* extra = manager.createCamera("forest-extra-" + std::to_string(i));
+            extra->setAspectRatio(4.0f / 3.0f);
+            extra->setNearClipDistance(0.1f);
+            holder->attachObject(extra);
+            renderWith(extra);
+            EXPECT_GT(forest->getGpuBytes(), viewerBytes) << "camera " << i << " drew with its own buffers";
+            holder->detachObject(extra);
+            manager.destroyCamera(extra);
+            EXPECT_EQ(forest->getGpuBytes(), viewerBytes) << "camera " << i << "'s buffers outlived it";
+        }
+        // The viewer still draws what it drew.
+        const Image after = toImage(r.render(view, 96, 72, 1));
+        EXPECT_LT(flipMean(before, after), 1e-6);
+        EXPECT_GT(treeCoverage(after, BACKGROUND), 0.05);
+
+        // The Forest goes first: destroying the camera afterwards must not call into it.
+        Ogre::Camera* survivor = manager.createCamera("forest-survivor");
+        survivor->setAspectRatio(4.0f / 3.0f);
+        holder->attachObject(survivor);
+        renderWith(survivor);
+        r.clearContent();
+        holder->detachObject(survivor);
+        manager.destroyCamera(survivor);
+        manager.destroySceneNode(holder);
+    }
 }

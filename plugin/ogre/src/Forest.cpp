@@ -355,6 +355,17 @@ namespace TreeLod
         Forest& mForest;
     };
 
+    /// Drops a camera's state when the camera is destroyed (Forest.h, "Per-camera state").
+    class Forest::CameraListener : public Ogre::Camera::Listener
+    {
+    public:
+        explicit CameraListener(Forest& forest) : mForest(forest) {}
+        void cameraDestroyed(Ogre::Camera* camera) override { mForest.dropCamera(camera); }
+
+    private:
+        Forest& mForest;
+    };
+
     // ---- Forest ----------------------------------------------------------------------------------
 
     const Ogre::String ForestFactory::FACTORY_TYPE_NAME = "Forest";
@@ -364,12 +375,15 @@ namespace TreeLod
         static std::atomic<std::uint32_t> serial{0};
         mMaterialPrefix = "TreeLod/Forest" + std::to_string(serial++) + "/";
         mBounds.setNull();
+        mCameraListener = std::make_unique<CameraListener>(*this);
     }
 
     Forest::~Forest()
     {
         if (mManager && mViewerListener)
             mManager->removeListener(mViewerListener.get());
+        for (const auto& camera : mCameras)
+            camera.first->removeListener(mCameraListener.get());
         mCameras.clear();
         mSpecies.clear();
         if (Ogre::MaterialManager* materials = Ogre::MaterialManager::getSingletonPtr())
@@ -961,7 +975,10 @@ namespace TreeLod
                                               Ogre::SceneManager::IRS_RENDER_TO_TEXTURE);
         std::unique_ptr<CameraState>& entry = mCameras[camera];
         if (!entry)
+        {
             entry = std::make_unique<CameraState>();
+            camera->addListener(mCameraListener.get());
+        }
         CameraState& state = *entry;
         while (state.buckets.size() < mInstances.getBucketCount()) // species added since
             state.buckets.push_back(std::make_unique<BucketState>());
@@ -1048,6 +1065,19 @@ namespace TreeLod
             mStats.fallbackInstances = fallbacks;
         }
         mStats.instanceBufferBytes = mInstanceBufferBytes;
+    }
+
+    void Forest::dropCamera(Ogre::Camera* camera)
+    {
+        const auto found = mCameras.find(camera);
+        if (found == mCameras.end())
+            return;
+        for (const std::unique_ptr<BucketState>& bucket : found->second->buckets)
+            mInstanceBufferBytes -= bucket->capacity * INSTANCE_BYTES;
+        mStats.instanceBufferBytes = mInstanceBufferBytes;
+        if (mCurrentCamera == camera)
+            mCurrentCamera = nullptr;
+        mCameras.erase(found);
     }
 
     void Forest::visitRenderables(Ogre::Renderable::Visitor* visitor, bool)

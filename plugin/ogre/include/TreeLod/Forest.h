@@ -62,12 +62,14 @@
 // - ForestStats describe the last viewer camera (one whose LoD camera is itself, outside shadow
 //   texture rendering); they are cleared before each viewer's visibility pass, so a viewer that
 //   does not see the Forest's bounds reports nothing visible. Cameras without a viewport (area
-//   0) see every tree at its last level. Camera states live as long as the Forest.
+//   0) see every tree at its last level. A camera's state (instance buffers, Renderables) lives
+//   until the camera is destroyed (a Camera::Listener drops it) or the Forest is.
 #pragma once
 
 #include "TreeLod/ForestInstances.h"
 #include "TreeLod/TreeAsset.h"
 
+#include <OgreCamera.h>
 #include <OgreMaterial.h>
 #include <OgreMovableObject.h>
 
@@ -195,6 +197,7 @@ namespace TreeLod
         struct BucketState;
         struct CameraState;
         class ViewerListener;
+        class CameraListener;
 
         /// The parts `level` of `asset` draws (instanced materials made on the way).
         std::vector<std::unique_ptr<Part>> buildParts(TreeAsset& asset, const ForestLevel& level,
@@ -213,10 +216,13 @@ namespace TreeLod
         void fillBucket(CameraState& state, std::uint32_t bucket);
         /// Zero the per-frame counts of mStats (a viewer's visibility pass begins).
         void clearFrameStats();
+        /// Free the state of `camera` (being destroyed): its instance buffers and Renderables.
+        void dropCamera(Ogre::Camera* camera);
 
         ForestInstances mInstances;
         std::vector<std::unique_ptr<Species>> mSpecies;
-        std::map<const Ogre::Camera*, std::unique_ptr<CameraState>> mCameras;
+        std::map<Ogre::Camera*, std::unique_ptr<CameraState>> mCameras; ///< each listened to
+        std::unique_ptr<CameraListener> mCameraListener;
         std::map<Ogre::String, Ogre::MaterialPtr> mInstancedMaterials; ///< by source material name
         Ogre::String mMaterialPrefix;
         Ogre::Camera* mCurrentCamera = nullptr;
