@@ -5,7 +5,13 @@ packages=(cmake g++ make pkg-config
   libogre-1.12-dev libglm-dev libtinygltf-dev libopenimageio-dev libeigen3-dev libembree-dev
   libsquish-dev libtbb-dev nlohmann-json3-dev libcli11-dev libgtest-dev googletest libbenchmark-dev
   xvfb xauth libgl1-mesa-dri)
-if [ "${1:-}" = "--with-fuzzers" ]; then packages+=(clang libclang-rt-14-dev); fi
+for flag in "$@"; do
+  case $flag in
+    --with-fuzzers) packages+=(clang libclang-rt-14-dev) ;;
+    --with-gpu-bundle) packages+=(mesa-utils x11-xkb-utils xz-utils) ;; # ../shared/gpu/bundle.sh packs glxinfo, xkbcomp
+    *) echo "deps.sh: unknown flag $flag (known: --with-fuzzers, --with-gpu-bundle)" >&2; exit 2 ;;
+  esac
+done
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

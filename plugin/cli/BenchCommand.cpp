@@ -474,6 +474,9 @@ namespace TreeLod
             nlohmann::json timings = nlohmann::json::parse(in, nullptr, false);
             if (timings.is_discarded() || !timings.contains("runs"))
                 return fail(path, "", "not the timings treelod_frames writes");
+            if (!timings.value("complete", true))
+                std::fprintf(stderr, "treelod: %s: incomplete (the frame timer stopped after %zu runs); reporting those\n",
+                             path.c_str(), timings["runs"].size());
             auto load = [&](const std::string& stem) -> Result<Image> {
                 return readImage(directory + "/images/" + stem + ".png");
             };

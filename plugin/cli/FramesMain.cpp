@@ -201,6 +201,22 @@ namespace TreeLod
 
             using nlohmann::json;
             json runsJson = json::array();
+            // Rewritten whole after every run ("complete": false until the last): a run cut short
+            // (the GPU machine's time limit) keeps the runs it finished.
+            auto writeTimings = [&](bool complete) {
+                const json out = {{"scene", script.name},
+                                  {"file", script.file},
+                                  {"resolution", {width, height}},
+                                  {"frames", frames},
+                                  {"sampled", sampled},
+                                  {"scale", args.scale},
+                                  {"renderer", renderer.getRoot().getRenderSystem()->getName()},
+                                  {"complete", complete},
+                                  {"runs", runsJson}};
+                const std::string text = out.dump(1) + "\n";
+                return writeFileAtomic(args.output + "/timings.json",
+                                       std::vector<std::uint8_t>(text.begin(), text.end()));
+            };
             for (std::uint32_t count : counts)
             {
                 ForestSceneOptions options;
@@ -322,22 +338,13 @@ namespace TreeLod
                         run["rssMiB"] = rss;
                         run["peakRssMiB"] = peak;
                         runsJson.push_back(std::move(run));
+                        if (Result<void> w = writeTimings(false); !w)
+                            return printError(w.error());
                     }
                     scene.reset();
                 }
             }
-            json out = {{"scene", script.name},
-                        {"file", script.file},
-                        {"resolution", {width, height}},
-                        {"frames", frames},
-                        {"sampled", sampled},
-                        {"scale", args.scale},
-                        {"renderer", renderer.getRoot().getRenderSystem()->getName()},
-                        {"runs", std::move(runsJson)}};
-            const std::string text = out.dump(1) + "\n";
-            if (Result<void> w = writeFileAtomic(args.output + "/timings.json",
-                                                 std::vector<std::uint8_t>(text.begin(), text.end()));
-                !w)
+            if (Result<void> w = writeTimings(true); !w)
                 return printError(w.error());
             return EXIT_OK;
         }

@@ -51,6 +51,19 @@ awk -F, 'NR > 1 && $2 == "auto" && $NF > 0 { n++ } END { exit !(n > 0) }' "$out/
   -o "$out/preload" --skip-comparisons --techniques auto --lod-bias 1 --frames 6 --size 160x90 --samples 1 --preload -q
 grep -q '"uploadedBytes": 0' "$out/preload/timings.json" || fail "preloaded frames record no uploaded bytes"
 ! grep -Eq '"uploadedBytes": [1-9]' "$out/preload/timings.json" || fail "a preloaded frame uploaded"
+# timings.json is rewritten after every run: a timer cut short (the GPU machine's time limit)
+# leaves "complete": false and the runs it finished, which --frames-from reports with a warning.
+grep -q '"complete": true' "$out/single/timings.json" || fail "finished timings are not marked complete"
+mkdir -p "$out/cut"; cp -r "$out/single/images" "$out/cut/"
+python3 - "$out/single/timings.json" "$out/cut/timings.json" <<'EOF'
+import json, sys
+t = json.load(open(sys.argv[1])); t["runs"] = t["runs"][:2]; t["complete"] = False
+json.dump(t, open(sys.argv[2], "w"))
+EOF
+"$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/cut-report" --frames 6 --size 160x90 \
+  --techniques auto --lod-bias 1,0.5 --samples 2 --cache "$cache" --frames-from "$out/cut" -q 2> "$out/cut.txt"
+grep -q "incomplete (the frame timer stopped after 2 runs)" "$out/cut.txt" || { cat "$out/cut.txt"; fail "no warning"; }
+[ "$(grep -c '"lodBias"' "$out/cut-report/summary.json")" = 2 ] || fail "a cut-short timer's 2 runs not reported"
 # The bake cache reported what it built; a second run reuses everything.
 grep -q 'baked' "$out/single/summary.json" || fail "first run baked nothing?"
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/single2" --frames 2 --size 64x36 \
