@@ -15,7 +15,7 @@
 #
 # Settings (environment; prepare writes them to .gpu/settings.env and the other steps read them):
 #   SCENES="flythrough-10k forest-100k" FRAMES=240 SIZE=1920x1080 SCALE=1 SAMPLES=6
-#   REFERENCE_BUDGET=3e8 (triangles of a timed reference frame) SCENE_TIMEOUT=240 (s, on the device)
+#   REFERENCE_BUDGET=3e8 (triangles of a timed reference frame) SCENE_TIMEOUT=200 (s a scene, on the device)
 # Trying the device step here (llvmpipe), small:
 #   SCALE=0.01 FRAMES=6 SIZE=320x180 SAMPLES=1 bench/gpu-run.sh prepare
 #   __GLX_VENDOR_LIBRARY_NAME=mesa OUT=/tmp/gpu-out bash .gpu/on-device.sh .gpu/bundle.tar.xz \
@@ -32,7 +32,7 @@ fail() { echo "gpu-run: $*" >&2; exit 2; }
 case $step in
 prepare)
   : "${SCENES:=flythrough-10k forest-100k}" "${FRAMES:=240}" "${SIZE:=1920x1080}" "${SCALE:=1}" "${SAMPLES:=6}"
-  : "${REFERENCE_BUDGET:=3e8}" "${SCENE_TIMEOUT:=240}"
+  : "${REFERENCE_BUDGET:=3e8}" "${SCENE_TIMEOUT:=200}"
   build=${TREELOD_BUILD_DIR:-$root/build}
   for b in treelod treelod_frames; do
     [ -x "$build/bin/$b" ] || fail "$build/bin/$b is missing: build first (tests/run.sh or cmake --build build)"
@@ -128,7 +128,7 @@ device)
     load_command flythrough-10k rss-flythrough-10k
     set_arg --samples 1
     code=0
-    timeout 120 "${args[@]}" -q --skip-comparisons >"$OUT/rss.log" 2>&1 || code=$?
+    timeout 60 "${args[@]}" -q --skip-comparisons >"$OUT/rss.log" 2>&1 || code=$?
     echo "gpu-run: rss-flythrough-10k: exit $code" | tee -a "$OUT/device.txt"
   fi
   ;;
