@@ -69,6 +69,7 @@ namespace TreeLod
             std::string cacheDirectory;
             std::string counts;       // "" = the script's counts
             std::uint64_t uploadBudget = 8000000; // bytes of Forest levels built per frame (0 = no limit)
+            int shadowSize = -1;                  // -1: the script's; 0: off (applyShadowSize)
             bool bakeOnly = false;    // bake, write packages.json, print the treelod_frames command
             std::string framesFrom;   // "" = run treelod_frames here; else read its output from this directory
             bool json = false;
@@ -250,6 +251,7 @@ namespace TreeLod
                             {"resolution", {width, height}},
                             {"frames", frames},
                             {"scale", args.scale},
+                            {"shadowMap", script.shadows.enabled ? script.shadows.textureSize : 0},
                             {"referenceBudgetTriangles", args.referenceBudget},
                             {"referenceImageBudgetTriangles", imageBudget(args)},
                             {"timing", "frame_ms: wall time until a one-pixel read-back (GPU-bounded; Ogre's GL3Plus "
@@ -566,7 +568,9 @@ namespace TreeLod
             Result<SceneScript> loaded = loadSceneScript(args.scene, readGreyImage);
             if (!loaded)
                 return printError(loaded.error());
-            const SceneScript& script = *loaded;
+            SceneScript& script = *loaded;
+            if (Result<void> shadows = applyShadowSize(args.shadowSize, script.shadows); !shadows)
+                return printError(shadows.error());
             if (!(args.scale > 0.0) || !std::isfinite(args.scale))
                 return printError(fail("", "--scale", "must be a positive number"));
             int width = script.width, height = script.height;
@@ -623,7 +627,8 @@ namespace TreeLod
                                                 "--scale", number(args.scale, 8), "--size",
                                                 std::to_string(width) + "x" + std::to_string(height), "--frames",
                                                 std::to_string(frames), "--upload-budget",
-                                                std::to_string(args.uploadBudget)};
+                                                std::to_string(args.uploadBudget), "--shadow-size",
+                                                std::to_string(args.shadowSize)};
             if (!args.counts.empty())
                 command.insert(command.end(), {"--counts", args.counts});
             if (args.quiet)
@@ -684,6 +689,9 @@ namespace TreeLod
         cmd->add_option("--reference-image-budget", args->referenceImageBudget,
                         "the same for the reference's supersampled images on sampled frames (default: "
                         "--reference-budget); images cost no timed frames, so this may be larger");
+        cmd->add_option("--shadow-size", args->shadowSize,
+                        "shadow map size over the script's (-1: the script's, 0: off; scaled-down runs on llvmpipe)")
+            ->capture_default_str();
         cmd->add_option("--upload-budget", args->uploadBudget,
                         "bytes of Forest levels built per frame (0 = no limit); levels waiting draw a coarser one")
             ->capture_default_str();

@@ -109,4 +109,20 @@ namespace TreeLod
             return fail("", "--lod-bias", "needs at least one value");
         return biases;
     }
+
+    Result<void> applyShadowSize(int size, SceneShadows& shadows)
+    {
+        if (size == -1)
+            return {};
+        if (size == 0)
+        {
+            shadows.enabled = false;
+            return {};
+        }
+        if (size < 256 || size > 16384 || (size & (size - 1)) != 0)
+            return fail("", "--shadow-size",
+                        std::to_string(size) + " is not -1 (the script's), 0 (off) or a power of two in 256..16384");
+        shadows.textureSize = size;
+        return {};
+    }
 }

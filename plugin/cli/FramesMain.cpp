@@ -1,6 +1,6 @@
 // treelod_frames SCENE.json --packages LIST -o DIR [--techniques] [--lod-bias] [--frames] [--scale] [--counts]
 //                [--size] [--samples] [--reference-budget] [--reference-image-budget] [--entity-limit]
-//                [--upload-budget] [--preload] [--skip-comparisons] [-q]
+//                [--upload-budget] [--shadow-size] [--preload] [--skip-comparisons] [-q]
 //
 // The program that renders and times the frames of `treelod bench` (issue 7): it links OGRE and the
 // runtime only (Plugin_TreeLod, TreeLodOffscreen, TreeLodScene, TreeLodScript, TreeLodRuntime), never
@@ -55,6 +55,7 @@ namespace TreeLod
             std::string counts;
             std::uint64_t entityLimit = 200000;
             std::uint64_t uploadBudget = 8000000; // bytes per frame (Forest::setUploadBudget; 0 = no limit)
+            int shadowSize = -1;          // -1: the script's; 0: off (applyShadowSize)
             bool preload = false;         // every Forest level built before the frames (no uploads timed)
             bool skipComparisons = false; // only the techniques: no reference, no floors (memory of one scene)
             bool quiet = false;
@@ -130,7 +131,9 @@ namespace TreeLod
             Result<SceneScript> loaded = loadSceneScript(args.scene, readGreyImageOgre);
             if (!loaded)
                 return printError(loaded.error());
-            const SceneScript& script = *loaded;
+            SceneScript& script = *loaded;
+            if (Result<void> shadows = applyShadowSize(args.shadowSize, script.shadows); !shadows)
+                return printError(shadows.error());
             if (!(args.scale > 0.0) || !std::isfinite(args.scale))
                 return printError(fail("", "--scale", "must be a positive number"));
             int width = script.width, height = script.height;
@@ -210,6 +213,7 @@ namespace TreeLod
                                   {"frames", frames},
                                   {"sampled", sampled},
                                   {"scale", args.scale},
+                                  {"shadowMap", script.shadows.enabled ? script.shadows.textureSize : 0},
                                   {"renderer", renderer.getRoot().getRenderSystem()->getName()},
                                   {"complete", complete},
                                   {"runs", runsJson}};
@@ -377,6 +381,8 @@ int main(int argc, char** argv)
         ->capture_default_str();
     app.add_option("--upload-budget", args.uploadBudget,
                    "bytes of Forest levels built per frame (0 = no limit); levels waiting draw a coarser one")
+        ->capture_default_str();
+    app.add_option("--shadow-size", args.shadowSize, "shadow map size over the script's (-1: the script's, 0: off)")
         ->capture_default_str();
     app.add_flag("--preload", args.preload,
                  "build every Forest level before the frames (Forest::makeAllResident: nothing uploaded while timing)");

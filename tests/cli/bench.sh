@@ -92,4 +92,17 @@ set -e
 [ "$code" = 2 ] || fail "bad script: exit $code, expected 2"
 grep -q "bad.json: line" "$out/bad.txt" || { cat "$out/bad.txt"; fail "error does not name file and line"; }
 [ ! -e "$out/bad" ] || fail "bad script created its output directory"
+# --shadow-size: 0 turns the script's shadows off (recorded), a size that is no power of two is
+# refused before anything is written.
+"$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/noshadow" --frames 2 --size 64x36 \
+  --techniques lodf --lod-bias 1 --samples 1 --cache "$cache" --shadow-size 0 -q
+grep -q '"shadowMap": 0' "$out/noshadow/summary.json" || fail "--shadow-size 0 not recorded"
+grep -Eq '"shadowMap": [1-9]' "$out/single/summary.json" || fail "the script's shadow map not recorded"
+set +e
+"$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/badshadow" --shadow-size 300 -q 2> "$out/badshadow.txt"
+code=$?
+set -e
+[ "$code" = 2 ] || fail "--shadow-size 300: exit $code, expected 2"
+grep -q -- "--shadow-size: 300 is not" "$out/badshadow.txt" || { cat "$out/badshadow.txt"; fail "no reason given"; }
+[ ! -e "$out/badshadow" ] || fail "a bad --shadow-size created its output directory"
 echo "bench test passed"
