@@ -548,6 +548,12 @@ namespace TreeLod
         EXPECT_EQ(forest->getStats().levelCounts[0][last], 25u);
         EXPECT_EQ(levels[last].technique, "quad");
         EXPECT_LT(treeCoverage(distant, BACKGROUND), 0.01);
+        // ... at the floor's cost: what a quad-only Forest of the same trees submits (one draw,
+        // two triangles a tree), and nothing but the quad level built.
+        EXPECT_EQ(forest->getStats().batches, 1u);
+        EXPECT_EQ(forest->getStats().triangles, 25u * 2u);
+        for (std::size_t l = 0; l < last; ++l)
+            EXPECT_FALSE(forest->isResident(0, std::uint32_t(l))) << "level " << l << " built for a view from 10 km";
 
         // Inside the middle tree's crown: no failure, leaves all around.
         const glm::vec3 centre = 0.5f * (tree.model.boundsMin + tree.model.boundsMax);
