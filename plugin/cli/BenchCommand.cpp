@@ -69,7 +69,8 @@ namespace TreeLod
             std::string cacheDirectory;
             std::string counts;       // "" = the script's counts
             std::uint64_t uploadBudget = 8000000; // bytes of Forest levels built per frame (0 = no limit)
-            int shadowSize = -1;                  // -1: the script's; 0: off (applyShadowSize)
+            int shadowSize = -1;                  // -1: the script's; 0: off (applyShadowOptions)
+            double shadowLodBias = 0.0;           // 0: the script's
             bool bakeOnly = false;    // bake, write packages.json, print the treelod_frames command
             std::string framesFrom;   // "" = run treelod_frames here; else read its output from this directory
             bool json = false;
@@ -252,6 +253,7 @@ namespace TreeLod
                             {"frames", frames},
                             {"scale", args.scale},
                             {"shadowMap", script.shadows.enabled ? script.shadows.textureSize : 0},
+                            {"shadowLodBias", script.shadows.lodBias},
                             {"referenceBudgetTriangles", args.referenceBudget},
                             {"referenceImageBudgetTriangles", imageBudget(args)},
                             {"timing", "frame_ms: wall time until a one-pixel read-back (GPU-bounded; Ogre's GL3Plus "
@@ -569,7 +571,7 @@ namespace TreeLod
             if (!loaded)
                 return printError(loaded.error());
             SceneScript& script = *loaded;
-            if (Result<void> shadows = applyShadowSize(args.shadowSize, script.shadows); !shadows)
+            if (Result<void> shadows = applyShadowOptions(args.shadowSize, args.shadowLodBias, script.shadows); !shadows)
                 return printError(shadows.error());
             if (!(args.scale > 0.0) || !std::isfinite(args.scale))
                 return printError(fail("", "--scale", "must be a positive number"));
@@ -628,7 +630,8 @@ namespace TreeLod
                                                 std::to_string(width) + "x" + std::to_string(height), "--frames",
                                                 std::to_string(frames), "--upload-budget",
                                                 std::to_string(args.uploadBudget), "--shadow-size",
-                                                std::to_string(args.shadowSize)};
+                                                std::to_string(args.shadowSize), "--shadow-lod-bias",
+                                                number(args.shadowLodBias, 8)};
             if (!args.counts.empty())
                 command.insert(command.end(), {"--counts", args.counts});
             if (args.quiet)
@@ -691,6 +694,9 @@ namespace TreeLod
                         "--reference-budget); images cost no timed frames, so this may be larger");
         cmd->add_option("--shadow-size", args->shadowSize,
                         "shadow map size over the script's (-1: the script's, 0: off; scaled-down runs on llvmpipe)")
+            ->capture_default_str();
+        cmd->add_option("--shadow-lod-bias", args->shadowLodBias,
+                        "LoD bias of the Forest's shadow casters over the script's (0: the script's; < 1: coarser)")
             ->capture_default_str();
         cmd->add_option("--upload-budget", args->uploadBudget,
                         "bytes of Forest levels built per frame (0 = no limit); levels waiting draw a coarser one")

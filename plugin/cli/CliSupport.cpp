@@ -110,19 +110,19 @@ namespace TreeLod
         return biases;
     }
 
-    Result<void> applyShadowSize(int size, SceneShadows& shadows)
+    Result<void> applyShadowOptions(int size, double lodBias, SceneShadows& shadows)
     {
-        if (size == -1)
-            return {};
-        if (size == 0)
-        {
-            shadows.enabled = false;
-            return {};
-        }
-        if (size < 256 || size > 16384 || (size & (size - 1)) != 0)
+        if (!(lodBias >= 0.0) || !std::isfinite(lodBias))
+            return fail("", "--shadow-lod-bias", std::to_string(lodBias) + " is not 0 (the script's) or finite and > 0");
+        if (size != -1 && size != 0 && (size < 256 || size > 16384 || (size & (size - 1)) != 0))
             return fail("", "--shadow-size",
                         std::to_string(size) + " is not -1 (the script's), 0 (off) or a power of two in 256..16384");
-        shadows.textureSize = size;
+        if (lodBias > 0.0)
+            shadows.lodBias = float(lodBias);
+        if (size == 0)
+            shadows.enabled = false;
+        else if (size > 0)
+            shadows.textureSize = size;
         return {};
     }
 }

@@ -34,10 +34,11 @@ namespace TreeLod
     /// `--lod-bias`: comma-separated finite numbers > 0, at least one.
     Result<std::vector<float>> parseLodBiases(const std::string& text);
 
-    /// `--shadow-size N` over a script's shadows: -1 keeps the script's, 0 turns them off, else a
-    /// power of two in 256..16384 (scaled-down llvmpipe runs: the map's fill does not scale with
-    /// the tree count).
-    Result<void> applyShadowSize(int size, SceneShadows& shadows);
+    /// `--shadow-size N` and `--shadow-lod-bias B` over a script's shadows. Size: -1 keeps the
+    /// script's, 0 turns them off, else a power of two in 256..16384 (scaled-down llvmpipe runs:
+    /// the map's fill does not scale with the tree count). Bias: 0 keeps the script's, else
+    /// finite and > 0 (Forest::setShadowLodBias).
+    Result<void> applyShadowOptions(int size, double lodBias, SceneShadows& shadows);
 
     /// Set the exit code a subcommand callback produced (CLI11 callbacks return void).
     void setExitCode(int code);

@@ -1,6 +1,6 @@
 // treelod_frames SCENE.json --packages LIST -o DIR [--techniques] [--lod-bias] [--frames] [--scale] [--counts]
 //                [--size] [--samples] [--reference-budget] [--reference-image-budget] [--entity-limit]
-//                [--upload-budget] [--shadow-size] [--preload] [--skip-comparisons] [-q]
+//                [--upload-budget] [--shadow-size] [--shadow-lod-bias] [--preload] [--skip-comparisons] [-q]
 //
 // The program that renders and times the frames of `treelod bench` (issue 7): it links OGRE and the
 // runtime only (Plugin_TreeLod, TreeLodOffscreen, TreeLodScene, TreeLodScript, TreeLodRuntime), never
@@ -55,7 +55,8 @@ namespace TreeLod
             std::string counts;
             std::uint64_t entityLimit = 200000;
             std::uint64_t uploadBudget = 8000000; // bytes per frame (Forest::setUploadBudget; 0 = no limit)
-            int shadowSize = -1;          // -1: the script's; 0: off (applyShadowSize)
+            int shadowSize = -1;          // -1: the script's; 0: off (applyShadowOptions)
+            double shadowLodBias = 0.0;   // 0: the script's
             bool preload = false;         // every Forest level built before the frames (no uploads timed)
             bool skipComparisons = false; // only the techniques: no reference, no floors (memory of one scene)
             bool quiet = false;
@@ -132,7 +133,7 @@ namespace TreeLod
             if (!loaded)
                 return printError(loaded.error());
             SceneScript& script = *loaded;
-            if (Result<void> shadows = applyShadowSize(args.shadowSize, script.shadows); !shadows)
+            if (Result<void> shadows = applyShadowOptions(args.shadowSize, args.shadowLodBias, script.shadows); !shadows)
                 return printError(shadows.error());
             if (!(args.scale > 0.0) || !std::isfinite(args.scale))
                 return printError(fail("", "--scale", "must be a positive number"));
@@ -214,6 +215,7 @@ namespace TreeLod
                                   {"sampled", sampled},
                                   {"scale", args.scale},
                                   {"shadowMap", script.shadows.enabled ? script.shadows.textureSize : 0},
+                                  {"shadowLodBias", script.shadows.lodBias},
                                   {"renderer", renderer.getRoot().getRenderSystem()->getName()},
                                   {"complete", complete},
                                   {"runs", runsJson}};
@@ -383,6 +385,9 @@ int main(int argc, char** argv)
                    "bytes of Forest levels built per frame (0 = no limit); levels waiting draw a coarser one")
         ->capture_default_str();
     app.add_option("--shadow-size", args.shadowSize, "shadow map size over the script's (-1: the script's, 0: off)")
+        ->capture_default_str();
+    app.add_option("--shadow-lod-bias", args.shadowLodBias,
+                   "LoD bias of the Forest's shadow casters over the script's (0: the script's; < 1: coarser)")
         ->capture_default_str();
     app.add_flag("--preload", args.preload,
                  "build every Forest level before the frames (Forest::makeAllResident: nothing uploaded while timing)");

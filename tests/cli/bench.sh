@@ -95,8 +95,10 @@ grep -q "bad.json: line" "$out/bad.txt" || { cat "$out/bad.txt"; fail "error doe
 # --shadow-size: 0 turns the script's shadows off (recorded), a size that is no power of two is
 # refused before anything is written.
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/noshadow" --frames 2 --size 64x36 \
-  --techniques lodf --lod-bias 1 --samples 1 --cache "$cache" --shadow-size 0 -q
+  --techniques lodf --lod-bias 1 --samples 1 --cache "$cache" --shadow-size 0 --shadow-lod-bias 0.5 -q
 grep -q '"shadowMap": 0' "$out/noshadow/summary.json" || fail "--shadow-size 0 not recorded"
+grep -q '"shadowLodBias": 0.5' "$out/noshadow/summary.json" || fail "--shadow-lod-bias 0.5 not recorded"
+grep -q '"shadowLodBias": 0.5' "$out/noshadow/timings.json" || fail "--shadow-lod-bias did not reach treelod_frames"
 grep -Eq '"shadowMap": [1-9]' "$out/single/summary.json" || fail "the script's shadow map not recorded"
 set +e
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/badshadow" --shadow-size 300 -q 2> "$out/badshadow.txt"
@@ -105,4 +107,10 @@ set -e
 [ "$code" = 2 ] || fail "--shadow-size 300: exit $code, expected 2"
 grep -q -- "--shadow-size: 300 is not" "$out/badshadow.txt" || { cat "$out/badshadow.txt"; fail "no reason given"; }
 [ ! -e "$out/badshadow" ] || fail "a bad --shadow-size created its output directory"
+set +e
+"$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/badbias" --shadow-lod-bias -1 -q 2> "$out/badbias.txt"
+code=$?
+set -e
+[ "$code" = 2 ] && grep -q -- "--shadow-lod-bias" "$out/badbias.txt" || { cat "$out/badbias.txt"; fail "--shadow-lod-bias -1 accepted"; }
+[ ! -e "$out/badbias" ] || fail "a bad --shadow-lod-bias created its output directory"
 echo "bench test passed"

@@ -243,6 +243,11 @@ namespace TreeLod
             {"\"techniques\": \"auto\"", "\"techniques\": [{\"technique\": \"Bill Board\"}]", "\"technique\":",
              "/species/0/techniques/0/technique", "not a technique name"},
             {"[-10, -10, 10, 10]", "[-10, -10, 10, 60]", "60", "/placements/0/random/area/rect/3", "<= 50"},
+            // the shadow casters' LoD bias (Forest::setShadowLodBias)
+            {"\"frames\": 2", "\"frames\": 2, \"shadows\": {\"enabled\": true, \"lodBias\": 0}", "\"lodBias\"",
+             "/shadows/lodBias", "must be > 0"},
+            {"\"frames\": 2", "\"frames\": 2, \"shadows\": {\"enabled\": true, \"lodBias\": \"low\"}", "\"lodBias\"",
+             "/shadows/lodBias", "expected a number"},
         };
         for (const Case& c : cases)
         {
@@ -252,6 +257,19 @@ namespace TreeLod
             EXPECT_EQ(message.rfind(expected, 0), 0u) << "expected '" << expected << "' in\n" << message;
             EXPECT_NE(message.find(c.reason), std::string::npos) << message;
         }
+    }
+
+    TEST(SceneScript, shadowsTakeACasterLodBias)
+    {
+        Result<SceneScript> plain = parseSceneScript(
+            replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"shadows\": {\"enabled\": true}"), "test.json", "");
+        ASSERT_TRUE(plain.ok()) << plain.error().message();
+        EXPECT_EQ(plain->shadows.lodBias, 1.0f);
+        Result<SceneScript> coarse = parseSceneScript(
+            replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"shadows\": {\"enabled\": true, \"lodBias\": 0.25}"),
+            "test.json", "");
+        ASSERT_TRUE(coarse.ok()) << coarse.error().message();
+        EXPECT_EQ(coarse->shadows.lodBias, 0.25f);
     }
 
     TEST(SceneScript, techniqueBandsParseAndMustBeOrdered)

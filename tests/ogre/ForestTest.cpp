@@ -693,6 +693,22 @@ namespace TreeLod
         const Image cloudForest = toImage(r.render(view, 192, 160, 2));
         place(separateClouds, true);
         const Image cloudSeparate = toImage(r.render(view, 192, 160, 2));
+        // Shadow LoD bias: the view keeps its levels (the mesh), the casters drop to the quad.
+        Forest* biased = nullptr;
+        auto meshOrQuad = [&](Ogre::Real shadowLodBias) {
+            return [&, shadowLodBias](Ogre::SceneNode& node) {
+                forestOf({ForestLevel{"mesh", 0, false, 1.0f}, ForestLevel{"quad", 0, false, 0.0f}})(node);
+                biased = static_cast<Forest*>(node.getAttachedObject(0));
+                biased->setShadowLodBias(shadowLodBias);
+            };
+        };
+        place(meshOrQuad(1.0f), true);
+        const Image casterMesh = toImage(r.render(view, 192, 160, 2));
+        place(meshOrQuad(1e-9f), true);
+        const Image casterQuad = toImage(r.render(view, 192, 160, 2));
+        EXPECT_EQ(biased->getStats().levelCounts.at(0), (std::vector<std::uint32_t>{2u, 0u})) << "the view's levels";
+        EXPECT_THROW(biased->setShadowLodBias(0.0f), Ogre::InvalidParametersException);
+        EXPECT_THROW(biased->setShadowLodBias(std::nanf("")), Ogre::InvalidParametersException);
         // LiSPSM (paper 000 §5.2): a perspective shadow camera with its own matrices culls too.
         place(forestTrees, true);
         r.setShadows(true, 1024, ShadowCamera::LiSPSM);
@@ -712,8 +728,16 @@ namespace TreeLod
         // Not 0: the focused shadow camera frames the Forest's bounds (spheres), not the
         // Entities' boxes, so the shadow texels fall differently.
         EXPECT_LT(error, 0.015) << "instanced casters and receivers as the separate objects'";
+        const double sameCasters = flipMean(casterMesh, shadowed), quadCasters = flipMean(casterQuad, casterMesh);
+        const double dropQuadCasters = meanLuminance(plain) - meanLuminance(casterQuad);
+        std::printf("shadow LoD bias: mesh casters vs the mesh Forest FLIP %.5f, quad casters vs mesh casters FLIP "
+                    "%.5f, luminance drop %.4f\n", sameCasters, quadCasters, dropQuadCasters);
+        // Not 0 either: this Forest's bounds hold the quad level too (the focused camera frames them).
+        EXPECT_LT(sameCasters, 0.015) << "bias 1: the casters are the view's levels";
+        EXPECT_GT(quadCasters, 3.0 * sameCasters) << "bias 1e-9: the casters must be the quads";
+        EXPECT_GT(dropQuadCasters, 0.25 * drop) << "quad casters still shade the ground";
         writePng(OgreEnvironment::outDir() + "/forest-shadows-strip.png",
-                 sideBySide({plain, shadowed, separate, lispsm, cloudForest, cloudSeparate}));
+                 sideBySide({plain, shadowed, separate, lispsm, cloudForest, cloudSeparate, casterMesh, casterQuad}));
         compareWithGolden(shadowed, "forest-shadows", 0.02);
     }
 

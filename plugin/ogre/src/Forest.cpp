@@ -764,6 +764,14 @@ namespace TreeLod
         mLodBias = bias;
     }
 
+    void Forest::setShadowLodBias(Ogre::Real bias)
+    {
+        if (!std::isfinite(bias) || !(bias > 0.0f))
+            invalid("Forest '" + mName + "': shadow LoD bias " + std::to_string(bias) + " is not finite and > 0",
+                    "Forest::setShadowLodBias");
+        mShadowLodBias = bias;
+    }
+
     void Forest::setLodFrozen(bool frozen) { mLodFrozen = frozen; }
 
     bool Forest::useShadowedMaterials() const
@@ -970,9 +978,9 @@ namespace TreeLod
         Ogre::Camera* camera = mCurrentCamera;
         if (!camera || mSpecies.empty())
             return;
-        const bool viewer = camera->getLodCamera() == camera &&
-                            !(mManager && mManager->_getCurrentRenderStage() ==
-                                              Ogre::SceneManager::IRS_RENDER_TO_TEXTURE);
+        const bool shadowTexture =
+            mManager && mManager->_getCurrentRenderStage() == Ogre::SceneManager::IRS_RENDER_TO_TEXTURE;
+        const bool viewer = camera->getLodCamera() == camera && !shadowTexture;
         std::unique_ptr<CameraState>& entry = mCameras[camera];
         if (!entry)
         {
@@ -998,7 +1006,7 @@ namespace TreeLod
             state.camera.lodPosition = glm::vec3(eye.x, eye.y, eye.z);
             state.camera.lodPixelScale = area * std::abs(projection[0][0] * projection[1][1]);
             state.camera.lodOrthographic = lod->getProjectionType() == Ogre::PT_ORTHOGRAPHIC;
-            state.lodBias = lod->getLodBias() * mLodBias;
+            state.lodBias = lod->getLodBias() * mLodBias * (shadowTexture ? mShadowLodBias : 1.0f);
             state.hasLod = true;
         }
 

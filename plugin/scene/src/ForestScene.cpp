@@ -212,6 +212,7 @@ namespace TreeLod
         mForestNode = mParent.createChildSceneNode();
         mForestNode->attachObject(mForest);
         mForest->setUploadBudget(mOptions.uploadBudget);
+        mForest->setShadowLodBias(mScript.shadows.lodBias);
 
         // Bands per species; then one bake request per distinct source with every technique its
         // species draw (two species sharing a file share one package and one asset).

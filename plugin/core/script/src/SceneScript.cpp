@@ -854,7 +854,7 @@ namespace TreeLod
 
         SceneShadows readShadows(const Json& j, const std::string& pointer)
         {
-            allowKeys(j, pointer, {"enabled", "textureSize", "camera"});
+            allowKeys(j, pointer, {"enabled", "textureSize", "camera", "lodBias"});
             SceneShadows s;
             s.enabled = flag(need(j, pointer, "enabled"), child(pointer, "enabled"));
             if (const Json* v = find(j, "textureSize"))
@@ -870,6 +870,8 @@ namespace TreeLod
                     bad(child(pointer, "camera"),
                         "unknown shadow camera '" + s.camera + "' (expected focused, lispsm)");
             }
+            if (const Json* v = find(j, "lodBias"))
+                s.lodBias = float(number(*v, child(pointer, "lodBias"), 0.0, 1e6, true));
             return s;
         }
 

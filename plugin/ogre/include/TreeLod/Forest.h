@@ -14,7 +14,7 @@
 // Every frame and for every camera that renders the Forest (the viewer's and the shadow
 // cameras), _updateRenderQueue culls all instances against that camera's frustum and picks each
 // visible one's level from its LoD camera (Camera::getLodCamera(), so shadows see the viewer's
-// levels) in one loop (ForestInstances::cull), then queues one instanced draw per (species,
+// levels, times setShadowLodBias) in one loop (ForestInstances::cull), then queues one instanced draw per (species,
 // level, part) with at least one instance: the instance data (24 bytes: position + scale as
 // uv4 float4, cos/sin of the rotation about +Y as uv5 float2) goes into a per-camera,
 // per-bucket instance vertex buffer written with HBL_DISCARD and grown by doubling. Parts are
@@ -160,6 +160,11 @@ namespace TreeLod
         /// Multiplies the camera's LoD bias (> 0).
         void setLodBias(Ogre::Real bias);
         Ogre::Real getLodBias() const { return mLodBias; }
+        /// Multiplies the LoD value of shadow casters (> 0; default 1: the viewer's levels). Below
+        /// 1 the shadow textures draw coarser levels than the view: their fill, not the view's,
+        /// bounds the worst frames when a shadow camera magnifies the trees near the viewer (LiSPSM).
+        void setShadowLodBias(Ogre::Real bias);
+        Ogre::Real getShadowLodBias() const { return mShadowLodBias; }
         /// Keep the LoD camera of the last frame (levels stop changing; culling goes on).
         void setLodFrozen(bool frozen);
         bool isLodFrozen() const { return mLodFrozen; }
@@ -229,6 +234,7 @@ namespace TreeLod
         Ogre::AxisAlignedBox mBounds;
         Ogre::Real mRadius = 0.0f;
         Ogre::Real mLodBias = 1.0f;
+        Ogre::Real mShadowLodBias = 1.0f;
         bool mLodFrozen = false;
         ForestStats mStats;
         std::uint64_t mInstanceBufferBytes = 0;

@@ -131,6 +131,7 @@ namespace TreeLod
         bool enabled = false;
         int textureSize = 2048;       ///< power of two, 256..16384
         std::string camera = "focused"; ///< "focused" | "lispsm" (Ogre's shadow camera setups)
+        float lodBias = 1.0f;           ///< Forest::setShadowLodBias: < 1 = coarser casters than the view
     };
 
     struct SceneKeyframe
