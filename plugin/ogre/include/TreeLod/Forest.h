@@ -14,12 +14,13 @@
 // Every frame and for every camera that renders the Forest (the viewer's and the shadow
 // cameras), _updateRenderQueue culls all instances against that camera's frustum and picks each
 // visible one's level from its LoD camera (Camera::getLodCamera(), so shadows see the viewer's
-// levels, times setShadowLodBias) in one loop (ForestInstances::cull), then queues one instanced draw per (species,
-// level, part) with at least one instance: the instance data (24 bytes: position + scale as
-// uv4 float4, cos/sin of the rotation about +Y as uv5 float2) goes into a per-camera,
-// per-bucket instance vertex buffer written with HBL_DISCARD and grown by doubling. Parts are
-// drawn with instanced clones of the asset's materials (vertex programs with INSTANCED=1), and
-// their shadow-receiving / caster variants under integrated texture shadows.
+// levels, times setShadowLodBias) in one loop (ForestInstances::cull), then queues one
+// instanced draw per (species, level, part) with at least one instance: the instance data
+// (24 bytes: position + scale as uv4 float4, cos/sin of the rotation about +Y as uv5 float2)
+// goes into a per-camera, per-bucket instance vertex buffer written with HBL_DISCARD and grown
+// by doubling. Parts are drawn with instanced clones of the asset's materials (vertex programs
+// with INSTANCED=1), and their shadow-receiving / caster variants under integrated texture
+// shadows.
 //
 // LoD value: Ogre's absolute pixel count (4 pi r_px^2 of the instance's bounding sphere, see
 // ForestInstances.h) times the camera's LoD bias times the Forest's own bias. Instances are in
