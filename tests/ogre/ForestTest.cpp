@@ -3,7 +3,9 @@
 // BillboardCloudTree under SceneNodes: the test of the INSTANCED vertex programs' rotation,
 // scale and normals); the quad level; culling and level counts against ForestInstances::cull;
 // LoD at 10 km, inside a crown, with bias and frozen; texture shadows cast and received; bad
-// input; two species of one asset, one instance and 20,000 quads; levels from bands.
+// input; two species of one asset, one instance, 20,000 quads and 1,000,000 in one draw; levels
+// from bands; residency within an upload budget; camera states freed with their cameras; the
+// shadow casters' LoD bias.
 //
 // The package (reference, lodf, billboard-cloud, impostor of media/oak.glb) is baked here with
 // the core bakers (few AO rays) and cached in $TREELOD_TEST_OUT/forest, keyed by this binary's
@@ -873,6 +875,59 @@ namespace TreeLod
         r.render(over, 256, 160, 1);
         EXPECT_EQ(forest->getStats().instanceBufferBytes, bytes);
         compareWithGolden(many, "forest-20k-quads", 0.02);
+    }
+
+    TEST(Forest, aMillionTreesInOneDraw)
+    {
+        // Issue 7's extreme: 1,000,000 instances all in view draw in one instanced call of 2 M
+        // triangles (no 16-bit count anywhere on the way), the store at ~30 bytes a tree and the
+        // instance buffer at 24 (grown by doubling) a visible tree.
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+        Forest* forest = placeForest();
+        forest->addSpecies(tree.asset, {ForestLevel{"quad", 0, false, 0.0f}});
+        // Trees 16x their size (overlapping) so that each covers pixels from afar: were only the first
+        // 1,000,000 mod 65,536 instances drawn (a 16-bit count), they would fill one corner of the
+        // Z-ordered store, not every part of the picture.
+        std::vector<ForestInstance> trees = grid(1000, 0.5f * h);
+        for (ForestInstance& t : trees)
+            t.scale *= 16.0f;
+        forest->addInstances(trees);
+        const float half = 500.0f * 0.5f * h;
+        // 45 degrees down onto the middle (the quads are upright: seen from straight above they vanish).
+        const CameraSpec above = look(glm::vec3(0.0f, 1.6f * half, 1.6f * half), glm::vec3(0.0f), 60.0f);
+        const Image image = toImage(r.render(above, 160, 120, 1));
+        const ForestStats& stats = forest->getStats();
+        std::printf("1M quads: %u visible, %u batches, %llu triangles, cull %.1f ms, store %.1f B a tree, "
+                    "instance buffer %.1f MB\n",
+                    stats.visibleInstances, stats.batches, (unsigned long long)stats.triangles, stats.cullMilliseconds,
+                    double(forest->getInstances().getMemoryBytes()) / double(stats.instances),
+                    double(stats.instanceBufferBytes) / 1e6);
+        EXPECT_EQ(stats.instances, 1000000u);
+        EXPECT_EQ(stats.visibleInstances, 1000000u);
+        EXPECT_EQ(stats.batches, 1u);
+        EXPECT_EQ(stats.triangles, 2000000u);
+        EXPECT_LE(forest->getInstances().getMemoryBytes(), 32u * 1000000u);
+        EXPECT_GE(stats.instanceBufferBytes, 24u * 1000000u);
+        EXPECT_LE(stats.instanceBufferBytes, 2u * 24u * 1000000u);
+        writePng(OgreEnvironment::outDir() + "/forest-1m-quads.png", image);
+        // Trees around the middle of each quarter of the grid (projected with the camera).
+        const Ogre::Matrix4 viewProjection = ogreCamera().getProjectionMatrix() * ogreCamera().getViewMatrix();
+        for (const glm::vec2 q : {glm::vec2(-0.5f, -0.5f), glm::vec2(0.5f, -0.5f), glm::vec2(-0.5f, 0.5f),
+                                  glm::vec2(0.5f, 0.5f)})
+        {
+            const Ogre::Vector3 ndc = viewProjection * Ogre::Vector3(q.x * half, 0.0f, q.y * half);
+            const int cx = int((ndc.x * 0.5f + 0.5f) * float(image.width));
+            const int cy = int((0.5f - ndc.y * 0.5f) * float(image.height));
+            Image window(6, 4);
+            for (int y = 0; y < window.height; ++y)
+                for (int x = 0; x < window.width; ++x)
+                    window.at(x, y) = image.at(std::clamp(cx - 3 + x, 0, image.width - 1),
+                                               std::clamp(cy - 2 + y, 0, image.height - 1));
+            EXPECT_GT(treeCoverage(window, BACKGROUND), 0.9) << "quarter " << q.x << ", " << q.y << " at pixel "
+                                                             << cx << ", " << cy;
+        }
     }
 
     TEST(Forest, levelsForBandsFollowTheTechniquesCurves)
