@@ -1,17 +1,16 @@
 // treelod info FILE [--json]
 // What a .treelod package holds (version, size, chunks with their checksums, the reference
-// model's counts) or what a .glb/.gltf imports to (the same counts plus texture sizes).
+// model's counts, what each technique's descriptor says of its chunk) or what a .glb/.gltf imports
+// to (the same counts plus texture sizes).
 // The kind is told by content (the "TRLD" magic), not by extension. A package with a damaged
 // chunk is still listed (crc "BAD"), then the command exits 2.
 #include "CliSupport.h"
 #include "Commands.h"
 
-#include "TreeLod/BillboardCloudData.h"
-#include "TreeLod/FoliageLodData.h"
 #include "TreeLod/GltfImporter.h"
-#include "TreeLod/ImpostorData.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
+#include "TreeLod/TechniqueDescriptor.h"
 
 #include <nlohmann/json.hpp>
 
@@ -112,9 +111,8 @@ namespace TreeLod
             json chunks = json::array();
             std::vector<bool> crcOk(reader.chunks().size(), false);
             std::optional<ReferenceChunk> reference;
-            std::optional<FoliageLodData> foliageLod;
-            std::vector<BillboardCloudData> clouds; ///< billboard-cloud, classic-billboard-cloud
-            std::optional<ImpostorData> impostor;
+            /// (chunk index, summary) of every chunk a registered technique decoded.
+            std::vector<std::pair<std::size_t, ChunkSummary>> summaries;
             json meta;
             for (std::size_t i = 0; i < reader.chunks().size(); ++i)
             {
@@ -138,57 +136,33 @@ namespace TreeLod
                     meta = json::parse(text, nullptr, false);
                     if (meta.is_discarded())
                         meta = text;
+                    continue;
                 }
-                else if (c.technique == REFERENCE_CHUNK && c.level == 0)
+                const TechniqueDescriptor* technique = findTechniqueDescriptor(c.technique);
+                if (!technique)
+                    continue; // a chunk of a technique this build does not know: listed only
+                if (c.formatVersion != technique->formatVersion)
                 {
-                    if (c.formatVersion != REFERENCE_CHUNK_FORMAT_VERSION)
-                    {
-                        if (!firstError)
-                            firstError = fail(reader.label(), c.element(),
-                                              "unsupported format version " + std::to_string(c.formatVersion) +
-                                                  ", this build reads " +
-                                                  std::to_string(REFERENCE_CHUNK_FORMAT_VERSION));
-                        continue;
-                    }
+                    if (!firstError)
+                        firstError = fail(reader.label(), c.element(),
+                                          "unsupported format version " + std::to_string(c.formatVersion) +
+                                              ", this build reads " + std::to_string(technique->formatVersion));
+                    continue;
+                }
+                Result<ChunkSummary> summary = technique->inspect(bytes.value(), reader.label());
+                if (!summary)
+                {
+                    if (!firstError)
+                        firstError = summary.error();
+                    continue;
+                }
+                summaries.emplace_back(i, std::move(summary.value()));
+                // The model, printed as for glTF input.
+                if (c.technique == REFERENCE_CHUNK && c.level == 0)
+                {
                     Result<ReferenceChunk> decoded = decodeReferenceChunk(bytes.value(), reader.label());
                     if (decoded)
                         reference = std::move(decoded.value());
-                    else if (!firstError)
-                        firstError = decoded.error();
-                }
-                else if (c.technique == FOLIAGE_LOD_CHUNK && c.level == 0)
-                {
-                    Result<FoliageLodData> decoded = decodeFoliageLodChunk(bytes.value(), reader.label());
-                    if (decoded)
-                        foliageLod = std::move(decoded.value());
-                    else if (!firstError)
-                        firstError = decoded.error();
-                }
-                else if ((c.technique == BILLBOARD_CLOUD_CHUNK || c.technique == CLASSIC_BILLBOARD_CLOUD_CHUNK) &&
-                         c.level == 0)
-                {
-                    Result<BillboardCloudData> decoded = decodeBillboardCloudChunk(bytes.value(), reader.label());
-                    if (decoded)
-                        clouds.push_back(std::move(decoded.value()));
-                    else if (!firstError)
-                        firstError = decoded.error();
-                }
-                else if (c.technique == IMPOSTOR_CHUNK && c.level == 0)
-                {
-                    if (c.formatVersion != IMPOSTOR_CHUNK_FORMAT_VERSION)
-                    {
-                        if (!firstError)
-                            firstError = fail(reader.label(), c.element(),
-                                              "unsupported format version " + std::to_string(c.formatVersion) +
-                                                  ", this build reads " +
-                                                  std::to_string(IMPOSTOR_CHUNK_FORMAT_VERSION));
-                        continue;
-                    }
-                    Result<ImpostorData> decoded = decodeImpostorChunk(bytes.value(), reader.label());
-                    if (decoded)
-                        impostor = std::move(decoded.value());
-                    else if (!firstError)
-                        firstError = decoded.error();
                 }
             }
 
@@ -209,41 +183,13 @@ namespace TreeLod
                     j["meta"] = meta;
                 if (reference)
                     j["model"] = modelJson(reference->model, textures); // same key as for glTF input
-                if (foliageLod)
-                    j["lodf"] = {{"leaves", foliageLod->maxLeafCount()},
-                                 {"coarsestLeaves", foliageLod->minLeafCount()},
-                                 {"clusters", foliageLod->clusters.size()},
-                                 {"storedLeaves", foliageLod->entries.size()},
-                                 {"collapses", foliageLod->changedGroup.size()},
-                                 {"paperWords", foliageLod->paperWords()},
-                                 {"eq9Words", foliageLod->paperEq9Words()},
-                                 {"bytes", foliageLod->byteSize()}};
-                for (const BillboardCloudData& cloud : clouds)
+                for (const auto& [index, summary] : summaries)
                 {
-                    json levels = json::array();
-                    for (const BillboardCloudLevel& level : cloud.levels)
-                        levels.push_back({{"billboards", level.billboardCount},
-                                          {"layered", level.layered},
-                                          {"cellSize", level.cellSize},
-                                          {"lowResTexelSize", level.lowResTexelSize}});
-                    j[cloud.classic ? CLASSIC_BILLBOARD_CLOUD_CHUNK : BILLBOARD_CLOUD_CHUNK] = {
-                        {"levels", levels},
-                        {"listEntries", cloud.entries.size()},
-                        {"hashAtlas", {cloud.hashAtlasWidth, cloud.hashAtlasHeight}},
-                        {"listsAtlas", {cloud.listsAtlasWidth, cloud.listsAtlasHeight}},
-                        {"leavesTexture", {cloud.leavesColour.width, cloud.leavesColour.height}},
-                        {"lowResTexture", {cloud.lowRes.width, cloud.lowRes.height}},
-                        {"gpuBytes", cloud.gpuBytes()}};
+                    const ChunkInfo& c = reader.chunks()[index];
+                    const std::string key = c.level == 0 ? c.technique : c.technique + "/" + std::to_string(c.level);
+                    if (c.technique != REFERENCE_CHUNK) // the model above says more
+                        j[key] = json::parse(summary.json, nullptr, false);
                 }
-                if (impostor)
-                    j[IMPOSTOR_CHUNK] = {{"halfWidth", impostor->halfWidth},
-                                         {"bottom", impostor->bottom},
-                                         {"top", impostor->top},
-                                         {"alphaCutoff", impostor->alphaCutoff},
-                                         {"texture", {impostor->colour.width, impostor->colour.height}},
-                                         {"mipCount", impostor->colour.mipCount},
-                                         {"compressed", isBlockCompressed(impostor->colour.format)},
-                                         {"gpuBytes", impostor->gpuBytes()}};
                 if (firstError)
                     j["error"] = firstError->message();
                 std::printf("%s\n", j.dump(2, ' ', false, json::error_handler_t::replace).c_str());
@@ -270,35 +216,14 @@ namespace TreeLod
                 }
                 if (reference)
                     printModel(reference->model, textures);
-                if (foliageLod)
-                    std::printf("lodf: %u leaves down to %u (%zu clusters), %zu stored leaves (2L - clusters), "
-                                "%llu words as paper 004 counts them (eq. 9: %llu), %llu bytes\n",
-                                foliageLod->maxLeafCount(), foliageLod->minLeafCount(), foliageLod->clusters.size(),
-                                foliageLod->entries.size(), (unsigned long long)foliageLod->paperWords(),
-                                (unsigned long long)foliageLod->paperEq9Words(),
-                                (unsigned long long)foliageLod->byteSize());
-                for (const BillboardCloudData& cloud : clouds)
+                for (const auto& [index, summary] : summaries)
                 {
-                    std::string counts;
-                    for (const BillboardCloudLevel& level : cloud.levels)
-                        counts += (counts.empty() ? "" : " / ") + std::to_string(level.billboardCount) +
-                                  (level.layered ? "" : " (low-res)");
-                    std::printf("%s: %s billboards, %zu list entries, hash atlas %ux%u, lists atlas %ux%u, leaves "
-                                "texture %ux%u, low-res texture %ux%u, %llu bytes on the GPU\n",
-                                cloud.classic ? CLASSIC_BILLBOARD_CLOUD_CHUNK : BILLBOARD_CLOUD_CHUNK, counts.c_str(),
-                                cloud.entries.size(), cloud.hashAtlasWidth, cloud.hashAtlasHeight,
-                                cloud.listsAtlasWidth, cloud.listsAtlasHeight, cloud.leavesColour.width,
-                                cloud.leavesColour.height, cloud.lowRes.width, cloud.lowRes.height,
-                                (unsigned long long)cloud.gpuBytes());
+                    const ChunkInfo& c = reader.chunks()[index];
+                    if (c.technique == REFERENCE_CHUNK)
+                        continue; // printModel above
+                    std::printf("%s%s: %s\n", c.technique.c_str(),
+                                c.level == 0 ? "" : (" level " + std::to_string(c.level)).c_str(), summary.text.c_str());
                 }
-                if (impostor)
-                    std::printf("%s: quad %.3f x %.3f m (y %.3f .. %.3f), colour and normal textures %ux%u %s, %u "
-                                "mip levels, alpha cutoff %.2f, %llu bytes on the GPU\n",
-                                IMPOSTOR_CHUNK, 2.0f * impostor->halfWidth, impostor->top - impostor->bottom,
-                                impostor->bottom, impostor->top, impostor->colour.width, impostor->colour.height,
-                                isBlockCompressed(impostor->colour.format) ? "DXT5 / DXT1" : "RGBA8",
-                                impostor->colour.mipCount, impostor->alphaCutoff,
-                                (unsigned long long)impostor->gpuBytes());
             }
             if (firstError)
                 return printError(*firstError);

@@ -1,20 +1,15 @@
-// libFuzzer target: PackageReader::fromMemory on arbitrary bytes, then every chunk read,
-// every "reference" chunk decoded, every "lodf" chunk decoded and walked through its
-// levels as FoliageLodTree does (writeCluster must stay inside each cluster's region), and
-// every "billboard-cloud" / "classic-billboard-cloud" chunk decoded and sampled as the
-// shader addresses it (BillboardCloudSampler), and every "impostor" chunk decoded and its
-// texture mips walked. Must never crash, read out of bounds or
+// libFuzzer target: PackageReader::fromMemory on arbitrary bytes, then every chunk read and,
+// for every registered technique (TechniqueDescriptor.h), decoded and validated (inspect) and
+// walked as a renderer reads it (the descriptor's fuzz hook: LoDF levels written cluster by
+// cluster, billboard-cloud list walks, texture mips). Must never crash, read out of bounds or
 // allocate more than a small multiple of the input (Package.h, "Hostile input").
 //
 // Seeds: tests/fuzz/corpus/package/ (small valid packages). The chunk CRCs stop most
 // mutations at readChunk; the input's last byte may ask the fuzzer to skip those checks by
 // resealing the checksums, so the decoders behind them are fuzzed too.
-#include "TreeLod/BillboardCloudData.h"
 #include "TreeLod/Crc32.h"
-#include "TreeLod/FoliageLodState.h"
-#include "TreeLod/ImpostorData.h"
-#include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
+#include "TreeLod/TechniqueDescriptor.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -77,67 +72,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         TreeLod::Result<std::vector<std::uint8_t>> chunk = reader->readChunk(i);
         if (!chunk)
             continue;
-        if (reader->chunks()[i].technique == TreeLod::REFERENCE_CHUNK)
-        {
-            TreeLod::Result<TreeLod::ReferenceChunk> decoded = TreeLod::decodeReferenceChunk(chunk.value(), "fuzz");
-            if (decoded)
-            {
-                // What a loader does next: walk the mips of each texture.
-                for (const TreeLod::GpuTexture& t : decoded->textures)
-                    for (std::uint32_t level = 0; level < t.mipCount; ++level)
-                        if (t.mipOffset(level) + t.mipBytes(level) > t.data.size())
-                            __builtin_trap();
-            }
-        }
-        else if (reader->chunks()[i].technique == TreeLod::BILLBOARD_CLOUD_CHUNK ||
-                 reader->chunks()[i].technique == TreeLod::CLASSIC_BILLBOARD_CLOUD_CHUNK)
-        {
-            TreeLod::Result<TreeLod::BillboardCloudData> decoded =
-                TreeLod::decodeBillboardCloudChunk(chunk.value(), "fuzz");
-            if (!decoded)
-                continue;
-            // What the shader does per fragment: hash fetch, list walk from either end; every
-            // entry and tile it reads must exist.
-            const TreeLod::BillboardCloudSampler sampler(decoded.value());
-            const std::uint32_t billboards = std::uint32_t(decoded->billboards.size());
-            for (std::uint32_t b = 0; b < billboards && b < 64; ++b)
-                for (float uv : {0.0f, 0.37f, 0.5f, 1.0f})
-                    for (bool front : {true, false})
-                        for (const TreeLod::BillboardCloudSampler::Fragment& f : sampler.walk(b, uv, 1.0f - uv, front))
-                            if (f.entry >= decoded->entries.size() || f.tile >= decoded->tileCount())
-                                __builtin_trap();
-            sampler.walk(billboards, 0.5f, 0.5f, true); // out of range: no fragments, no crash
-        }
-        else if (reader->chunks()[i].technique == TreeLod::IMPOSTOR_CHUNK)
-        {
-            TreeLod::Result<TreeLod::ImpostorData> decoded = TreeLod::decodeImpostorChunk(chunk.value(), "fuzz");
-            if (!decoded)
-                continue;
-            // What TreeAsset::getImpostorGpu uploads: every mip of both textures.
-            for (const TreeLod::GpuTexture* t : {&decoded->colour, &decoded->normal})
-                for (std::uint32_t level = 0; level < t->mipCount; ++level)
-                    if (t->mipOffset(level) + t->mipBytes(level) > t->data.size())
-                        __builtin_trap();
-        }
-        else if (reader->chunks()[i].technique == TreeLod::FOLIAGE_LOD_CHUNK)
-        {
-            TreeLod::Result<TreeLod::FoliageLodData> decoded = TreeLod::decodeFoliageLodChunk(chunk.value(), "fuzz");
-            if (!decoded)
-                continue;
-            TreeLod::FoliageLodState state(decoded.value());
-            const std::uint32_t lo = decoded->minLeafCount(), hi = decoded->maxLeafCount();
-            for (std::uint32_t target : {lo, (lo + hi) / 2, hi + 1, 0u})
-            {
-                state.setLeafCount(target);
-                for (std::uint32_t c : state.changedClusters())
-                {
-                    // A region of exactly slotCount: ASan reports any write past it.
-                    std::vector<std::uint32_t> region(decoded->clusters[c].slotCount);
-                    if (!region.empty() && state.writeCluster(c, region.data()) > region.size())
-                        __builtin_trap();
-                }
-            }
-        }
+        // Every registered technique: what `treelod info` and a loader do (decode, validate), then
+        // what a renderer reads from the result (the descriptor's fuzz hook).
+        const TreeLod::TechniqueDescriptor* technique =
+            TreeLod::findTechniqueDescriptor(reader->chunks()[i].technique);
+        if (!technique)
+            continue;
+        technique->inspect(chunk.value(), "fuzz");
+        if (technique->fuzz)
+            technique->fuzz(chunk.value());
     }
     reader->findChunk(TreeLod::REFERENCE_CHUNK, 0);
     return 0;

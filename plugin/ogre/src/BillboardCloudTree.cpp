@@ -54,7 +54,7 @@ namespace TreeLod
     const Ogre::String BillboardCloudTreeFactory::FACTORY_TYPE_NAME = "BillboardCloudTree";
 
     BillboardCloudTree::BillboardCloudTree(const Ogre::String& name, const TreeAssetPtr& asset, const Options& options)
-        : Ogre::MovableObject(name), mAsset(asset), mGpu(&asset->getBillboardCloudGpu(options.classic)),
+        : Ogre::MovableObject(name), mAsset(asset), mGpu(&BillboardCloudResources::of(*asset, options.classic).getGpu()),
           mOptions(options)
     {
         const std::uint32_t levels = getLevelCount();
@@ -81,10 +81,11 @@ namespace TreeLod
         {
             // ambientOcclusion=false: the reference's own bark (no AO), lit like the polygonal tree.
             const bool ao = mOptions.ambientOcclusion;
-            mBarkMesh = ao ? mAsset->getBarkAoMesh(mOptions.classic) : mAsset->getBarkMesh();
-            const std::vector<Ogre::String>& plain = ao ? mAsset->getBarkAoMaterialNames(false)
+            BillboardCloudResources& cloud = BillboardCloudResources::of(*mAsset, mOptions.classic);
+            mBarkMesh = ao ? cloud.getBarkAoMesh() : mAsset->getBarkMesh();
+            const std::vector<Ogre::String>& plain = ao ? cloud.getBarkAoMaterialNames(false)
                                                         : mAsset->getMaterialNames();
-            const std::vector<Ogre::String>& shadowed = ao ? mAsset->getBarkAoMaterialNames(true)
+            const std::vector<Ogre::String>& shadowed = ao ? cloud.getBarkAoMaterialNames(true)
                                                            : mAsset->getShadowedMaterialNames();
             for (Ogre::SubMesh* sub : mBarkMesh->getSubMeshes())
             {

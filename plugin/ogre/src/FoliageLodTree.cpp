@@ -3,6 +3,7 @@
 #include "ObjectParams.h"
 #include "TreePart.h"
 
+#include "TreeLod/FoliageLodResources.h"
 #include "TreeLod/TreeAssetManager.h"
 
 #include <OgreCamera.h>
@@ -43,7 +44,7 @@ namespace TreeLod
     const Ogre::String FoliageLodTreeFactory::FACTORY_TYPE_NAME = "FoliageLodTree";
 
     FoliageLodTree::FoliageLodTree(const Ogre::String& name, const TreeAssetPtr& asset, const Options& options)
-        : Ogre::MovableObject(name), mAsset(asset), mData(&asset->getFoliageLod()), mState(*mData), mOptions(options)
+        : Ogre::MovableObject(name), mAsset(asset), mData(&FoliageLodResources::of(*asset).getFoliageLod()), mState(*mData), mOptions(options)
     {
         mBounds = mAsset->getBounds();
         // Ogre's convention (Mesh::_setBounds): a sphere about the object's origin holding the
@@ -54,7 +55,7 @@ namespace TreeLod
 
         if (!mData->clusters.empty())
         {
-            Ogre::VertexData* vertices = mAsset->getLeafVertexData();
+            Ogre::VertexData* vertices = FoliageLodResources::of(*mAsset).getLeafVertexData();
             const bool wide = vertices->vertexCount > 65535;
             if (!isQuantised())
                 mIndexBuffer = Ogre::HardwareBufferManager::getSingleton().createIndexBuffer(
@@ -126,7 +127,7 @@ namespace TreeLod
 
     void FoliageLodTree::useSharedLevel()
     {
-        const FoliageLodLevel& level = mAsset->getFoliageLodLevel(mState.leafCount());
+        const FoliageLodLevel& level = FoliageLodResources::of(*mAsset).getFoliageLodLevel(mState.leafCount());
         for (std::size_t i = 0; i < mLeafParts.size(); ++i)
         {
             mLeafParts[i]->mIndexData.indexBuffer = level.buffer;

@@ -4,9 +4,7 @@
 
 #include "ObjectParams.h"
 
-#include "TreeLod/BillboardCloudTree.h"
-#include "TreeLod/FoliageLodTree.h"
-#include "TreeLod/ImpostorData.h"
+#include "TreeLod/TechniqueRegistry.h"
 
 #include <OgreCamera.h>
 #include <OgreException.h>
@@ -44,40 +42,32 @@ namespace TreeLod
         static_assert(INSTANCE_BYTES == 24, "the instance layout of Forest.h");
         constexpr std::size_t MIN_INSTANCE_CAPACITY = 16;
         constexpr std::size_t MAX_LEVELS = ForestInstances::MAX_THRESHOLDS + 1;
-        constexpr Ogre::Real NO_UPPER = std::numeric_limits<Ogre::Real>::max();
+        constexpr Ogre::Real NO_UPPER = ForestLevelSpan::NO_UPPER;
         constexpr std::uint32_t NO_LEVEL = std::numeric_limits<std::uint32_t>::max();
-
-        enum class Technique
-        {
-            Mesh,
-            Lodf,
-            BillboardCloud,
-            ClassicBillboardCloud,
-            Quad
-        };
-
-        const char* const KNOWN_TECHNIQUES = "mesh, lodf, billboard-cloud, classic-billboard-cloud, quad";
-
-        bool isCloud(Technique t) { return t == Technique::BillboardCloud || t == Technique::ClassicBillboardCloud; }
 
         [[noreturn]] void invalid(const Ogre::String& text, const char* source)
         {
             OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, text, source);
         }
 
-        /// The technique named `name`; throws "<element>unknown technique (known: ...)" from `source`.
-        Technique parseTechnique(const Ogre::String& name, const Ogre::String& element, const char* source)
+        /// The Forest levels of technique `name`; throws "<element>unknown technique ..." or
+        /// "<element>technique '...' cannot be a Forest level" from `source`.
+        ForestLevelProvider& levelProvider(const Ogre::String& name, const Ogre::String& element, const char* source)
         {
-            static const std::pair<const char*, Technique> names[] = {
-                {"mesh", Technique::Mesh},
-                {FOLIAGE_LOD_CHUNK, Technique::Lodf},
-                {BILLBOARD_CLOUD_CHUNK, Technique::BillboardCloud},
-                {CLASSIC_BILLBOARD_CLOUD_CHUNK, Technique::ClassicBillboardCloud},
-                {"quad", Technique::Quad}};
-            for (const auto& n : names)
-                if (name == n.first)
-                    return n.second;
-            invalid(element + "unknown technique (known: " + KNOWN_TECHNIQUES + ")", source);
+            TechniqueRegistry* registry = TechniqueRegistry::getSingletonPtr();
+            if (!registry)
+                invalid(element + "no technique registry: is Plugin_TreeLod installed?", source);
+            const TechniqueInfo& technique = registry->get(name, element, source);
+            if (!technique.forestLevels)
+            {
+                Ogre::String known;
+                for (const TechniqueInfo& t : registry->getTechniques())
+                    if (t.forestLevels)
+                        known += (known.empty() ? "" : ", ") + t.name;
+                invalid(element + "technique '" + name + "' cannot be a Forest level (those that can: " + known + ")",
+                        source);
+            }
+            return *technique.forestLevels;
         }
 
         /// Radius of the asset's reference sphere: the units of ForestLevel::minPixelCount (Forest.h).
@@ -93,84 +83,12 @@ namespace TreeLod
             return g;
         }
 
-        /// A technique's level with the LoD values it is drawn at: [level.minPixelCount, upper).
-        struct Span
-        {
-            ForestLevel level;
-            Ogre::Real upper = NO_UPPER;
-        };
+        using Span = ForestLevelSpan;
 
         /// Every level of `technique` over all LoD values, near to far (reference-sphere units).
-        std::vector<Span> techniqueSpans(TreeAsset& asset, Technique technique, const Ogre::String& name)
+        std::vector<Span> techniqueSpans(TreeAsset& asset, ForestLevelProvider& technique, const Ogre::String& name)
         {
-            std::vector<Span> spans;
-            auto add = [&](std::uint32_t techniqueLevel, bool lowRes, Ogre::Real lower, Ogre::Real upper) {
-                if (lower < upper)
-                    spans.push_back(Span{ForestLevel{name, techniqueLevel, lowRes, lower}, upper});
-            };
-            switch (technique)
-            {
-            case Technique::Mesh:
-                asset.getReference();
-                add(0, false, 0.0f, NO_UPPER);
-                break;
-            case Technique::Quad:
-                asset.getImpostorGpu();
-                add(0, false, 0.0f, NO_UPPER);
-                break;
-            case Technique::Lodf:
-            {
-                // Leaf counts halving from all leaves; the level drawing N leaves keeps them while
-                // FoliageLodTree's curve asks for more than N / 2, so it never draws fewer leaves
-                // than the curve (the same rule as FoliageLodState::quantise, which rounds up).
-                const FoliageLodData& data = asset.getFoliageLod();
-                const float perLeaf = FoliageLodTree::DEFAULT_PIXELS_PER_LEAF;
-                std::uint32_t count = data.maxLeafCount();
-                Ogre::Real upper = NO_UPPER;
-                while (true)
-                {
-                    const std::uint32_t next = std::max((count + 1) / 2, data.minLeafCount());
-                    if (data.clusters.empty() || next >= count)
-                    {
-                        add(count, false, 0.0f, upper);
-                        break;
-                    }
-                    const Ogre::Real lower = FoliageLodTree::pixelCountForLeaves(next, perLeaf);
-                    add(count, false, lower, upper);
-                    upper = lower;
-                    count = next;
-                }
-                break;
-            }
-            case Technique::BillboardCloud:
-            case Technique::ClassicBillboardCloud:
-            {
-                // The switches BillboardCloudTree makes (§6), in the reference sphere's units; a
-                // layered level splits where its material LoD turns to the low-res technique (§5.1).
-                const bool classic = technique == Technique::ClassicBillboardCloud;
-                const BillboardCloudGpu& gpu = asset.getBillboardCloudLayout(classic);
-                const float radius = float(referenceRadius(asset));
-                const std::vector<Ogre::Real> switches =
-                    BillboardCloudTree::switchPixelCounts(gpu, gpu.listFactor, radius);
-                if (gpu.levels.empty())
-                    add(0, false, 0.0f, NO_UPPER);
-                for (std::uint32_t l = 0; l < gpu.levels.size(); ++l)
-                {
-                    const Ogre::Real upper = l == 0 ? NO_UPPER : switches[l - 1];
-                    const Ogre::Real lower = l < switches.size() ? switches[l] : 0.0f;
-                    if (!gpu.levels[l].layered)
-                    {
-                        add(l, false, lower, upper);
-                        continue;
-                    }
-                    const Ogre::Real lowRes =
-                        billboardCloudPixelCount(1.0f, gpu.levels[l].cellSize, radius, gpu.listFactor);
-                    add(l, false, std::max(lowRes, lower), upper);
-                    add(l, true, lower, std::min(lowRes, upper));
-                }
-                break;
-            }
-            }
+            std::vector<Span> spans = technique.getSpans(asset, name);
 
             // Bark: split where the drawn mesh's own LoD levels switch (MeshLodGenerator levels,
             // pixel-count values), so that a level's bark level (the one of its largest value,
@@ -178,7 +96,7 @@ namespace TreeLod
             // bark and bark-AO meshes share those levels (the generator runs on the bark alone,
             // with the same options: TreeMeshBuilder.h), so the plain bark mesh plans them all.
             Ogre::MeshPtr bark;
-            if (technique != Technique::Quad && !asset.getReference().model.barkIndices.empty())
+            if (technique.drawsBarkMesh() && !asset.getReference().model.barkIndices.empty())
                 bark = asset.getBarkMesh();
             if (!bark || bark->getLodStrategy() != Ogre::AbsolutePixelCountLodStrategy::getSingletonPtr())
                 return spans;
@@ -242,9 +160,8 @@ namespace TreeLod
         Ogre::IndexData ownIndexData;
         Ogre::MaterialPtr material;
         Ogre::MaterialPtr shadowedMaterial; ///< may be null
-        unsigned short techniqueLod = 0;    ///< billboard-cloud: 1 = the low-res technique
-        bool cloud = false;                 ///< takes the list factor (custom parameter 0)
-        float listFactor = 0.0f;            ///< the cloud's shader LoD factor (paper 000 §5.1)
+        unsigned short techniqueLod = 0;    ///< ForestPartOptions::techniqueLod
+        float lengthFactor = 0.0f;          ///< ForestPartOptions::lengthFactor (custom parameter 0 when > 0)
     };
 
     /// Where a level's drawables are (Forest.h, "Residency").
@@ -395,8 +312,7 @@ namespace TreeLod
 
     std::vector<ForestBand> Forest::getAutoBands()
     {
-        return {ForestBand{FOLIAGE_LOD_CHUNK, 160.0f}, ForestBand{BILLBOARD_CLOUD_CHUNK, 24.0f},
-                ForestBand{"quad", 0.0f}};
+        return {ForestBand{"lodf", 160.0f}, ForestBand{"billboard-cloud", 24.0f}, ForestBand{"impostor", 0.0f}};
     }
 
     std::vector<ForestLevel> Forest::levelsForBands(TreeAsset& asset, const std::vector<ForestBand>& bands)
@@ -423,7 +339,7 @@ namespace TreeLod
         {
             const ForestBand& band = bands[b];
             const Ogre::String element = label + "band " + std::to_string(b) + " '" + band.technique + "': ";
-            const Technique technique = parseTechnique(band.technique, element, source);
+            ForestLevelProvider& technique = levelProvider(band.technique, element, source);
             const bool last = b + 1 == bands.size();
             if (last && band.minHeightPixels != 0.0f)
                 invalid(element + "the last band must reach 0 pixels, not " + std::to_string(band.minHeightPixels),
@@ -493,37 +409,33 @@ namespace TreeLod
         return clone;
     }
 
-    std::vector<std::unique_ptr<Forest::Part>> Forest::buildParts(TreeAsset& asset, const ForestLevel& level,
-                                                                  Ogre::Real upperPixelCount)
+    /// The ForestPartBuilder a level's provider adds its parts through.
+    class Forest::PartBuilder : public ForestPartBuilder
     {
-        const Technique technique = parseTechnique(level.technique, "", "Forest");
-        const Ogre::String& group = asset.getGroup();
-        std::vector<std::unique_ptr<Part>> parts;
-        auto addPart = [&](Ogre::VertexData* vertices, const Ogre::String& material, const Ogre::String& shadowed) {
-            auto part = std::make_unique<Part>();
-            part->vertexData = vertices;
-            part->material = instancedMaterial(material, group);
-            if (!shadowed.empty())
-                part->shadowedMaterial = instancedMaterial(shadowed, group);
-            parts.push_back(std::move(part));
-            return parts.back().get();
-        };
-        auto addRange = [&](Ogre::VertexData* vertices, const Ogre::HardwareIndexBufferSharedPtr& buffer,
-                            std::size_t start, std::size_t count, const Ogre::String& material,
-                            const Ogre::String& shadowed) -> Part* {
+    public:
+        PartBuilder(Forest& forest, TreeAsset& asset, Ogre::Real upperPixelCount)
+            : mForest(forest), mAsset(asset), mUpperPixelCount(upperPixelCount)
+        {
+        }
+
+        void addRange(Ogre::VertexData* vertices, const Ogre::HardwareIndexBufferSharedPtr& buffer, std::size_t start,
+                      std::size_t count, const Ogre::String& material, const Ogre::String& shadowed,
+                      const ForestPartOptions& options) override
+        {
             if (count == 0 || !vertices)
-                return nullptr;
-            Part* part = addPart(vertices, material, shadowed);
-            part->ownIndexData.indexBuffer = buffer;
-            part->ownIndexData.indexStart = start;
-            part->ownIndexData.indexCount = count;
-            part->indexData = &part->ownIndexData;
-            return part;
-        };
-        // A mesh's submeshes at the LoD level its strategy gives for the level's largest value.
-        auto addMesh = [&](const Ogre::MeshPtr& mesh, const std::vector<Ogre::String>& plain,
-                           const std::vector<Ogre::String>& shadowed) {
-            const unsigned short lod = upperPixelCount == NO_UPPER ? 0 : mesh->getLodIndex(upperPixelCount);
+                return;
+            Part& part = add(vertices, material, shadowed, options);
+            part.ownIndexData.indexBuffer = buffer;
+            part.ownIndexData.indexStart = start;
+            part.ownIndexData.indexCount = count;
+            part.indexData = &part.ownIndexData;
+        }
+
+        void addMesh(const Ogre::MeshPtr& mesh, const std::vector<Ogre::String>& plain,
+                     const std::vector<Ogre::String>& shadowed) override
+        {
+            // The submeshes at the LoD level the mesh's strategy gives for the level's largest value.
+            const unsigned short lod = mUpperPixelCount == NO_UPPER ? 0 : mesh->getLodIndex(mUpperPixelCount);
             for (Ogre::SubMesh* sub : mesh->getSubMeshes())
             {
                 Ogre::IndexData* indices =
@@ -534,84 +446,56 @@ namespace TreeLod
                     continue;
                 const auto it = std::find(plain.begin(), plain.end(), sub->getMaterialName());
                 const Ogre::String receiver = it == plain.end() ? "" : shadowed[std::size_t(it - plain.begin())];
-                addPart(sub->vertexData, sub->getMaterialName(), receiver)->indexData = indices;
+                add(sub->vertexData, sub->getMaterialName(), receiver, {}).indexData = indices;
             }
-        };
-        const bool hasBark = !asset.getReference().model.barkIndices.empty();
+        }
 
-        switch (technique)
+        std::vector<std::unique_ptr<Part>> mParts;
+
+    private:
+        Part& add(Ogre::VertexData* vertices, const Ogre::String& material, const Ogre::String& shadowed,
+                  const ForestPartOptions& options)
         {
-        case Technique::Mesh:
-            addMesh(asset.getReferenceMesh(), asset.getMaterialNames(), asset.getShadowedMaterialNames());
-            break;
-        case Technique::Lodf:
-        {
-            const FoliageLodData& data = asset.getFoliageLod();
-            const std::vector<Ogre::String>& materials = asset.getMaterialNames();
-            const std::vector<Ogre::String>& shadowed = asset.getShadowedMaterialNames();
-            if (!data.clusters.empty())
-            {
-                const FoliageLodLevel& shared =
-                    asset.getFoliageLodLevel(level.techniqueLevel == 0 ? data.maxLeafCount() : level.techniqueLevel);
-                // One range per run of same-material clusters (TreeAsset::getFoliageLodLevel).
-                std::size_t run = 0;
-                for (std::size_t c = 0; c < data.clusters.size(); ++run)
-                {
-                    const std::uint32_t material = data.clusters[c].material;
-                    while (c < data.clusters.size() && data.clusters[c].material == material)
-                        ++c;
-                    addRange(asset.getLeafVertexData(), shared.buffer, shared.ranges[run].first,
-                             shared.ranges[run].second, materials[material], shadowed[material]);
-                }
-            }
-            if (hasBark)
-                addMesh(asset.getBarkMesh(), materials, shadowed);
-            break;
-        }
-        case Technique::BillboardCloud:
-        case Technique::ClassicBillboardCloud:
-        {
-            const bool classic = technique == Technique::ClassicBillboardCloud;
-            const BillboardCloudGpu& gpu = asset.getBillboardCloudGpu(classic);
-            if (level.techniqueLevel < gpu.levels.size())
-            {
-                const BillboardCloudGpu::Level& cloud = gpu.levels[level.techniqueLevel];
-                if (Part* part = addRange(gpu.vertexData.get(), gpu.indexBuffer, cloud.indexStart, cloud.indexCount,
-                                          cloud.material, cloud.shadowedMaterial))
-                {
-                    part->techniqueLod = level.lowRes ? 1 : 0;
-                    part->cloud = true;
-                    part->listFactor = gpu.listFactor;
-                }
-            }
-            if (hasBark)
-                addMesh(asset.getBarkAoMesh(classic), asset.getBarkAoMaterialNames(false),
-                        asset.getBarkAoMaterialNames(true));
-            break;
-        }
-        case Technique::Quad:
-        {
-            // Instanced already (TreeLodImpostor.vert): its materials as they are.
-            const ImpostorGpu& gpu = asset.getImpostorGpu();
+            const Ogre::String& group = mAsset.getGroup();
             auto part = std::make_unique<Part>();
-            part->vertexData = gpu.vertexData.get();
-            part->ownIndexData.indexBuffer = gpu.indexBuffer;
-            part->ownIndexData.indexStart = 0;
-            part->ownIndexData.indexCount = 6;
-            part->indexData = &part->ownIndexData;
-            part->material = Ogre::MaterialManager::getSingleton().getByName(gpu.material, group);
-            part->shadowedMaterial = Ogre::MaterialManager::getSingleton().getByName(gpu.shadowedMaterial, group);
-            if (!part->material || !part->shadowedMaterial)
-                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
-                            "impostor material '" + gpu.material + "' or its shadowed variant not found",
-                            "Forest '" + mName + "'");
-            part->material->load();
-            part->shadowedMaterial->load();
-            parts.push_back(std::move(part));
-            break;
+            part->vertexData = vertices;
+            part->techniqueLod = options.techniqueLod;
+            part->lengthFactor = options.lengthFactor;
+            if (options.instancedMaterial)
+            {
+                for (auto [name, slot] : {std::make_pair(&material, &part->material),
+                                          std::make_pair(&shadowed, &part->shadowedMaterial)})
+                {
+                    if (name->empty())
+                        continue;
+                    *slot = Ogre::MaterialManager::getSingleton().getByName(*name, group);
+                    if (!*slot)
+                        OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND, "material '" + *name + "' not found",
+                                    "Forest '" + mForest.mName + "'");
+                    (*slot)->load();
+                }
+            }
+            else
+            {
+                part->material = mForest.instancedMaterial(material, group);
+                if (!shadowed.empty())
+                    part->shadowedMaterial = mForest.instancedMaterial(shadowed, group);
+            }
+            mParts.push_back(std::move(part));
+            return *mParts.back();
         }
-        }
-        return parts;
+
+        Forest& mForest;
+        TreeAsset& mAsset;
+        const Ogre::Real mUpperPixelCount;
+    };
+
+    std::vector<std::unique_ptr<Forest::Part>> Forest::buildParts(TreeAsset& asset, const ForestLevel& level,
+                                                                  Ogre::Real upperPixelCount)
+    {
+        PartBuilder builder(*this, asset, upperPixelCount);
+        levelProvider(level.technique, "", "Forest").buildParts(asset, level, builder);
+        return std::move(builder.mParts);
     }
 
     std::uint32_t Forest::addSpecies(const TreeAssetPtr& asset, const std::vector<ForestLevel>& levels)
@@ -636,7 +520,7 @@ namespace TreeLod
         {
             const ForestLevel& level = levels[l];
             const Ogre::String element = label + "level " + std::to_string(l) + " '" + level.technique + "': ";
-            const Technique technique = parseTechnique(level.technique, element, source);
+            ForestLevelProvider& technique = levelProvider(level.technique, element, source);
             const bool last = l + 1 == levels.size();
             if (!std::isfinite(level.minPixelCount) || level.minPixelCount < 0.0f ||
                 (l > 0 && !(level.minPixelCount < levels[l - 1].minPixelCount)) ||
@@ -646,36 +530,7 @@ namespace TreeLod
                         source);
             try
             {
-                if (!isCloud(technique) && level.lowRes)
-                    invalid("lowRes is for billboard-cloud levels only", source);
-                switch (technique)
-                {
-                case Technique::Mesh:
-                    asset->getReference();
-                    break;
-                case Technique::Lodf:
-                    asset->getFoliageLod(); // decoded and checked against the reference
-                    break;
-                case Technique::Quad:
-                    asset->getImpostorGpu(); // one quad: always resident, the fallback of last resort
-                    break;
-                case Technique::BillboardCloud:
-                case Technique::ClassicBillboardCloud:
-                {
-                    const BillboardCloudGpu& layout =
-                        asset->getBillboardCloudLayout(technique == Technique::ClassicBillboardCloud);
-                    if (level.techniqueLevel >= std::max<std::size_t>(layout.levels.size(), 1))
-                        invalid("cloud level " + std::to_string(level.techniqueLevel) + " does not exist (" +
-                                    std::to_string(layout.levels.size()) + " levels)",
-                                source);
-                    if (level.lowRes && !(level.techniqueLevel < layout.levels.size() &&
-                                          layout.levels[level.techniqueLevel].layered))
-                        invalid("lowRes on a cloud level that is not layered", source);
-                    if (level.techniqueLevel < layout.levels.size())
-                        drawn.merge(layout.bounds);
-                    break;
-                }
-                }
+                technique.checkLevel(*asset, level, drawn);
                 // The last level is the fallback of every other: resident from the start.
                 if (last)
                 {
@@ -1037,7 +892,7 @@ namespace TreeLod
         std::uint32_t batches = 0;
         std::uint64_t triangles = 0;
         std::uint32_t fallbacks = 0;
-        const Ogre::Vector4 cloudParams(0.0f, 1.0f, 0.0f, 0.0f);
+        const Ogre::Vector4 lengthParams(0.0f, 1.0f, 0.0f, 0.0f);
         for (std::uint32_t b = 0; b < state.visibility.getBucketCount(); ++b)
         {
             const ForestBucket& bucket = state.visibility.getBucket(b);
@@ -1051,11 +906,11 @@ namespace TreeLod
             for (const std::unique_ptr<Batch>& batch : state.buckets[b]->batches)
             {
                 batch->mInstanceCount = bucket.count;
-                if (batch->getPart().cloud)
+                if (batch->getPart().lengthFactor > 0.0f)
                 {
-                    // x: the shader's list factor, the bias applied to lengths; y: AO on (TreeLod.program).
-                    Ogre::Vector4 params = cloudParams;
-                    params.x = batch->getPart().listFactor * std::sqrt(state.lodBias);
+                    // x: the length factor, the bias applied to lengths; y: 1 (ForestLevelProvider.h).
+                    Ogre::Vector4 params = lengthParams;
+                    params.x = batch->getPart().lengthFactor * std::sqrt(state.lodBias);
                     batch->setCustomParameter(0, params);
                 }
                 queue->addRenderable(batch.get(), mRenderQueueID, mRenderQueuePriority);

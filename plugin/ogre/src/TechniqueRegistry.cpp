@@ -1,59 +1,56 @@
 #include "TreeLod/TechniqueRegistry.h"
 
-#include "TreeLod/BillboardCloudTree.h"
-#include "TreeLod/FoliageLodTree.h"
 #include "TreeLod/TreeAsset.h"
 
-#include <OgreEntity.h>
 #include <OgreException.h>
 #include <OgreSceneManager.h>
+
+#include <algorithm>
 
 template <> TreeLod::TechniqueRegistry* Ogre::Singleton<TreeLod::TechniqueRegistry>::msSingleton = nullptr;
 
 namespace TreeLod
 {
+    namespace
+    {
+        std::vector<void (*)(TechniqueRegistry&)>& registrations()
+        {
+            static std::vector<void (*)(TechniqueRegistry&)> functions;
+            return functions;
+        }
+    }
+
     TechniqueRegistry& TechniqueRegistry::getSingleton() { return *msSingleton; }
     TechniqueRegistry* TechniqueRegistry::getSingletonPtr() { return msSingleton; }
 
-    namespace
+    TechniqueRegistry::Registration::Registration(void (*registerTechnique)(TechniqueRegistry& registry))
     {
-        /// A create function for a tree object factory: `params` plus the asset (and `extra`).
-        decltype(TechniqueInfo::create) byFactory(const Ogre::String& type, Ogre::NameValuePairList extra = {})
-        {
-            return [type, extra](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset,
-                                 const Ogre::NameValuePairList& params) {
-                Ogre::NameValuePairList all = params;
-                all["asset"] = asset.getName();
-                all["group"] = asset.getGroup();
-                for (const auto& [key, value] : extra)
-                    all[key] = value;
-                return sm.createMovableObject(name, type, &all);
-            };
-        }
+        registrations().push_back(registerTechnique);
     }
 
     TechniqueRegistry::TechniqueRegistry()
     {
-        // The polygonal reference: every comparison in this project is against it.
-        add({"mesh", "polygonal reference: bark with MeshLodGenerator levels, every leaf", "reference",
-             Ogre::EntityFactory::FACTORY_TYPE_NAME,
-             [](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset, const Ogre::NameValuePairList&) {
-                 return static_cast<Ogre::MovableObject*>(sm.createEntity(name, asset.getReferenceMesh()));
-             }});
-        // paper 004: continuous foliage LoD by leaf collapse.
-        add({"lodf", "LoDF: every leaf geometric, leaf count continuous with screen size (paper 004)",
-             FOLIAGE_LOD_CHUNK, FoliageLodTreeFactory::FACTORY_TYPE_NAME,
-             byFactory(FoliageLodTreeFactory::FACTORY_TYPE_NAME)});
-        // paper 000: billboard clouds with multi-layered indirect texturing, and the classic cloud.
-        add({BILLBOARD_CLOUD_CHUNK,
-             "billboard clouds with multi-layered indirect texturing and shader LoD (paper 000)",
-             BILLBOARD_CLOUD_CHUNK, BillboardCloudTreeFactory::FACTORY_TYPE_NAME,
-             byFactory(BillboardCloudTreeFactory::FACTORY_TYPE_NAME, {{"classic", "false"}})});
-        add({CLASSIC_BILLBOARD_CLOUD_CHUNK,
-             "classic billboard cloud: one RGBA texture per billboard, the baseline of paper 000 Fig. 13",
-             CLASSIC_BILLBOARD_CLOUD_CHUNK, BillboardCloudTreeFactory::FACTORY_TYPE_NAME,
-             byFactory(BillboardCloudTreeFactory::FACTORY_TYPE_NAME, {{"classic", "true"}})});
-        // Technique issues add their line here.
+        for (void (*registerTechnique)(TechniqueRegistry&) : registrations())
+            registerTechnique(*this);
+        // Static initialisation runs the registrations in link order: list "mesh", the reference
+        // every comparison is made against, first, then the others by name.
+        std::stable_sort(mTechniques.begin(), mTechniques.end(), [](const TechniqueInfo& a, const TechniqueInfo& b) {
+            return std::make_pair(a.name != "mesh", a.name) < std::make_pair(b.name != "mesh", b.name);
+        });
+    }
+
+    decltype(TechniqueInfo::create) TechniqueRegistry::byFactory(const Ogre::String& type,
+                                                                 Ogre::NameValuePairList extra)
+    {
+        return [type, extra](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset,
+                             const Ogre::NameValuePairList& params) {
+            Ogre::NameValuePairList all = params;
+            all["asset"] = asset.getName();
+            all["group"] = asset.getGroup();
+            for (const auto& [key, value] : extra)
+                all[key] = value;
+            return sm.createMovableObject(name, type, &all);
+        };
     }
 
     void TechniqueRegistry::add(TechniqueInfo info)
@@ -75,6 +72,16 @@ namespace TreeLod
         return nullptr;
     }
 
+    const TechniqueInfo& TechniqueRegistry::get(const Ogre::String& name, const Ogre::String& element,
+                                                const char* source) const
+    {
+        const TechniqueInfo* info = find(name);
+        if (!info)
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                        element + "unknown technique '" + name + "' (known: " + describe() + ")", source);
+        return *info;
+    }
+
     Ogre::String TechniqueRegistry::describe() const
     {
         Ogre::String out;
@@ -88,11 +95,6 @@ namespace TreeLod
                                                            const Ogre::String& name, TreeAsset& asset,
                                                            const Ogre::NameValuePairList& params) const
     {
-        const TechniqueInfo* info = find(technique);
-        if (!info)
-            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
-                        "unknown technique '" + technique + "' (known: " + describe() + ")",
-                        "TechniqueRegistry::createInstance");
-        return info->create(sceneManager, name, asset, params);
+        return get(technique, "", "TechniqueRegistry::createInstance").create(sceneManager, name, asset, params);
     }
 }

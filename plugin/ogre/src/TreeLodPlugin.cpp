@@ -1,7 +1,5 @@
 #include "TreeLod/TreeLodPlugin.h"
 
-#include "TreeLod/BillboardCloudTree.h"
-#include "TreeLod/FoliageLodTree.h"
 #include "TreeLod/Forest.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
@@ -9,6 +7,8 @@
 #include <MeshLodGenerator/OgreMeshLodGenerator.h>
 #include <OgreLogManager.h>
 #include <OgreRoot.h>
+
+#include <algorithm>
 
 namespace TreeLod
 {
@@ -25,11 +25,16 @@ namespace TreeLod
     {
         mTechniques = std::make_unique<TechniqueRegistry>();
         mAssetManager = std::make_unique<TreeAssetManager>();
-        // One MovableObject factory per technique (DESIGN.md, "Factories").
-        mFoliageLodFactory = std::make_unique<FoliageLodTreeFactory>();
-        Ogre::Root::getSingleton().addMovableObjectFactory(mFoliageLodFactory.get());
-        mBillboardCloudFactory = std::make_unique<BillboardCloudTreeFactory>();
-        Ogre::Root::getSingleton().addMovableObjectFactory(mBillboardCloudFactory.get());
+        // One MovableObject factory per technique (docs/architecture.md, "Factories"), some shared.
+        for (const TechniqueInfo& technique : mTechniques->getTechniques())
+        {
+            Ogre::MovableObjectFactory* factory = technique.factory.get();
+            if (factory && std::find(mFactories.begin(), mFactories.end(), factory) == mFactories.end())
+            {
+                Ogre::Root::getSingleton().addMovableObjectFactory(factory);
+                mFactories.push_back(factory);
+            }
+        }
         mForestFactory = std::make_unique<ForestFactory>();
         Ogre::Root::getSingleton().addMovableObjectFactory(mForestFactory.get());
         Ogre::LogManager::getSingleton().logMessage("TreeLod: installed (techniques: " +
@@ -50,12 +55,9 @@ namespace TreeLod
 
     void TreeLodPlugin::uninstall()
     {
-        if (mFoliageLodFactory)
-            Ogre::Root::getSingleton().removeMovableObjectFactory(mFoliageLodFactory.get());
-        mFoliageLodFactory.reset();
-        if (mBillboardCloudFactory)
-            Ogre::Root::getSingleton().removeMovableObjectFactory(mBillboardCloudFactory.get());
-        mBillboardCloudFactory.reset();
+        for (Ogre::MovableObjectFactory* factory : mFactories)
+            Ogre::Root::getSingleton().removeMovableObjectFactory(factory);
+        mFactories.clear();
         if (mForestFactory)
             Ogre::Root::getSingleton().removeMovableObjectFactory(mForestFactory.get());
         mForestFactory.reset();

@@ -3,13 +3,11 @@
 
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/BakeTechniques.h"
-#include "TreeLod/BillboardCloudData.h"
-#include "TreeLod/FoliageLodData.h"
 #include "TreeLod/GltfImporter.h"
-#include "TreeLod/ImpostorData.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
 #include "TreeLod/PackageWriter.h"
+#include "TreeLod/TechniqueDescriptor.h"
 
 #include <nlohmann/json.hpp>
 
@@ -331,12 +329,11 @@ namespace TreeLod
         key.options = options.value();
 
         // Every version that changes what a cached chunk means: a bump gives a new file name.
-        char versions[160];
-        std::snprintf(versions, sizeof(versions), "cache %d package %u reference %u lodf %u billboard-cloud %u impostor %u",
-                      BAKE_CACHE_KEY_VERSION, unsigned(PACKAGE_VERSION), unsigned(REFERENCE_CHUNK_FORMAT_VERSION),
-                      unsigned(FOLIAGE_LOD_CHUNK_FORMAT_VERSION), unsigned(BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION),
-                      unsigned(IMPOSTOR_CHUNK_FORMAT_VERSION));
-        const std::uint64_t fileKey = hashString(std::string(versions) + "\nsource " + key.sourceHash +
+        std::string versions = "cache " + std::to_string(BAKE_CACHE_KEY_VERSION) + " package " +
+                               std::to_string(PACKAGE_VERSION);
+        for (const TechniqueDescriptor& technique : techniqueDescriptors())
+            versions += " " + technique.name + " " + std::to_string(technique.formatVersion);
+        const std::uint64_t fileKey = hashString(versions + "\nsource " + key.sourceHash +
                                                  "\noptions " + key.options);
         const std::string stem =
             safeStem(key.generator ? source : std::filesystem::path(source).stem().string());

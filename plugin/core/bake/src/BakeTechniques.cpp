@@ -1,35 +1,41 @@
-// The technique table of BakeTechniques.h.
+// The baker registry of BakeTechniques.h.
 #include "TreeLod/BakeTechniques.h"
 
-#include "TreeLod/BillboardCloudBaker.h"
-#include "TreeLod/FoliageLodBaker.h"
-#include "TreeLod/FoliageLodData.h"
-#include "TreeLod/ImpostorBaker.h"
 #include "TreeLod/Package.h"
+
+#include <algorithm>
 
 namespace TreeLod
 {
-    const std::vector<BakeTechnique>& bakeTechniques()
+    namespace
     {
-        static const std::vector<BakeTechnique> techniques = {
-            {REFERENCE_CHUNK, "the polygonal tree with GPU-ready mip-mapped textures", &addReferenceChunk},
-            {FOLIAGE_LOD_CHUNK, "LoDF continuous foliage by leaf collapse, paper 004 (adds reference)",
-             static_cast<BakeFunction>(&addFoliageLodChunk)},
-            {BILLBOARD_CLOUD_CHUNK, "billboard cloud, multi-layered indirect texturing, paper 000 (adds reference)",
-             &addBillboardCloudChunk},
-            {CLASSIC_BILLBOARD_CLOUD_CHUNK,
-             "classic billboard cloud at equal memory, paper 000 Fig. 13 (adds reference)",
-             &addClassicBillboardCloudChunk},
-            {IMPOSTOR_CHUNK,
-             "one camera-facing quad with baked colour and normal textures, the speed floor (adds reference)",
-             &addImpostorChunk},
-        };
-        return techniques;
+        std::vector<BakeTechnique>& registry()
+        {
+            static std::vector<BakeTechnique> techniques = {
+                {REFERENCE_CHUNK, "the polygonal tree with GPU-ready mip-mapped textures", &addReferenceChunk}};
+            return techniques;
+        }
     }
+
+    void registerBakeTechnique(const BakeTechnique& technique)
+    {
+        std::vector<BakeTechnique>& all = registry();
+        const std::string name = technique.name;
+        auto same = std::find_if(all.begin(), all.end(), [&](const BakeTechnique& t) { return name == t.name; });
+        if (same != all.end())
+        {
+            *same = technique;
+            return;
+        }
+        auto at = std::find_if(all.begin() + 1, all.end(), [&](const BakeTechnique& t) { return name < t.name; });
+        all.insert(at, technique);
+    }
+
+    const std::vector<BakeTechnique>& bakeTechniques() { return registry(); }
 
     const BakeTechnique* findBakeTechnique(const std::string& name)
     {
-        for (const BakeTechnique& t : bakeTechniques())
+        for (const BakeTechnique& t : registry())
             if (name == t.name)
                 return &t;
         return nullptr;
@@ -38,7 +44,7 @@ namespace TreeLod
     std::string knownBakeTechniques()
     {
         std::string list;
-        for (const BakeTechnique& t : bakeTechniques())
+        for (const BakeTechnique& t : registry())
             list += (list.empty() ? "" : ", ") + std::string(t.name);
         return list;
     }

@@ -36,6 +36,7 @@
 // no AO; the image-error study compares that way).
 #pragma once
 
+#include "TreeLod/BillboardCloudResources.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreMovableObject.h>

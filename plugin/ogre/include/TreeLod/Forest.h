@@ -1,16 +1,12 @@
-// Forest: thousands of trees of several TreeAssets in one MovableObject (issue 5). MovableObject
-// type "Forest".
+// Forest: thousands of trees of several TreeAssets in one MovableObject. MovableObject type
+// "Forest".
 //
 // Instances live in a ForestInstances (packed structure of arrays, no SceneNode per tree). A
 // species is one TreeAsset drawn by a list of levels, near to far; each level is one
-// technique's drawable at one of its own levels of detail:
-//   "mesh"                     the polygonal reference (bark + every leaf)
-//   "lodf"                     LoDF (paper 004) at a quantised leaf count: the asset's shared
-//                              level (TreeAsset::getFoliageLodLevel) + the bark mesh
-//   "billboard-cloud"          billboard cloud level N (paper 000), layered or low-res material
-//   "classic-billboard-cloud"  the classic cloud's level N
-//   "quad"                     one camera-facing quad with the baked impostor (TreeAsset::getImpostorGpu):
-//                              the cheapest representation, the speed floor of `treelod bench`
+// technique's drawable at one of its own levels of detail, planned, checked and built by the
+// technique's ForestLevelProvider (TechniqueRegistry.h): e.g. "mesh" (the polygonal reference),
+// "lodf" at a quantised leaf count, "billboard-cloud" level N with its layered or low-res
+// material, "impostor" (one camera-facing quad, the cheapest representation).
 // Every frame and for every camera that renders the Forest (the viewer's and the shadow
 // cameras), _updateRenderQueue culls all instances against that camera's frustum and picks each
 // visible one's level from its LoD camera (Camera::getLodCamera(), so shadows see the viewer's
@@ -48,11 +44,11 @@
 // - Materials: the Forest clones each part's material (and its shadow caster's) once, with
 //   every pass's vertex program swapped for its INSTANCED variant "<program>/Instanced" (made
 //   in code from the plain program: same source, defines + INSTANCED=1, shared by every
-//   Forest); the clones are the Forest's and go with it. The quad's materials are instanced
-//   already and used as they are.
-// - Residency (issue 7, "model only what a scene requires"; no stall when a level first shows):
-//   addSpecies plans every level from decoded chunks (BillboardCloudGpu layouts, LoDF leaf
-//   counts; the bark mesh that levelsForBands plans with is the one upload there) and builds
+//   Forest); the clones are the Forest's and go with it. Parts whose materials read the instance
+//   data already (ForestPartOptions::instancedMaterial, the impostor's) are used as they are.
+// - Residency ("model only what a scene requires"; no stall when a level first shows):
+//   addSpecies plans every level from decoded chunks (ForestLevelProvider::checkLevel; the bark
+//   mesh that levelsForBands plans with is the one upload there) and builds
 //   the last level only, the fallback of every other. A level's drawables (asset buffers and
 //   textures, instanced materials) are built the first time a camera sees trees at it; queued
 //   levels are built in the order asked for, in _updateRenderQueue, while this Root frame's
@@ -68,6 +64,7 @@
 #pragma once
 
 #include "TreeLod/ForestInstances.h"
+#include "TreeLod/ForestLevelProvider.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreCamera.h>
@@ -82,24 +79,6 @@
 
 namespace TreeLod
 {
-    /// One level of a species: what its trees draw while their LoD value is >= minPixelCount.
-    struct ForestLevel
-    {
-        Ogre::String technique;            ///< see the file comment
-        std::uint32_t techniqueLevel = 0;  ///< lodf: leaf count (0 = all); clouds: cloud level; else 0
-        bool lowRes = false;               ///< billboard-cloud: the low-res material of a layered level
-        Ogre::Real minPixelCount = 0.0f;   ///< Ogre pixel-count units; the last level's is 0
-    };
-
-    /// A technique over a band of screen sizes, near to far (scene scripts' "techniques").
-    struct ForestBand
-    {
-        Ogre::String technique;
-        /// The band draws trees whose height on screen is >= this many pixels (at LoD bias 1);
-        /// the last band's is 0.
-        Ogre::Real minHeightPixels = 0.0f;
-    };
-
     /// What the last frame of the viewer's camera drew.
     struct ForestStats
     {
@@ -127,20 +106,20 @@ namespace TreeLod
         ~Forest() override;
 
         /// The default technique choice ("techniques": "auto"): lodf while the tree is at least
-        /// 160 px tall on screen, billboard-cloud down to 24 px, then quad.
+        /// 160 px tall on screen, billboard-cloud down to 24 px, then impostor.
         static std::vector<ForestBand> getAutoBands();
 
         /// The levels `bands` give for `asset`: each band's technique contributes its own levels
-        /// (lodf: halving leaf counts on its pixel curve; billboard-cloud: layered, low-res, then
-        /// coarser clouds; mesh and quad: one; split where the bark mesh's LoD switches) clipped
-        /// to the band's screen-size range. At most ForestInstances::MAX_THRESHOLDS + 1. Throws
+        /// (ForestLevelProvider::getSpans: lodf halving leaf counts on its pixel curve,
+        /// billboard-cloud layered, low-res, then coarser clouds, mesh and impostor one; split where
+        /// the bark mesh's LoD switches) clipped to the band's screen-size range. At most ForestInstances::MAX_THRESHOLDS + 1. Throws
         /// Ogre::InvalidParametersException naming the band and technique when a technique is
         /// unknown or the asset lacks its chunk.
         static std::vector<ForestLevel> levelsForBands(TreeAsset& asset, const std::vector<ForestBand>& bands);
 
         /// Add a species; returns its index (= ForestInstances kind). Levels near to far (at most
         /// ForestInstances::MAX_THRESHOLDS + 1), strictly decreasing minPixelCount, the last 0;
-        /// lowRes only on layered billboard-cloud levels. Throws as levelsForBands, naming the
+        /// each level as its technique's ForestLevelProvider::checkLevel accepts. Throws as levelsForBands, naming the
         /// species and level; nothing is added then.
         std::uint32_t addSpecies(const TreeAssetPtr& asset, const std::vector<ForestLevel>& levels);
         std::uint32_t getSpeciesCount() const;
@@ -197,6 +176,7 @@ namespace TreeLod
 
     private:
         struct Part;
+        class PartBuilder;
         enum class Residency : std::uint8_t;
         struct Species;
         class Batch;

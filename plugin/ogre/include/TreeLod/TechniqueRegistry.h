@@ -1,20 +1,28 @@
-// TechniqueRegistry: the LoD techniques this plugin can draw a TreeAsset with.
+// TechniqueRegistry: the LoD techniques this plugin can draw a TreeAsset with, the Ogre half of
+// the technique seam (docs/architecture.md, "The technique seam").
 //
-// One entry per technique: its name on the command line and in scene scripts, the
-// package chunk it needs, the MovableObject type that draws it, and a function that
-// creates that object. "mesh" (the polygonal reference, an Entity) is registered by the
-// plugin itself; each technique issue adds one line in TechniqueRegistry.cpp.
+// One TechniqueInfo per technique: its name on the command line and in scene scripts, the
+// package chunk it draws from, the MovableObject type that draws a single tree and the factory
+// that makes it, the ForestLevelProvider that draws it as a Forest level, and what the sample
+// browser shows of an object's state. A technique registers itself from its own source file with
+// one namespace-scope TechniqueRegistry::Registration; the registry runs every registration when
+// the plugin installs it. TreeAsset, the Forest, ForestScene, `treelod render`/`bench` and the
+// browser iterate the registry and name no technique.
 #pragma once
+
+#include "TreeLod/ForestLevelProvider.h"
 
 #include <OgreCommon.h>
 #include <OgreSingleton.h>
 
 #include <functional>
+#include <memory>
 #include <vector>
 
 namespace Ogre
 {
     class MovableObject;
+    class MovableObjectFactory;
     class SceneManager;
 }
 
@@ -22,9 +30,18 @@ namespace TreeLod
 {
     class TreeAsset;
 
+    /// One line of an object's state for the sample browser: label, a bar filled to `fraction`
+    /// (none when < 0), suffix; e.g. {"leaves ", 0.25, " 300/1200"}.
+    struct TechniqueStateLine
+    {
+        Ogre::String label;
+        double fraction = -1.0;
+        Ogre::String suffix;
+    };
+
     struct TechniqueInfo
     {
-        Ogre::String name;           ///< "mesh", "billboardcloud", "lodf", ...
+        Ogre::String name;           ///< "mesh", "lodf", "billboard-cloud", "impostor", ...
         Ogre::String description;
         Ogre::String chunkTechnique; ///< package chunk it draws from ("reference", ...)
         Ogre::String movableType;    ///< factory type of the object it creates
@@ -32,19 +49,38 @@ namespace TreeLod
         std::function<Ogre::MovableObject*(Ogre::SceneManager& sceneManager, const Ogre::String& name,
                                            TreeAsset& asset, const Ogre::NameValuePairList& params)>
             create;
+        /// The factory of movableType, added to Ogre::Root by the plugin (several techniques may
+        /// share one); null when Ogre provides the type (Entity).
+        std::shared_ptr<Ogre::MovableObjectFactory> factory;
+        /// Draws the technique as a Forest level; null when it cannot be one.
+        std::shared_ptr<ForestLevelProvider> forestLevels;
+        /// The state of an object `create` made (level, leaves, ...), for the sample browser's
+        /// level panel; may be empty.
+        std::function<std::vector<TechniqueStateLine>(Ogre::MovableObject& object)> describeState;
     };
 
     class TechniqueRegistry : public Ogre::Singleton<TechniqueRegistry>
     {
     public:
-        TechniqueRegistry(); ///< registers the built-in techniques
+        /// A technique's registration: a function adding its TechniqueInfo(s), run by every
+        /// registry constructed afterwards. One namespace-scope instance in the technique's source.
+        struct Registration
+        {
+            explicit Registration(void (*registerTechnique)(TechniqueRegistry& registry));
+        };
+
+        TechniqueRegistry(); ///< runs every Registration
 
         /// Add or replace a technique.
         void add(TechniqueInfo info);
         /// nullptr when unknown.
         const TechniqueInfo* find(const Ogre::String& name) const;
+        /// The technique named `name` or Ogre::InvalidParametersException "<element>unknown technique
+        /// '<name>' (known: ...)" from `source`.
+        const TechniqueInfo& get(const Ogre::String& name, const Ogre::String& element = "",
+                                 const char* source = "TechniqueRegistry::get") const;
         const std::vector<TechniqueInfo>& getTechniques() const { return mTechniques; }
-        /// "mesh, billboardcloud, ..." for messages.
+        /// "mesh, billboard-cloud, ..." for messages.
         Ogre::String describe() const;
 
         /// Create `technique` for `asset` or throw Ogre::InvalidParametersException naming
@@ -52,6 +88,10 @@ namespace TreeLod
         Ogre::MovableObject* createInstance(const Ogre::String& technique, Ogre::SceneManager& sceneManager,
                                             const Ogre::String& name, TreeAsset& asset,
                                             const Ogre::NameValuePairList& params = {}) const;
+
+        /// A create function for a technique whose factory takes `asset` and `group` parameters:
+        /// `params` plus the asset (and `extra`).
+        static decltype(TechniqueInfo::create) byFactory(const Ogre::String& type, Ogre::NameValuePairList extra = {});
 
         static TechniqueRegistry& getSingleton();
         static TechniqueRegistry* getSingletonPtr();

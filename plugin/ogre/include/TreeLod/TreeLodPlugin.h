@@ -1,7 +1,8 @@
 // TreeLodPlugin: the Ogre::Plugin of TreeLod (Plugin_TreeLod.so).
 //
 // install: creates the TreeAsset resource manager (resource type "TreeAsset", files
-// *.treelod found through resource groups like meshes) and the technique registry.
+// *.treelod found through resource groups like meshes) and the technique registry, and adds the
+// MovableObject factory of every registered technique and the Forest's to Ogre::Root.
 // initialise: creates the MeshLodGenerator singleton if the application has none.
 // shutdown/uninstall undo the same in reverse order.
 #pragma once
@@ -9,16 +10,16 @@
 #include <OgrePlugin.h>
 
 #include <memory>
+#include <vector>
 
 namespace Ogre
 {
     class MeshLodGenerator;
+    class MovableObjectFactory;
 }
 
 namespace TreeLod
 {
-    class BillboardCloudTreeFactory;
-    class FoliageLodTreeFactory;
     class ForestFactory;
     class TreeAssetManager;
     class TechniqueRegistry;
@@ -38,8 +39,7 @@ namespace TreeLod
     private:
         std::unique_ptr<TreeAssetManager> mAssetManager;
         std::unique_ptr<TechniqueRegistry> mTechniques;
-        std::unique_ptr<FoliageLodTreeFactory> mFoliageLodFactory;
-        std::unique_ptr<BillboardCloudTreeFactory> mBillboardCloudFactory;
+        std::vector<Ogre::MovableObjectFactory*> mFactories; ///< added to Root by install(), owned by the registry
         std::unique_ptr<ForestFactory> mForestFactory;
         Ogre::MeshLodGenerator* mLodGenerator = nullptr; ///< owned only when we created it
     };

@@ -1,4 +1,6 @@
-// TreeAsset::getImpostorGpu: the one-quad impostor (chunk "impostor", ImpostorData.h) on the GPU.
+// ImpostorResources: the one-quad impostor (chunk "impostor", ImpostorData.h) on the GPU.
+#include "TreeLod/ImpostorResources.h"
+
 #include "TreeAssetSupport.h"
 #include "TreeLod/ImpostorData.h"
 #include "TreeLod/TreeAsset.h"
@@ -14,28 +16,38 @@
 
 namespace TreeLod
 {
-    const ImpostorGpu& TreeAsset::getImpostorGpu()
+    ImpostorResources& ImpostorResources::of(TreeAsset& asset)
     {
-        if (mImpostorGpu)
-            return *mImpostorGpu;
-        const PackageReader& package = getPackage();
-        const int index = package.findChunk(IMPOSTOR_CHUNK, 0);
-        if (index >= 0 && package.chunks()[std::size_t(index)].formatVersion != IMPOSTOR_CHUNK_FORMAT_VERSION)
-            raise(fail(mName, chunkElement(IMPOSTOR_CHUNK, 0),
-                       "format version " + std::to_string(package.chunks()[std::size_t(index)].formatVersion) +
-                           ", this build reads " + std::to_string(IMPOSTOR_CHUNK_FORMAT_VERSION) +
-                           ": bake the package again"));
-        Result<ImpostorData> decoded = decodeImpostorChunk(readChunk(IMPOSTOR_CHUNK), mName);
+        return asset.getResources<ImpostorResources>(IMPOSTOR_CHUNK,
+                                                     [&asset] { return std::make_unique<ImpostorResources>(asset); });
+    }
+
+    ImpostorResources::~ImpostorResources()
+    {
+        if (!mGpu)
+            return;
+        for (const Ogre::String& m : {mGpu->material, mGpu->shadowedMaterial, mGpu->material + "/Caster"})
+            Ogre::MaterialManager::getSingleton().remove(m, mAsset.getGroup());
+        for (const Ogre::String& t : {mGpu->texture, mGpu->normalTexture})
+            Ogre::TextureManager::getSingleton().remove(t, mAsset.getGroup());
+    }
+
+    const ImpostorGpu& ImpostorResources::getGpu()
+    {
+        if (mGpu)
+            return *mGpu;
+        // TreeAsset::readChunk checks the format version against the registered descriptor.
+        Result<ImpostorData> decoded = decodeImpostorChunk(mAsset.readChunk(IMPOSTOR_CHUNK), mAsset.getName());
         if (!decoded)
-            raise(decoded.error());
+            mAsset.raise(decoded.error());
         const ImpostorData& data = decoded.value();
 
         auto gpu = std::make_unique<ImpostorGpu>();
-        const Ogre::String prefix = "TreeLod/" + mName + "/impostor";
+        const Ogre::String prefix = "TreeLod/" + mAsset.getName() + "/impostor";
         gpu->texture = prefix + "-colour";
         gpu->normalTexture = prefix + "-normal";
-        uploadTexture(gpu->texture, mGroup, data.colour);
-        uploadTexture(gpu->normalTexture, mGroup, data.normal);
+        uploadTexture(gpu->texture, mAsset.getGroup(), data.colour);
+        uploadTexture(gpu->normalTexture, mAsset.getGroup(), data.normal);
 
         // The quad (ImpostorData.h): x in [-halfWidth, halfWidth], y in [bottom, top], facing +Z.
         const float w = data.halfWidth;
@@ -82,7 +94,7 @@ namespace TreeLod
                 }
         };
         auto clone = [&](const Ogre::String& base, const Ogre::String& name) {
-            Ogre::MaterialPtr material = cloneBaseMaterial(base, name, mGroup, mName);
+            Ogre::MaterialPtr material = cloneBaseMaterial(base, name, mAsset.getGroup(), mAsset.getName());
             configure(material);
             return material;
         };
@@ -101,7 +113,7 @@ namespace TreeLod
                 tech->setShadowCasterMaterial(caster);
             }
         }
-        mImpostorGpu = std::move(gpu);
-        return *mImpostorGpu;
+        mGpu = std::move(gpu);
+        return *mGpu;
     }
 }

@@ -1,0 +1,38 @@
+# treelod_add_technique(<Name>
+#   [RUNTIME_SOURCES src...] [RUNTIME_LIBS lib...]   the chunk format, its descriptor (TechniqueDescriptor.h)
+#   [BAKE_SOURCES src...]    [BAKE_LIBS lib...]      the baker and its registration (BakeTechniques.h)
+#   [OGRE_SOURCES src...]    [OGRE_LIBS lib...])     the Ogre technique (TreeTechnique.h), built into Plugin_TreeLod
+#
+# One technique = one folder with an include/ directory and this call. Each half is a static
+# library (TreeLod<Name>Runtime, TreeLod<Name>Bake, TreeLod<Name>Ogre) whose namespace-scope
+# registration object registers the technique; it is linked whole (WHOLE_ARCHIVE) into the
+# aggregates TreeLodTechniques (runtime halves), TreeLodBakeTechniques (bake halves) and into
+# Plugin_TreeLod (Ogre halves), so that registration runs wherever the aggregate is linked.
+# Nothing else in the build names a technique.
+function(treelod_add_technique name)
+  cmake_parse_arguments(T "" "" "RUNTIME_SOURCES;RUNTIME_LIBS;BAKE_SOURCES;BAKE_LIBS;OGRE_SOURCES;OGRE_LIBS" ${ARGN})
+  set(include $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include> $<INSTALL_INTERFACE:include>)
+  if(T_RUNTIME_SOURCES)
+    add_library(TreeLod${name}Runtime STATIC ${T_RUNTIME_SOURCES})
+    target_include_directories(TreeLod${name}Runtime PUBLIC ${include})
+    target_link_libraries(TreeLod${name}Runtime PUBLIC TreeLodRuntime ${T_RUNTIME_LIBS}
+      PRIVATE nlohmann_json::nlohmann_json treelod_warnings)
+    target_link_libraries(TreeLodTechniques INTERFACE "$<LINK_LIBRARY:WHOLE_ARCHIVE,TreeLod${name}Runtime>")
+    set_property(GLOBAL APPEND PROPERTY TREELOD_TECHNIQUE_TARGETS TreeLod${name}Runtime)
+  endif()
+  if(T_BAKE_SOURCES)
+    add_library(TreeLod${name}Bake STATIC ${T_BAKE_SOURCES})
+    target_include_directories(TreeLod${name}Bake PUBLIC ${include})
+    target_link_libraries(TreeLod${name}Bake PUBLIC TreeLodBake TreeLodTechniques ${T_BAKE_LIBS}
+      PRIVATE nlohmann_json::nlohmann_json treelod_warnings)
+    target_link_libraries(TreeLodBakeTechniques INTERFACE "$<LINK_LIBRARY:WHOLE_ARCHIVE,TreeLod${name}Bake>")
+    set_property(GLOBAL APPEND PROPERTY TREELOD_TECHNIQUE_TARGETS TreeLod${name}Bake)
+  endif()
+  if(T_OGRE_SOURCES AND TARGET Plugin_TreeLod)
+    add_library(TreeLod${name}Ogre STATIC ${T_OGRE_SOURCES})
+    target_include_directories(TreeLod${name}Ogre PUBLIC ${include})
+    # The plugin's headers and what they need, without linking the plugin (it links this library).
+    target_link_libraries(TreeLod${name}Ogre PUBLIC TreeLodOgreHeaders ${T_OGRE_LIBS} PRIVATE treelod_warnings)
+    target_link_libraries(Plugin_TreeLod PRIVATE "$<LINK_LIBRARY:WHOLE_ARCHIVE,TreeLod${name}Ogre>")
+  endif()
+endfunction()

@@ -1,0 +1,56 @@
+// Technique "impostor": the one-quad impostor drawn by ImpostorTree, and as a Forest level (the
+// cheapest one: two triangles a tree, the fallback of every other level).
+#include "TreeLod/ImpostorData.h"
+#include "TreeLod/ImpostorResources.h"
+#include "TreeLod/ImpostorTree.h"
+#include "TreeLod/TechniqueRegistry.h"
+#include "TreeLod/TreeAsset.h"
+
+#include <OgreException.h>
+
+namespace TreeLod
+{
+    namespace
+    {
+        class ImpostorLevels : public ForestLevelProvider
+        {
+        public:
+            std::vector<ForestLevelSpan> getSpans(TreeAsset& asset, const Ogre::String& technique) override
+            {
+                ImpostorResources::of(asset).getGpu();
+                return {{ForestLevel{technique, 0, false, 0.0f}, ForestLevelSpan::NO_UPPER}};
+            }
+
+            bool drawsBarkMesh() const override { return false; }
+
+            void checkLevel(TreeAsset& asset, const ForestLevel& level, Ogre::AxisAlignedBox&) override
+            {
+                if (level.lowRes)
+                    OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, "lowRes is for billboard-cloud levels only",
+                                "ImpostorLevels::checkLevel");
+                ImpostorResources::of(asset).getGpu(); // one quad: always resident, the fallback of last resort
+            }
+
+            void buildParts(TreeAsset& asset, const ForestLevel&, ForestPartBuilder& parts) override
+            {
+                // Instanced already (TreeLodImpostor.vert): its materials as they are.
+                const ImpostorGpu& gpu = ImpostorResources::of(asset).getGpu();
+                ForestPartOptions options;
+                options.instancedMaterial = true;
+                parts.addRange(gpu.vertexData.get(), gpu.indexBuffer, 0, 6, gpu.material, gpu.shadowedMaterial,
+                               options);
+            }
+        };
+
+        void registerImpostor(TechniqueRegistry& registry)
+        {
+            registry.add({IMPOSTOR_CHUNK,
+                          "one camera-facing quad with baked colour and normal textures: the cheapest level",
+                          IMPOSTOR_CHUNK, ImpostorTreeFactory::FACTORY_TYPE_NAME,
+                          TechniqueRegistry::byFactory(ImpostorTreeFactory::FACTORY_TYPE_NAME),
+                          std::make_shared<ImpostorTreeFactory>(), std::make_shared<ImpostorLevels>(), {}});
+        }
+
+        const TechniqueRegistry::Registration registration(&registerImpostor);
+    }
+}

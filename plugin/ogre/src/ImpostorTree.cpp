@@ -1,0 +1,103 @@
+#include "TreeLod/ImpostorTree.h"
+
+#include "ObjectParams.h"
+
+#include "TreeLod/ImpostorResources.h"
+
+#include <OgreException.h>
+#include <OgreHardwareBufferManager.h>
+#include <OgreMaterialManager.h>
+#include <OgreNode.h>
+#include <OgreRenderQueue.h>
+#include <OgreSceneManager.h>
+
+namespace TreeLod
+{
+    const Ogre::String ImpostorTreeFactory::FACTORY_TYPE_NAME = "ImpostorTree";
+
+    ImpostorTree::ImpostorTree(const Ogre::String& name, const TreeAssetPtr& asset)
+        : Ogre::MovableObject(name), mAsset(asset), mGpu(&ImpostorResources::of(*asset).getGpu())
+    {
+        const Ogre::String& group = asset->getGroup();
+        mMaterial = Ogre::MaterialManager::getSingleton().getByName(mGpu->material, group);
+        mShadowedMaterial = Ogre::MaterialManager::getSingleton().getByName(mGpu->shadowedMaterial, group);
+        if (!mMaterial || !mShadowedMaterial)
+            OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
+                        "impostor material '" + mGpu->material + "' or its shadowed variant not found",
+                        "ImpostorTree '" + name + "'");
+        mMaterial->load();
+        mShadowedMaterial->load();
+
+        // The asset's quad, plus one instance at the origin (position 0, scale 1, no rotation) as
+        // constant per-vertex attributes uv4, uv5 in a buffer of its own.
+        mVertexData.reset(mGpu->vertexData->clone(false));
+        const unsigned short source = static_cast<unsigned short>(mVertexData->vertexDeclaration->getMaxSource() + 1);
+        mVertexData->vertexDeclaration->addElement(source, 0, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 4);
+        mVertexData->vertexDeclaration->addElement(source, 4 * sizeof(float), Ogre::VET_FLOAT2,
+                                                   Ogre::VES_TEXTURE_COORDINATES, 5);
+        float instance[4][6];
+        for (float(&v)[6] : instance)
+        {
+            const float one[6] = {0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 0.0f};
+            std::copy(one, one + 6, v);
+        }
+        Ogre::HardwareVertexBufferSharedPtr buffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
+            sizeof(instance[0]), mVertexData->vertexCount, Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+        OgreAssert(mVertexData->vertexCount == 4, "the impostor is one quad");
+        buffer->writeData(0, sizeof(instance), instance, true);
+        mVertexData->vertexBufferBinding->setBinding(source, buffer);
+        mIndexData.indexBuffer = mGpu->indexBuffer;
+        mIndexData.indexStart = 0;
+        mIndexData.indexCount = 6;
+
+        const Ogre::Real w = mGpu->halfWidth;
+        mBounds = Ogre::AxisAlignedBox(-w, mGpu->bottom, -w, w, mGpu->top, w);
+        mRadius = Ogre::Math::boundingRadiusFromAABB(mBounds);
+    }
+
+    ImpostorTree::~ImpostorTree() = default;
+
+    const Ogre::String& ImpostorTree::getMovableType() const { return ImpostorTreeFactory::FACTORY_TYPE_NAME; }
+
+    void ImpostorTree::_updateRenderQueue(Ogre::RenderQueue* queue)
+    {
+        queue->addRenderable(this, mRenderQueueID, mRenderQueuePriority);
+    }
+
+    void ImpostorTree::visitRenderables(Ogre::Renderable::Visitor* visitor, bool)
+    {
+        visitor->visit(this, 0, false);
+    }
+
+    const Ogre::MaterialPtr& ImpostorTree::getMaterial() const
+    {
+        const bool shadowed =
+            mManager && mManager->isShadowTechniqueTextureBased() && mManager->isShadowTechniqueIntegrated();
+        return shadowed ? mShadowedMaterial : mMaterial;
+    }
+
+    void ImpostorTree::getRenderOperation(Ogre::RenderOperation& op)
+    {
+        op.operationType = Ogre::RenderOperation::OT_TRIANGLE_LIST;
+        op.useIndexes = true;
+        op.vertexData = mVertexData.get();
+        op.indexData = &mIndexData;
+        op.srcRenderable = this;
+    }
+
+    void ImpostorTree::getWorldTransforms(Ogre::Matrix4* xform) const { *xform = _getParentNodeFullTransform(); }
+
+    Ogre::Real ImpostorTree::getSquaredViewDepth(const Ogre::Camera* camera) const
+    {
+        return getParentNode() ? getParentNode()->getSquaredViewDepth(camera) : 0.0f;
+    }
+
+    const Ogre::LightList& ImpostorTree::getLights() const { return queryLights(); }
+
+    Ogre::MovableObject* ImpostorTreeFactory::createInstanceImpl(const Ogre::String& name,
+                                                                 const Ogre::NameValuePairList* params)
+    {
+        const ObjectParams p(params, "ImpostorTreeFactory::createInstanceImpl");
+        return new ImpostorTree(name, p.loadAsset(name, "ImpostorTree"));
+    }
+}

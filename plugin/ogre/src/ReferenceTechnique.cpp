@@ -1,0 +1,63 @@
+// Technique "mesh": the polygonal reference (bark with MeshLodGenerator levels, every leaf) as an
+// Ogre Entity of TreeAsset::getReferenceMesh, and as a Forest level. Every comparison in this
+// project is made against it.
+#include "TreeLod/Package.h"
+#include "TreeLod/TechniqueRegistry.h"
+#include "TreeLod/TreeAsset.h"
+
+#include <OgreEntity.h>
+#include <OgreException.h>
+#include <OgreSceneManager.h>
+
+namespace TreeLod
+{
+    namespace
+    {
+        class ReferenceLevels : public ForestLevelProvider
+        {
+        public:
+            std::vector<ForestLevelSpan> getSpans(TreeAsset& asset, const Ogre::String& technique) override
+            {
+                asset.getReference();
+                return {{ForestLevel{technique, 0, false, 0.0f}, ForestLevelSpan::NO_UPPER}};
+            }
+
+            void checkLevel(TreeAsset& asset, const ForestLevel& level, Ogre::AxisAlignedBox&) override
+            {
+                if (level.lowRes)
+                    OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, "lowRes is for billboard-cloud levels only",
+                                "ReferenceLevels::checkLevel");
+                asset.getReference();
+            }
+
+            void buildParts(TreeAsset& asset, const ForestLevel&, ForestPartBuilder& parts) override
+            {
+                parts.addMesh(asset.getReferenceMesh(), asset.getMaterialNames(), asset.getShadowedMaterialNames());
+            }
+        };
+
+        void registerReference(TechniqueRegistry& registry)
+        {
+            registry.add({"mesh", "polygonal reference: bark with MeshLodGenerator levels, every leaf", REFERENCE_CHUNK,
+                          Ogre::EntityFactory::FACTORY_TYPE_NAME,
+                          [](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset,
+                             const Ogre::NameValuePairList&) {
+                              return static_cast<Ogre::MovableObject*>(sm.createEntity(name, asset.getReferenceMesh()));
+                          },
+                          nullptr, std::make_shared<ReferenceLevels>(),
+                          [](Ogre::MovableObject& object) {
+                              auto& entity = static_cast<Ogre::Entity&>(object);
+                              std::vector<TechniqueStateLine> lines;
+                              const unsigned levels = entity.getMesh()->getNumLodLevels();
+                              for (unsigned level = 0; level < levels; ++level)
+                              {
+                                  const bool drawn = level == entity.getCurrentLodIndex();
+                                  lines.push_back({"bark LoD " + std::to_string(level) + "  ", drawn ? 1.0 : 0.0, ""});
+                              }
+                              return lines;
+                          }});
+        }
+
+        const TechniqueRegistry::Registration registration(&registerReference);
+    }
+}
