@@ -24,7 +24,7 @@
 // pop-worst.png (the discrete baseline's largest pop next to lodf at the same step).
 //
 // Needs an X server: xvfb-run -a -s "-screen 0 1280x1024x24" treelod_lodf_study [options]
-// Errors print one line and exit 2. Timings on llvmpipe are CPU timings (DESIGN.md,
+// Errors print one line and exit 2. Timings on llvmpipe are CPU timings (docs/architecture.md,
 // "Measuring"): compare ratios, not milliseconds, across machines.
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/FoliageLodBaker.h"

@@ -3,8 +3,8 @@
 // Submeshes: one per bark material, then one per leaf material, each with its own
 // vertex buffer (position float3, normal float3, uv0 float2) and 16-bit indices when
 // its vertices fit, 32-bit otherwise. Bark gets `barkLodLevels` MeshLodGenerator levels
-// (pixel-count strategy, DESIGN.md "LoD thresholds in screen pixels"); leaf submeshes
-// keep every leaf at every level (the technique issues are the foliage LoD). Optionally the bark
+// (pixel-count strategy, docs/architecture.md, "Units"); leaf submeshes keep every leaf at
+// every level (the foliage LoD is the techniques' job). Optionally the bark
 // carries a per-vertex ambient occlusion colour (MeshBuildOptions::barkVertexAo).
 #pragma once
 
