@@ -1,4 +1,4 @@
-// treelod_lodf_study: what LoDF (paper 004) buys on one tree, measured headless through the
+// treelod_lodf_study: what LoDF (Rebollo et al. 2006) buys on one tree, measured headless through the
 // plugin against the polygonal reference ("mesh") rendered by the same Ogre pipeline.
 //
 // 1. Continuity (zoom): F frames with the camera log-spaced from --near to --far metres
@@ -1057,7 +1057,7 @@ int main(int argc, char** argv)
 {
     using TreeLod::StudyArgs;
     StudyArgs args;
-    CLI::App app{"LoDF study (paper 004): popping along a zoom, and frame time against the reference at equal FLIP. "
+    CLI::App app{"LoDF study (Rebollo et al. 2006): popping along a zoom, and frame time against the reference at equal FLIP. "
                  "Run under xvfb-run -a -s \"-screen 0 1280x1024x24\"."};
     app.add_option("--tree", args.tree, "glTF tree (default: media/oak.glb of the source tree)");
     app.add_option("--leaves", args.leaves, "generate an oak preset with this many leaves instead (100..200000)");

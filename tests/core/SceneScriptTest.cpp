@@ -105,7 +105,8 @@ namespace TreeLod
 
     TEST(SceneScript, shippedScenesHaveTheirTreeCounts)
     {
-        // flythrough: paper 001's 10 000 plants; plaza: paper 002's 290, none on the free square.
+        // flythrough: the ellipsoids-and-lines paper's 10 000 plants; plaza: Linz et al. 2006's 290,
+        // none on the free square.
         std::vector<PlacedTree> fly = generatePlacements(*loadSceneScript(scenePath("flythrough-10k.json")));
         EXPECT_EQ(fly.size(), 10000u);
         Result<SceneScript> plaza = loadSceneScript(scenePath("plaza-290.json"));

@@ -24,7 +24,7 @@ namespace TreeLod
         float lodReduction = 0.5f;         ///< fraction of bark vertices removed per level (cumulative)
         /// Ambient occlusion per model bark vertex (0..255 = 0..1), or empty. When set, bark
         /// submeshes get a second vertex buffer with a colour element (VES_DIFFUSE, UBYTE4_NORM,
-        /// ao in rgb) that the TreeLod/BarkAo materials read (paper 000 §5.2).
+        /// ao in rgb) that the TreeLod/BarkAo materials read (García et al. 2007 §5.2).
         std::vector<std::uint8_t> barkVertexAo;
     };
 

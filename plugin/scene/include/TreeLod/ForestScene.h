@@ -1,5 +1,5 @@
 // ForestScene: a scene script (SceneScript.h) built in an Ogre SceneManager: the ground, the
-// sun and shadows, and one Forest holding every placed tree (issue 5). Used by treelod_frames,
+// sun and shadows, and one Forest holding every placed tree. Used by treelod_frames,
 // `treelod bench` and the sample browser. In TreeLodScene, which links the runtime side only
 // (Plugin_TreeLod, TreeLodOffscreen, TreeLodScript; docs/architecture.md, "Runtime vs bake").
 //

@@ -1,4 +1,4 @@
-// BillboardCloudBaker: TreeModel -> BillboardCloudData (BillboardCloudData.h), paper 000.
+// BillboardCloudBaker: TreeModel -> BillboardCloudData (BillboardCloudData.h), García et al. 2007.
 //
 //   1. Clustering (§4.1): leaves grouped into planes, k-means-like on leaf planes with an
 //      error bound ([BCF*05], [GSSK05]); each billboard's quad bounds its leaves' projection.
@@ -59,7 +59,7 @@ namespace TreeLod
     {
         BillboardCloudOptions cloud;  ///< clustering and compression settings (finest cloud)
         /// GPU bytes for all billboard textures; 0 = the layered cloud's gpuBytes() with the
-        /// same options (the equal-memory comparison of paper 000 Fig. 13).
+        /// same options (the equal-memory comparison of García et al. 2007 Fig. 13).
         std::uint64_t memoryBytes = 0;
     };
 

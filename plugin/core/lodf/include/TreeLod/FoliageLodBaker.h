@@ -1,4 +1,5 @@
-// FoliageLodBaker: builds LoDF's multiresolution foliage (paper 004 §3, §3.1) from a tree.
+// FoliageLodBaker: builds LoDF's multiresolution foliage from a tree (Rebollo et al. 2006 §3,
+// §3.1).
 //
 // 1. Independent groups (§3.1): the leaves of each leaf material are split into spatially
 //    compact clusters of at most `clusterSize` leaves (recursive median split of the leaf

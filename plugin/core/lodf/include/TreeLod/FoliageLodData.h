@@ -1,4 +1,4 @@
-// FoliageLodData: the multiresolution foliage F^r of LoDF (paper 004 §3.1-3.2) and its
+// FoliageLodData: the multiresolution foliage F^r of LoDF (Rebollo et al. 2006 §3.1-3.2) and its
 // package chunk "lodf".
 //
 // The leaves of the tree (originals and the ones created by leaf collapses, 2L - 1 at most,
@@ -78,7 +78,7 @@ namespace TreeLod
             return clusters.empty() ? 0 : clusters.back().firstSlot + clusters.back().slotCount;
         }
 
-        /// Words of the structure as paper 004 eq. 7-8 counts them (3 per vertex position,
+        /// Words of the structure as Rebollo et al. 2006 eq. 7-8 count them (3 per vertex position,
         /// per leaf its number + vertex indices + next, 3 per cluster, 1 per collapse), and
         /// eq. 9's estimate 6.25 V for comparison.
         std::uint64_t paperWords() const;
