@@ -499,7 +499,7 @@ namespace TreeLod
         EXPECT_NE(wrong.error().message().find("outside [0, 1]: 2"), std::string::npos) << wrong.error().message();
     }
 
-    // samples/scenes/README.md: azimuth 0 is the +Z side, 90 the +X side; elevation above the horizon.
+    // docs/scene-format.md: azimuth 0 is the +Z side, 90 the +X side; elevation above the horizon.
     TEST(SceneScript, sunAzimuthAndElevationGiveTheDocumentedDirection)
     {
         std::string text = replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"sun\": {\"azimuth\": 90, "

@@ -18,7 +18,7 @@
 // until no assignment changes or after maxIterations. Seeds: farthest-point sampling of the leaf
 // centres, starting from the leaf farthest from their mean. (length = the leaf's diameter.)
 //
-// Deviations from a plain plane k-means (README), both measured on generated oaks against the
+// Deviations from a plain plane k-means (docs/billboard-cloud.md), both measured on generated oaks against the
 // reference renderer (BillboardCloudBakerTest):
 //   - the spatial term: plane error alone lets one plane collect leaves from both sides of the
 //     crown wherever it cuts through it, which gives billboards as large as the tree with sparse

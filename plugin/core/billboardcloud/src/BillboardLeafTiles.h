@@ -10,7 +10,7 @@
 // Canonical leaf of a material: its texture's full UV rectangle [uvMin, uvMax] of the
 // material's leaves (the union) on a flat rectangle in the (w, t) plane with the material's
 // median aspect (leaf width / length, from the leaves' fitted |dP/du| and |dP/dv| extents).
-// Deviation (README): every leaf of a material is drawn with the canonical leaf's shape and
+// Deviation (docs/billboard-cloud.md): every leaf of a material is drawn with the canonical leaf's shape and
 // texture rectangle; non-planar leaves are drawn flat (the paper also stores one image per
 // orientation). A leaf whose texture is mirrored on it (fitted (w, t, n) left-handed) uses
 // the frame (w, t, -n): its image is right, but its front and back tints are swapped.

@@ -9,7 +9,7 @@
 // quad over four vertices of the leaves it replaces, so all vertices are the reference
 // chunk's leaf vertices and live on the GPU once.
 //
-// Deviation from Fig. 7 (documented in README): the paper gives each entry a fixed `next`
+// Deviation from Fig. 7 (documented in docs/lodf.md): the paper gives each entry a fixed `next`
 // position; a fixed chain cannot represent every state in general (in the paper's own
 // group 1, after two collapses the chain from position 4 yields {l3, l10} instead of
 // {l3, l12}). Each entry stores instead the cluster-local collapse step that creates it:
