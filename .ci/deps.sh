@@ -8,7 +8,7 @@ packages=(cmake g++ make pkg-config
 for flag in "$@"; do
   case $flag in
     --with-fuzzers) packages+=(clang libclang-rt-14-dev) ;;
-    --with-gpu-bundle) packages+=(mesa-utils x11-xkb-utils xz-utils) ;; # ../shared/gpu/bundle.sh packs glxinfo, xkbcomp
+    --with-gpu-bundle) packages+=(mesa-utils x11-xkb-utils xz-utils) ;; # the GPU bundle (bench/gpu-run.sh) packs glxinfo, xkbcomp
     *) echo "deps.sh: unknown flag $flag (known: --with-fuzzers, --with-gpu-bundle)" >&2; exit 2 ;;
   esac
 done

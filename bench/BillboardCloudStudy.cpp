@@ -1,6 +1,6 @@
-// treelod_bc_study: what billboard clouds with multi-layered indirect texturing (paper 000)
+// treelod_bc_study: what billboard clouds with multi-layered indirect texturing (García et al. 2007)
 // cost and how close they come to the polygonal tree, measured headless through the plugin;
-// the numbers issue 3 asks for, in the shape of the paper's Tables 1 and 2.
+// memory, bake time, image error and frame time, in the shape of the paper's Tables 1 and 2.
 //
 // 1. Memory and bake time (Table 1): per tree, leaves, polygons per leaf, billboards of the
 //    three clouds, list entries, GPU bytes of the multi-layered chunk (DXT) and bake seconds
@@ -8,11 +8,11 @@
 //    baked at the same memory.
 // 2. Image error: the error tree seen with the tree filling the view (90 % of the height), a
 //    quarter of the view height and 32 px tall, and close up (3x the view height: branches and
-//    leaves). Reference ("mesh"), classic and multi-layered
-//    are rendered by the same Ogre pipeline at S x S supersampling, the clouds without their AO
-//    term (the polygonal reference has none); multi-scale RMSE (paper 001 §4) and FLIP over the
-//    square around the tree. Pictures: reference | classic |
-//    multi-layered | FLIP of the multi-layered (magnified crops), one PNG per view.
+//    leaves). Reference ("mesh"), classic and multi-layered are rendered by the same Ogre pipeline
+//    at S x S supersampling, the clouds without their AO term (the polygonal reference has none);
+//    multi-scale RMSE (ellipsoids-and-lines paper §4) and FLIP over the square around the tree.
+//    Pictures: reference | classic | multi-layered | FLIP of the multi-layered (magnified crops),
+//    one PNG per view.
 // 3. Frame time (Table 2): N trees on a square grid (spacing 1.25 tree widths), the camera at
 //    a corner of the grid at eye height looking across it, so distances range from a close
 //    view to far trees; the median frame time of mesh, classic and multi-layered for each N in
@@ -231,8 +231,9 @@ namespace TreeLod
                 params["level"] = std::to_string(args.level);
             populate(renderer, scene, 1, 0.0f, params);
             const double height = tree.model.boundsMax.y - tree.model.boundsMin.y;
-            // The issue's three views, and a close-up (the tree 3x the view's height: branches and
-            // leaves, where paper 000 §7 says the layers matter most).
+            // Three views (the tree filling the view, a quarter of its height, 32 px), and a close-up
+            // (the tree 3x the view's height: branches and leaves, where García et al. 2007 §7 says
+            // the layers matter most).
             const std::vector<ErrorView> views = {
                 {"close", 3.0, 0.0}, {"fill", 0.9, 0.0}, {"quarter", 0.25, 0.0}, {"32px", 0.0, 32.0}};
             std::vector<ErrorRow> rows;
@@ -360,7 +361,7 @@ namespace TreeLod
             renderer.setLighting(LightingSpec());
             std::ostringstream md;
             nlohmann::json json;
-            md << "# Billboard clouds (paper 000): memory, bake time, image error, frame time\n\n";
+            md << "# Billboard clouds (García et al. 2007): memory, bake time, image error, frame time\n\n";
             md << "Command: `" << commandLine << "`\n\n";
             md << "## Memory and bake time (Table 1)\n\n";
             md << "| tree | leaves | polys/leaf | billboards (3 clouds) | list entries | multi-layered bytes | "
@@ -466,7 +467,7 @@ namespace TreeLod
 int main(int argc, char** argv)
 {
     TreeLod::StudyArgs args;
-    CLI::App app{"Billboard clouds (paper 000): memory, bake time, image error and frame time against the polygonal "
+    CLI::App app{"Billboard clouds (García et al. 2007): memory, bake time, image error and frame time against the polygonal "
                  "reference. Needs an X server (xvfb-run)."};
     app.add_option("--trees", args.trees, "glTF trees for Table 1");
     app.add_option("--generated", args.generatedLeaves, "generated oaks with these leaf counts");

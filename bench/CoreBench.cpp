@@ -1,4 +1,4 @@
-// glTF import + leaf extraction of a 200k-leaf tree. Target (issue 2): 2 s or less.
+// glTF import + leaf extraction of a 200k-leaf tree. Target: 2 s or less.
 // The .glb files are built once per run in the system temp directory:
 //   synthetic: 200,000 leaf quads (4 own vertices each, scattered in a crown) + a small
 //              trunk cylinder, written by encodeGlb;

@@ -1,7 +1,7 @@
-// LoDF (paper 004 §5, Figs. 10-11): per level-of-detail change, extraction time and bytes
+// LoDF (Rebollo et al. 2006 §5, Figs. 10-11): per level-of-detail change, extraction time and bytes
 // uploaded, LoDF against a rebuild-everything baseline, on a generated oak of 100k leaves
 // (preset oak, seed 1, built once).
-// Target (issue): a 1 % change at 100k leaves costs at least 5x less time and bytes than the
+// Target: a 1 % change at 100k leaves costs at least 5x less time and bytes than the
 // rebuild.
 //   LoDF:    setLeafCount + writeCluster<uint32_t> of each changed cluster into a CPU mirror
 //            of the index buffer at its firstSlot (§4: only the changed groups are sent);

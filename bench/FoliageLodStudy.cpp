@@ -1,4 +1,4 @@
-// treelod_lodf_study: what LoDF (paper 004) buys on one tree, measured headless through the
+// treelod_lodf_study: what LoDF (Rebollo et al. 2006) buys on one tree, measured headless through the
 // plugin against the polygonal reference ("mesh") rendered by the same Ogre pipeline.
 //
 // 1. Continuity (zoom): F frames with the camera log-spaced from --near to --far metres
@@ -24,7 +24,7 @@
 // pop-worst.png (the discrete baseline's largest pop next to lodf at the same step).
 //
 // Needs an X server: xvfb-run -a -s "-screen 0 1280x1024x24" treelod_lodf_study [options]
-// Errors print one line and exit 2. Timings on llvmpipe are CPU timings (DESIGN.md,
+// Errors print one line and exit 2. Timings on llvmpipe are CPU timings (docs/architecture.md,
 // "Measuring"): compare ratios, not milliseconds, across machines.
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/FoliageLodBaker.h"
@@ -1057,7 +1057,7 @@ int main(int argc, char** argv)
 {
     using TreeLod::StudyArgs;
     StudyArgs args;
-    CLI::App app{"LoDF study (paper 004): popping along a zoom, and frame time against the reference at equal FLIP. "
+    CLI::App app{"LoDF study (Rebollo et al. 2006): popping along a zoom, and frame time against the reference at equal FLIP. "
                  "Run under xvfb-run -a -s \"-screen 0 1280x1024x24\"."};
     app.add_option("--tree", args.tree, "glTF tree (default: media/oak.glb of the source tree)");
     app.add_option("--leaves", args.leaves, "generate an oak preset with this many leaves instead (100..200000)");

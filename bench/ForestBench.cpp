@@ -1,7 +1,7 @@
-// Forest (issue 5): instances culled and LoD-selected per second on one core, by
+// Forest: instances culled and LoD-selected per second on one core, by
 // ForestInstances::cull (frustum test, LoD level, counting sort into (kind, level) buckets with
 // packed 3x4 world matrices).
-// Target (issue 7): 20 M instances per second or better on one core.
+// Target: 20 M instances per second or better on one core.
 // Input: 1 M instances at random positions in a 10 km square (seed 1), random rotation, scale
 // 0.7-1.3, 4 kinds (3 with pixel-count tables of 3-4 levels, 1 with a distance table), a
 // 1920 x 1080 viewport, fov 60 degrees. Cameras (the argument):
@@ -9,7 +9,7 @@
 //   1 overview: 1.5 km above a corner looking at the centre, far clip 20 km (most are visible:
 //               the fill pass writes a matrix for each);
 //   2 random:   64 cameras (seed 2), one per iteration in turn: anywhere over the square, 2 m to
-//               1.5 km high, any heading, pitch 0 to -60 degrees, far clip 5-20 km (issue 7).
+//               1.5 km high, any heading, pitch 0 to -60 degrees, far clip 5-20 km.
 // Counters: visible (instances drawn per frame, the mean over the cameras); items = instances culled and selected.
 // Run: build/bin/treelod_core_bench --benchmark_filter=Forest --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 #include "TreeLod/ForestInstances.h"

@@ -1,5 +1,5 @@
 // CPU reference renderer and ambient occlusion on a synthetic 30k-leaf tree.
-// Target (issue 2): a 512 x 512 render with 4 samples per pixel in 1 s or less on 2 cores.
+// Target: a 512 x 512 render with 4 samples per pixel in 1 s or less on 2 cores.
 //   build/bin/treelod_core_bench --benchmark_filter=Render
 // TREELOD_BENCH_THREADS=N limits TBB (and Embree's builder) to N threads. The CPU column is the
 // process's CPU time (all threads): on a busy machine, CPU / threads estimates the idle wall time.

@@ -2,7 +2,7 @@
 # The main job: install what is missing, build, and render the bundled trees headless
 # through the Ogre plugin (the polygonal reference and LoDF) and through the CPU reference
 # renderer into PNGs.
-# Also billboard clouds with multi-layered indirect texturing (paper 000) close up and far,
+# Also billboard clouds with multi-layered indirect texturing (García et al. 2007) close up and far,
 # and the classic billboard cloud at the same memory.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -23,13 +23,14 @@ for tree in "$root"/media/*.glb; do
   done
   "$build/bin/treelod" render "$tree" --renderer cpu --camera "orbit:0,8,1.0" --size 512x512 \
     -o "$out/$name-front-cpu.png"
-  # LoDF (paper 004): the full tree close up, and a quarter of the leaves with shadows.
+  # LoDF (Rebollo et al. 2006): the full tree close up, and a quarter of the leaves with shadows.
   run "$build/bin/treelod" render "$tree" --technique lodf --camera "orbit:0,8,1.0" --size 512x512 \
     -o "$out/$name-front-lodf.png"
   leaves=$("$build/bin/treelod" info "$tree" --json | sed -n 's/.*"leaves": \([0-9]*\).*/\1/p' | head -n 1)
   run "$build/bin/treelod" render "$tree" --technique lodf --leaves $((leaves / 4)) --shadows \
     --camera "orbit:0,8,1.0" --size 512x512 -o "$out/$name-front-lodf-quarter-shadows.png"
-  # Billboard clouds (paper 000): bake both clouds once, render close up, far, and the classic one.
+  # Billboard clouds (García et al. 2007): bake both clouds once, render close up, far, and the
+  # classic one.
   "$build/bin/treelod" bake "$tree" --technique billboard-cloud --technique classic-billboard-cloud -q \
     -o "$out/$name.treelod"
   run "$build/bin/treelod" render "$out/$name.treelod" --technique billboard-cloud --camera "orbit:0,8,1.0" \

@@ -1,5 +1,5 @@
 #version 330 core
-// Billboard clouds with multi-layered indirect texturing (paper 000 §5, Fig. 7), one pass.
+// Billboard clouds with multi-layered indirect texturing (García et al. 2007 §5, Fig. 7), one pass.
 // Addressing: plugin/core/billboardcloud/include/TreeLod/BillboardCloudData.h (its
 // BillboardCloudSampler does the same steps on the CPU); all atlas addressing is integer.
 //   1. hash fetch: the cell of the billboard's hash grid under the fragment -> list start, length;

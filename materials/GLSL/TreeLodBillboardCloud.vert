@@ -1,5 +1,5 @@
 #version 330 core
-// Billboard cloud quads (paper 000 §4.2, §6; vertex layout in TreeLod/TreeAsset.h,
+// Billboard cloud quads (García et al. 2007 §4.2, §6; vertex layout in TreeLod/TreeAsset.h,
 // BillboardCloudGpu): the billboard frame in world space, its (u, v), hash rectangle and
 // low-res rectangle to the fragment stage.
 // CASTER: the shadow camera's clip z and w, and the direction towards the light (the shadow

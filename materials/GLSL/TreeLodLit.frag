@@ -3,7 +3,7 @@
 // (LightingSpec in TreeLod/Camera.h; the CPU reference renderer uses the same formula).
 // LEAF: alpha test by discard; two-sided, the back side with backColour instead of baseColour.
 // SHADOW_RECEIVER: the sun term is scaled by the sun's visibility in the shadow texture.
-// AO: the ambient term is scaled by the vertex colour's red channel (bark AO, paper 000 §5.2).
+// AO: the vertex colour's red channel scales the ambient term (bark AO, García et al. 2007 §5.2).
 uniform sampler2D diffuseMap;
 uniform vec4 sunDirection;  // world space, towards the sun (w = 0 for a directional light)
 uniform vec4 sunColour;

@@ -638,7 +638,7 @@ namespace TreeLod
                 command.push_back("-q");
             if (args.bakeOnly)
             {
-                // For a GPU machine (../shared/gpu/README.md): run this there, bring DIR back, then
+                // For a GPU machine (bench/gpu-run.sh bundles it): run this there, bring DIR back, then
                 // `treelod bench ... --frames-from DIR` here computes the image metrics and the plots.
                 std::string line;
                 for (const std::string& a : command)

@@ -1,6 +1,6 @@
 // treelod compare REFERENCE TEST [--json] [--heatmap OUT.png] [--ppd X]
-// Prints FLIP (mean, max, median), multi-scale RMSE (paper 001 §4: bands and combined)
-// and PSNR of TEST against REFERENCE. Alpha is ignored; sizes must match.
+// Prints FLIP (mean, max, median), multi-scale RMSE (ellipsoids-and-lines paper §4: bands and
+// combined) and PSNR of TEST against REFERENCE. Alpha is ignored; sizes must match.
 #include "CliSupport.h"
 #include "Commands.h"
 

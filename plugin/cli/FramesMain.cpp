@@ -2,9 +2,10 @@
 //                [--size] [--samples] [--reference-budget] [--reference-image-budget] [--entity-limit]
 //                [--upload-budget] [--shadow-size] [--shadow-lod-bias] [--preload] [--skip-comparisons] [-q]
 //
-// The program that renders and times the frames of `treelod bench` (issue 7): it links OGRE and the
+// The program that renders and times the frames of `treelod bench`: it links OGRE and the
 // runtime only (Plugin_TreeLod, TreeLodOffscreen, TreeLodScene, TreeLodScript, TreeLodRuntime), never
-// TreeLodBake (DESIGN.md, "Runtime vs bake"), so it fits the GPU bundle of ../shared/gpu/README.md.
+// TreeLodBake (docs/architecture.md, "Runtime vs bake"), so it fits the GPU bundle that
+// bench/gpu-run.sh prepares.
 // It bakes nothing: packages come from the list `treelod bench` writes after baking them
 // (PackageListBaker). `treelod bench` runs it and then computes the image metrics from the frames it
 // saved; on a GPU machine run it directly with the same options and the bench's package list.

@@ -1,4 +1,4 @@
-// treelod: generate, inspect, bake, render and compare trees (DESIGN.md, "CLI").
+// treelod: generate, inspect, bake, render and compare trees (docs/architecture.md, "CLI").
 #include "CliSupport.h"
 #include "Commands.h"
 

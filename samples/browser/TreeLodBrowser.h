@@ -1,6 +1,6 @@
 // TreeLodBrowser: TreeLod's sample browser, an OgreBites ApplicationContext shaped like Ogre's own
 // (Samples/Browser): a menu of samples with thumbnails and descriptions, trays for the controls
-// and the stats, CameraMan for keyboard and mouse (issue 5, "Sample browser").
+// and the stats, CameraMan for keyboard and mouse.
 //
 // Screen layout: a column of COLUMN_WIDTH pixels on the left holds the trays (menu, controls,
 // stats, LoD histogram); the sample draws into the rest. Viewports: the sample's (z-order 0..9),

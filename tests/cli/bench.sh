@@ -71,7 +71,7 @@ grep -q 'baked' "$out/single/summary.json" || fail "first run baked nothing?"
 grep -q '"bake"' "$out/single2/summary.json" && ! grep -q ': baked' "$out/single2/summary.json" \
   || fail "second run rebaked"
 
-# 2. Paper 000 Table 2 scaled down: two tree counts (1 and 1 + 49 x 0.1), a trees.png plot.
+# 2. García et al. 2007 Table 2 scaled down: two tree counts (1 and 1 + 49 x 0.1), a trees.png plot.
 "$treelod" bench "$src/samples/scenes/table2.json" -o "$out/table2" --scale 0.1 --counts 1,50 --frames 3 \
   --size 128x96 --techniques billboard-cloud --lod-bias 1 --samples 1 --cache "$cache" -q
 for f in frames.csv summary.json trees.png; do [ -s "$out/table2/$f" ] || fail "table2/$f missing"; done

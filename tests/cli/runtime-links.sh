@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# DESIGN.md "Runtime vs bake" (issue 7): the plugin and the program that renders and times the
+# docs/architecture.md "Runtime vs bake": the plugin and the program that renders and times the
 # bench's frames (treelod_frames) load no baker library, so they fit the GPU bundle
-# (../shared/gpu/README.md). Fails naming the library that leaked in.
+# (bench/gpu-run.sh prepare). Fails naming the library that leaked in.
 set -euo pipefail
 status=0
 for binary in "$@"; do

@@ -1,4 +1,4 @@
-// BillboardCloudBaker (paper 000 §4, §5.1, §5.2, §6): the extremes of the issue (1 leaf, no
+// BillboardCloudBaker (García et al. 2007 §4, §5.1, §5.2, §6): the extremes (1 leaf, no
 // leaves, more billboards than leaves, coplanar leaves, NaN, 0.5 m and 500 m trees, 200k leaves),
 // the geometry (quads hold their leaves, every listed entry really covers its cell, truncated
 // lists keep both ends), chunk round trip and determinism, DXT fidelity, and the accuracy of
@@ -350,7 +350,7 @@ namespace TreeLod
         }
     }
 
-    // ---- extremes (issue 3) --------------------------------------------------------------------
+    // ---- extremes ------------------------------------------------------------------------------
 
     TEST(BillboardCloudBaker, oneLeafGivesOneBillboardPerLevel)
     {

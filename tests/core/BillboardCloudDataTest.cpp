@@ -1,4 +1,4 @@
-// Billboard clouds (paper 000): the "billboard-cloud" chunk (BillboardCloudData.h), list entry
+// Billboard clouds (García et al. 2007): the "billboard-cloud" chunk (BillboardCloudData.h), list entry
 // quantisation (§4.2, Fig. 8), the hemi-octahedral orientations of the Leaves Texture (§3, §5),
 // validation of corrupt input, and BillboardCloudSampler, the shader's hash/lists addressing,
 // including its exactness on a 4096 x 4096 hash atlas with 2^24 list entries.
@@ -772,7 +772,7 @@ namespace TreeLod
 
     TEST(BillboardCloudData, hashAndListsAddressingIsExactAt4096Squared)
     {
-        // The check: a 4096 x 4096 hash atlas fully covered by billboards of uneven
+        // The addressing limit: a 4096 x 4096 hash atlas fully covered by billboards of uneven
         // sizes (not powers of two), and a 4096 x 4096 lists atlas holding 2^24 entries. Hash
         // texel t (row-major) lists start = (t * 0x9E3779B1 + 12345) mod 2^24 (a bijection, so
         // every 24-bit start occurs, 2^24 - 1 included, with a list of length <= 1 there) and

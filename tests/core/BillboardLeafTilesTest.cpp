@@ -1,4 +1,4 @@
-// BillboardLeafTiles (paper 000 §3, §5, §5.2): the Leaves Texture and the leaf -> billboard
+// BillboardLeafTiles (García et al. 2007 §3, §5, §5.2): the Leaves Texture and the leaf -> billboard
 // placement. The key check goes through the shader's own addressing: a leaf is placed on a
 // one-cell billboard, its entry encoded, and points of the leaf surface projected onto the
 // plane are looked up with BillboardCloudSampler (hash -> list entry -> tile-local) and the

@@ -1,4 +1,4 @@
-// LoDF (paper 004): the baker's F^r (eqs. 3, 5, 9), the "lodf" chunk, and the retrieval
+// LoDF (Rebollo et al. 2006): the baker's F^r (eqs. 3, 5, 9), the "lodf" chunk, and the retrieval
 // algorithms of §3.3 (eqs. 10-13) against independent recomputations, on tiny hand-made
 // trees (the extremes), the bundled oak and generated trees up to 200k leaves.
 #include "TreeLod/FoliageLodBaker.h"

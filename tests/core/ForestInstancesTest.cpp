@@ -669,7 +669,7 @@ namespace TreeLod
         EXPECT_FALSE(forest.contains(handles[0]));
     }
 
-    // Issue 7: a million instances (no index overflow, memory linear at <= 32 bytes each), every
+    // A million instances (no index overflow, memory linear at <= 32 bytes each), every
     // tree at one spot, and the camera 10 km away.
     TEST(ForestInstances, aMillionInstancesThirtyTwoBytesEach)
     {
@@ -726,7 +726,7 @@ namespace TreeLod
             EXPECT_EQ(b.count, b.level + 1 == stacked.getLevelCount(b.kind) ? 1250u : 0u) << b.kind << "/" << b.level;
     }
 
-    // Blocks (issue 7): a store in spatial order, whose culling skips whole blocks, sees exactly
+    // Blocks: a store in spatial order, whose culling skips whole blocks, sees exactly
     // what the per-instance test of a store in input order sees, camera after camera; removals and
     // updates keep the block boxes conservative.
     TEST(ForestInstances, blocksSkipNothingVisible)

@@ -240,7 +240,7 @@ TEST(Image, SrgbTransferMatchesStandardAndInverts)
         EXPECT_NEAR(linearToSrgb(srgbToLinear(c)), c, 1e-5) << c;
 }
 
-// ---- multi-scale RMSE (paper 001 §4) --------------------------------------------------
+// ---- multi-scale RMSE (ellipsoids-and-lines paper §4) ---------------------------------
 
 TEST(MultiScaleRmse, IdenticalImagesGiveZeroInEveryBand)
 {

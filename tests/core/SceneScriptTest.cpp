@@ -105,7 +105,8 @@ namespace TreeLod
 
     TEST(SceneScript, shippedScenesHaveTheirTreeCounts)
     {
-        // flythrough: paper 001's 10 000 plants; plaza: paper 002's 290, none on the free square.
+        // flythrough: the ellipsoids-and-lines paper's 10 000 plants; plaza: Linz et al. 2006's 290,
+        // none on the free square.
         std::vector<PlacedTree> fly = generatePlacements(*loadSceneScript(scenePath("flythrough-10k.json")));
         EXPECT_EQ(fly.size(), 10000u);
         Result<SceneScript> plaza = loadSceneScript(scenePath("plaza-290.json"));
@@ -498,7 +499,7 @@ namespace TreeLod
         EXPECT_NE(wrong.error().message().find("outside [0, 1]: 2"), std::string::npos) << wrong.error().message();
     }
 
-    // samples/scenes/README.md: azimuth 0 is the +Z side, 90 the +X side; elevation above the horizon.
+    // docs/scene-format.md: azimuth 0 is the +Z side, 90 the +X side; elevation above the horizon.
     TEST(SceneScript, sunAzimuthAndElevationGiveTheDocumentedDirection)
     {
         std::string text = replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"sun\": {\"azimuth\": 90, "

@@ -122,7 +122,7 @@ TEST(TreeGenerator, rejectsBadTextureSizeAndHeight)
     EXPECT_NE(model.error().element.find("--height"), std::string::npos);
 }
 
-// "broadleaf" is the name for the oak preset; unknown names are refused.
+// "broadleaf" is another name for the oak preset; unknown names are refused.
 TEST(TreeGenerator, parsesPresetNames)
 {
     TreePreset preset = TreePreset::Shrub;

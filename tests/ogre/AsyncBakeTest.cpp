@@ -1,4 +1,4 @@
-// Baking off the frame path (issue 7): TreeAssetManager::requireAsync runs the registered
+// Baking off the frame path: TreeAssetManager::requireAsync runs the registered
 // TreeBaker on a worker thread while the render thread goes on drawing; ForestScene's
 // requestTechnique/update switch a scene's technique once its bakes have ended. A gated baker
 // (it waits until the test opens its gate) makes "not ready yet" deterministic.

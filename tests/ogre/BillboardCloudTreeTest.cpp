@@ -1,4 +1,4 @@
-// BillboardCloudTree (paper 000: billboard clouds with multi-layered indirect texturing) through
+// BillboardCloudTree (García et al. 2007: billboard clouds with multi-layered indirect texturing) through
 // Plugin_TreeLod: factory and registry, bad parameters, bounds, render queue group and query
 // flags, geometric LoD against pixel count, bias and distance, material LoD at its threshold,
 // shader LoD visible in the picture, golden images of the bundled trees and a 50k-leaf tree

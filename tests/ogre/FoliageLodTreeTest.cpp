@@ -1,4 +1,4 @@
-// FoliageLodTree (paper 004, LoDF) through Plugin_TreeLod: factory and registry, the leaf
+// FoliageLodTree (Rebollo et al. 2006, LoDF) through Plugin_TreeLod: factory and registry, the leaf
 // count curve and LoD bias, partial index uploads, drift-free GPU state, golden images at
 // three distances, shadows, extremes (no leaves, 100k leaves, camera inside the crown and
 // 10 km away) and bad input.

@@ -1,4 +1,4 @@
-// Forest (issue 5) through Plugin_TreeLod: the factory, render queue group and query flags;
+// Forest through Plugin_TreeLod: the factory, render queue group and query flags;
 // the instanced draws against the same trees as separate objects (Entity, FoliageLodTree,
 // BillboardCloudTree under SceneNodes: the test of the INSTANCED vertex programs' rotation,
 // scale and normals); the quad level; culling and level counts against ForestInstances::cull;
@@ -711,7 +711,7 @@ namespace TreeLod
         EXPECT_EQ(biased->getStats().levelCounts.at(0), (std::vector<std::uint32_t>{2u, 0u})) << "the view's levels";
         EXPECT_THROW(biased->setShadowLodBias(0.0f), Ogre::InvalidParametersException);
         EXPECT_THROW(biased->setShadowLodBias(std::nanf("")), Ogre::InvalidParametersException);
-        // LiSPSM (paper 000 §5.2): a perspective shadow camera with its own matrices culls too.
+        // LiSPSM (García et al. 2007 §5.2): a perspective shadow camera with its own matrices culls too.
         place(forestTrees, true);
         r.setShadows(true, 1024, ShadowCamera::LiSPSM);
         const Image lispsm = toImage(r.render(view, 192, 160, 2));
@@ -879,7 +879,7 @@ namespace TreeLod
 
     TEST(Forest, aMillionTreesInOneDraw)
     {
-        // Issue 7's extreme: 1,000,000 instances all in view draw in one instanced call of 2 M
+        // The extreme: 1,000,000 instances all in view draw in one instanced call of 2 M
         // triangles (no 16-bit count anywhere on the way), the store at ~30 bytes a tree and the
         // instance buffer at 24 (grown by doubling) a visible tree.
         const ForestTree& tree = oak();

@@ -1,5 +1,5 @@
-// BillboardCloudTree: billboard clouds with multi-layered indirect texturing (paper 000 §5, §6).
-// See BillboardCloudTree.h for the LoD rules.
+// BillboardCloudTree: billboard clouds with multi-layered indirect texturing (García et al. 2007
+// §5, §6). See BillboardCloudTree.h for the LoD rules.
 #include "TreeLod/BillboardCloudTree.h"
 
 #include "ObjectParams.h"

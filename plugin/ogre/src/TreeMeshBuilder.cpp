@@ -159,7 +159,7 @@ namespace TreeLod
                                  model.boundsMax.y, model.boundsMax.z);
         mesh->_setBounds(box);
 
-        // paper 000 §6 (Hoppe's progressive meshes for the trunk): MeshLodGenerator on the
+        // García et al. 2007 §6 (Hoppe's progressive meshes for the trunk): MeshLodGenerator on the
         // bark alone, before the leaf submeshes exist.
         if (options.barkLodLevels > 0 && !bark.empty() && Ogre::MeshLodGenerator::getSingletonPtr())
         {

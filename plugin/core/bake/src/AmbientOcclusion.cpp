@@ -1,9 +1,11 @@
 // Ambient occlusion by ray casting, for the AO terms of:
-//   paper 000 §5.2: García, Patow, Szirmay-Kalos, Sbert, "Multi-layered indirect texturing for
-//                   tree rendering": AO "computed for the original polygonal tree" per vertex,
-//                   then extrapolated to billboard corners (the extrapolation is the baker's).
-//   paper 001 §5:   per-vertex AO of the mesh "by path tracing random directions in the surface
-//                   normal hemisphere until the ray leaves the model".
+//   García et al. 2007 §5.2: García, Patow, Szirmay-Kalos, Sbert, "Multi-layered indirect
+//                   texturing for tree rendering": AO "computed for the original polygonal tree"
+//                   per vertex, then extrapolated to billboard corners (the extrapolation is the
+//                   baker's).
+//   the ellipsoids-and-lines paper §5 ("A level-of-detail method for trees based on ellipsoids
+//                   and lines"): per-vertex AO of the mesh "by path tracing random directions in
+//                   the surface normal hemisphere until the ray leaves the model".
 // Directions: cosine-weighted (Malley's method: a uniform point on the unit disc lifted to the
 // hemisphere) over a Fibonacci disc lattice, stratified in radius, randomly rotated per point.
 // The orthonormal basis follows Duff et al., "Building an Orthonormal Basis, Revisited" (JCGT 2017).

@@ -1,7 +1,8 @@
 // Multi-scale RMSE.
 //
 // This work is based on:
-//   paper 001 §4 "Image Error Metric" and Fig. 8: the RMSE of the difference image
+//   "A level-of-detail method for trees based on ellipsoids and lines" (docs/papers.md),
+//   §4 "Image Error Metric" and Fig. 8: the RMSE of the difference image
 //   (test - reference) at several resolutions, computed in a single scan along a
 //   space-filling Z-order curve with one accumulated value per resolution band.
 //
@@ -84,8 +85,8 @@ namespace TreeLod
             difference(0, 0, unused);
         }
 
-        // paper 001 §4: one scan of the difference image along the Z curve. The scan steps
-        // over 2x2 quads (level-1 blocks, Z-ordered inside) so that band 0 and band 1
+        // Ellipsoids-and-lines paper §4: one scan of the difference image along the Z curve. The
+        // scan steps over 2x2 quads (level-1 blocks, Z-ordered inside) so that band 0 and band 1
         // are done in the same step; coarser blocks close as their runs of quads end.
         const std::uint64_t quads = levels > 0 ? std::uint64_t(1) << (2 * (levels - 1)) : 0;
         std::uint64_t j = 0;

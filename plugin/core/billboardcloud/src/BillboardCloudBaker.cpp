@@ -1,7 +1,8 @@
-// BillboardCloudBaker: TreeModel -> BillboardCloudData, paper 000 (García, Patow,
+// BillboardCloudBaker: TreeModel -> BillboardCloudData, García et al. 2007 (García, Patow,
 // Szirmay-Kalos, Sbert, "Multi-layered indirect texturing for tree rendering", 2007) §4, §5.1,
 // §5.2, §6, and the classic billboard cloud it is compared with (Fig. 13). Contract:
-// BillboardCloudBaker.h and BillboardCloudData.h. Choices the paper leaves open (README):
+// BillboardCloudBaker.h and BillboardCloudData.h. Choices the paper leaves open
+// (docs/billboard-cloud.md):
 //   - leaf length (cell and texel sizes are multiples of the median): the leaf's diameter,
 //     2 x the largest distance of its vertices from its centre (the diagonal of a quad leaf);
 //   - clustering: BillboardClustering.h (plane error + spatial and orientation terms, error

@@ -1,8 +1,9 @@
-// BillboardCloudData: the "billboard-cloud" / "classic-billboard-cloud" chunk format of paper 000
-// (billboard clouds with multi-layered indirect texturing): list entry quantisation (§4.2, Fig. 8),
-// the hemi-octahedral orientations of the Leaves Texture (§3, §5), validation of every invariant
-// the shader relies on, the chunk encoder/decoder, and BillboardCloudSampler, the shader's hash and
-// list addressing (§4.2, §5) evaluated on the CPU with the same float steps.
+// BillboardCloudData: the "billboard-cloud" / "classic-billboard-cloud" chunk format of
+// García et al. 2007 (billboard clouds with multi-layered indirect texturing): list entry
+// quantisation (§4.2, Fig. 8), the hemi-octahedral orientations of the Leaves Texture (§3, §5),
+// validation of every invariant the shader relies on, the chunk encoder/decoder, and
+// BillboardCloudSampler, the shader's hash and list addressing (§4.2, §5) evaluated on the CPU
+// with the same float steps.
 #include "TreeLod/BillboardCloudData.h"
 
 #include "TreeLod/ByteReader.h"

@@ -1,5 +1,5 @@
-// BillboardClustering: leaf clustering into planes for the billboard clouds of paper 000 §4.1
-// (contract and deviations in BillboardClustering.h).
+// BillboardClustering: leaf clustering into planes for the billboard clouds of García et al. 2007
+// §4.1 (contract and deviations in BillboardClustering.h).
 #include "BillboardClustering.h"
 
 #include <Eigen/Dense>

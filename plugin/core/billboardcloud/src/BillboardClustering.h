@@ -1,6 +1,6 @@
-// BillboardClustering: the leaf clustering of paper 000 §4.1, k-means-like on leaf planes with
-// an error bound, in the spirit of [BCF*05] (Behrendt et al., "Realistic real-time rendering of
-// landscapes using billboard clouds", 2005) and [GSSK05] (García et al., "Leaf cluster impostors
+// BillboardClustering: the leaf clustering of García et al. 2007 §4.1, k-means-like on leaf planes
+// with an error bound, in the spirit of [BCF*05] (Behrendt et al., "Realistic real-time rendering
+// of landscapes using billboard clouds", 2005) and [GSSK05] (García et al., "Leaf cluster impostors
 // for tree rendering with parallax", 2005). Private to the baker (BillboardCloudBaker.cpp).
 //
 // A cluster is a plane (unit normal n, offset d: n.p = d) and a centroid g. The plane error of a
@@ -18,7 +18,7 @@
 // until no assignment changes or after maxIterations. Seeds: farthest-point sampling of the leaf
 // centres, starting from the leaf farthest from their mean. (length = the leaf's diameter.)
 //
-// Deviations from a plain plane k-means (README), both measured on generated oaks against the
+// Deviations from a plain plane k-means (docs/billboard-cloud.md), both measured on generated oaks against the
 // reference renderer (BillboardCloudBakerTest):
 //   - the spatial term: plane error alone lets one plane collect leaves from both sides of the
 //     crown wherever it cuts through it, which gives billboards as large as the tree with sparse

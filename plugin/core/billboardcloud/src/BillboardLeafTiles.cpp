@@ -1,6 +1,6 @@
-// BillboardLeafTiles: the Leaves Texture of paper 000 (§3, §5, §5.2) and the placement of a
-// leaf on a billboard plane. Contract: BillboardLeafTiles.h and the "Lists atlas", "AO atlas"
-// and "Leaves Texture" sections of BillboardCloudData.h.
+// BillboardLeafTiles: the Leaves Texture of García et al. 2007 (§3, §5, §5.2) and the placement of
+// a leaf on a billboard plane. Contract: BillboardLeafTiles.h and the "Lists atlas", "AO atlas" and
+// "Leaves Texture" sections of BillboardCloudData.h.
 //
 // Coordinates used below:
 //   leaf frame   (w, t, n): a leaf point is centre + length * (a w + b t), (a, b) in leaf
@@ -295,7 +295,8 @@ namespace TreeLod
         }
 
         // Tile frames and tile edges: the canonical rectangle projected along d_k fits the
-        // inner (1 - 2 TILE_MARGIN) of the tile (paper 000 §3: one leaf image per orientation).
+        // inner (1 - 2 TILE_MARGIN) of the tile (García et al. 2007 §3: one leaf image per
+        // orientation).
         mTileAxes.resize(orientationCount);
         for (std::uint32_t k = 0; k < orientationCount; ++k)
             mTileAxes[k] = tileAxes(glm::normalize(billboardOrientationDirection(k, mGrid)));

@@ -1,7 +1,7 @@
-// BillboardLeafTiles: the Leaves Texture of paper 000 (§3, §5, §5.2) and the one place that
-// maps a leaf onto a billboard plane (orientation, mirror, rotation, tile edge, centre, AO).
-// Everything here follows the "Leaves Texture" and "Lists atlas" sections of
-// BillboardCloudData.h; the baker (BillboardCloudBaker.cpp) and the tests use only this API.
+// BillboardLeafTiles: the Leaves Texture of García et al. 2007 (§3, §5, §5.2) and the one place
+// that maps a leaf onto a billboard plane (orientation, mirror, rotation, tile edge, centre, AO).
+// Everything here follows the "Leaves Texture" and "Lists atlas" sections of BillboardCloudData.h;
+// the baker (BillboardCloudBaker.cpp) and the tests use only this API.
 //
 // Leaf frame (per leaf, from its triangles): w = direction of increasing texture u, t = towards
 // the tip (decreasing texture v), both least-squares fits of dP/du and -dP/dv over the leaf's
@@ -10,7 +10,7 @@
 // Canonical leaf of a material: its texture's full UV rectangle [uvMin, uvMax] of the
 // material's leaves (the union) on a flat rectangle in the (w, t) plane with the material's
 // median aspect (leaf width / length, from the leaves' fitted |dP/du| and |dP/dv| extents).
-// Deviation (README): every leaf of a material is drawn with the canonical leaf's shape and
+// Deviation (docs/billboard-cloud.md): every leaf of a material is drawn with the canonical leaf's shape and
 // texture rectangle; non-planar leaves are drawn flat (the paper also stores one image per
 // orientation). A leaf whose texture is mirrored on it (fitted (w, t, n) left-handed) uses
 // the frame (w, t, -n): its image is right, but its front and back tints are swapped.
@@ -61,10 +61,10 @@ namespace TreeLod
         BillboardListEntry entryFor(const LeafPlacement& placement, float cellSize, std::uint32_t i,
                                     std::uint32_t j) const;
 
-        /// Paper 000 §5.2, Fig. 11: AO at the tile corners local (0,0), (1,0), (0,1), (1,1) by
-        /// least squares of the bilinear function to the leaf's vertex AO values at their
-        /// tile-local positions (clamped to [0, 1]; ao must hold one value per leaf vertex of
-        /// the model). A leaf with one distinct position gives its mean everywhere.
+        /// García et al. 2007 §5.2, Fig. 11: AO at the tile corners local (0,0), (1,0), (0,1),
+        /// (1,1) by least squares of the bilinear function to the leaf's vertex AO values at their
+        /// tile-local positions (clamped to [0, 1]; ao must hold one value per leaf vertex of the
+        /// model). A leaf with one distinct position gives its mean everywhere.
         std::array<std::uint8_t, 4> fitAo(std::uint32_t leaf, const LeafPlacement& placement, const glm::vec3& origin,
                                           const glm::vec3& U, const glm::vec3& V,
                                           const std::vector<float>& leafVertexAo) const;

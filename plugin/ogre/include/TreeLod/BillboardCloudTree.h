@@ -1,5 +1,5 @@
 // BillboardCloudTree: a tree drawn as a billboard cloud with multi-layered indirect texturing
-// (paper 000), or as the classic billboard cloud it is compared with. MovableObject type
+// (García et al. 2007), or as the classic billboard cloud it is compared with. MovableObject type
 // "BillboardCloudTree".
 //
 // Foliage: the asset's billboard cloud chunk (TreeAsset::getBillboardCloudGpu): the quads of

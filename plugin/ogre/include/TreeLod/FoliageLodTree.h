@@ -1,5 +1,5 @@
 // FoliageLodTree: a tree drawn with LoDF, continuous foliage level of detail by leaf collapse
-// (paper 004). MovableObject type "FoliageLodTree".
+// (Rebollo et al. 2006). MovableObject type "FoliageLodTree".
 //
 // Every leaf vertex lives on the GPU once per asset (TreeAsset::getLeafVertexData); each
 // instance owns one index buffer holding every cluster's region (FoliageLodData). When the

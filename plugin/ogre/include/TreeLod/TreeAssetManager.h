@@ -2,7 +2,7 @@
 // Packages are found through resource groups like meshes:
 //   TreeAssetManager::getSingleton().load("oak.treelod", "General")
 //
-// Baking off the frame path (issue 7): requireAsync runs the registered TreeBaker on a worker
+// Baking off the frame path: requireAsync runs the registered TreeBaker on a worker
 // thread and returns at once; the render thread polls TreeAssetRequest::isReady() and then get()s
 // the asset (loading the package: header and chunk table only, TreeAsset.h). Bakes run one at a
 // time (require() waits for a running one); the baker must not call Ogre's render-thread APIs

@@ -1,7 +1,7 @@
-// TreeBaker: how Plugin_TreeLod reaches a baker without linking one (DESIGN.md, "Runtime vs
-// bake"). An application that can bake (the CLI, the sample browser, a user's tool) registers
-// one with TreeAssetManager::setBaker; TreeAssetManager::require then asks it for a package
-// holding the chunks a scene needs ("model only what a scene requires", issue 5) and loads it.
+// TreeBaker: how Plugin_TreeLod reaches a baker without linking one (docs/architecture.md,
+// "Runtime vs bake"). An application that can bake (the CLI, the sample browser, a user's tool)
+// registers one with TreeAssetManager::setBaker; TreeAssetManager::require then asks it for a
+// package holding the chunks a scene needs ("model only what a scene requires") and loads it.
 // Without a registered baker, require() throws, naming the source.
 #pragma once
 

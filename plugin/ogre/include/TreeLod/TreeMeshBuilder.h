@@ -3,8 +3,8 @@
 // Submeshes: one per bark material, then one per leaf material, each with its own
 // vertex buffer (position float3, normal float3, uv0 float2) and 16-bit indices when
 // its vertices fit, 32-bit otherwise. Bark gets `barkLodLevels` MeshLodGenerator levels
-// (pixel-count strategy, DESIGN.md "LoD thresholds in screen pixels"); leaf submeshes
-// keep every leaf at every level (the technique issues are the foliage LoD). Optionally the bark
+// (pixel-count strategy, docs/architecture.md, "Units"); leaf submeshes keep every leaf at
+// every level (the foliage LoD is the techniques' job). Optionally the bark
 // carries a per-vertex ambient occlusion colour (MeshBuildOptions::barkVertexAo).
 #pragma once
 
@@ -24,7 +24,7 @@ namespace TreeLod
         float lodReduction = 0.5f;         ///< fraction of bark vertices removed per level (cumulative)
         /// Ambient occlusion per model bark vertex (0..255 = 0..1), or empty. When set, bark
         /// submeshes get a second vertex buffer with a colour element (VES_DIFFUSE, UBYTE4_NORM,
-        /// ao in rgb) that the TreeLod/BarkAo materials read (paper 000 §5.2).
+        /// ao in rgb) that the TreeLod/BarkAo materials read (García et al. 2007 §5.2).
         std::vector<std::uint8_t> barkVertexAo;
     };
 

@@ -27,7 +27,7 @@ namespace TreeLod
 
         /// Writes (atomically) the JSON list PackageListBaker reads: one entry per source required
         /// so far, with every technique (chunk) its package holds and the package's path (both relative to the list's folder)
-        /// (samples/scenes/README.md, "Package lists"). Error naming `path` when it cannot write.
+        /// (docs/scene-format.md, "Package lists"). Error naming `path` when it cannot write.
         Result<void> writePackageList(const std::string& path) const;
 
     private:

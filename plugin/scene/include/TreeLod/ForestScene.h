@@ -1,7 +1,7 @@
 // ForestScene: a scene script (SceneScript.h) built in an Ogre SceneManager: the ground, the
-// sun and shadows, and one Forest holding every placed tree (issue 5). Used by treelod_frames,
+// sun and shadows, and one Forest holding every placed tree. Used by treelod_frames,
 // `treelod bench` and the sample browser. In TreeLodScene, which links the runtime side only
-// (Plugin_TreeLod, TreeLodOffscreen, TreeLodScript; DESIGN.md, "Runtime vs bake").
+// (Plugin_TreeLod, TreeLodOffscreen, TreeLodScript; docs/architecture.md, "Runtime vs bake").
 //
 // Packages: each species' package comes from TreeAssetManager::require, so the registered
 // TreeBaker supplies exactly the chunks the species' techniques draw from: CacheTreeBaker

@@ -1,7 +1,7 @@
 // PackageListBaker: the TreeBaker (TreeBaker.h) of programs that draw but never bake
-// (treelod_frames; DESIGN.md, "Runtime vs bake"). It answers requirePackage() from a package list,
-// the JSON file CacheTreeBaker::writePackageList() writes after baking (samples/scenes/README.md,
-// "Package lists"):
+// (treelod_frames; docs/architecture.md, "Runtime vs bake"). It answers requirePackage() from a
+// package list, the JSON file CacheTreeBaker::writePackageList() writes after baking
+// (docs/scene-format.md, "Package lists"):
 //   {"format": "treelod-package-list", "version": 1,
 //    "packages": [{"source": "../media/oak.glb", "techniques": ["impostor", "reference"],
 //                  "path": "cache/oak-1234.treelod"}]}

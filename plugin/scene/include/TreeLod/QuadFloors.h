@@ -1,9 +1,9 @@
-// QuadFloors: the two speed floors `treelod bench` measures the Forest against (issue 7), both
+// QuadFloors: the two speed floors `treelod bench` measures the Forest against, both
 // drawing each tree as the one camera-facing quad of its baked impostor (TreeAsset::getImpostorGpu,
 // materials/GLSL/TreeLodImpostor.vert), so all three give the same picture:
 // - EntityFloor: one Ogre Entity on its own SceneNode per tree, one draw each: what Ogre users
-//   pay today (../shared/gpu/README.md: 10,000 one-quad entities cost 16 ms on an H100, all of
-//   it Ogre's per-object CPU cost).
+//   pay today (measured with a minimal Ogre program: 10,000 one-quad entities cost 16 ms on an
+//   H100, all of it Ogre's per-object CPU cost).
 // - MergedQuadFloor: every tree's quad merged into static batches of at most BATCH_TREES trees
 //   (one Entity of a built Mesh per batch, culled by its own bounds): the cheapest drawing.
 // The impostor's vertex program reads uv4 (position + uniform scale) and uv5 (cos, sin) that the

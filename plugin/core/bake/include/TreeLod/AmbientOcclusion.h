@@ -1,10 +1,10 @@
 // AmbientOcclusion: per-vertex ambient occlusion of a TreeModel by ray casting (Embree).
 //
-// paper 000 §5.2 (García et al., "Multi-layered indirect texturing for tree rendering") and
-// paper 001 §5 ("a level of detail method for trees based on ellipsoids and lines") both add a
-// precomputed AO term, per vertex of the original polygonal tree, to the ambient light; 001
-// computes it "by path tracing random directions in the surface normal hemisphere until the ray
-// leaves the model". This file casts exactly those rays:
+// García et al. 2007 §5.2 ("Multi-layered indirect texturing for tree rendering") and the
+// ellipsoids-and-lines paper §5 ("a level of detail method for trees based on ellipsoids and
+// lines") both add a precomputed AO term, per vertex of the original polygonal tree, to the ambient
+// light; the latter computes it "by path tracing random directions in the surface normal hemisphere
+// until the ray leaves the model". This file casts exactly those rays:
 //   ao(p) = fraction of cosine-weighted directions around n(p) whose ray, started at p offset
 //           along n by epsilon, hits nothing within maxDistance.
 // Cosine-weighted sampling makes the plain fraction the cosine-weighted visibility, the

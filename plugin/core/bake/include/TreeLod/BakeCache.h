@@ -1,4 +1,4 @@
-// BakeCache: scene-driven, lazy baking ("model only what a scene requires", issue 5).
+// BakeCache: scene-driven, lazy baking ("model only what a scene requires").
 //
 // A scene names, per tree, a source and the techniques it draws it with; require() returns a
 // package holding those chunks, baking only the ones the cache lacks and reporting what it

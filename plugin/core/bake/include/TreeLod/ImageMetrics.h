@@ -13,7 +13,7 @@
 
 namespace TreeLod
 {
-    /// Multi-scale RMSE (paper 001 §4): the RMSE of the difference image at full
+    /// Multi-scale RMSE (ellipsoids-and-lines paper §4): the RMSE of the difference image at full
     /// resolution and at every halved resolution down to 1x1, found in one pass along a
     /// Z-order curve.
     struct MultiScaleRmseResult

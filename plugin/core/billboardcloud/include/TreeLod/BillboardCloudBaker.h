@@ -1,4 +1,4 @@
-// BillboardCloudBaker: TreeModel -> BillboardCloudData (BillboardCloudData.h), paper 000.
+// BillboardCloudBaker: TreeModel -> BillboardCloudData (BillboardCloudData.h), García et al. 2007.
 //
 //   1. Clustering (§4.1): leaves grouped into planes, k-means-like on leaf planes with an
 //      error bound ([BCF*05], [GSSK05]); each billboard's quad bounds its leaves' projection.
@@ -38,8 +38,8 @@ namespace TreeLod
         /// as a fraction of the tree's bounding-box diagonal.
         float maxPlaneError = 0.04f;
         /// Hash cell edge in median leaf lengths (cell size of a layered level). A leaf's length
-        /// here is its diameter (twice its largest vertex distance from its centre). 2: about
-        /// 1.6 entries per leaf per layered level, 1.5 MB for a 20k-leaf tree (README).
+        /// here is its diameter (twice its largest vertex distance from its centre). 2: about 1.6
+        /// entries per leaf per layered level, 1.5 MB for a 20k-leaf tree (docs/measurements.md).
         float cellLeafRatio = 2.0f;
         /// Low-res texel edge of level 0 in median leaf lengths (levels 1 and 2: 2x and 4x).
         float lowResLeafRatio = 0.75f;
@@ -49,7 +49,8 @@ namespace TreeLod
         std::uint32_t orientationGrid = 5;
         std::uint32_t listsAtlasWidth = 1024; ///< grows (power of two up to 4096) when needed
         /// Shader LoD factor stored in the chunk: list entries walked per pixel of projected cell
-        /// diagonal. 4 measured best against 1 and 2 on the 20k-leaf oak (README, treelod_bc_study).
+        /// diagonal. 4 measured best against 1 and 2 on the 20k-leaf oak (docs/measurements.md,
+        /// treelod_bc_study).
         float listFactor = 4.0f;
         bool compress = true;              ///< DXT5 leaves colour and low-res, DXT1 normals (libsquish)
         int aoRays = 32;                   ///< per leaf vertex (AmbientOcclusion.h)
@@ -59,7 +60,7 @@ namespace TreeLod
     {
         BillboardCloudOptions cloud;  ///< clustering and compression settings (finest cloud)
         /// GPU bytes for all billboard textures; 0 = the layered cloud's gpuBytes() with the
-        /// same options (the equal-memory comparison of paper 000 Fig. 13).
+        /// same options (the equal-memory comparison of García et al. 2007 Fig. 13).
         std::uint64_t memoryBytes = 0;
     };
 

@@ -1,17 +1,17 @@
-// BillboardCloudData: billboard clouds with multi-layered indirect texturing (paper 000) and
-// the classic billboard cloud it is compared with; package chunks "billboard-cloud" and
+// BillboardCloudData: billboard clouds with multi-layered indirect texturing (García et al. 2007)
+// and the classic billboard cloud it is compared with; package chunks "billboard-cloud" and
 // "classic-billboard-cloud". The baker is BillboardCloudBaker.h, the Ogre object
 // BillboardCloudTree, the shader materials/GLSL/TreeLodBillboardCloud.frag, and
-// BillboardCloudSampler below evaluates that shader's addressing on the CPU (tests use it
-// as the exact reference of what the GPU must fetch).
+// BillboardCloudSampler below evaluates that shader's addressing on the CPU (tests use it as the
+// exact reference of what the GPU must fetch).
 //
 // ---- Geometry -------------------------------------------------------------------------
 // A billboard is a planar quad: corner(u, v) = origin + u * axisU + v * axisV, u, v in [0, 1];
 // normal = normalize(cross(axisU, axisV)); axisU and axisV are orthogonal. Its "billboard
 // coordinates" are (u * hashWidth, v * hashHeight): hash cells are unit squares there.
-// Levels (paper 000 §6): level 0 the finest cloud, then coarser ones; a level is `layered`
-// when its billboards have hash grids (shader walks lists), else it draws the low-res texture
-// only (the coarsest cloud, and every level of a classic cloud).
+// Levels (García et al. 2007 §6): level 0 the finest cloud, then coarser ones; a level is `layered`
+// when its billboards have hash grids (shader walks lists), else it draws the low-res texture only
+// (the coarsest cloud, and every level of a classic cloud).
 //
 // ---- Hash atlas (§4.2, §6) ---------------------------------------------------------------
 // RGBA8, hashAtlasWidth x hashAtlasHeight, rows top to bottom; billboard b's grid occupies

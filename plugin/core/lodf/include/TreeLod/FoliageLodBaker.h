@@ -1,4 +1,5 @@
-// FoliageLodBaker: builds LoDF's multiresolution foliage (paper 004 §3, §3.1) from a tree.
+// FoliageLodBaker: builds LoDF's multiresolution foliage from a tree (Rebollo et al. 2006 §3,
+// §3.1).
 //
 // 1. Independent groups (§3.1): the leaves of each leaf material are split into spatially
 //    compact clusters of at most `clusterSize` leaves (recursive median split of the leaf
@@ -17,13 +18,13 @@
 //    and the choice kept is the one closest to covering the area A_a + A_b, centred on the
 //    pair, without folding. So the crown's covered area is kept as leaves disappear, and the
 //    whole leaf image stays mapped on the new quad.
-// 4. Order (Fig. 8): Changed_group lists the collapses by cost band (`costBands` equal-count
-//    bands of each collapse's running-maximum cost in its cluster), and inside a band cluster
-//    by cluster (clusters in a fixed pseudo-random order, so no region of the crown simplifies
-//    first). Deviation from a pure global cost order, stated in README: with it, any 1 % change
+// 4. Order (Fig. 8): Changed_group lists the collapses by cost band (`costBands` equal-count bands
+//    of each collapse's running-maximum cost in its cluster), and inside a band cluster by cluster
+//    (clusters in a fixed pseudo-random order, so no region of the crown simplifies first).
+//    Deviation from a pure global cost order, stated in docs/lodf.md: with it, any 1 % change
 //    touches nearly every cluster and §4's partial upload saves nothing; with bands, a run of
-//    consecutive changes touches few clusters, at the price of reordering collapses whose
-//    costs lie in the same band.
+//    consecutive changes touches few clusters, at the price of reordering collapses whose costs lie
+//    in the same band.
 // Deterministic: the same model and options give the same data, whatever the thread count.
 #pragma once
 

@@ -1,4 +1,4 @@
-// FoliageLodData: the multiresolution foliage F^r of LoDF (paper 004 §3.1-3.2) and its
+// FoliageLodData: the multiresolution foliage F^r of LoDF (Rebollo et al. 2006 §3.1-3.2) and its
 // package chunk "lodf".
 //
 // The leaves of the tree (originals and the ones created by leaf collapses, 2L - 1 at most,
@@ -9,7 +9,7 @@
 // quad over four vertices of the leaves it replaces, so all vertices are the reference
 // chunk's leaf vertices and live on the GPU once.
 //
-// Deviation from Fig. 7 (documented in README): the paper gives each entry a fixed `next`
+// Deviation from Fig. 7 (documented in docs/lodf.md): the paper gives each entry a fixed `next`
 // position; a fixed chain cannot represent every state in general (in the paper's own
 // group 1, after two collapses the chain from position 4 yields {l3, l10} instead of
 // {l3, l12}). Each entry stores instead the cluster-local collapse step that creates it:
@@ -78,7 +78,7 @@ namespace TreeLod
             return clusters.empty() ? 0 : clusters.back().firstSlot + clusters.back().slotCount;
         }
 
-        /// Words of the structure as paper 004 eq. 7-8 counts them (3 per vertex position,
+        /// Words of the structure as Rebollo et al. 2006 eq. 7-8 count them (3 per vertex position,
         /// per leaf its number + vertex indices + next, 3 per cluster, 1 per collapse), and
         /// eq. 9's estimate 6.25 V for comparison.
         std::uint64_t paperWords() const;

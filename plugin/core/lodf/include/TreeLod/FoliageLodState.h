@@ -1,4 +1,4 @@
-// FoliageLodState: the retrieval algorithms of LoDF (paper 004 §3.3) on one instance's
+// FoliageLodState: the retrieval algorithms of LoDF (Rebollo et al. 2006 §3.3) on one instance's
 // current level of detail.
 //
 // Per cluster it keeps Init_group, Active_leaves and Changes_number; init_position is the

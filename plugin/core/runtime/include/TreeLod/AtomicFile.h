@@ -1,4 +1,4 @@
-// Whole-or-nothing output files (DESIGN.md, "Errors"): write to a temporary file
+// Whole-or-nothing output files (docs/architecture.md, "Errors"): write to a temporary file
 // beside the target, then rename over it. A failure leaves the target untouched.
 #pragma once
 

@@ -1,9 +1,9 @@
-// ForestInstances: the Forest's packed instance data (issue 5, "Forest"), and its per-frame
+// ForestInstances: the Forest's packed instance data (docs/forest.md), and its per-frame
 // culling and level-of-detail selection in one tight loop, without Ogre.
 //
 // Storage is structure-of-arrays: per instance its position, scale * (cos, sin) of its rotation
 // about +Y and kind (16 bits), 30 bytes with the handle maps, plus a box per block of 256
-// instances (issue 7: <= 32 B per instance); scale,
+// instances (at most 32 B per instance); scale,
 // rotation and the world bounding sphere are derived from them (get() returns the rotation in
 // (-pi, pi] and both to float rounding). A kind is one (asset, technique) pair with its local
 // bounding sphere and LoD table.
@@ -239,7 +239,7 @@ namespace TreeLod
         std::vector<float> mKindTable;
         std::uint32_t mBucketCount = 0;
 
-        // instances (structure of arrays, dense): 32 bytes each with the handle maps (issue 7);
+        // instances (structure of arrays, dense): 32 bytes each with the handle maps;
         // scale, rotation and the world sphere are derived from these where needed
         std::vector<float> mX, mY, mZ;             // position
         std::vector<float> mCosScale, mSinScale;   // scale * cos / sin of the rotation

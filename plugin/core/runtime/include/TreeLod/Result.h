@@ -1,6 +1,6 @@
 // Result<T>: the outcome of a core function that can fail on its input.
 //
-// Contract (DESIGN.md, "Errors"): a failure carries the file, the element
+// Contract (docs/architecture.md, "Errors"): a failure carries the file, the element
 // (node, mesh, primitive, chunk, pixel...) and the reason, so the caller can print
 // "file: element: reason" and stop. Results never throw; the CLI exits 2 on one.
 #pragma once
