@@ -169,7 +169,7 @@ for r in s["results"]:
     f = lambda v, d=2: "-" if v is None else f"{v:.{d}f}"
     print(" | ".join([r["technique"], str(r["trees"]), f(ms.get("median")), f(r.get("p95OverMedian")),
                       f(r.get("worstFrame", {}).get("frameMs")), f(floors.get("entities")),
-                      f(floors.get("merged-quads")), f(floors.get("quad")), f(flip.get("mean"), 4),
+                      f(floors.get("merged-quads")), f(floors.get("impostor")), f(flip.get("mean"), 4),
                       f(r.get("rssMiB"), 0)]))
 EOF
   done

@@ -2,7 +2,7 @@
 //
 // Scripted scene benchmark (issues 5 and 7): the scene's camera path rendered headless for each
 // technique and LoD bias, with the polygonal reference ("mesh") and three floors in the same run:
-// the Forest's one-quad level ("quad"), one plain Ogre Entity per tree ("entities": what Ogre users
+// the Forest's one-quad level ("impostor"), one plain Ogre Entity per tree ("entities": what Ogre users
 // pay today) and every tree's quad merged into a few static batches ("merged-quads": the cheapest
 // possible drawing). The bench bakes what the runs draw (BakeCache), writes the package list and
 // runs treelod_frames, which renders and times the frames and links no baker (DESIGN.md, "Runtime
@@ -142,7 +142,7 @@ namespace TreeLod
         {
             static const std::vector<std::pair<std::string, std::string>> runs = {
                 {"mesh", "polygonal reference (mesh, 1 spp)"},
-                {"quad", "floor: the Forest's one-quad level"},
+                {"impostor", "floor: the Forest's one-quad level"},
                 {"entities", "floor: one Ogre entity per tree (a quad)"},
                 {"merged-quads", "floor: quads merged into a few batches"}};
             return runs;
@@ -315,7 +315,7 @@ namespace TreeLod
                                    {"worstFrame", worst},
                                    {"cpuMs", toJson(statsOf(cpuMs))},
                                    {"speedupVsReference", num(referenceOnShared / techniqueOnShared)},
-                                   {"ratioToFloor", ratios.contains("quad") ? ratios["quad"] : json(nullptr)},
+                                   {"ratioToFloor", ratios.contains("impostor") ? ratios["impostor"] : json(nullptr)},
                                    {"ratioToFloors", ratios},
                                    {"maxUploadedBytesPerFrame", maxUploaded},
                                    {"instanceBytes", run.instanceBytes},
@@ -582,7 +582,7 @@ namespace TreeLod
             if (Result<std::vector<float>> biases = parseLodBiases(args.lodBiases); !biases)
                 return printError(biases.error());
             // Every run draws from these: the reference, the floors, then the techniques.
-            std::vector<std::string> drawn = {"mesh", "quad"};
+            std::vector<std::string> drawn = {"mesh", "impostor"};
             for (const std::string& t : splitList(args.techniques))
             {
                 if (t != "auto" && bakeTechniqueOf(t).empty())
@@ -674,7 +674,7 @@ namespace TreeLod
         cmd->add_option("scene", args->scene, "scene script (samples/scenes/*.json)")->required();
         cmd->add_option("-o,--output", args->output, "output directory")->required();
         cmd->add_option("--techniques", args->techniques,
-                        "comma-separated techniques besides the reference (mesh) and the floor (quad): auto (the "
+                        "comma-separated techniques besides the reference (mesh) and the floor (impostor): auto (the "
                         "script's choice), lodf, billboard-cloud, classic-billboard-cloud")
             ->capture_default_str();
         cmd->add_option("--lod-bias", args->lodBiases, "comma-separated LoD biases (< 1 = less detail)")

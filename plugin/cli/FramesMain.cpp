@@ -10,7 +10,7 @@
 // (PackageListBaker). `treelod bench` runs it and then computes the image metrics from the frames it
 // saved; on a GPU machine run it directly with the same options and the bench's package list.
 //
-// Runs per tree count: the polygonal reference ("mesh"), the floors ("quad": the Forest's one-quad
+// Runs per tree count: the polygonal reference ("mesh"), the floors ("impostor": the Forest's one-quad
 // level; "entities": one Ogre Entity per tree; "merged-quads": all quads merged into a few static
 // batches), then every technique at every LoD bias. Writes DIR/timings.json (per run: per frame
 // CPU ms, frame ms (bounded by a one-pixel read-back), batches, triangles, visible trees, trees per
@@ -154,7 +154,7 @@ namespace TreeLod
                 if (t != "auto" && bakeTechniqueOf(t).empty())
                     return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: " +
                                                                    knownSceneTechniques() + ")"));
-                if (args.skipComparisons || (t != "mesh" && t != "quad" && !isFloor(t)))
+                if (args.skipComparisons || (t != "mesh" && t != "impostor" && !isFloor(t)))
                     techniques.push_back(t); // otherwise run once below, with the comparisons
             }
             std::vector<std::uint32_t> counts = script.counts;
@@ -232,7 +232,7 @@ namespace TreeLod
                 options.uploadBudget = args.uploadBudget;
                 std::vector<std::pair<std::string, std::vector<float>>> plan;
                 if (!args.skipComparisons)
-                    plan = {{"mesh", {1.0f}}, {"quad", {1.0f}}, {"entities", {1.0f}}, {"merged-quads", {1.0f}}};
+                    plan = {{"mesh", {1.0f}}, {"impostor", {1.0f}}, {"entities", {1.0f}}, {"merged-quads", {1.0f}}};
                 for (const std::string& t : techniques)
                     plan.push_back({t, biases});
                 for (const auto& [technique, runBiases] : plan)

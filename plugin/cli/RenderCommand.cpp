@@ -145,9 +145,13 @@ namespace TreeLod
         CLI::App* cmd = app.add_subcommand("render", "render a tree (.glb, .gltf, .mesh or .treelod) to a PNG, headless");
         cmd->add_option("input", args->input, "tree file")->required();
         cmd->add_option("-o,--output", args->output, "PNG to write")->required();
+#ifdef TREELOD_WITH_OGRE
+        const std::string techniques = TechniqueRegistry::getSingleton().describe();
+#else
+        const std::string techniques = "mesh";
+#endif
         cmd->add_option("--technique", args->technique,
-                        "LoD technique: mesh (polygonal reference), lodf (paper 004), billboard-cloud (paper 000), "
-                        "classic-billboard-cloud; a .glb is baked in memory");
+                        "LoD technique: " + techniques + " (mesh: the polygonal reference); a .glb is baked in memory");
         cmd->add_option("--leaves", args->leaves, "lodf: draw exactly this many leaves (default: from screen size)");
         cmd->add_option("--pixels-per-leaf", args->pixelsPerLeaf, "lodf: projected pixels per leaf (default 4)");
         cmd->add_option("--level", args->level, "billboard clouds: draw this cloud (0 finest .. 2 low-res only) "
@@ -159,7 +163,7 @@ namespace TreeLod
         cmd->add_flag("--shadows", args->shadows, "texture shadows from the sun (2048^2 float depth)");
         cmd->add_option("--shadow-camera", args->shadowCamera,
                         "with --shadows: focused (orthographic, Ogre's FocusedShadowCameraSetup) or lispsm "
-                        "(LiSPSMShadowCameraSetup, paper 000 §5.2)");
+                        "(LiSPSMShadowCameraSetup, García et al. 2007 §5.2)");
         cmd->add_option("--camera", args->camera,
                         "orbit:AZIMUTH,ELEVATION,DISTANCE (degrees; distance 1 = tree fills the view), "
                         "ortho:AZ,EL,DIST, or PX,PY,PZ,TX,TY,TZ[,FOV]");

@@ -129,8 +129,8 @@ namespace TreeLod
     {
         std::vector<std::string> names{SCRIPT_TECHNIQUE};
         for (const TechniqueInfo& info : TechniqueRegistry::getSingleton().getTechniques())
-            names.push_back(info.name);
-        names.push_back("quad"); // the Forest's one-quad impostor (Forest.h), not a registry technique
+            if (info.forestLevels)
+                names.push_back(info.name);
         return names;
     }
 
@@ -219,13 +219,8 @@ namespace TreeLod
                     continue;
                 // "oak L2 cloud 1 low": species, Forest level, what it draws (Forest.h).
                 const ForestLevel& l = levels[level];
-                std::string what = l.technique;
-                if (l.technique == "lodf")
-                    what += " " + (l.techniqueLevel ? formatCount(l.techniqueLevel) : std::string("all"));
-                else if (l.technique == "billboard-cloud")
-                    what = "cloud " + std::to_string(l.techniqueLevel) + (l.lowRes ? " low" : "");
-                else if (l.technique == "classic-billboard-cloud")
-                    what = "classic " + std::to_string(l.techniqueLevel);
+                const TechniqueInfo* info = TechniqueRegistry::getSingleton().find(l.technique);
+                const std::string what = info && info->forestLevels ? info->forestLevels->describeLevel(l) : l.technique;
                 lines.push_back(mScript.species[species].name + " L" + std::to_string(level) + " " + what + " " +
                                 textBar(double(count) / double(most), CELLS) + " " +
                                 std::to_string(count));

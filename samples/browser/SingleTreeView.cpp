@@ -1,7 +1,5 @@
 #include "SingleTreeView.h"
 
-#include "TreeLod/BillboardCloudTree.h"
-#include "TreeLod/FoliageLodTree.h"
 #include "TreeLod/ImageMetrics.h"
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/RgbaImageConversion.h"
@@ -103,11 +101,10 @@ namespace TreeLod
             return;
         // Every technique's chunk in one request: a later request for fewer chunks (a forest of
         // the same tree) then finds the package complete instead of rewriting it under our objects.
-        std::vector<Ogre::String> chunks{"reference"};
+        std::vector<Ogre::String> chunks{REFERENCE_CHUNK};
         for (const TechniqueInfo& info : TechniqueRegistry::getSingleton().getTechniques())
             if (std::find(chunks.begin(), chunks.end(), info.chunkTechnique) == chunks.end())
                 chunks.push_back(info.chunkTechnique);
-        chunks.push_back("impostor");
         mAsset = TreeAssetManager::getSingleton().require(mSource, chunks, TREELOD_GROUP);
         report(progress, "single tree: creating the objects", 0.0f);
 
@@ -528,33 +525,10 @@ namespace TreeLod
         constexpr int CELLS = 16;
         std::vector<std::string> lines;
         Ogre::MovableObject* object = techniqueObject();
-        if (auto* lodf = dynamic_cast<FoliageLodTree*>(object))
-        {
-            const double fraction = double(lodf->getLeafCount()) / double(std::max(1u, lodf->getMaxLeafCount()));
-            lines.push_back("leaves " + textBar(fraction, CELLS) + " " + std::to_string(lodf->getLeafCount()) + "/" +
-                            std::to_string(lodf->getMaxLeafCount()));
-            lines.push_back("bark LoD " + std::to_string(lodf->getBarkLodIndex()));
-        }
-        else if (auto* cloud = dynamic_cast<BillboardCloudTree*>(object))
-        {
-            for (std::uint32_t level = 0; level < cloud->getLevelCount(); ++level)
-            {
-                const bool drawn = level == cloud->getLevel();
-                const char* material = cloud->isClassic() ? "" : cloud->getMaterialLodIndex() == 0 ? " layered" : " low-res";
-                lines.push_back("cloud " + std::to_string(level) + "  " + textBar(drawn ? 1.0 : 0.0, CELLS) +
-                                (drawn ? material : ""));
-            }
-            lines.push_back("bark LoD " + std::to_string(cloud->getBarkLodIndex()));
-        }
-        else if (auto* entity = dynamic_cast<Ogre::Entity*>(object))
-        {
-            const unsigned levels = entity->getMesh()->getNumLodLevels();
-            for (unsigned level = 0; level < levels; ++level)
-            {
-                const bool drawn = level == entity->getCurrentLodIndex();
-                lines.push_back("bark LoD " + std::to_string(level) + "  " + textBar(drawn ? 1.0 : 0.0, CELLS));
-            }
-        }
+        const TechniqueInfo* info = object ? TechniqueRegistry::getSingleton().find(mTechnique) : nullptr;
+        if (info && info->describeState)
+            for (const TechniqueStateLine& line : info->describeState(*object))
+                lines.push_back(line.label + (line.fraction >= 0.0 ? textBar(line.fraction, CELLS) : "") + line.suffix);
         return lines;
     }
 }

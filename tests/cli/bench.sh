@@ -18,7 +18,7 @@ for f in frames.csv summary.json frame-time.png trade.png; do [ -s "$out/single/
 png "$out/single/frame-time.png"; png "$out/single/trade.png"
 rows=$(($(wc -l < "$out/single/frames.csv") - 1))
 [ "$rows" = 36 ] || fail "frames.csv has $rows rows, expected (mesh + 3 floors + auto x 2 biases) x 6 = 36"
-for t in mesh quad entities merged-quads auto; do
+for t in mesh impostor entities merged-quads auto; do
   n=$(awk -F, -v t=$t 'NR > 1 && $2 == t' "$out/single/frames.csv" | wc -l)
   want=6; [ $t = auto ] && want=12
   [ "$n" = "$want" ] || fail "technique $t has $n rows, expected $want"
@@ -36,7 +36,7 @@ grep -q '"ratioToFloor": [0-9]' "$out/single/summary.json" || fail "summary has 
 # The frames came from treelod_frames (which links no baker) through the package list.
 for f in packages.json timings.json; do [ -s "$out/single/$f" ] || fail "single/$f missing"; done
 grep -q '"format": "treelod-package-list"' "$out/single/packages.json" || fail "packages.json is not a package list"
-for floor in quad entities merged-quads; do
+for floor in impostor entities merged-quads; do
   grep -q "\"$floor\": [0-9]" "$out/single/summary.json" || fail "summary has no ratio to the $floor floor"
 done
 grep -q '"worstFrame": {' "$out/single/summary.json" || fail "summary does not record the worst frame"

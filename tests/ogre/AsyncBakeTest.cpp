@@ -189,7 +189,7 @@ namespace TreeLod
                                                       "async.json", "");
         ASSERT_TRUE(script.ok()) << script.error().message();
         ForestSceneOptions options;
-        options.technique = "quad";
+        options.technique = "impostor";
         ForestScene scene(r.getSceneManager(), r.getContentNode(), *script, options);
         const CameraSpec camera = scene.cameraAtFrame(0, 1);
         const Image quads = toImage(r.render(camera, 96, 64, 1));
@@ -205,8 +205,8 @@ namespace TreeLod
         {
             EXPECT_FALSE(scene.update());
             const Image frame = toImage(r.render(camera, 96, 64, 1));
-            EXPECT_EQ(scene.getTechnique(), "quad");
-            EXPECT_EQ(scene.getForest().getLevels(0).front().technique, "quad");
+            EXPECT_EQ(scene.getTechnique(), "impostor");
+            EXPECT_EQ(scene.getForest().getLevels(0).front().technique, "impostor");
             EXPECT_LT(flipMean(quads, frame), 0.001) << "the current technique keeps drawing";
         }
         baker.open();
@@ -220,7 +220,7 @@ namespace TreeLod
 
         // A failed bake: update() throws naming the script and the source; lodf stays.
         baker.fail = true;
-        scene.requestTechnique("quad");
+        scene.requestTechnique("impostor");
         std::string error;
         ASSERT_TRUE(waitFor([&] {
             try

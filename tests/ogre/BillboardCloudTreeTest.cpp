@@ -185,7 +185,7 @@ namespace TreeLod
         // Local bounds hold the tree (reference) and every billboard; the radius is Ogre's
         // sphere about the origin holding them.
         const Ogre::AxisAlignedBox& box = object->getBoundingBox();
-        const BillboardCloudData& data = oak.asset->getBillboardCloud(false);
+        const BillboardCloudData& data = BillboardCloudResources::of(*oak.asset, false).getData();
         EXPECT_TRUE(box.contains(Ogre::Vector3(oak.model.boundsMin.x, oak.model.boundsMin.y, oak.model.boundsMin.z)));
         EXPECT_TRUE(box.contains(Ogre::Vector3(oak.model.boundsMax.x, oak.model.boundsMax.y, oak.model.boundsMax.z)));
         for (const Billboard& b : data.billboards)
@@ -288,7 +288,7 @@ namespace TreeLod
         const BakedTree& oak = bundled("oak");
         OffscreenRenderer& r = OgreEnvironment::renderer();
         BillboardCloudTree* tree = placeCloud(oak.asset);
-        const BillboardCloudGpu& gpu = oak.asset->getBillboardCloudGpu(false);
+        const BillboardCloudGpu& gpu = BillboardCloudResources::of(*oak.asset, false).getGpu();
         // §6: level 0 -> 1 where level 0 walks SWITCH_ENTRIES entries, 1 -> 2 exactly where level
         // 1's material LoD switches to the low-res technique (one entry).
         EXPECT_FLOAT_EQ(tree->getSwitchPixelCount(0),
@@ -352,7 +352,7 @@ namespace TreeLod
     TEST(BillboardCloudTree, materialLodSwitchesAtTheShaderLodThreshold)
     {
         const BakedTree& oak = bundled("oak");
-        const BillboardCloudGpu& gpu = oak.asset->getBillboardCloudGpu(false);
+        const BillboardCloudGpu& gpu = BillboardCloudResources::of(*oak.asset, false).getGpu();
         // The clone's lod_values: one entry walked (listFactor * projected diagonal = 1).
         const Ogre::Real threshold = gpu.levels[1].lowResPixelCount;
         EXPECT_FLOAT_EQ(threshold, billboardCloudPixelCount(1.0f, gpu.levels[1].cellSize, float(gpu.radius),
@@ -473,7 +473,7 @@ namespace TreeLod
     {
         // The baseline of Fig. 13: one level, low-res technique only, same memory as the layered cloud.
         const BakedTree& oak = bundled("oak");
-        const BillboardCloudData& classic = oak.asset->getBillboardCloud(true);
+        const BillboardCloudData& classic = BillboardCloudResources::of(*oak.asset, true).getData();
         EXPECT_TRUE(classic.classic);
         ASSERT_EQ(classic.levels.size(), 1u);
         EXPECT_FALSE(classic.levels[0].layered);
@@ -527,7 +527,7 @@ namespace TreeLod
     TEST(BillboardCloudTree, barkIsDrawnWithItsLodLevelsAndAo)
     {
         const BakedTree& oak = bundled("oak");
-        Ogre::MeshPtr bark = oak.asset->getBarkAoMesh(false);
+        Ogre::MeshPtr bark = BillboardCloudResources::of(*oak.asset, false).getBarkAoMesh();
         ASSERT_GT(bark->getNumSubMeshes(), 0u);
         EXPECT_GT(bark->getNumLodLevels(), 1u);
         for (Ogre::SubMesh* sub : bark->getSubMeshes())
@@ -573,7 +573,7 @@ namespace TreeLod
         bare.updateBounds();
         BillboardCloudTree* trunk = placeCloud(bake(bare, "oak-bare", false));
         const Image trunkImage = toImage(r.render(camera(bare, "orbit:30,10,1.0"), 96, 96, 1));
-        EXPECT_EQ(trunk->getAsset()->getBillboardCloud(false).billboards.size(), 0u);
+        EXPECT_EQ(BillboardCloudResources::of(*trunk->getAsset(), false).getData().billboards.size(), 0u);
         EXPECT_GT(treeCoverage(trunkImage, BACKGROUND), 0.01);
 
         // 0.5 m and 500 m tall trees (the model scaled, then baked): the same picture at the

@@ -4,6 +4,7 @@
 // 10 km away) and bad input.
 #include "OgreTestSupport.h"
 
+#include "TreeLod/FoliageLodResources.h"
 #include "TreeLod/FoliageLodBaker.h"
 #include "TreeLod/FoliageLodTree.h"
 #include "TreeLod/GltfImporter.h"
@@ -176,7 +177,7 @@ namespace TreeLod
     {
         const LodfTree& oak = bundledOak();
         FoliageLodTree* tree = place(oak.asset);
-        const FoliageLodData& data = oak.asset->getFoliageLod();
+        const FoliageLodData& data = FoliageLodResources::of(*oak.asset).getFoliageLod();
         const std::uint64_t fullBytes = std::uint64_t(data.slotCount()) * 2; // 16-bit indices
         tree->updateLeafCount(2000);
         // A 1 % change (30 leaves) rewrites a few clusters' regions, not the buffer.
@@ -321,7 +322,7 @@ namespace TreeLod
         ASSERT_TRUE(model.ok());
         TreeAssetPtr asset = loadLodf(model.value(), "oak100k.lodf-test");
         FoliageLodTree* tree = place(asset);
-        EXPECT_GT(asset->getLeafVertexData()->vertexCount, 65535u);
+        EXPECT_GT(FoliageLodResources::of(*asset).getLeafVertexData()->vertexCount, 65535u);
         OffscreenRenderer& r = OgreEnvironment::renderer();
         const Image image = toImage(r.render(camera(model.value(), "orbit:30,10,1.2"), 128, 128, 1));
         EXPECT_GT(treeCoverage(image, LightingSpec().background), 0.02); // measured 0.037
@@ -347,12 +348,12 @@ namespace TreeLod
         EXPECT_TRUE(a->isQuantised());
         EXPECT_GE(a->getLeafCount(), 500u); // snapped up, never fewer leaves than asked
         EXPECT_EQ(b->getLeafCount(), 3000u);
-        const std::size_t levels = oak.asset->getFoliageLodLevelCount();
+        const std::size_t levels = FoliageLodResources::of(*oak.asset).getFoliageLodLevelCount();
         b->setFixedLeafCount(a->getLeafCount()); // to a level that exists: nothing is built or sent
         EXPECT_EQ(b->getLeafCount(), a->getLeafCount());
-        EXPECT_EQ(oak.asset->getFoliageLodLevelCount(), levels);
+        EXPECT_EQ(FoliageLodResources::of(*oak.asset).getFoliageLodLevelCount(), levels);
         EXPECT_EQ(b->getUpdateStats().bytesUploaded, 0u);
-        EXPECT_GT(oak.asset->getFoliageLodLevelBytes(), 0u);
+        EXPECT_GT(FoliageLodResources::of(*oak.asset).getFoliageLodLevelBytes(), 0u);
         r.getSceneManager().destroyMovableObject(second);
 
         // A shared level draws exactly what a continuous instance draws at that count.

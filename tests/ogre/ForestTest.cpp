@@ -12,6 +12,8 @@
 // modification time.
 #include "OgreTestSupport.h"
 
+#include "TreeLod/BillboardCloudResources.h"
+#include "TreeLod/FoliageLodResources.h"
 #include "TreeLod/BillboardCloudBaker.h"
 #include "TreeLod/BillboardCloudTree.h"
 #include "TreeLod/FoliageLodBaker.h"
@@ -310,7 +312,7 @@ namespace TreeLod
         const Ogre::Vector3 eye = middle + nodeOrientation * Ogre::Vector3(0.0f, 0.25f * h, 2.0f * h);
         const CameraSpec view = look(glm::vec3(eye.x, eye.y, eye.z), glm::vec3(middle.x, middle.y, middle.z), 36.0f);
         const int width = 800, height = 340;
-        const FoliageLodData& lodf = tree.asset->getFoliageLod();
+        const FoliageLodData& lodf = FoliageLodResources::of(*tree.asset).getFoliageLod();
         const std::uint32_t leaves = (lodf.maxLeafCount() + lodf.minLeafCount()) / 2;
 
         struct Case
@@ -404,7 +406,7 @@ namespace TreeLod
         const float h = treeHeight(tree.model);
         const CameraSpec view = look(glm::vec3(1.5f * h, 3.0f * h, 5.5f * h), glm::vec3(0.0f, 0.2f * h, 0.0f));
         Forest* forest = placeForest();
-        forest->addSpecies(tree.asset, {ForestLevel{"quad", 0, false, 0.0f}});
+        forest->addSpecies(tree.asset, {ForestLevel{"impostor", 0, false, 0.0f}});
         forest->addInstances(grid(4, 1.3f * h));
         const Image quads = toImage(r.render(view, 256, 192, 2));
         EXPECT_EQ(forest->getStats().visibleInstances, 16u);
@@ -441,7 +443,7 @@ namespace TreeLod
         const float h = treeHeight(tree.model);
         Forest* forest = placeForest();
         forest->addSpecies(tree.asset,
-                           Forest::levelsForBands(*tree.asset, {{"billboard-cloud", 40.0f}, {"quad", 0.0f}}));
+                           Forest::levelsForBands(*tree.asset, {{"billboard-cloud", 40.0f}, {"impostor", 0.0f}}));
         forest->addInstances(grid(12, 1.5f * h));
         // Standing inside the forest, looking along -Z: the trees behind are not drawn.
         const glm::vec3 eye(0.0f, 0.5f * h, 0.0f);
@@ -548,7 +550,7 @@ namespace TreeLod
         const Image distant = toImage(r.render(look(glm::vec3(0.0f, 200.0f, 10000.0f), glm::vec3(0.0f)), 96, 96, 1));
         EXPECT_EQ(forest->getStats().visibleInstances, 25u);
         EXPECT_EQ(forest->getStats().levelCounts[0][last], 25u);
-        EXPECT_EQ(levels[last].technique, "quad");
+        EXPECT_EQ(levels[last].technique, "impostor");
         EXPECT_LT(treeCoverage(distant, BACKGROUND), 0.01);
         // ... at the floor's cost: what a quad-only Forest of the same trees submits (one draw,
         // two triangles a tree), and nothing but the quad level built.
@@ -699,7 +701,7 @@ namespace TreeLod
         Forest* biased = nullptr;
         auto meshOrQuad = [&](Ogre::Real shadowLodBias) {
             return [&, shadowLodBias](Ogre::SceneNode& node) {
-                forestOf({ForestLevel{"mesh", 0, false, 1.0f}, ForestLevel{"quad", 0, false, 0.0f}})(node);
+                forestOf({ForestLevel{"mesh", 0, false, 1.0f}, ForestLevel{"impostor", 0, false, 0.0f}})(node);
                 biased = static_cast<Forest*>(node.getAttachedObject(0));
                 biased->setShadowLodBias(shadowLodBias);
             };
@@ -747,7 +749,7 @@ namespace TreeLod
     {
         const ForestTree& tree = oak();
         Forest* forest = placeForest();
-        forest->addSpecies(tree.asset, {ForestLevel{"quad", 0, false, 0.0f}});
+        forest->addSpecies(tree.asset, {ForestLevel{"impostor", 0, false, 0.0f}});
         forest->addInstances({instance(0, 0, 0)});
         const Ogre::AxisAlignedBox bounds = forest->getBoundingBox();
         const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -775,7 +777,7 @@ namespace TreeLod
         // Species: bad level lists are named, nothing is added.
         const std::pair<std::vector<ForestLevel>, const char*> levels[] = {
             {{}, "0 levels"},
-            {{ForestLevel{"mesh", 0, false, 10.0f}, ForestLevel{"quad", 0, false, 20.0f}}, "level 1 'quad'"},
+            {{ForestLevel{"mesh", 0, false, 10.0f}, ForestLevel{"impostor", 0, false, 20.0f}}, "level 1 'impostor'"},
             {{ForestLevel{"mesh", 0, false, 10.0f}}, "level 0 'mesh'"},
             {{ForestLevel{"trees", 0, false, 0.0f}}, "unknown technique"},
             {{ForestLevel{"lodf", 0, true, 0.0f}}, "lowRes"},
@@ -806,7 +808,7 @@ namespace TreeLod
         {
             EXPECT_NE(e.getDescription().find("band 1 'bush'"), std::string::npos) << e.getDescription();
         }
-        EXPECT_THROW(Forest::levelsForBands(*tree.asset, {{"lodf", 10.0f}, {"mesh", 20.0f}, {"quad", 0.0f}}),
+        EXPECT_THROW(Forest::levelsForBands(*tree.asset, {{"lodf", 10.0f}, {"mesh", 20.0f}, {"impostor", 0.0f}}),
                      Ogre::InvalidParametersException);
         EXPECT_THROW(Forest::levelsForBands(*tree.asset, {{"lodf", 10.0f}}), Ogre::InvalidParametersException);
         PackageWriter writer;
@@ -852,7 +854,7 @@ namespace TreeLod
 
         // 20,000 quads (a 142 x 142 grid, 1.2 tree heights apart) seen from a little above the edge.
         forest = placeForest();
-        forest->addSpecies(tree.asset, {ForestLevel{"quad", 0, false, 0.0f}});
+        forest->addSpecies(tree.asset, {ForestLevel{"impostor", 0, false, 0.0f}});
         forest->addInstances(grid(142, 1.2f * h));
         const float half = 71.0f * 1.2f * h;
         const CameraSpec over = look(glm::vec3(0.0f, 4.0f * h, half + 8.0f * h), glm::vec3(0.0f, 0.0f, 0.0f), 60.0f);
@@ -886,7 +888,7 @@ namespace TreeLod
         OffscreenRenderer& r = OgreEnvironment::renderer();
         const float h = treeHeight(tree.model);
         Forest* forest = placeForest();
-        forest->addSpecies(tree.asset, {ForestLevel{"quad", 0, false, 0.0f}});
+        forest->addSpecies(tree.asset, {ForestLevel{"impostor", 0, false, 0.0f}});
         // Trees 16x their size (overlapping) so that each covers pixels from afar: were only the first
         // 1,000,000 mod 65,536 instances drawn (a 16-bit count), they would fill one corner of the
         // Z-ordered store, not every part of the picture.
@@ -939,9 +941,9 @@ namespace TreeLod
         for (std::size_t l = 1; l < levels.size(); ++l)
             EXPECT_LT(levels[l].minPixelCount, levels[l - 1].minPixelCount);
         EXPECT_EQ(levels.back().minPixelCount, 0.0f);
-        EXPECT_EQ(levels.back().technique, "quad");
+        EXPECT_EQ(levels.back().technique, "impostor");
         EXPECT_EQ(levels.front().technique, "lodf");
-        EXPECT_EQ(levels.front().techniqueLevel, asset.getFoliageLod().maxLeafCount());
+        EXPECT_EQ(levels.front().techniqueLevel, FoliageLodResources::of(asset).getFoliageLod().maxLeafCount());
 
         // Band edges: a tree h_px tall has r_px = h_px * R / h, value 4 pi r_px^2.
         const Ogre::AxisAlignedBox bounds = asset.getBounds();
@@ -987,7 +989,7 @@ namespace TreeLod
                                                                 FoliageLodTree::DEFAULT_PIXELS_PER_LEAF));
         }
         // Billboard cloud: BillboardCloudTree's switches (in the same units) inside the band.
-        const BillboardCloudGpu& gpu = asset.getBillboardCloudGpu(false);
+        const BillboardCloudGpu& gpu = BillboardCloudResources::of(asset, false).getGpu();
         const std::vector<Ogre::Real> switches =
             BillboardCloudTree::switchPixelCounts(gpu, gpu.listFactor, float(radius));
         for (std::size_t l = lastLodf + 1; l < lastCloud; ++l)
@@ -996,7 +998,7 @@ namespace TreeLod
             const ForestLevel& next = levels[l + 1];
             if (same(level, next))
             {
-                EXPECT_TRUE(isBarkSwitch(asset.getBarkAoMesh(false), level.minPixelCount)) << "level " << l;
+                EXPECT_TRUE(isBarkSwitch(BillboardCloudResources::of(asset, false).getBarkAoMesh(), level.minPixelCount)) << "level " << l;
                 ++barkSplits;
             }
             else if (next.techniqueLevel == level.techniqueLevel)
@@ -1013,7 +1015,7 @@ namespace TreeLod
 
         // A single band: the technique's own levels from the finest to 0.
         const std::vector<ForestLevel> lodf = Forest::levelsForBands(asset, {{"lodf", 0.0f}});
-        EXPECT_EQ(lodf.back().techniqueLevel, asset.getFoliageLod().minLeafCount());
+        EXPECT_EQ(lodf.back().techniqueLevel, FoliageLodResources::of(asset).getFoliageLod().minLeafCount());
         const std::vector<ForestLevel> mesh = Forest::levelsForBands(asset, {{"mesh", 0.0f}});
         const Ogre::MeshPtr reference = asset.getReferenceMesh();
         ASSERT_EQ(mesh.size(), std::size_t(reference->getNumLodLevels()));
@@ -1034,7 +1036,7 @@ namespace TreeLod
         const CameraSpec view = look(glm::vec3(1.5f * h, 3.0f * h, 5.5f * h), glm::vec3(0.0f, 0.2f * h, 0.0f));
         const std::vector<ForestInstance> trees = grid(4, 1.3f * h);
         Forest* forest = placeForest();
-        forest->addSpecies(tree.asset, {ForestLevel{"quad", 0, false, 0.0f}});
+        forest->addSpecies(tree.asset, {ForestLevel{"impostor", 0, false, 0.0f}});
         forest->addInstances(trees);
         const Image quads = toImage(r.render(view, 256, 192, 1));
         r.clearContent();
@@ -1189,7 +1191,7 @@ namespace TreeLod
         const float h = treeHeight(tree.model);
         const CameraSpec view = look(glm::vec3(0.0f, 4.0f * h, 9.0f * h), glm::vec3(0.0f, 0.0f, 0.0f), 50.0f);
         Forest* forest = placeForest();
-        forest->addSpecies(tree.asset, {ForestLevel{"quad", 0, false, 0.0f}});
+        forest->addSpecies(tree.asset, {ForestLevel{"impostor", 0, false, 0.0f}});
         forest->addInstances(grid(6, 1.4f * h));
         const Image before = toImage(r.render(view, 96, 72, 1));
         const std::uint64_t viewerBytes = forest->getGpuBytes();

@@ -1,10 +1,11 @@
-// The one-quad impostor through Plugin_TreeLod: TreeAsset::getImpostorGpu (quad, textures,
+// The one-quad impostor through Plugin_TreeLod: ImpostorResources::getGpu (quad, textures,
 // materials and their shadow caster, a missing chunk named, unload), and the quad drawn
 // instanced as the Forest draws it (a Renderable with an instance buffer of uv4 / uv5): it
 // turns to face the camera, it looks like the polygonal tree at a distance (FLIP against the
 // reference mesh), it casts and receives texture shadows, and a golden image.
 #include "OgreTestSupport.h"
 
+#include "TreeLod/ImpostorResources.h"
 #include "TreeLod/ImpostorBaker.h"
 #include "TreeLod/ImpostorData.h"
 #include "TreeLod/PackageWriter.h"
@@ -147,7 +148,7 @@ namespace TreeLod
         {
             const ImpostorTree& t = oak();
             clearContent();
-            const ImpostorGpu& gpu = t.asset->getImpostorGpu();
+            const ImpostorGpu& gpu = ImpostorResources::of(*t.asset).getGpu();
             drawn() = std::make_unique<InstancedImpostor>(
                 gpu, instances, shadowed ? gpu.shadowedMaterial : gpu.material, bounds(t.model));
             OgreEnvironment::renderer().getContentNode().createChildSceneNode()->attachObject(drawn().get());
@@ -191,12 +192,12 @@ namespace TreeLod
         }
     }
 
-    TEST(Impostor, getImpostorGpuBuildsTheQuadTexturesAndMaterials)
+    TEST(Impostor, getGpuBuildsTheQuadTexturesAndMaterials)
     {
         const ImpostorTree& t = oak();
         ASSERT_TRUE(t.asset);
-        const ImpostorGpu& gpu = t.asset->getImpostorGpu();
-        EXPECT_EQ(&gpu, &t.asset->getImpostorGpu()); // built once
+        const ImpostorGpu& gpu = ImpostorResources::of(*t.asset).getGpu();
+        EXPECT_EQ(&gpu, &ImpostorResources::of(*t.asset).getGpu()); // built once
 
         ASSERT_TRUE(gpu.vertexData);
         EXPECT_EQ(gpu.vertexData->vertexCount, 4u);
@@ -247,7 +248,7 @@ namespace TreeLod
             TreeAssetManager::getSingleton().loadFromBytes("plain.impostor-test", Ogre::RGN_DEFAULT, writer.toBytes());
         try
         {
-            plain->getImpostorGpu();
+            ImpostorResources::of(*plain).getGpu();
             FAIL() << "a package without the impostor chunk must throw";
         }
         catch (const Ogre::Exception& e)
@@ -261,7 +262,7 @@ namespace TreeLod
         ASSERT_TRUE(addImpostorChunk(writer, model.value(), "small").ok()); // the table's default options
         TreeAssetPtr small =
             TreeAssetManager::getSingleton().loadFromBytes("small.impostor-test", Ogre::RGN_DEFAULT, writer.toBytes());
-        const ImpostorGpu& gpu = small->getImpostorGpu();
+        const ImpostorGpu& gpu = ImpostorResources::of(*small).getGpu();
         const std::vector<Ogre::String> materials = {gpu.material, gpu.shadowedMaterial, gpu.material + "/Caster"};
         const std::vector<Ogre::String> textures = {gpu.texture, gpu.normalTexture};
         for (const Ogre::String& m : materials)
@@ -272,7 +273,7 @@ namespace TreeLod
         for (const Ogre::String& t : textures)
             EXPECT_FALSE(Ogre::TextureManager::getSingleton().resourceExists(t, Ogre::RGN_DEFAULT)) << t;
         small->load();
-        EXPECT_TRUE(small->getImpostorGpu().vertexData); // built again after a reload
+        EXPECT_TRUE(ImpostorResources::of(*small).getGpu().vertexData); // built again after a reload
         TreeAssetManager::getSingleton().remove(small);
         TreeAssetManager::getSingleton().remove(plain);
     }

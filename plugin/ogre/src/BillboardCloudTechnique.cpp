@@ -88,6 +88,12 @@ namespace TreeLod
                                   resources.getBarkAoMaterialNames(true));
             }
 
+            Ogre::String describeLevel(const ForestLevel& level) const override
+            {
+                return (mClassic ? "classic " : "cloud ") + std::to_string(level.techniqueLevel) +
+                       (level.lowRes ? " low" : "");
+            }
+
         private:
             const bool mClassic;
         };

@@ -78,6 +78,11 @@ namespace TreeLod
                 if (!asset.getReference().model.barkIndices.empty())
                     parts.addMesh(asset.getBarkMesh(), materials, shadowed);
             }
+
+            Ogre::String describeLevel(const ForestLevel& level) const override
+            {
+                return level.technique + " " + (level.techniqueLevel ? std::to_string(level.techniqueLevel) : "all");
+            }
         };
 
         void registerFoliageLod(TechniqueRegistry& registry)

@@ -54,14 +54,12 @@ namespace TreeLod
         /// "<element>technique '...' cannot be a Forest level" from `source`.
         ForestLevelProvider& levelProvider(const Ogre::String& name, const Ogre::String& element, const char* source)
         {
-            TechniqueRegistry* registry = TechniqueRegistry::getSingletonPtr();
-            if (!registry)
-                invalid(element + "no technique registry: is Plugin_TreeLod installed?", source);
-            const TechniqueInfo& technique = registry->get(name, element, source);
+            const TechniqueRegistry& registry = TechniqueRegistry::getSingleton();
+            const TechniqueInfo& technique = registry.get(name, element, source);
             if (!technique.forestLevels)
             {
                 Ogre::String known;
-                for (const TechniqueInfo& t : registry->getTechniques())
+                for (const TechniqueInfo& t : registry.getTechniques())
                     if (t.forestLevels)
                         known += (known.empty() ? "" : ", ") + t.name;
                 invalid(element + "technique '" + name + "' cannot be a Forest level (those that can: " + known + ")",

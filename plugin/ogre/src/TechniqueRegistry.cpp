@@ -7,8 +7,6 @@
 
 #include <algorithm>
 
-template <> TreeLod::TechniqueRegistry* Ogre::Singleton<TreeLod::TechniqueRegistry>::msSingleton = nullptr;
-
 namespace TreeLod
 {
     namespace
@@ -18,20 +16,41 @@ namespace TreeLod
             static std::vector<void (*)(TechniqueRegistry&)> functions;
             return functions;
         }
+
+        TechniqueRegistry*& made()
+        {
+            static TechniqueRegistry* registry = nullptr;
+            return registry;
+        }
     }
 
-    TechniqueRegistry& TechniqueRegistry::getSingleton() { return *msSingleton; }
-    TechniqueRegistry* TechniqueRegistry::getSingletonPtr() { return msSingleton; }
+    TechniqueRegistry& TechniqueRegistry::getSingleton()
+    {
+        static TechniqueRegistry registry;
+        return registry;
+    }
 
     TechniqueRegistry::Registration::Registration(void (*registerTechnique)(TechniqueRegistry& registry))
     {
-        registrations().push_back(registerTechnique);
+        if (TechniqueRegistry* registry = made())
+        {
+            registerTechnique(*registry);
+            registry->sortTechniques();
+        }
+        else
+            registrations().push_back(registerTechnique);
     }
 
     TechniqueRegistry::TechniqueRegistry()
     {
         for (void (*registerTechnique)(TechniqueRegistry&) : registrations())
             registerTechnique(*this);
+        sortTechniques();
+        made() = this;
+    }
+
+    void TechniqueRegistry::sortTechniques()
+    {
         // Static initialisation runs the registrations in link order: list "mesh", the reference
         // every comparison is made against, first, then the others by name.
         std::stable_sort(mTechniques.begin(), mTechniques.end(), [](const TechniqueInfo& a, const TechniqueInfo& b) {

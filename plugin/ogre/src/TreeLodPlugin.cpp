@@ -23,10 +23,9 @@ namespace TreeLod
 
     void TreeLodPlugin::install()
     {
-        mTechniques = std::make_unique<TechniqueRegistry>();
         mAssetManager = std::make_unique<TreeAssetManager>();
         // One MovableObject factory per technique (docs/architecture.md, "Factories"), some shared.
-        for (const TechniqueInfo& technique : mTechniques->getTechniques())
+        for (const TechniqueInfo& technique : TechniqueRegistry::getSingleton().getTechniques())
         {
             Ogre::MovableObjectFactory* factory = technique.factory.get();
             if (factory && std::find(mFactories.begin(), mFactories.end(), factory) == mFactories.end())
@@ -38,7 +37,7 @@ namespace TreeLod
         mForestFactory = std::make_unique<ForestFactory>();
         Ogre::Root::getSingleton().addMovableObjectFactory(mForestFactory.get());
         Ogre::LogManager::getSingleton().logMessage("TreeLod: installed (techniques: " +
-                                                    mTechniques->describe() + ")");
+                                                    TechniqueRegistry::getSingleton().describe() + ")");
     }
 
     void TreeLodPlugin::initialise()
@@ -64,6 +63,5 @@ namespace TreeLod
         delete mLodGenerator;
         mLodGenerator = nullptr;
         mAssetManager.reset();
-        mTechniques.reset();
     }
 }

@@ -1,6 +1,8 @@
 #include "TreeLod/ForestScene.h"
 
+#include "TreeLod/ImpostorData.h"
 #include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 
 #include <OgreManualObject.h>
@@ -40,7 +42,7 @@ namespace TreeLod
             else
                 for (const TechniqueBand& band : species.bands)
                     bands.push_back(ForestBand{band.technique, band.minPixels});
-            bake.insert("reference");
+            bake.insert(REFERENCE_CHUNK);
             for (const ForestBand& band : bands)
             {
                 const std::string name = bakeTechniqueOf(band.technique);
@@ -73,20 +75,21 @@ namespace TreeLod
 
     std::string bakeTechniqueOf(const std::string& technique)
     {
-        if (technique == "mesh")
-            return "reference";
-        if (technique == "quad" || isQuadFloor(technique))
-            return "impostor";
-        if (technique == "lodf" || technique == "billboard-cloud" || technique == "classic-billboard-cloud")
-            return technique;
-        return "";
+        if (isQuadFloor(technique))
+            return IMPOSTOR_CHUNK;
+        const TechniqueInfo* info = TechniqueRegistry::getSingleton().find(technique);
+        return info && info->forestLevels ? info->chunkTechnique : "";
     }
 
     bool isQuadFloor(const std::string& technique) { return technique == "entities" || technique == "merged-quads"; }
 
     std::string knownSceneTechniques()
     {
-        return "mesh, lodf, billboard-cloud, classic-billboard-cloud, quad, entities, merged-quads";
+        std::string known;
+        for (const TechniqueInfo& t : TechniqueRegistry::getSingleton().getTechniques())
+            if (t.forestLevels)
+                known += t.name + ", ";
+        return known + "entities, merged-quads";
     }
 
     std::map<std::string, std::vector<std::string>> scenePackages(const SceneScript& script,

@@ -1,5 +1,7 @@
 #include "TreeLod/QuadFloors.h"
 
+#include "TreeLod/ImpostorResources.h"
+
 #include <OgreEntity.h>
 #include <OgreHardwareBufferManager.h>
 #include <OgreMeshManager.h>
@@ -32,7 +34,7 @@ namespace TreeLod
                 if (!asset)
                     OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, "species " + std::to_string(out.size()) +
                                                                         " has no asset", who);
-                out.push_back(&asset->getImpostorGpu()); // throws naming the asset without the chunk
+                out.push_back(&ImpostorResources::of(*asset).getGpu()); // throws naming the asset without the chunk
             }
             for (std::size_t i = 0; i < instances.size(); ++i)
                 if (instances[i].kind >= assets.size())

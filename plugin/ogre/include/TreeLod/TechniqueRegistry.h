@@ -6,14 +6,15 @@
 // that makes it, the ForestLevelProvider that draws it as a Forest level, and what the sample
 // browser shows of an object's state. A technique registers itself from its own source file with
 // one namespace-scope TechniqueRegistry::Registration; the registry runs every registration when
-// the plugin installs it. TreeAsset, the Forest, ForestScene, `treelod render`/`bench` and the
-// browser iterate the registry and name no technique.
+// the registry is first used. TreeAsset, the Forest, ForestScene, `treelod render`/`bench` and the
+// browser iterate the registry and name no technique. The registry is one per process, made on
+// first use (no Ogre::Root needed: a bench lists techniques before it renders); the plugin adds
+// the factories to Root when it installs.
 #pragma once
 
 #include "TreeLod/ForestLevelProvider.h"
 
 #include <OgreCommon.h>
-#include <OgreSingleton.h>
 
 #include <functional>
 #include <memory>
@@ -59,17 +60,18 @@ namespace TreeLod
         std::function<std::vector<TechniqueStateLine>(Ogre::MovableObject& object)> describeState;
     };
 
-    class TechniqueRegistry : public Ogre::Singleton<TechniqueRegistry>
+    class TechniqueRegistry
     {
     public:
-        /// A technique's registration: a function adding its TechniqueInfo(s), run by every
-        /// registry constructed afterwards. One namespace-scope instance in the technique's source.
+        /// A technique's registration: a function adding its TechniqueInfo(s), run when the registry
+        /// is made (or at once if it exists). One namespace-scope instance in the technique's source.
         struct Registration
         {
             explicit Registration(void (*registerTechnique)(TechniqueRegistry& registry));
         };
 
-        TechniqueRegistry(); ///< runs every Registration
+        TechniqueRegistry(const TechniqueRegistry&) = delete;
+        TechniqueRegistry& operator=(const TechniqueRegistry&) = delete;
 
         /// Add or replace a technique.
         void add(TechniqueInfo info);
@@ -93,10 +95,14 @@ namespace TreeLod
         /// `params` plus the asset (and `extra`).
         static decltype(TechniqueInfo::create) byFactory(const Ogre::String& type, Ogre::NameValuePairList extra = {});
 
+        /// The process's registry (made on first call, running every Registration).
         static TechniqueRegistry& getSingleton();
-        static TechniqueRegistry* getSingletonPtr();
+        static TechniqueRegistry* getSingletonPtr() { return &getSingleton(); }
 
     private:
+        TechniqueRegistry();
+        void sortTechniques();
+
         std::vector<TechniqueInfo> mTechniques;
     };
 }

@@ -1,8 +1,8 @@
 // TreeLodPlugin: the Ogre::Plugin of TreeLod (Plugin_TreeLod.so).
 //
 // install: creates the TreeAsset resource manager (resource type "TreeAsset", files
-// *.treelod found through resource groups like meshes) and the technique registry, and adds the
-// MovableObject factory of every registered technique and the Forest's to Ogre::Root.
+// *.treelod found through resource groups like meshes), and adds the MovableObject factory of
+// every technique in the TechniqueRegistry and the Forest's to Ogre::Root.
 // initialise: creates the MeshLodGenerator singleton if the application has none.
 // shutdown/uninstall undo the same in reverse order.
 #pragma once
@@ -22,7 +22,6 @@ namespace TreeLod
 {
     class ForestFactory;
     class TreeAssetManager;
-    class TechniqueRegistry;
 
     class TreeLodPlugin : public Ogre::Plugin
     {
@@ -38,7 +37,6 @@ namespace TreeLod
 
     private:
         std::unique_ptr<TreeAssetManager> mAssetManager;
-        std::unique_ptr<TechniqueRegistry> mTechniques;
         std::vector<Ogre::MovableObjectFactory*> mFactories; ///< added to Root by install(), owned by the registry
         std::unique_ptr<ForestFactory> mForestFactory;
         Ogre::MeshLodGenerator* mLodGenerator = nullptr; ///< owned only when we created it

@@ -1,5 +1,5 @@
 // QuadFloors: the two speed floors `treelod bench` measures the Forest against, both
-// drawing each tree as the one camera-facing quad of its baked impostor (TreeAsset::getImpostorGpu,
+// drawing each tree as the one camera-facing quad of its baked impostor (ImpostorResources::getGpu,
 // materials/GLSL/TreeLodImpostor.vert), so all three give the same picture:
 // - EntityFloor: one Ogre Entity on its own SceneNode per tree, one draw each: what Ogre users
 //   pay today (measured with a minimal Ogre program: 10,000 one-quad entities cost 16 ms on an
