@@ -1,6 +1,7 @@
 #include "TreeLod/OffscreenRenderer.h"
 
 #include "TreeLod/AtomicFile.h"
+#include "TreeLod/Colour.h"
 #include "TreeLod/OgreBootstrap.h"
 #include "TreeLod/TreeLodPlugin.h"
 
@@ -14,16 +15,6 @@
 
 namespace TreeLod
 {
-    namespace
-    {
-        float toLinear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
-        float toSrgb(float c)
-        {
-            c = c < 0.0f ? 0.0f : (c > 1.0f ? 1.0f : c);
-            return c <= 0.0031308f ? c * 12.92f : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
-        }
-    }
-
     OffscreenRenderer::OffscreenRenderer(const OffscreenOptions& options)
     {
         // Debian's OGRE is GLX only; fail before Ogre half-starts (its teardown then crashes).
@@ -265,11 +256,11 @@ namespace TreeLod
                     {
                         const std::uint8_t* p = &big[(std::size_t(y * s + sy) * w + (x * s + sx)) * 4];
                         for (int c = 0; c < 3; ++c)
-                            sum[c] += toLinear(p[c] / 255.0f);
+                            sum[c] += srgbByteToLinear(p[c]);
                     }
                 std::uint8_t* o = &out.pixels[(std::size_t(y) * width + x) * 4];
                 for (int c = 0; c < 3; ++c)
-                    o[c] = std::uint8_t(std::lround(toSrgb(sum[c] * norm) * 255.0f));
+                    o[c] = linearToSrgbByte(sum[c] * norm);
                 o[3] = 255;
             }
         return out;
