@@ -62,7 +62,7 @@ def read_series(path, x_column, y_column, log_x, log_y):
     return list(lines.values()), markers
 
 
-def draw(plt, directory, out_directory, spec):
+def draw(plt, ticker, directory, out_directory, spec):
     log_x, log_y = bool(spec.get("logX")), bool(spec.get("logY"))
     lines, markers = read_series(os.path.join(directory, spec["csv"]), spec["x"], spec["y"], log_x, log_y)
     figure, axes = plt.subplots(figsize=(9.6, 6.0), dpi=100)
@@ -75,10 +75,12 @@ def draw(plt, directory, out_directory, spec):
         has_data = True
         axes.plot([x], [y], linestyle="none", marker=shape, markersize=9, color="black",
                   markerfacecolor="none" if shape != "x" else "black", markeredgewidth=1.5, label=label or None)
-    if log_x and has_data:
-        axes.set_xscale("log")
-    if log_y and has_data:
-        axes.set_yscale("log")
+    for log, axis, scale in ((log_x, axes.xaxis, axes.set_xscale), (log_y, axes.yaxis, axes.set_yscale)):
+        if log and has_data:
+            scale("log")
+            # Plain numbers (20, 300) rather than 2x10^1; in-between ticks labelled on short ranges.
+            axis.set_major_formatter(ticker.LogFormatter())
+            axis.set_minor_formatter(ticker.LogFormatter(labelOnlyBase=False, minor_thresholds=(2, 0.5)))
     axes.set_title(spec.get("title", ""), fontsize=11)
     axes.set_xlabel(spec.get("xLabel", ""))
     axes.set_ylabel(spec.get("yLabel", ""))
@@ -105,6 +107,7 @@ def main():
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
+        import matplotlib.ticker as ticker
     except ImportError:
         print("plot.py: needs matplotlib (Debian: apt install python3-matplotlib)", file=sys.stderr)
         return 3
@@ -118,7 +121,7 @@ def main():
     out_directory = args.out or args.directory
     os.makedirs(out_directory, exist_ok=True)
     for spec in plots:
-        path = draw(plt, args.directory, out_directory, spec)
+        path = draw(plt, ticker, args.directory, out_directory, spec)
         if args.verbose:
             print(path)
     return 0

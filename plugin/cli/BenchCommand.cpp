@@ -201,34 +201,7 @@ namespace TreeLod
             return out + "\"";
         }
 
-        /// Run `argv`, looked up on PATH, and wait; its exit code, or -1 when it died of a signal and
-        /// 127 when it could not start. `silent`: its stdout and stderr go to /dev/null.
-        int runSearchedProcess(const std::vector<std::string>& argv, bool silent)
-        {
-            std::vector<char*> args;
-            for (const std::string& a : argv)
-                args.push_back(const_cast<char*>(a.c_str()));
-            args.push_back(nullptr);
-            const pid_t pid = fork();
-            if (pid < 0)
-                return -1;
-            if (pid == 0)
-            {
-                if (silent)
-                    if (const int null = open("/dev/null", O_WRONLY); null >= 0)
-                    {
-                        dup2(null, 1);
-                        dup2(null, 2);
-                    }
-                execvp(args[0], args.data());
-                _exit(127);
-            }
-            int status = 0;
-            while (waitpid(pid, &status, 0) < 0)
-                if (errno != EINTR)
-                    return -1;
-            return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        }
+        int runProcess(const std::vector<std::string>& argv, bool searchPath = false, bool silent = false);
 
         /// bench/plot.py: $TREELOD_PLOT_SCRIPT, else the one in the source tree this was built from.
         std::string plotScript()
@@ -245,7 +218,7 @@ namespace TreeLod
             const std::string script = plotScript();
             std::error_code ec;
             if (!std::filesystem::is_regular_file(script, ec) ||
-                runSearchedProcess({"python3", "-c", "import matplotlib"}, true) != 0)
+                runProcess({"python3", "-c", "import matplotlib"}, true, true) != 0)
             {
                 std::fprintf(stderr,
                              "treelod: bench: plots not drawn (python3 with matplotlib needed: apt install "
@@ -253,7 +226,7 @@ namespace TreeLod
                              script.c_str(), directory.c_str());
                 return true;
             }
-            if (const int code = runSearchedProcess({"python3", script, directory}, false); code != 0)
+            if (const int code = runProcess({"python3", script, directory}, true); code != 0)
             {
                 std::fprintf(stderr, "treelod: bench: python3 %s %s failed (exit %d)\n", script.c_str(),
                              directory.c_str(), code);
@@ -548,7 +521,9 @@ namespace TreeLod
         }
 
         /// Run `argv` and wait; its exit code, or -1 when it could not start or died of a signal.
-        int runProcess(const std::vector<std::string>& argv)
+        /// `searchPath`: argv[0] is looked up on PATH; `silent`: its stdout and stderr, and the
+        /// message when it cannot start, go nowhere.
+        int runProcess(const std::vector<std::string>& argv, bool searchPath, bool silent)
         {
             std::vector<char*> args;
             for (const std::string& a : argv)
@@ -559,8 +534,15 @@ namespace TreeLod
                 return -1;
             if (pid == 0)
             {
-                execv(args[0], args.data());
-                std::fprintf(stderr, "treelod: bench: cannot run %s: %s\n", args[0], std::strerror(errno));
+                if (silent)
+                    if (const int null = open("/dev/null", O_WRONLY); null >= 0)
+                    {
+                        dup2(null, 1);
+                        dup2(null, 2);
+                    }
+                (searchPath ? execvp : execv)(args[0], args.data());
+                if (!silent)
+                    std::fprintf(stderr, "treelod: bench: cannot run %s: %s\n", args[0], std::strerror(errno));
                 _exit(127);
             }
             int status = 0;
