@@ -15,13 +15,13 @@
 // temporal noise: the multi-scale RMSE between the frame and the next frame of the path (paper 001
 // §5, Fig. 13), for the reference too. A reference frame whose triangle count would exceed
 // --reference-budget is skipped and said so, never estimated. Writes DIR/frames.csv,
-// DIR/summary.json and PNG plots (frame time along the path, paper 001 Fig. 11; the speed/accuracy
-// trade over the LoD biases with the reference and the floors marked).
+// DIR/summary.json and the data of the plots as CSV (frame time along the path, paper 001 Fig. 11;
+// the speed/accuracy trade over the LoD biases with the reference and the floors marked) with
+// DIR/plots.json; bench/plot.py draws them as PNG when python3 has matplotlib.
 #include "CliSupport.h"
 #include "Commands.h"
 
 #include "TreeLod/ImageMetrics.h"
-#include "TreeLod/Plot.h"
 #include "TreeLod/SceneScript.h"
 
 #include <nlohmann/json.hpp>
@@ -46,6 +46,7 @@
 #include <cerrno>
 #include <cstring>
 
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #endif
@@ -189,6 +190,49 @@ namespace TreeLod
         Result<void> writeText(const std::string& path, const std::string& text)
         {
             return writeFileAtomic(path, std::vector<std::uint8_t>(text.begin(), text.end()));
+        }
+
+        /// A CSV field: quoted, quotes doubled.
+        std::string csvField(const std::string& text)
+        {
+            std::string out = "\"";
+            for (char c : text)
+                out += c == '"' ? std::string("\"\"") : std::string(1, c);
+            return out + "\"";
+        }
+
+        int runProcess(const std::vector<std::string>& argv, bool searchPath = false, bool silent = false);
+
+        /// bench/plot.py: $TREELOD_PLOT_SCRIPT, else the one in the source tree this was built from.
+        std::string plotScript()
+        {
+            if (const char* env = std::getenv("TREELOD_PLOT_SCRIPT"); env && *env)
+                return env;
+            return TREELOD_PLOT_SCRIPT;
+        }
+
+        /// Draw DIR/plots.json's plots with bench/plot.py when python3 has matplotlib; otherwise one
+        /// line saying how. False when the script ran and failed.
+        bool drawPlots(const std::string& directory)
+        {
+            const std::string script = plotScript();
+            std::error_code ec;
+            if (!std::filesystem::is_regular_file(script, ec) ||
+                runProcess({"python3", "-c", "import matplotlib"}, true, true) != 0)
+            {
+                std::fprintf(stderr,
+                             "treelod: bench: plots not drawn (python3 with matplotlib needed: apt install "
+                             "python3-matplotlib); draw them with: python3 %s %s\n",
+                             script.c_str(), directory.c_str());
+                return true;
+            }
+            if (const int code = runProcess({"python3", script, directory}, true); code != 0)
+            {
+                std::fprintf(stderr, "treelod: bench: python3 %s %s failed (exit %d)\n", script.c_str(),
+                             directory.c_str(), code);
+                return false;
+            }
+            return true;
         }
 
         /// Median frame ms of `run` over the frames where `other` was timed too (all when null).
@@ -337,7 +381,15 @@ namespace TreeLod
             if (args.json)
                 std::printf("%s\n", summary.dump(2).c_str());
 
-            // Plots, one set per tree count.
+            // Plot data, one set per tree count: a CSV per plot and DIR/plots.json saying how to draw
+            // each (bench/plot.py draws them).
+            json plots = json::array();
+            auto addPlot = [&](const std::string& name, const std::string& csvText, json spec) {
+                spec["csv"] = name + ".csv";
+                spec["png"] = name + ".png";
+                plots.push_back(std::move(spec));
+                return writeText(args.output + "/" + name + ".csv", csvText);
+            };
             std::vector<std::uint32_t> counts;
             for (const Run& run : runs)
                 if (std::find(counts.begin(), counts.end(), run.count) == counts.end())
@@ -345,19 +397,14 @@ namespace TreeLod
             for (std::uint32_t count : counts)
             {
                 const std::string suffix = counts.size() > 1 ? "-" + std::to_string(count) : "";
-                PlotSpec time;
-                time.title = script.name + ": frame time along the path (" + treesText(count) + ", " +
-                             std::to_string(width) + "x" + std::to_string(height) + ")";
-                time.xLabel = "path time (s)";
-                time.yLabel = "frame ms";
-                time.logY = true;
-                PlotSpec trade;
-                trade.title = script.name + ": error against frame time (" + treesText(count) + ")";
-                trade.xLabel = "median frame ms (over the frames every run timed)";
                 const std::vector<bool> common = commonTimedFrames(runs, count);
-                trade.yLabel = "mean FLIP vs supersampled reference";
-                trade.logX = true;
-                std::map<std::string, PlotSeries> curves;
+                // frame-time: per run at bias 1 (and the comparisons), frame ms along the path; empty
+                // where the frame was not timed (a gap in the line).
+                std::string timeCsv = "series,label,time_s,frame_ms\n";
+                // trade: one curve per technique over the biases; the comparisons are single points
+                // drawn with their `marker` (matplotlib's o, s, ^, x).
+                std::string tradeCsv = "series,label,lod_bias,median_frame_ms,mean_flip,marker\n";
+                std::vector<std::string> curveRows;
                 for (const Run& run : runs)
                 {
                     if (run.count != count)
@@ -378,61 +425,89 @@ namespace TreeLod
                         static const char shapes[] = {'o', 's', '^', 'x'};
                         for (std::size_t c = 0; c < comparisonRuns().size(); ++c)
                             if (comparisonRuns()[c].first == run.technique)
-                                trade.markers.push_back(PlotMarker{comparisonRuns()[c].second,
-                                                                   glm::dvec2(median, meanFlip), glm::vec3(0.0f),
-                                                                   shapes[c]});
+                                tradeCsv += csvField(run.technique) + "," + csvField(comparisonRuns()[c].second) +
+                                            "," + number(run.lodBias, 3) + "," + number(median, 6) + "," +
+                                            number(meanFlip, 6) + "," + std::string(1, shapes[c]) + "\n";
                     }
                     else
-                    {
-                        PlotSeries& curve = curves[run.technique];
-                        curve.label = run.technique + " (LoD bias " + args.lodBiases + ")";
-                        curve.points.push_back(glm::dvec2(median, meanFlip));
-                    }
+                        curveRows.push_back(csvField(run.technique) + "," +
+                                            csvField(run.technique + " (LoD bias " + args.lodBiases + ")") + "," +
+                                            number(run.lodBias, 3) + "," + number(median, 6) + "," +
+                                            number(meanFlip, 6) + ",\n");
                     if (run.lodBias == 1.0f || isComparisonRun(run.technique))
                     {
-                        PlotSeries series;
-                        series.label = run.technique;
+                        std::string label = run.technique;
                         for (const auto& [name, text] : comparisonRuns())
                             if (name == run.technique)
-                                series.label = text;
-                        series.markers = false;
+                                label = text;
                         if (std::none_of(run.frames.begin(), run.frames.end(),
                                          [](const FrameRecord& r) { return r.timed; }))
-                            series.label += ": every frame over the triangle budget, skipped";
+                            label += ": every frame over the triangle budget, skipped";
                         for (const FrameRecord& r : run.frames)
-                            series.points.push_back(
-                                glm::dvec2(r.time, r.timed ? r.timing.frameMilliseconds : std::nan("")));
-                        time.series.push_back(std::move(series));
+                            timeCsv += csvField(run.technique) + "," + csvField(label) + "," + number(r.time, 6) +
+                                       "," + (r.timed ? number(r.timing.frameMilliseconds, 6) : "") + "\n";
                     }
                 }
-                for (auto& [name, curve] : curves)
-                    trade.series.push_back(std::move(curve));
-                for (const auto& [spec, name] : {std::pair<const PlotSpec*, std::string>{&time, "frame-time"},
-                                                 {&trade, "trade"}})
-                    if (Result<void> w = writePlot(args.output + "/" + name + suffix + ".png", *spec); !w)
-                        return printError(w.error()), false;
+                // Curves after the markers, by technique name.
+                std::stable_sort(curveRows.begin(), curveRows.end(), [](const std::string& a, const std::string& b) {
+                    return a.substr(0, a.find(',')) < b.substr(0, b.find(','));
+                });
+                for (const std::string& row : curveRows)
+                    tradeCsv += row;
+                const std::string frameTimeTitle = script.name + ": frame time along the path (" + treesText(count) +
+                                                   ", " + std::to_string(width) + "x" + std::to_string(height) + ")";
+                if (Result<void> w = addPlot("frame-time" + suffix, timeCsv,
+                                             {{"title", frameTimeTitle},
+                                              {"x", "time_s"},
+                                              {"y", "frame_ms"},
+                                              {"xLabel", "path time (s)"},
+                                              {"yLabel", "frame ms"},
+                                              {"logX", false},
+                                              {"logY", true},
+                                              {"markers", false}});
+                    !w)
+                    return printError(w.error()), false;
+                if (Result<void> w = addPlot("trade" + suffix, tradeCsv,
+                                             {{"title", script.name + ": error against frame time (" +
+                                                            treesText(count) + ")"},
+                                              {"x", "median_frame_ms"},
+                                              {"y", "mean_flip"},
+                                              {"xLabel", "median frame ms (over the frames every run timed)"},
+                                              {"yLabel", "mean FLIP vs supersampled reference"},
+                                              {"logX", true},
+                                              {"logY", false},
+                                              {"markers", true}});
+                    !w)
+                    return printError(w.error()), false;
             }
             if (counts.size() > 1) // paper 000 Table 2: frame time against the number of trees
             {
-                PlotSpec table;
-                table.title = script.name + ": median frame ms against trees (LoD bias 1)";
-                table.xLabel = "trees";
-                table.yLabel = "median frame ms";
-                table.logX = table.logY = true;
-                std::map<std::string, PlotSeries> curves;
+                std::string treesCsv = "series,label,trees,median_frame_ms\n";
+                std::vector<std::string> rows;
                 for (const Run& run : runs)
                     if (run.lodBias == 1.0f)
-                    {
-                        PlotSeries& curve = curves[run.technique];
-                        curve.label = run.technique;
-                        curve.points.push_back(glm::dvec2(run.count, medianOver(run, nullptr)));
-                    }
-                for (auto& [name, curve] : curves)
-                    table.series.push_back(std::move(curve));
-                if (Result<void> w = writePlot(args.output + "/trees.png", table); !w)
+                        rows.push_back(csvField(run.technique) + "," + csvField(run.technique) + "," +
+                                       std::to_string(run.count) + "," + number(medianOver(run, nullptr), 6) + "\n");
+                std::stable_sort(rows.begin(), rows.end(), [](const std::string& a, const std::string& b) {
+                    return a.substr(0, a.find(',')) < b.substr(0, b.find(','));
+                });
+                for (const std::string& row : rows)
+                    treesCsv += row;
+                if (Result<void> w = addPlot("trees", treesCsv,
+                                             {{"title", script.name + ": median frame ms against trees (LoD bias 1)"},
+                                              {"x", "trees"},
+                                              {"y", "median_frame_ms"},
+                                              {"xLabel", "trees"},
+                                              {"yLabel", "median frame ms"},
+                                              {"logX", true},
+                                              {"logY", true},
+                                              {"markers", true}});
+                    !w)
                     return printError(w.error()), false;
             }
-            return true;
+            if (Result<void> w = writeText(args.output + "/plots.json", json{{"plots", plots}}.dump(2) + "\n"); !w)
+                return printError(w.error()), false;
+            return drawPlots(args.output);
         }
 
         /// treelod_frames: $TREELOD_FRAMES, else beside this executable.
@@ -446,7 +521,9 @@ namespace TreeLod
         }
 
         /// Run `argv` and wait; its exit code, or -1 when it could not start or died of a signal.
-        int runProcess(const std::vector<std::string>& argv)
+        /// `searchPath`: argv[0] is looked up on PATH; `silent`: its stdout and stderr, and the
+        /// message when it cannot start, go nowhere.
+        int runProcess(const std::vector<std::string>& argv, bool searchPath, bool silent)
         {
             std::vector<char*> args;
             for (const std::string& a : argv)
@@ -457,8 +534,15 @@ namespace TreeLod
                 return -1;
             if (pid == 0)
             {
-                execv(args[0], args.data());
-                std::fprintf(stderr, "treelod: bench: cannot run %s: %s\n", args[0], std::strerror(errno));
+                if (silent)
+                    if (const int null = open("/dev/null", O_WRONLY); null >= 0)
+                    {
+                        dup2(null, 1);
+                        dup2(null, 2);
+                    }
+                (searchPath ? execvp : execv)(args[0], args.data());
+                if (!silent)
+                    std::fprintf(stderr, "treelod: bench: cannot run %s: %s\n", args[0], std::strerror(errno));
                 _exit(127);
             }
             int status = 0;

@@ -4,6 +4,7 @@
 #include "SingleTreeView.h"
 #include "TechniqueSample.h"
 #include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/OgreBootstrap.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 #include "TreeLod/TreeLodPlugin.h"
@@ -35,12 +36,6 @@ namespace TreeLod
         constexpr int HISTOGRAM_LINES = 7;
         const Ogre::ColourValue COLUMN_COLOUR(0.10f, 0.11f, 0.12f);
         const Ogre::ColourValue MENU_COLOUR(0.16f, 0.19f, 0.22f);
-
-        std::string envOr(const char* name, const std::string& fallback)
-        {
-            const char* v = std::getenv(name);
-            return v && *v ? std::string(v) : fallback;
-        }
 
         double secondsSince(std::chrono::steady_clock::time_point start)
         {
@@ -77,12 +72,9 @@ namespace TreeLod
     void TreeLodBrowser::createRoot()
     {
         // Own LogManager first, else Ogre logs to stdout (OGRE-NOTES.md); no config or log files.
-        mLogManager = std::make_unique<Ogre::LogManager>();
-        mLogManager->createLog("", true, mOptions.verbose, true);
+        mLogManager = createLogManager("", mOptions.verbose);
         mRoot = OGRE_NEW Ogre::Root("", "", "");
-        const std::string pluginDir = envOr("OGRE_PLUGIN_DIR_OVERRIDE", TREELOD_OGRE_PLUGIN_DIR);
-        mRoot->loadPlugin(pluginDir + "/RenderSystem_GL3Plus.so");
-        mRoot->loadPlugin(pluginDir + "/Codec_STBI.so");
+        loadRenderPlugins(*mRoot);
         mPlugin = std::make_unique<TreeLodPlugin>();
         mRoot->installPlugin(mPlugin.get());
         mOverlaySystem = OGRE_NEW Ogre::OverlaySystem();
@@ -111,9 +103,8 @@ namespace TreeLod
             return OgreBites::ApplicationContext::createWindow(name, uint32_t(mOptions.width), uint32_t(mOptions.height),
                                                     miscParams);
         // Headless: a hidden 1x1 window owns the GL context; the screens render into a texture.
-        miscParams["hidden"] = "true";
-        miscParams["vsync"] = "false";
-        OgreBites::NativeWindowPair pair = OgreBites::ApplicationContextBase::createWindow(name, 1, 1, miscParams);
+        OgreBites::NativeWindowPair pair =
+            OgreBites::ApplicationContextBase::createWindow(name, 1, 1, hiddenWindowParams(miscParams));
         pair.render->setAutoUpdated(false);
         return pair;
     }
@@ -121,14 +112,12 @@ namespace TreeLod
     void TreeLodBrowser::locateResources()
     {
         Ogre::ResourceGroupManager& rgm = Ogre::ResourceGroupManager::getSingleton();
-        const std::string media = envOr("TREELOD_OGRE_MEDIA_DIR", TREELOD_OGRE_MEDIA_DIR);
+        const std::string media = ogreMediaDirectory();
         rgm.addResourceLocation(media + "/packs/SdkTrays.zip", "Zip", "Essential");
         rgm.addResourceLocation(media + "/RTShaderLib/materials", "FileSystem", Ogre::RGN_INTERNAL);
         rgm.addResourceLocation(media + "/RTShaderLib/GLSL", "FileSystem", Ogre::RGN_INTERNAL);
-        rgm.addResourceLocation(media + "/ShadowVolume", "FileSystem", Ogre::RGN_INTERNAL);
-        const std::string materials = envOr("TREELOD_MATERIALS_DIR", TREELOD_DEFAULT_MATERIALS_DIR);
-        rgm.addResourceLocation(materials, "FileSystem", TREELOD_GROUP);
-        rgm.addResourceLocation(materials + "/GLSL", "FileSystem", TREELOD_GROUP);
+        addShadowVolumeLocation();
+        addMaterialsLocations(materialsDirectory(), TREELOD_GROUP);
     }
 
     void TreeLodBrowser::setup()
@@ -180,7 +169,7 @@ namespace TreeLod
         if (!shaderGenerator)
             OGRE_EXCEPT(Ogre::Exception::ERR_FILE_NOT_FOUND,
                         "the RT shader system did not start (RTShaderLib not found under " +
-                            envOr("TREELOD_OGRE_MEDIA_DIR", TREELOD_OGRE_MEDIA_DIR) + ")",
+                            ogreMediaDirectory() + ")",
                         "TreeLodBrowser::createUi");
         shaderGenerator->addSceneManager(mUiSceneManager);
 

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # treelod bench end to end (run by ctest under xvfb-run): single-tree.json on a short path and
 # table2.json scaled down with two tree counts. Checks that the outputs exist and agree with each
-# other (row counts, techniques, biases, tree counts, PNG plots), not the timings. A bad script
-# exits 2 naming file, line and column, and writes nothing.
+# other (row counts, techniques, biases, tree counts, the plots' CSV data; PNG plots only where
+# python3 has matplotlib to draw them), not the timings. A bad script exits 2 naming file, line
+# and column, and writes nothing.
 set -euo pipefail
 treelod=$1; src=$2; out=$3
 rm -rf "$out"; mkdir -p "$out"
@@ -10,12 +11,23 @@ cache="$out/cache"
 
 fail() { echo "bench test: $*"; exit 1; }
 png() { [ -s "$1" ] && head -c 8 "$1" | od -An -tx1 | grep -q "89 50 4e 47" || fail "$1 is not a PNG"; }
+# The plots' data: a CSV with a header and `want` rows, listed in plots.json; its PNG when drawn.
+plotted=0; python3 -c 'import matplotlib' 2>/dev/null && plotted=1
+plot() {
+  local dir=$1 name=$2 want=$3
+  [ -s "$dir/$name.csv" ] || fail "$dir/$name.csv missing"
+  local rows=$(($(wc -l < "$dir/$name.csv") - 1))
+  [ "$rows" = "$want" ] || fail "$name.csv has $rows rows, expected $want"
+  grep -q "\"$name.csv\"" "$dir/plots.json" || fail "plots.json does not list $name.csv"
+  if [ $plotted = 1 ]; then png "$dir/$name.png"; fi
+}
 
 # 1. One tree: reference, the three floors and auto at two biases over 6 frames.
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/single" --frames 6 --size 160x90 \
   --techniques auto --lod-bias 1,0.5 --samples 2 --upload-budget 1 --cache "$cache" -q
-for f in frames.csv summary.json frame-time.png trade.png; do [ -s "$out/single/$f" ] || fail "single/$f missing"; done
-png "$out/single/frame-time.png"; png "$out/single/trade.png"
+for f in frames.csv summary.json plots.json; do [ -s "$out/single/$f" ] || fail "single/$f missing"; done
+# frame time: the reference, 3 floors and auto at bias 1, 6 frames each; trade: 4 points + auto at 2 biases.
+plot "$out/single" frame-time 30; plot "$out/single" trade 6
 rows=$(($(wc -l < "$out/single/frames.csv") - 1))
 [ "$rows" = 36 ] || fail "frames.csv has $rows rows, expected (mesh + 3 floors + auto x 2 biases) x 6 = 36"
 for t in mesh impostor entities merged-quads auto; do
@@ -71,16 +83,17 @@ grep -q 'baked' "$out/single/summary.json" || fail "first run baked nothing?"
 grep -q '"bake"' "$out/single2/summary.json" && ! grep -q ': baked' "$out/single2/summary.json" \
   || fail "second run rebaked"
 
-# 2. García et al. 2007 Table 2 scaled down: two tree counts (1 and 1 + 49 x 0.1), a trees.png plot.
+# 2. García et al. 2007 Table 2 scaled down: two tree counts (1 and 1 + 49 x 0.1), a trees plot.
 "$treelod" bench "$src/samples/scenes/table2.json" -o "$out/table2" --scale 0.1 --counts 1,50 --frames 3 \
   --size 128x96 --techniques billboard-cloud --lod-bias 1 --samples 1 --cache "$cache" -q
-for f in frames.csv summary.json trees.png; do [ -s "$out/table2/$f" ] || fail "table2/$f missing"; done
+for f in frames.csv summary.json plots.json; do [ -s "$out/table2/$f" ] || fail "table2/$f missing"; done
+plot "$out/table2" trees 10 # 5 runs at bias 1 x 2 counts
 counts=$(awk -F, 'NR > 1 { print $1 }' "$out/table2/frames.csv" | sort -n | uniq)
 [ "$(echo $counts)" = "1 6" ] || fail "tree counts '$(echo $counts)', expected '1 6'"
 for c in $counts; do
   n=$(awk -F, -v c=$c 'NR > 1 && $1 == c' "$out/table2/frames.csv" | wc -l)
   [ "$n" = 15 ] || fail "$c trees: $n rows, expected 5 runs x 3 frames"
-  png "$out/table2/trade-$c.png"; png "$out/table2/frame-time-$c.png"
+  plot "$out/table2" trade-$c 5; plot "$out/table2" frame-time-$c 15
   grep -Eq "\"trees\": $c,?\$" "$out/table2/summary.json" || fail "summary lacks $c trees"
 done
 

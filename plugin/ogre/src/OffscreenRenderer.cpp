@@ -1,6 +1,8 @@
 #include "TreeLod/OffscreenRenderer.h"
 
 #include "TreeLod/AtomicFile.h"
+#include "TreeLod/Colour.h"
+#include "TreeLod/OgreBootstrap.h"
 #include "TreeLod/TreeLodPlugin.h"
 
 #include <OgreShadowCameraSetupFocused.h>
@@ -10,26 +12,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
 
 namespace TreeLod
 {
-    namespace
-    {
-        float toLinear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
-        float toSrgb(float c)
-        {
-            c = c < 0.0f ? 0.0f : (c > 1.0f ? 1.0f : c);
-            return c <= 0.0031308f ? c * 12.92f : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
-        }
-
-        std::string envOr(const char* name, const std::string& fallback)
-        {
-            const char* v = std::getenv(name);
-            return v && *v ? std::string(v) : fallback;
-        }
-    }
-
     OffscreenRenderer::OffscreenRenderer(const OffscreenOptions& options)
     {
         // Debian's OGRE is GLX only; fail before Ogre half-starts (its teardown then crashes).
@@ -39,13 +24,10 @@ namespace TreeLod
                         "no X display (DISPLAY is not set): run under xvfb-run -a -s \"-screen 0 1280x1024x24\"",
                         "OffscreenRenderer");
         // Own LogManager first, else Ogre logs to stdout (OGRE-NOTES.md).
-        mLogManager = std::make_unique<Ogre::LogManager>();
-        mLogManager->createLog(options.logFile, true, options.verbose, options.logFile.empty());
+        mLogManager = createLogManager(options.logFile, options.verbose);
         mRoot = std::make_unique<Ogre::Root>("", "", "");
 
-        const std::string pluginDir = envOr("OGRE_PLUGIN_DIR_OVERRIDE", TREELOD_OGRE_PLUGIN_DIR);
-        mRoot->loadPlugin(pluginDir + "/RenderSystem_GL3Plus.so");
-        mRoot->loadPlugin(pluginDir + "/Codec_STBI.so");
+        const std::string pluginDir = loadRenderPlugins(*mRoot);
         if (options.pluginPath.empty())
         {
             mPlugin = std::make_unique<TreeLodPlugin>();
@@ -60,26 +42,16 @@ namespace TreeLod
                         "OffscreenRenderer");
         mRoot->setRenderSystem(systems.front());
         mRoot->initialise(false);
-        Ogre::NameValuePairList misc;
-        misc["hidden"] = "true";
-        misc["vsync"] = "false";
+        const Ogre::NameValuePairList misc = hiddenWindowParams();
         mWindow = mRoot->createRenderWindow("TreeLodOffscreen", 1, 1, false, &misc);
         mWindow->setAutoUpdated(false);
 
-        const std::string materials = !options.materialsDir.empty()
-                                          ? options.materialsDir
-                                          : envOr("TREELOD_MATERIALS_DIR", TREELOD_DEFAULT_MATERIALS_DIR);
         Ogre::ResourceGroupManager& rgm = Ogre::ResourceGroupManager::getSingleton();
-        rgm.addResourceLocation(materials, "FileSystem", "TreeLod");
-        rgm.addResourceLocation(materials + "/GLSL", "FileSystem", "TreeLod");
+        addMaterialsLocations(!options.materialsDir.empty() ? options.materialsDir : materialsDirectory());
         rgm.initialiseResourceGroup("TreeLod");
         // Texture shadows need OGRE's ShadowVolume programs (the shadow setup loads them).
-        const std::string shadowVolume = envOr("TREELOD_OGRE_MEDIA_DIR", TREELOD_OGRE_MEDIA_DIR) + std::string("/ShadowVolume");
-        if (std::filesystem::is_directory(shadowVolume))
-        {
-            rgm.addResourceLocation(shadowVolume, "FileSystem", Ogre::RGN_INTERNAL);
+        if (addShadowVolumeLocation())
             rgm.initialiseResourceGroup(Ogre::RGN_INTERNAL);
-        }
 
         mSceneManager = mRoot->createSceneManager();
         mCamera = mSceneManager->createCamera("TreeLodOffscreenCamera");
@@ -284,11 +256,11 @@ namespace TreeLod
                     {
                         const std::uint8_t* p = &big[(std::size_t(y * s + sy) * w + (x * s + sx)) * 4];
                         for (int c = 0; c < 3; ++c)
-                            sum[c] += toLinear(p[c] / 255.0f);
+                            sum[c] += srgbByteToLinear(p[c]);
                     }
                 std::uint8_t* o = &out.pixels[(std::size_t(y) * width + x) * 4];
                 for (int c = 0; c < 3; ++c)
-                    o[c] = std::uint8_t(std::lround(toSrgb(sum[c] * norm) * 255.0f));
+                    o[c] = linearToSrgbByte(sum[c] * norm);
                 o[3] = 255;
             }
         return out;

@@ -97,9 +97,8 @@ namespace TreeLod
         for (std::size_t i = 0; i < image.pixels.size(); ++i)
             for (int c = 0; c < 4; ++c)
             {
-                float v = image.pixels[i][c];
-                v = std::isnan(v) ? 0.0f : std::clamp(v, 0.0f, 1.0f);
-                bytes[i * 4 + c] = std::uint8_t(std::lround(v * 255.0f));
+                const float v = image.pixels[i][c];
+                bytes[i * 4 + c] = unitToByte(std::isnan(v) ? 0.0f : v);
             }
 
         return writeFileAtomicVia(path, [&](const std::string& temp) -> Result<void> {
@@ -118,17 +117,6 @@ namespace TreeLod
                 return fail(path, "", "cannot finish file: " + out->geterror());
             return {};
         });
-    }
-
-    // IEC 61966-2-1 piecewise transfer functions.
-    float srgbToLinear(float c)
-    {
-        return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-    }
-
-    float linearToSrgb(float c)
-    {
-        return c <= 0.0031308f ? c * 12.92f : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
     }
 
     void bleedValues(std::vector<glm::vec3>& values, const std::vector<std::uint8_t>& known, int width, int height,

@@ -6,6 +6,7 @@
 // evaluated at the texel centre everywhere and then bled outwards into the empty texels.
 #include "TreeLod/LeafTexture.h"
 
+#include "TreeLod/Colour.h"
 #include "TreeLod/Image.h"
 
 #include <algorithm>
@@ -386,10 +387,10 @@ namespace TreeLod
         for (std::size_t i = 0; i < alpha.size(); ++i)
         {
             const glm::vec3 c = known[i] ? colour[i] : mean;
-            image.rgba[i * 4 + 0] = std::uint8_t(std::lround(c.r * 255.0f));
-            image.rgba[i * 4 + 1] = std::uint8_t(std::lround(c.g * 255.0f));
-            image.rgba[i * 4 + 2] = std::uint8_t(std::lround(c.b * 255.0f));
-            image.rgba[i * 4 + 3] = std::uint8_t(std::lround(alpha[i] * 255.0f));
+            image.rgba[i * 4 + 0] = unitToByte(c.r);
+            image.rgba[i * 4 + 1] = unitToByte(c.g);
+            image.rgba[i * 4 + 2] = unitToByte(c.b);
+            image.rgba[i * 4 + 3] = unitToByte(alpha[i]);
         }
         return image;
     }
@@ -453,9 +454,9 @@ namespace TreeLod
                 }
                 col = glm::clamp(col, glm::vec3(0.0f), glm::vec3(1.0f));
                 const std::size_t i = (std::size_t(py) * width + px) * 4;
-                image.rgba[i + 0] = std::uint8_t(std::lround(col.r * 255.0f));
-                image.rgba[i + 1] = std::uint8_t(std::lround(col.g * 255.0f));
-                image.rgba[i + 2] = std::uint8_t(std::lround(col.b * 255.0f));
+                image.rgba[i + 0] = unitToByte(col.r);
+                image.rgba[i + 1] = unitToByte(col.g);
+                image.rgba[i + 2] = unitToByte(col.b);
                 image.rgba[i + 3] = 255;
             }
         return image;

@@ -221,7 +221,7 @@ namespace TreeLod
         {
             const std::uint8_t* p = &image.rgba[4 * i];
             level.texels[i] = glm::vec4(srgbByteToLinear(p[0]), srgbByteToLinear(p[1]), srgbByteToLinear(p[2]),
-                                        float(p[3]) / 255.0f);
+                                        byteToUnit(p[3]));
             covered += p[3] >= K ? 1 : 0;
         }
         const double coverage = double(covered) / double(level.texels.size());
@@ -234,9 +234,9 @@ namespace TreeLod
             for (std::size_t i = 0; i < level.texels.size(); ++i)
             {
                 const glm::vec4& t = level.texels[i];
-                out[4 * i + 0] = unitToByte(linearToSrgb(t.r));
-                out[4 * i + 1] = unitToByte(linearToSrgb(t.g));
-                out[4 * i + 2] = unitToByte(linearToSrgb(t.b));
+                out[4 * i + 0] = linearToSrgbByte(t.r);
+                out[4 * i + 1] = linearToSrgbByte(t.g);
+                out[4 * i + 2] = linearToSrgbByte(t.b);
                 out[4 * i + 3] = unitToByte(t.a);
             }
             if (preserve)

@@ -630,9 +630,9 @@ namespace TreeLod
             for (std::size_t t = 0; t < texels; ++t)
             {
                 const glm::vec3 c = known[t] ? albedo[t] : fill;
-                bb.lowRes[4 * t + 0] = unitToByte(linearToSrgb(std::clamp(c.r, 0.0f, 1.0f)));
-                bb.lowRes[4 * t + 1] = unitToByte(linearToSrgb(std::clamp(c.g, 0.0f, 1.0f)));
-                bb.lowRes[4 * t + 2] = unitToByte(linearToSrgb(std::clamp(c.b, 0.0f, 1.0f)));
+                bb.lowRes[4 * t + 0] = linearToSrgbByte(c.r);
+                bb.lowRes[4 * t + 1] = linearToSrgbByte(c.g);
+                bb.lowRes[4 * t + 2] = linearToSrgbByte(c.b);
                 // §5.2: AO in alpha where the texel is covered.
                 bb.lowRes[4 * t + 3] = hits[t] >= least ? unitToByte(0.5f + 0.5f * ao[t]) : 0;
             }
@@ -751,9 +751,9 @@ namespace TreeLod
                         nextCoverage[o] = cov / float(n);
                         nextAo[o] = cov > 0.0f ? aoSum / cov : 1.0f;
                         std::uint8_t* q = dst + o * 4;
-                        q[0] = unitToByte(linearToSrgb(rgb.r));
-                        q[1] = unitToByte(linearToSrgb(rgb.g));
-                        q[2] = unitToByte(linearToSrgb(rgb.b));
+                        q[0] = linearToSrgbByte(rgb.r);
+                        q[1] = linearToSrgbByte(rgb.g);
+                        q[2] = linearToSrgbByte(rgb.b);
                         q[3] = 0;
                     }
                 });

@@ -359,7 +359,7 @@ namespace TreeLod
             dst.texels.resize(texels);
             for (std::size_t p = 0; p < texels; ++p)
                 dst.texels[p] = glm::vec4(srgbByteToLinear(src.rgba[p * 4]), srgbByteToLinear(src.rgba[p * 4 + 1]),
-                                          srgbByteToLinear(src.rgba[p * 4 + 2]), float(src.rgba[p * 4 + 3]) / 255.0f);
+                                          srgbByteToLinear(src.rgba[p * 4 + 2]), byteToUnit(src.rgba[p * 4 + 3]));
         }
 
         // Rasterise: one job per (block, orientation) writes its side 0 and side 1 tiles.
@@ -500,9 +500,9 @@ namespace TreeLod
                         const std::size_t i = std::size_t(py) * T + px;
                         const std::size_t o = (std::size_t(oy + py) * mColour.width + ox + px) * 4;
                         const glm::vec3 c = tint * (known[i] ? albedo[i] : mean);
-                        mColour.rgba[o + 0] = unitToByte(linearToSrgb(std::clamp(c.r, 0.0f, 1.0f)));
-                        mColour.rgba[o + 1] = unitToByte(linearToSrgb(std::clamp(c.g, 0.0f, 1.0f)));
-                        mColour.rgba[o + 2] = unitToByte(linearToSrgb(std::clamp(c.b, 0.0f, 1.0f)));
+                        mColour.rgba[o + 0] = linearToSrgbByte(c.r);
+                        mColour.rgba[o + 1] = linearToSrgbByte(c.g);
+                        mColour.rgba[o + 2] = linearToSrgbByte(c.b);
                         mColour.rgba[o + 3] = unitToByte(coverage[i]);
                         // The normal facing this side's viewer, in the tile frame.
                         const glm::vec3 nl = side == 0 ? normal[i] : -normal[i];

@@ -230,9 +230,9 @@ namespace TreeLod
         colourImage.rgba.resize(count * 4);
         for (std::size_t i = 0; i < count; ++i)
         {
-            colourImage.rgba[4 * i + 0] = unitToByte(linearToSrgb(albedo[i].r));
-            colourImage.rgba[4 * i + 1] = unitToByte(linearToSrgb(albedo[i].g));
-            colourImage.rgba[4 * i + 2] = unitToByte(linearToSrgb(albedo[i].b));
+            colourImage.rgba[4 * i + 0] = linearToSrgbByte(albedo[i].r);
+            colourImage.rgba[4 * i + 1] = linearToSrgbByte(albedo[i].g);
+            colourImage.rgba[4 * i + 2] = linearToSrgbByte(albedo[i].b);
             colourImage.rgba[4 * i + 3] = unitToByte(plain.alpha[i]);
         }
         MipChainOptions mips;

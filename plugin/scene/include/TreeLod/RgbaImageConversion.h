@@ -1,6 +1,7 @@
 // RgbaImage (the Ogre renderer's 8-bit output) as core's Image (what the image metrics read).
 #pragma once
 
+#include "TreeLod/Colour.h"
 #include "TreeLod/Image.h"
 #include "TreeLod/OffscreenRenderer.h"
 
@@ -11,9 +12,8 @@ namespace TreeLod
     {
         Image image(rgba.width, rgba.height);
         for (std::size_t i = 0; i < image.pixels.size(); ++i)
-            image.pixels[i] = glm::vec4(rgba.pixels[4 * i], rgba.pixels[4 * i + 1], rgba.pixels[4 * i + 2],
-                                        rgba.pixels[4 * i + 3]) /
-                              255.0f;
+            image.pixels[i] = glm::vec4(byteToUnit(rgba.pixels[4 * i]), byteToUnit(rgba.pixels[4 * i + 1]),
+                                        byteToUnit(rgba.pixels[4 * i + 2]), byteToUnit(rgba.pixels[4 * i + 3]));
         return image;
     }
 }

@@ -3,6 +3,7 @@
 // rows run top to bottom, pixels are interleaved RGBA.
 #pragma once
 
+#include "TreeLod/Colour.h" // srgbToLinear, linearToSrgb, unitToByte: colours as the images hold them
 #include "TreeLod/GreyImage.h"
 #include "TreeLod/Result.h"
 
@@ -43,23 +44,6 @@ namespace TreeLod
 
     /// Write an 8-bit RGBA PNG atomically (values clamped to [0, 1]).
     Result<void> writePng(const std::string& path, const Image& image);
-
-    /// sRGB <-> linear transfer (IEC 61966-2-1), per channel.
-    float srgbToLinear(float c);
-    float linearToSrgb(float c);
-    /// srgbToLinear(b / 255), from a 256-entry table.
-    inline float srgbByteToLinear(std::uint8_t b)
-    {
-        static const std::array<float, 256> table = [] {
-            std::array<float, 256> t{};
-            for (int i = 0; i < 256; ++i)
-                t[std::size_t(i)] = srgbToLinear(float(i) / 255.0f);
-            return t;
-        }();
-        return table[b];
-    }
-    /// A [0, 1] value as a byte: round(clamp(v, 0, 1) * 255).
-    inline std::uint8_t unitToByte(float v) { return std::uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
 
     /// Bleeding: fill the texels of a width x height grid (row-major) where `known` is 0 with
     /// the values of their known neighbours, so that bilinear filtering, mips and block

@@ -1,38 +1,27 @@
 // SceneScript: parsing (nlohmann::json for values, a position scan for line/column of
-// every key), instance files (CSV, std::from_chars), placements (uniform and Thomas-clustered)
-// and the camera path.
-//
-// This work is based on:
-//   M. Thomas, "A generalization of Poisson's binomial limit for use in ecology",
-//   Biometrika 36, 1949 (parents uniform, offspring Gaussian around them), the clumped
-//   point process of forest ecology; here with a fixed total count instead of Poisson counts.
-//   P. J. Barry, R. N. Goldman, "A recursive evaluation algorithm for a class of Catmull-Rom
-//   splines", SIGGRAPH 1988, with the centripetal knots of Yuksel, Schaefer, Keyser,
-//   "Parameterization and applications of Catmull-Rom curves", CAD 43(7), 2011.
+// every key) and the script's sun as the renderers' lighting. Instance files are read in
+// InstanceFile.cpp, placements sampled in Placement.cpp, the camera path in CameraPath.cpp.
 #include "TreeLod/SceneScript.h"
 
+#include "InstanceFile.h"
+#include "Placement.h"
+#include "SceneScriptDetail.h"
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/TreePreset.h"
 
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <charconv>
-#include <cstdlib>
 #include <cmath>
 #include <filesystem>
-#include <string_view>
 #include <map>
-#include <random>
-#include <sstream>
 
 namespace TreeLod
 {
     namespace
     {
         using Json = nlohmann::json;
-        constexpr double PI = 3.14159265358979323846;
-        constexpr std::uint32_t MAX_TREES = 10000000;
+        using namespace SceneScriptDetail;
 
         /// Internal only: thrown by the readers below, turned into a Result at the top.
         struct ScriptError
@@ -45,12 +34,6 @@ namespace TreeLod
         {
             throw ScriptError{pointer, reason};
         }
-
-        /// Internal only: an instance file's error, already naming the CSV file, line and column.
-        struct InstanceFileError
-        {
-            Error error;
-        };
 
         std::string child(const std::string& pointer, const std::string& key)
         {
@@ -236,13 +219,6 @@ namespace TreeLod
             if (!v)
                 bad(child(pointer, key), "missing required key");
             return *v;
-        }
-
-        std::string formatNumber(double v)
-        {
-            std::ostringstream out;
-            out << v;
-            return out.str();
         }
 
         /// A finite number in [lo, hi] (or (lo, hi] when loOpen).
@@ -512,205 +488,6 @@ namespace TreeLod
             return a;
         }
 
-        bool excluded(const std::vector<SceneArea>& exclude, const glm::vec2& p)
-        {
-            for (const SceneArea& e : exclude)
-                if (e.contains(p))
-                    return true;
-            return false;
-        }
-
-        /// Area of `area` outside the exclusions, in m²: exact without exclusions, otherwise
-        /// the fraction of 512 x 512 cell centres of the bounding box that are free.
-        double freeArea(const SceneArea& area, const std::vector<SceneArea>& exclude)
-        {
-            if (exclude.empty())
-                return area.areaM2();
-            glm::vec2 lo = area.kind == SceneArea::Kind::Rect ? area.min : area.centre - glm::vec2(area.radius);
-            glm::vec2 hi = area.kind == SceneArea::Kind::Rect ? area.max : area.centre + glm::vec2(area.radius);
-            const int n = 512;
-            std::size_t free = 0;
-            for (int y = 0; y < n; ++y)
-                for (int x = 0; x < n; ++x)
-                {
-                    glm::vec2 p = lo + (hi - lo) * glm::vec2((x + 0.5f) / n, (y + 0.5f) / n);
-                    free += area.contains(p) && !excluded(exclude, p);
-                }
-            return double(hi.x - lo.x) * double(hi.y - lo.y) * double(free) / (double(n) * n);
-        }
-
-        // ---- instance files (a placement's "file") -------------------------------------------
-
-        /// A number of an instance file: the whole field (a leading '+' allowed), finite.
-        /// Overflow (1e999) and "nan" / "inf" read as not finite; false when it is no number.
-        bool csvNumber(std::string_view field, double& out)
-        {
-            const char* begin = field.data();
-            const char* end = begin + field.size();
-            if (begin != end && *begin == '+')
-                ++begin;
-            auto [ptr, ec] = std::from_chars(begin, end, out);
-            if (ptr != end || begin == end || ec == std::errc::invalid_argument)
-                return false;
-            if (ec == std::errc::result_out_of_range) // strtod tells overflow (inf) from underflow (0)
-                out = std::strtod(std::string(begin, end).c_str(), nullptr);
-            return true;
-        }
-
-        std::string_view trimmed(std::string_view s)
-        {
-            while (!s.empty() && (s.front() == ' ' || s.front() == '\t'))
-                s.remove_prefix(1);
-            while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
-                s.remove_suffix(1);
-            return s;
-        }
-
-        /// Reads the CSV at `path` into the placement's explicit trees (samples/scenes/README.md,
-        /// "Instance files"). Throws InstanceFileError naming the file, line and column.
-        void readInstanceFile(const std::string& path, ScenePlacement& p, const SceneScript& script)
-        {
-            enum Column { X, Z, SPECIES, ROTATION, SCALE, Y, COLUMN_COUNT };
-            static const char* const NAMES[COLUMN_COUNT] = {"x", "z", "species", "rotation", "scale", "y"};
-            auto failAt = [&](std::size_t line, const std::string& column, const std::string& reason) {
-                throw InstanceFileError{fail(path, "line " + std::to_string(line) +
-                                                       (column.empty() ? "" : ", column " + column), reason)};
-            };
-            Result<std::vector<std::uint8_t>> bytes = readFile(path);
-            if (!bytes)
-                throw InstanceFileError{bytes.error()};
-            std::string_view text(reinterpret_cast<const char*>(bytes->data()), bytes->size());
-            if (text.substr(0, 3) == "\xEF\xBB\xBF") // a UTF-8 byte order mark
-                text.remove_prefix(3);
-
-            const double half = 0.5 * script.ground.size;
-            std::vector<Column> columns; // per field of a row
-            bool hasSpecies = false, hasY = false;
-            std::string columnList;      // "x, z, scale" for messages
-            std::string speciesList;     // "oak, pine" for messages
-            for (std::uint32_t s : p.species)
-                speciesList += (speciesList.empty() ? "" : ", ") + script.species[s].name;
-            std::size_t at = 0, line = 0;
-            std::string_view fields[COLUMN_COUNT + 1];
-            while (at < text.size())
-            {
-                std::size_t end = text.find('\n', at);
-                if (end == std::string_view::npos)
-                    end = text.size();
-                const std::string_view row = trimmed(text.substr(at, end - at));
-                at = end + 1;
-                ++line;
-                if (row.empty() || row.front() == '#')
-                    continue;
-                // Split at commas: more fields than columns is an error either way.
-                std::size_t count = 0;
-                for (std::size_t start = 0;;)
-                {
-                    const std::size_t comma = row.find(',', start);
-                    const std::string_view field =
-                        trimmed(row.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
-                    if (count <= COLUMN_COUNT)
-                        fields[count] = field;
-                    ++count;
-                    if (comma == std::string_view::npos)
-                        break;
-                    start = comma + 1;
-                }
-                if (columns.empty()) // the header
-                {
-                    bool seen[COLUMN_COUNT] = {};
-                    for (std::size_t i = 0; i < count; ++i)
-                    {
-                        if (i >= COLUMN_COUNT)
-                            failAt(line, "", "more columns than x, z, species, rotation, scale, y");
-                        const auto known = std::find(std::begin(NAMES), std::end(NAMES), fields[i]);
-                        if (known == std::end(NAMES))
-                            failAt(line, "", "unknown column '" + std::string(fields[i]) +
-                                                 "' (expected x, z and any of species, rotation, scale, y)");
-                        const Column c = Column(known - std::begin(NAMES));
-                        if (seen[c])
-                            failAt(line, "", "column '" + std::string(fields[i]) + "' named twice");
-                        seen[c] = true;
-                        columns.push_back(c);
-                        columnList += (columnList.empty() ? "" : ", ") + std::string(fields[i]);
-                    }
-                    for (Column c : {X, Z})
-                        if (!seen[c])
-                            failAt(line, "", std::string("the header lacks the column ") + NAMES[c] +
-                                                 " (first line: column names, e.g. x,z,species,rotation,scale)");
-                    hasSpecies = seen[SPECIES];
-                    hasY = seen[Y];
-                    continue;
-                }
-                if (count != columns.size())
-                    failAt(line, "", "expected " + std::to_string(columns.size()) + " columns (" + columnList +
-                                         "), got " + std::to_string(count));
-                if (p.positions.size() >= MAX_TREES)
-                    failAt(line, "", "more than " + std::to_string(MAX_TREES) + " trees");
-                glm::vec4 tree(0.0f, 0.0f, 0.0f, 1.0f);
-                std::uint32_t species = p.species[0];
-                float y = NAN;
-                for (std::size_t i = 0; i < count; ++i)
-                {
-                    const std::string_view f = fields[i];
-                    const char* name = NAMES[columns[i]];
-                    if (columns[i] == SPECIES)
-                    {
-                        auto known = std::find_if(p.species.begin(), p.species.end(), [&](std::uint32_t s) {
-                            return script.species[s].name == f;
-                        });
-                        if (known == p.species.end())
-                            failAt(line, name, "unknown species '" + std::string(f) + "' (this placement's: " +
-                                                   speciesList + ")");
-                        species = *known;
-                        continue;
-                    }
-                    double v = 0.0;
-                    if (!csvNumber(f, v))
-                        failAt(line, name, "'" + std::string(f) + "' is not a number");
-                    const std::string shown(f);
-                    switch (columns[i])
-                    {
-                    case X:
-                    case Z:
-                        if (!std::isfinite(v) || std::abs(v) > half)
-                            failAt(line, name, shown + " must be finite and on the ground (|" + name + "| <= " +
-                                                   formatNumber(half) + ")");
-                        (columns[i] == X ? tree.x : tree.y) = float(v);
-                        break;
-                    case ROTATION:
-                        if (!std::isfinite(v) || std::abs(v) > 360.0)
-                            failAt(line, name, shown + " must be finite degrees in [-360, 360]");
-                        tree.z = float(v * PI / 180.0);
-                        break;
-                    case SCALE:
-                        if (!std::isfinite(v) || !(v > 0.0))
-                            failAt(line, name, shown + " must be finite and > 0");
-                        if (v > 1e3)
-                            failAt(line, name, shown + " must be <= 1000");
-                        tree.w = float(v);
-                        break;
-                    case Y:
-                        if (!std::isfinite(v) || std::abs(v) > 1e6)
-                            failAt(line, name, shown + " must be finite metres in [-1e6, 1e6]");
-                        y = float(v);
-                        break;
-                    default:
-                        break;
-                    }
-                }
-                p.positions.push_back(tree);
-                if (hasSpecies)
-                    p.positionSpecies.push_back(species);
-                if (hasY)
-                    p.positionY.push_back(y);
-            }
-            if (columns.empty())
-                failAt(line, "", "no header line (the first line names the columns, e.g. x,z,species,rotation,scale)");
-            if (p.positions.empty())
-                failAt(line, "", "no trees (rows after the header)");
-        }
-
         ScenePlacement readPlacement(const Json& j, const std::string& pointer, const SceneScript& script,
                                      const std::string& baseDir)
         {
@@ -977,136 +754,6 @@ namespace TreeLod
             }
             return s;
         }
-
-        // ---- sampling --------------------------------------------------------------------------
-
-        /// Uniform in [0, 1) from two 32-bit draws (53 bits), in a fixed order.
-        double uniform(std::mt19937& rng)
-        {
-            std::uint64_t a = rng() >> 5, b = rng() >> 6;
-            return double(a * 67108864ull + b) / 9007199254740992.0;
-        }
-
-        /// Standard normal pair by Box-Muller.
-        glm::dvec2 gaussian(std::mt19937& rng)
-        {
-            double u = 1.0 - uniform(rng), v = uniform(rng);
-            double r = std::sqrt(-2.0 * std::log(u));
-            return glm::dvec2(r * std::cos(2.0 * PI * v), r * std::sin(2.0 * PI * v));
-        }
-
-        glm::vec2 uniformIn(const SceneArea& a, std::mt19937& rng)
-        {
-            double u = uniform(rng), v = uniform(rng);
-            if (a.kind == SceneArea::Kind::Rect)
-                return glm::vec2(float(a.min.x + u * (a.max.x - a.min.x)), float(a.min.y + v * (a.max.y - a.min.y)));
-            double r2 = double(a.innerRadius) * a.innerRadius;
-            double r = std::sqrt(r2 + u * (double(a.radius) * a.radius - r2));
-            return a.centre + glm::vec2(float(r * std::cos(2.0 * PI * v)), float(r * std::sin(2.0 * PI * v)));
-        }
-
-        /// A free point: uniform in the area outside the exclusions (rejection; after 1000
-        /// misses, which freeArea() > 0 makes vanishingly rare, the last point is kept).
-        glm::vec2 freePoint(const ScenePlacement& p, std::mt19937& rng)
-        {
-            glm::vec2 q = uniformIn(p.area, rng);
-            for (int tries = 0; tries < 1000 && excluded(p.exclude, q); ++tries)
-                q = uniformIn(p.area, rng);
-            return q;
-        }
-
-        /// `n` positions of a random placement. clumping 0: uniform. clumping c > 0: a Thomas
-        /// process with a fixed total: k = round(n / (1 + 19c)) cluster centres uniform in the
-        /// free area, each tree joins a random cluster and lies at a Gaussian offset of
-        /// sigma = (0.25 - 0.1875c) * sqrt(freeArea / k) (a quarter of the cluster spacing at
-        /// c -> 0, a sixteenth at c = 1); offsets outside the free area are drawn again.
-        std::vector<glm::vec2> samplePositions(const ScenePlacement& p, std::uint32_t n, std::mt19937& rng)
-        {
-            std::vector<glm::vec2> out;
-            out.reserve(n);
-            if (p.clumping <= 0.0f)
-            {
-                for (std::uint32_t i = 0; i < n; ++i)
-                    out.push_back(freePoint(p, rng));
-                return out;
-            }
-            const std::uint32_t k =
-                std::max<std::uint32_t>(1, std::uint32_t(std::lround(n / (1.0 + 19.0 * p.clumping))));
-            // The parser's figure; a placement built in code (freeAreaM2 0) is sampled here.
-            const double free = p.freeAreaM2 > 0.0 ? p.freeAreaM2 : freeArea(p.area, p.exclude);
-            std::vector<glm::vec2> centres;
-            for (std::uint32_t i = 0; i < k; ++i)
-                centres.push_back(freePoint(p, rng));
-            const double sigma = (0.25 - 0.1875 * p.clumping) * std::sqrt(free / k);
-            for (std::uint32_t i = 0; i < n; ++i)
-            {
-                glm::vec2 q;
-                bool placed = false;
-                for (int tries = 0; tries < 100 && !placed; ++tries)
-                {
-                    const glm::vec2& c = centres[std::min<std::uint32_t>(k - 1, std::uint32_t(uniform(rng) * k))];
-                    glm::dvec2 g = gaussian(rng) * sigma;
-                    q = c + glm::vec2(g);
-                    placed = p.area.contains(q) && !excluded(p.exclude, q);
-                }
-                out.push_back(placed ? q : freePoint(p, rng));
-            }
-            return out;
-        }
-
-        /// Centripetal Catmull-Rom between p1 and p2 (s in [0, 1]), neighbours p0 and p3.
-        glm::dvec3 catmullRom(glm::dvec3 p0, const glm::dvec3& p1, const glm::dvec3& p2, glm::dvec3 p3, double s)
-        {
-            const double d12 = glm::length(p2 - p1);
-            if (d12 < 1e-9)
-                return p1;
-            // A neighbour on top of its end point (a held camera, a fixed target) would make a
-            // zero knot interval: mirror the segment instead, as at the path's ends.
-            if (glm::length(p1 - p0) < 1e-6 * d12)
-                p0 = 2.0 * p1 - p2;
-            if (glm::length(p3 - p2) < 1e-6 * d12)
-                p3 = 2.0 * p2 - p1;
-            const double t0 = 0.0;
-            const double t1 = t0 + std::sqrt(glm::length(p1 - p0));
-            const double t2 = t1 + std::sqrt(d12);
-            const double t3 = t2 + std::sqrt(glm::length(p3 - p2));
-            const double t = t1 + s * (t2 - t1);
-            glm::dvec3 a1 = ((t1 - t) * p0 + (t - t0) * p1) / (t1 - t0);
-            glm::dvec3 a2 = ((t2 - t) * p1 + (t - t1) * p2) / (t2 - t1);
-            glm::dvec3 a3 = ((t3 - t) * p2 + (t - t2) * p3) / (t3 - t2);
-            glm::dvec3 b1 = ((t2 - t) * a1 + (t - t0) * a2) / (t2 - t0);
-            glm::dvec3 b2 = ((t3 - t) * a2 + (t - t1) * a3) / (t3 - t1);
-            return ((t2 - t) * b1 + (t - t1) * b2) / (t2 - t1);
-        }
-
-        glm::vec3 interpolate(const SceneCamera& camera, std::size_t i, double s, bool target)
-        {
-            const std::vector<SceneKeyframe>& k = camera.keyframes;
-            auto at = [&](std::size_t j) { return glm::dvec3(target ? k[j].target : k[j].position); };
-            glm::dvec3 p1 = at(i), p2 = at(i + 1);
-            if (s <= 0.0)
-                return glm::vec3(p1);
-            if (camera.linear)
-                return glm::vec3(p1 + s * (p2 - p1));
-            glm::dvec3 p0 = i > 0 ? at(i - 1) : 2.0 * p1 - p2;
-            glm::dvec3 p3 = i + 2 < k.size() ? at(i + 2) : 2.0 * p2 - p1;
-            return glm::vec3(catmullRom(p0, p1, p2, p3, s));
-        }
-    }
-
-    bool SceneArea::contains(const glm::vec2& p) const
-    {
-        if (kind == Kind::Rect)
-            return p.x >= min.x && p.x <= max.x && p.y >= min.y && p.y <= max.y;
-        float d = glm::length(p - centre);
-        return d <= radius && d >= innerRadius;
-    }
-
-    float SceneArea::areaM2() const
-    {
-        if (kind == Kind::Rect)
-            return (max.x - min.x) * (max.y - min.y);
-        return float(PI * (double(radius) * radius - double(innerRadius) * innerRadius));
     }
 
     Result<SceneScript> parseSceneScript(const std::string& text, const std::string& label, const std::string& baseDir,
@@ -1156,145 +803,6 @@ namespace TreeLod
             return bytes.error();
         return parseSceneScript(std::string(bytes->begin(), bytes->end()), path,
                                 std::filesystem::path(path).parent_path().string(), readImage);
-    }
-
-    float groundHeight(const SceneGround& ground, float x, float z)
-    {
-        if (ground.kind == SceneGround::Kind::Plane || ground.heights.empty())
-            return 0.0f;
-        const int w = ground.heightsWidth, h = ground.heightsHeight;
-        float u = glm::clamp((x / ground.size + 0.5f) * float(w - 1), 0.0f, float(w - 1));
-        float v = glm::clamp((z / ground.size + 0.5f) * float(h - 1), 0.0f, float(h - 1));
-        int x0 = std::min(int(u), w - 2), y0 = std::min(int(v), h - 2);
-        float fx = u - float(x0), fy = v - float(y0);
-        auto at = [&](int px, int py) { return ground.heights[std::size_t(py) * w + px]; };
-        float top = at(x0, y0) + fx * (at(x0 + 1, y0) - at(x0, y0));
-        float bottom = at(x0, y0 + 1) + fx * (at(x0 + 1, y0 + 1) - at(x0, y0 + 1));
-        return ground.heightScale * (top + fy * (bottom - top));
-    }
-
-    std::vector<PlacedTree> generatePlacements(const SceneScript& script, const PlacementOptions& options)
-    {
-        // Tree counts per placement: explicit ones as listed, random ones from the script,
-        // then the total (largest remainder over the random placements), then the scale.
-        std::vector<std::uint64_t> counts;
-        std::uint64_t explicitTotal = 0, randomTotal = 0;
-        for (const ScenePlacement& p : script.placements)
-        {
-            counts.push_back(p.random ? p.count : p.positions.size());
-            (p.random ? randomTotal : explicitTotal) += counts.back();
-        }
-        if (options.totalCount > 0)
-        {
-            std::uint64_t keepExplicit = std::min<std::uint64_t>(options.totalCount, explicitTotal);
-            std::uint64_t wantRandom = options.totalCount - keepExplicit;
-            std::vector<std::pair<double, std::size_t>> remainders;
-            std::uint64_t given = 0;
-            for (std::size_t i = 0; i < counts.size(); ++i)
-            {
-                if (script.placements[i].random)
-                {
-                    double exact = randomTotal ? double(wantRandom) * double(counts[i]) / double(randomTotal) : 0.0;
-                    counts[i] = std::uint64_t(exact);
-                    given += counts[i];
-                    remainders.emplace_back(-(exact - std::floor(exact)), i); // largest first, then script order
-                }
-                else
-                {
-                    counts[i] = std::min<std::uint64_t>(counts[i], keepExplicit);
-                    keepExplicit -= counts[i];
-                }
-            }
-            std::sort(remainders.begin(), remainders.end());
-            for (std::size_t r = 0; given < wantRandom && r < remainders.size(); ++r, ++given)
-                ++counts[remainders[r].second];
-        }
-        if (options.scale != 1.0 && options.scale > 0.0)
-            for (std::size_t i = 0; i < counts.size(); ++i)
-                if (script.placements[i].random && counts[i] > 0)
-                    counts[i] =
-                        std::max<std::uint64_t>(1, std::uint64_t(std::llround(double(counts[i]) * options.scale)));
-
-        std::vector<PlacedTree> trees;
-        // Explicit placements first, then random ones, each in script order.
-        for (int pass = 0; pass < 2; ++pass)
-            for (std::size_t i = 0; i < script.placements.size(); ++i)
-            {
-                const ScenePlacement& p = script.placements[i];
-                if (p.random != (pass == 1))
-                    continue;
-                if (!p.random)
-                {
-                    for (std::size_t k = 0; k < counts[i]; ++k)
-                    {
-                        const glm::vec4& e = p.positions[k];
-                        const float y = p.positionY.empty() || std::isnan(p.positionY[k])
-                                            ? groundHeight(script.ground, e.x, e.y)
-                                            : p.positionY[k];
-                        trees.push_back({p.positionSpecies.empty() ? p.species[0] : p.positionSpecies[k],
-                                         glm::vec3(e.x, y, e.y), e.z, e.w});
-                    }
-                    continue;
-                }
-                std::mt19937 rng(p.seed);
-                std::vector<glm::vec2> positions = samplePositions(p, std::uint32_t(counts[i]), rng);
-                for (const glm::vec2& q : positions)
-                {
-                    PlacedTree t;
-                    t.species = p.species[std::min<std::size_t>(p.species.size() - 1,
-                                                                std::size_t(uniform(rng) * p.species.size()))];
-                    t.position = glm::vec3(q.x, groundHeight(script.ground, q.x, q.y), q.y);
-                    t.rotation = float(uniform(rng) * 2.0 * PI);
-                    const SceneSpecies& s = script.species[t.species];
-                    t.scale = float(s.scaleMin + uniform(rng) * (s.scaleMax - s.scaleMin));
-                    trees.push_back(t);
-                }
-            }
-        return trees;
-    }
-
-    CameraSpec cameraAt(const SceneScript& script, double time)
-    {
-        const SceneCamera& c = script.camera;
-        CameraSpec spec;
-        spec.fovYDegrees = c.fovYDegrees;
-        spec.nearClip = c.nearClip;
-        spec.farClip = c.farClip;
-        if (c.keyframes.empty())
-            return spec;
-        const std::vector<SceneKeyframe>& k = c.keyframes;
-        if (k.size() == 1 || time <= k.front().time)
-        {
-            spec.position = k.front().position;
-            spec.target = k.front().target;
-            return spec;
-        }
-        if (time >= k.back().time)
-        {
-            spec.position = k.back().position;
-            spec.target = k.back().target;
-            return spec;
-        }
-        // Segment i with k[i].time <= time < k[i + 1].time.
-        std::size_t i = std::size_t(std::upper_bound(k.begin(), k.end(), time,
-                                                     [](double t, const SceneKeyframe& f) { return t < f.time; }) -
-                                    k.begin()) - 1;
-        double s = (time - k[i].time) / (k[i + 1].time - k[i].time);
-        spec.position = interpolate(c, i, s, false);
-        spec.target = interpolate(c, i, s, true);
-        return spec;
-    }
-
-    double frameTime(const SceneScript& script, std::uint32_t frame, std::uint32_t frameCount)
-    {
-        const std::vector<SceneKeyframe>& k = script.camera.keyframes;
-        if (k.empty())
-            return 0.0;
-        std::uint32_t n = frameCount ? frameCount : script.frames;
-        if (n <= 1)
-            return k.front().time;
-        frame = std::min(frame, n - 1);
-        return k.front().time + (k.back().time - k.front().time) * double(frame) / double(n - 1);
     }
 
     LightingSpec sceneLighting(const SceneScript& script)

@@ -1,0 +1,49 @@
+// OgreBootstrap: the Ogre start-up that OffscreenRenderer (the headless Root of the CLI, tests and
+// bench) and the sample browser (OgreBites) share: where OGRE's plugins and media and TreeLod's
+// materials are, a log that stays off stdout, the plugins TreeLod renders with, TreeLod's
+// resource locations, and the hidden window that owns the GL context when nothing is shown.
+//
+// Folders: the environment first, else those of the build (the OGRE it found, this source tree):
+//   $OGRE_PLUGIN_DIR_OVERRIDE  OGRE's plugins (RenderSystem_GL3Plus.so, Codec_STBI.so)
+//   $TREELOD_OGRE_MEDIA_DIR    OGRE's media (ShadowVolume, RTShaderLib, packs/SdkTrays.zip)
+//   $TREELOD_MATERIALS_DIR     TreeLod's materials/ (and materials/GLSL)
+// Part of TreeLodOffscreen, not of Plugin_TreeLod.
+#pragma once
+
+#include <OgreCommon.h>
+#include <OgreLogManager.h>
+#include <OgreRoot.h>
+
+#include <memory>
+#include <string>
+
+namespace TreeLod
+{
+    /// OGRE's plugin folder: $OGRE_PLUGIN_DIR_OVERRIDE, else the build's.
+    std::string ogrePluginDirectory();
+
+    /// OGRE's media folder: $TREELOD_OGRE_MEDIA_DIR, else the build's.
+    std::string ogreMediaDirectory();
+
+    /// TreeLod's materials folder: $TREELOD_MATERIALS_DIR, else the source tree's materials/.
+    std::string materialsDirectory();
+
+    /// An own LogManager, created before the Root (else Ogre logs to stdout, OGRE-NOTES.md), with
+    /// one default log written to `logFile` ("" = no file, messages dropped) and echoed to stdout
+    /// when `verbose`.
+    std::unique_ptr<Ogre::LogManager> createLogManager(const std::string& logFile, bool verbose);
+
+    /// Load RenderSystem_GL3Plus and Codec_STBI from ogrePluginDirectory() into `root`; returns
+    /// that folder (for messages).
+    std::string loadRenderPlugins(Ogre::Root& root);
+
+    /// Add `materialsDir` and its GLSL/ folder as FileSystem locations of `group` (not initialised).
+    void addMaterialsLocations(const std::string& materialsDir, const std::string& group = "TreeLod");
+
+    /// Add OGRE's ShadowVolume programs (texture shadows load them) to Ogre::RGN_INTERNAL (not
+    /// initialised); false, and nothing added, when the media folder has none.
+    bool addShadowVolumeLocation();
+
+    /// `params` with what a hidden window that only owns the GL context needs (hidden, no vsync).
+    Ogre::NameValuePairList hiddenWindowParams(Ogre::NameValuePairList params = Ogre::NameValuePairList());
+}

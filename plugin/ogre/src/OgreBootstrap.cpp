@@ -1,0 +1,63 @@
+#include "TreeLod/OgreBootstrap.h"
+
+#include <OgreResourceGroupManager.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+namespace TreeLod
+{
+    namespace
+    {
+        std::string envOr(const char* name, const std::string& fallback)
+        {
+            const char* v = std::getenv(name);
+            return v && *v ? std::string(v) : fallback;
+        }
+    }
+
+    std::string ogrePluginDirectory() { return envOr("OGRE_PLUGIN_DIR_OVERRIDE", TREELOD_OGRE_PLUGIN_DIR); }
+
+    std::string ogreMediaDirectory() { return envOr("TREELOD_OGRE_MEDIA_DIR", TREELOD_OGRE_MEDIA_DIR); }
+
+    std::string materialsDirectory() { return envOr("TREELOD_MATERIALS_DIR", TREELOD_DEFAULT_MATERIALS_DIR); }
+
+    std::unique_ptr<Ogre::LogManager> createLogManager(const std::string& logFile, bool verbose)
+    {
+        auto logManager = std::make_unique<Ogre::LogManager>();
+        logManager->createLog(logFile, true, verbose, logFile.empty());
+        return logManager;
+    }
+
+    std::string loadRenderPlugins(Ogre::Root& root)
+    {
+        const std::string pluginDir = ogrePluginDirectory();
+        root.loadPlugin(pluginDir + "/RenderSystem_GL3Plus.so");
+        root.loadPlugin(pluginDir + "/Codec_STBI.so");
+        return pluginDir;
+    }
+
+    void addMaterialsLocations(const std::string& materialsDir, const std::string& group)
+    {
+        Ogre::ResourceGroupManager& rgm = Ogre::ResourceGroupManager::getSingleton();
+        rgm.addResourceLocation(materialsDir, "FileSystem", group);
+        rgm.addResourceLocation(materialsDir + "/GLSL", "FileSystem", group);
+    }
+
+    bool addShadowVolumeLocation()
+    {
+        const std::string shadowVolume = ogreMediaDirectory() + "/ShadowVolume";
+        if (!std::filesystem::is_directory(shadowVolume))
+            return false;
+        Ogre::ResourceGroupManager::getSingleton().addResourceLocation(shadowVolume, "FileSystem",
+                                                                       Ogre::RGN_INTERNAL);
+        return true;
+    }
+
+    Ogre::NameValuePairList hiddenWindowParams(Ogre::NameValuePairList params)
+    {
+        params["hidden"] = "true";
+        params["vsync"] = "false";
+        return params;
+    }
+}
