@@ -1,21 +1,21 @@
 // treelod bench SCENE.json -o DIR [--techniques a,b] [--lod-bias 1,0.5,0.25] [--frames N] [--scale S]
 //
-// Scripted scene benchmark (issues 5 and 7): the scene's camera path rendered headless for each
+// Scripted scene benchmark: the scene's camera path rendered headless for each
 // technique and LoD bias, with the polygonal reference ("mesh") and three floors in the same run:
 // the Forest's one-quad level ("impostor"), one plain Ogre Entity per tree ("entities": what Ogre users
 // pay today) and every tree's quad merged into a few static batches ("merged-quads": the cheapest
 // possible drawing). The bench bakes what the runs draw (BakeCache), writes the package list and
-// runs treelod_frames, which renders and times the frames and links no baker (DESIGN.md, "Runtime
+// runs treelod_frames, which renders and times the frames and links no baker (docs/architecture.md, "Runtime
 // vs bake"); then it compares the frames treelod_frames saved. Per frame: CPU time (until the
 // frame's commands are submitted), frame time bounded by a one-pixel read-back (Ogre's GL3Plus
 // render system offers no timer queries, so the GPU time is the glFinish-bounded wall time),
 // batches, triangles, instances per level, bytes of Forest levels built in the frame (at most
 // --upload-budget plus one level). On sampled frames: the polygonal
-// reference supersampled 2x2, and against it FLIP and multi-scale RMSE (paper 001 §4), and
-// temporal noise: the multi-scale RMSE between the frame and the next frame of the path (paper 001
+// reference supersampled 2x2, and against it FLIP and multi-scale RMSE (the ellipsoids-and-lines paper §4), and
+// temporal noise: the multi-scale RMSE between the frame and the next frame of the path (the ellipsoids-and-lines paper
 // §5, Fig. 13), for the reference too. A reference frame whose triangle count would exceed
 // --reference-budget is skipped and said so, never estimated. Writes DIR/frames.csv,
-// DIR/summary.json and the data of the plots as CSV (frame time along the path, paper 001 Fig. 11;
+// DIR/summary.json and the data of the plots as CSV (frame time along the path, the ellipsoids-and-lines paper Fig. 11;
 // the speed/accuracy trade over the LoD biases with the reference and the floors marked) with
 // DIR/plots.json; bench/plot.py draws them as PNG when python3 has matplotlib.
 #include "CliSupport.h"
@@ -480,7 +480,7 @@ namespace TreeLod
                     !w)
                     return printError(w.error()), false;
             }
-            if (counts.size() > 1) // paper 000 Table 2: frame time against the number of trees
+            if (counts.size() > 1) // García et al. 2007 Table 2: frame time against the number of trees
             {
                 std::string treesCsv = "series,label,trees,median_frame_ms\n";
                 std::vector<std::string> rows;

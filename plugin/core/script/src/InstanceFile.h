@@ -1,4 +1,4 @@
-// Instance files: a placement's "file", CSV with one tree a line (samples/scenes/README.md,
+// Instance files: a placement's "file", CSV with one tree a line (docs/scene-format.md,
 // "Instance files"). Private to TreeLodScript; the parser calls it for each "file" placement.
 #pragma once
 
@@ -15,7 +15,7 @@ namespace TreeLod::SceneScriptDetail
         Error error;
     };
 
-    /// Reads the CSV at `path` into the placement's explicit trees (samples/scenes/README.md,
+    /// Reads the CSV at `path` into the placement's explicit trees (docs/scene-format.md,
     /// "Instance files"). Throws InstanceFileError naming the file, line and column.
     void readInstanceFile(const std::string& path, ScenePlacement& p, const SceneScript& script);
 }

@@ -22,7 +22,7 @@ namespace TreeLod
     enum class ShadowCamera
     {
         Focused, ///< Ogre::FocusedShadowCameraSetup: orthographic, fitted to the visible receivers
-        LiSPSM   ///< Ogre::LiSPSMShadowCameraSetup: light space perspective shadow maps [WSP04] (paper 000 §5.2)
+        LiSPSM   ///< Ogre::LiSPSMShadowCameraSetup: light space perspective shadow maps [WSP04] (García et al. 2007 §5.2)
     };
 
     struct OffscreenOptions

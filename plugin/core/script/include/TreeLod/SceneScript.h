@@ -1,5 +1,5 @@
 // SceneScript: samples/scenes/*.json, the scenes that `treelod bench`, the Forest and the
-// sample browser run (issue 5). samples/scenes/README.md documents the format key by key.
+// sample browser run. docs/scene-format.md documents the format key by key.
 //
 // Contract:
 // - Units: metres, degrees in the file (radians in PlacedTree::rotation), seconds for time.
@@ -12,8 +12,8 @@
 // - Paths (species sources, the heightfield image, instance files) are relative to the script's
 //   folder and stored resolved; species files, the heightfield image and instance files must
 //   exist when the script loads. The heightfield image is read by the caller's GreyImageReader
-//   (GreyImage.h): this library links the runtime only (DESIGN.md, "Runtime vs bake").
-// - Instance files (a placement's "file": CSV, one tree a line, see samples/scenes/README.md):
+//   (GreyImage.h): this library links the runtime only (docs/architecture.md, "Runtime vs bake").
+// - Instance files (a placement's "file": CSV, one tree a line, see docs/scene-format.md):
 //   errors name the CSV file, the line (1-based) and the column by its header name:
 //   "trees.csv: line 12, column scale: 0 must be finite and > 0". One read of the file,
 //   std::from_chars per number: 0.2 s for a million lines (2-core test machine).
