@@ -42,6 +42,7 @@
 #include "TreeLod/ForestScene.h"
 #include "TreeLod/Image.h"
 #include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/TechniqueRegistry.h"
 
 #include <cerrno>
 #include <cstring>
@@ -142,8 +143,8 @@ namespace TreeLod
         const std::vector<std::pair<std::string, std::string>>& comparisonRuns()
         {
             static const std::vector<std::pair<std::string, std::string>> runs = {
-                {"mesh", "polygonal reference (mesh, 1 spp)"},
-                {"impostor", "floor: the Forest's one-quad level"},
+                {REFERENCE_TECHNIQUE, "polygonal reference (mesh, 1 spp)"},
+                {FLOOR_TECHNIQUE, "floor: the Forest's one-quad level"},
                 {"entities", "floor: one Ogre entity per tree (a quad)"},
                 {"merged-quads", "floor: quads merged into a few batches"}};
             return runs;
@@ -254,7 +255,7 @@ namespace TreeLod
                 std::vector<bool> common;
                 for (const Run& run : runs)
                 {
-                    if (run.count != count || run.frames.empty() || (!withReference && run.technique == "mesh"))
+                    if (run.count != count || run.frames.empty() || (!withReference && run.technique == REFERENCE_TECHNIQUE))
                         continue;
                     if (common.empty())
                         common.assign(run.frames.size(), true);
@@ -311,7 +312,7 @@ namespace TreeLod
             {
                 const Run* reference = nullptr;
                 for (const Run& other : runs)
-                    if (other.count == run.count && other.technique == "mesh")
+                    if (other.count == run.count && other.technique == REFERENCE_TECHNIQUE)
                         reference = &other;
                 std::vector<double> frameMs, cpuMs, flips, rmse, noise, refNoise;
                 std::vector<std::string> skipped;
@@ -347,7 +348,7 @@ namespace TreeLod
                 // Ratios of medians measured in this run (the floors' own medians over their timed frames).
                 json ratios = json::object();
                 for (const auto& [floor, label] : comparisonRuns())
-                    if (floor != "mesh")
+                    if (floor != REFERENCE_TECHNIQUE)
                         for (const Run& other : runs)
                             if (other.count == run.count && other.technique == floor)
                                 ratios[floor] = num(frameStats.median / medianOver(other, nullptr));
@@ -359,7 +360,7 @@ namespace TreeLod
                                    {"worstFrame", worst},
                                    {"cpuMs", toJson(statsOf(cpuMs))},
                                    {"speedupVsReference", num(referenceOnShared / techniqueOnShared)},
-                                   {"ratioToFloor", ratios.contains("impostor") ? ratios["impostor"] : json(nullptr)},
+                                   {"ratioToFloor", ratios.contains(FLOOR_TECHNIQUE) ? ratios[FLOOR_TECHNIQUE] : json(nullptr)},
                                    {"ratioToFloors", ratios},
                                    {"maxUploadedBytesPerFrame", maxUploaded},
                                    {"instanceBytes", run.instanceBytes},
@@ -666,7 +667,7 @@ namespace TreeLod
             if (Result<std::vector<float>> biases = parseLodBiases(args.lodBiases); !biases)
                 return printError(biases.error());
             // Every run draws from these: the reference, the floors, then the techniques.
-            std::vector<std::string> drawn = {"mesh", "impostor"};
+            std::vector<std::string> drawn = {REFERENCE_TECHNIQUE, FLOOR_TECHNIQUE};
             for (const std::string& t : splitList(args.techniques))
             {
                 if (t != "auto" && bakeTechniqueOf(t).empty())

@@ -24,6 +24,7 @@
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/PackageListBaker.h"
 #include "TreeLod/SceneScript.h"
+#include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 
 #include <CLI/CLI.hpp>
@@ -154,7 +155,7 @@ namespace TreeLod
                 if (t != "auto" && bakeTechniqueOf(t).empty())
                     return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: " +
                                                                    knownSceneTechniques() + ")"));
-                if (args.skipComparisons || (t != "mesh" && t != "impostor" && !isFloor(t)))
+                if (args.skipComparisons || (t != REFERENCE_TECHNIQUE && t != FLOOR_TECHNIQUE && !isFloor(t)))
                     techniques.push_back(t); // otherwise run once below, with the comparisons
             }
             std::vector<std::uint32_t> counts = script.counts;
@@ -232,7 +233,7 @@ namespace TreeLod
                 options.uploadBudget = args.uploadBudget;
                 std::vector<std::pair<std::string, std::vector<float>>> plan;
                 if (!args.skipComparisons)
-                    plan = {{"mesh", {1.0f}}, {"impostor", {1.0f}}, {"entities", {1.0f}}, {"merged-quads", {1.0f}}};
+                    plan = {{REFERENCE_TECHNIQUE, {1.0f}}, {FLOOR_TECHNIQUE, {1.0f}}, {"entities", {1.0f}}, {"merged-quads", {1.0f}}};
                 for (const std::string& t : techniques)
                     plan.push_back({t, biases});
                 for (const auto& [technique, runBiases] : plan)
@@ -285,10 +286,10 @@ namespace TreeLod
                             json row = {{"frame", f}, {"time", frameTime(script, f, frames)}};
                             const CameraSpec camera = scene->cameraAtFrame(f, frames);
                             std::uint64_t referenceCost = 0;
-                            if (technique == "mesh")
+                            if (technique == REFERENCE_TECHNIQUE)
                                 referenceCost = referenceTriangles(*scene, camera, width, height);
                             std::string skipped;
-                            if (technique == "mesh" && double(referenceCost) > args.referenceBudget)
+                            if (technique == REFERENCE_TECHNIQUE && double(referenceCost) > args.referenceBudget)
                                 skipped = "reference too costly: " + std::to_string(referenceCost) +
                                           " triangles > budget " + std::to_string(std::uint64_t(args.referenceBudget));
                             else
@@ -312,7 +313,7 @@ namespace TreeLod
                             if (isSampled(f))
                             {
                                 const std::string stem = imageStem(trees, technique, bias, f);
-                                if (technique == "mesh")
+                                if (technique == REFERENCE_TECHNIQUE)
                                 {
                                     if (double(referenceCost) <= imageBudget)
                                     {
@@ -326,7 +327,7 @@ namespace TreeLod
                                                    " triangles > image budget " +
                                                    std::to_string(std::uint64_t(imageBudget));
                                 }
-                                if (technique != "mesh" || double(referenceCost) <= imageBudget)
+                                if (technique != REFERENCE_TECHNIQUE || double(referenceCost) <= imageBudget)
                                 {
                                     save(renderer.render(camera, width, height, 1), stem);
                                     save(renderer.render(nextCamera(f), width, height, 1), stem + "-next");

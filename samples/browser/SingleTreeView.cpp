@@ -116,7 +116,7 @@ namespace TreeLod
         mTreeNode = mSceneManager->getRootSceneNode()->createChildSceneNode();
         const TechniqueRegistry& registry = TechniqueRegistry::getSingleton();
         mReference = static_cast<Ogre::Entity*>(
-            registry.createInstance("mesh", *mSceneManager, "TreeLod/Browser/Reference", *mAsset));
+            registry.createInstance(REFERENCE_TECHNIQUE, *mSceneManager, "TreeLod/Browser/Reference", *mAsset));
         mReference->setVisibilityFlags(REFERENCE_VISIBILITY);
         mTreeNode->attachObject(mReference);
         for (const TechniqueInfo& info : registry.getTechniques())
@@ -467,7 +467,7 @@ namespace TreeLod
         mShadows = enabled;
         applyTextureShadows(*mSceneManager, *mSun, enabled, 2048, ShadowCamera::Focused);
         useShadowedMaterials(*mReference, *mAsset, enabled);
-        if (auto* mesh = dynamic_cast<Ogre::Entity*>(mTechniques["mesh"]))
+        if (auto* mesh = dynamic_cast<Ogre::Entity*>(mTechniques[REFERENCE_TECHNIQUE]))
             useShadowedMaterials(*mesh, *mAsset, enabled);
         updateShadowRange();
     }

@@ -5,9 +5,10 @@
 // reference mesh), it casts and receives texture shadows, and a golden image.
 #include "OgreTestSupport.h"
 
-#include "TreeLod/ImpostorResources.h"
 #include "TreeLod/ImpostorBaker.h"
 #include "TreeLod/ImpostorData.h"
+#include "TreeLod/ImpostorResources.h"
+#include "TreeLod/ImpostorTree.h"
 #include "TreeLod/PackageWriter.h"
 #include "TreeLod/TreeAssetManager.h"
 #include "TreeLod/TreeGenerator.h"
@@ -27,7 +28,7 @@ namespace TreeLod
 {
     namespace
     {
-        struct ImpostorTree
+        struct BakedOak
         {
             TreeModel model;
             ImpostorData data;
@@ -35,11 +36,11 @@ namespace TreeLod
         };
 
         /// A generated oak with the reference and impostor chunks, loaded as asset `name`.
-        const ImpostorTree& oak()
+        const BakedOak& oak()
         {
             OgreEnvironment::renderer(); // first: the Root must outlive the asset
-            static ImpostorTree tree = [] {
-                ImpostorTree t;
+            static BakedOak tree = [] {
+                BakedOak t;
                 GeneratorOptions generator;
                 generator.leafCount = 3000;
                 generator.textureSize = 64;
@@ -146,7 +147,7 @@ namespace TreeLod
         /// Clear the content node and draw the impostor's instances (x, y, z, scale).
         void placeImpostors(const std::vector<Ogre::Vector4>& instances, bool shadowed)
         {
-            const ImpostorTree& t = oak();
+            const BakedOak& t = oak();
             clearContent();
             const ImpostorGpu& gpu = ImpostorResources::of(*t.asset).getGpu();
             drawn() = std::make_unique<InstancedImpostor>(
@@ -157,7 +158,7 @@ namespace TreeLod
         /// The polygonal reference at the same places.
         void placeReference(const std::vector<Ogre::Vector4>& instances)
         {
-            const ImpostorTree& t = oak();
+            const BakedOak& t = oak();
             OffscreenRenderer& r = OgreEnvironment::renderer();
             clearContent();
             Ogre::MeshPtr mesh = t.asset->getReferenceMesh();
@@ -194,7 +195,7 @@ namespace TreeLod
 
     TEST(Impostor, getGpuBuildsTheQuadTexturesAndMaterials)
     {
-        const ImpostorTree& t = oak();
+        const BakedOak& t = oak();
         ASSERT_TRUE(t.asset);
         const ImpostorGpu& gpu = ImpostorResources::of(*t.asset).getGpu();
         EXPECT_EQ(&gpu, &ImpostorResources::of(*t.asset).getGpu()); // built once
@@ -280,7 +281,7 @@ namespace TreeLod
 
     TEST(Impostor, quadFacesTheCameraAndLooksLikeTheTree)
     {
-        const ImpostorTree& t = oak();
+        const BakedOak& t = oak();
         OffscreenRenderer& r = OgreEnvironment::renderer();
         r.setShadows(false);
         const std::vector<Ogre::Vector4> one = {Ogre::Vector4(0, 0, 0, 1)};
@@ -321,12 +322,66 @@ namespace TreeLod
         compareWithGolden(impostors[1], "oak-impostor", 0.02); // turned 90 degrees from the bake
     }
 
+    // The impostor as a single tree: an ImpostorTree made by its factory draws the picture the
+    // Forest's instanced quad draws for one instance at the origin, from every side.
+    TEST(Impostor, impostorTreeDrawsWhatTheInstancedQuadDraws)
+    {
+        const BakedOak& t = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        r.setShadows(false);
+        const Ogre::NameValuePairList params = {{"asset", t.asset->getName()}, {"group", t.asset->getGroup()}};
+        std::vector<Image> trees, quads;
+        for (float azimuth : {0.0f, 120.0f})
+        {
+            const CameraSpec camera = view(t.model, azimuth);
+            placeImpostors({Ogre::Vector4(0, 0, 0, 1)}, false);
+            quads.push_back(toImage(r.render(camera, 160, 160, 2)));
+            clearContent();
+            Ogre::MovableObject* tree = r.getSceneManager().createMovableObject(
+                "oak-impostor", ImpostorTreeFactory::FACTORY_TYPE_NAME, &params);
+            ASSERT_EQ(tree->getMovableType(), ImpostorTreeFactory::FACTORY_TYPE_NAME);
+            r.getContentNode().attachObject(tree);
+            trees.push_back(toImage(r.render(camera, 160, 160, 2)));
+            // The box the quad sweeps turning about +Y holds the tree's footprint.
+            const Ogre::AxisAlignedBox box = tree->getBoundingBox();
+            EXPECT_LE(box.getMinimum().y, t.model.boundsMin.y + 1e-3f);
+            EXPECT_GE(box.getMaximum().y, t.model.boundsMax.y - 1e-3f);
+            r.clearContent(); // destroys the object through its factory
+            EXPECT_FALSE(r.getSceneManager().hasMovableObject("oak-impostor", ImpostorTreeFactory::FACTORY_TYPE_NAME));
+        }
+        writePng(OgreEnvironment::outDir() + "/impostor-tree-vs-instanced.png",
+                 sideBySide({trees[0], quads[0], trees[1], quads[1]}));
+        for (std::size_t i = 0; i < trees.size(); ++i)
+        {
+            EXPECT_GT(treeCoverage(trees[i], BACKGROUND), 0.08) << "view " << i;
+            const double error = flipMean(quads[i], trees[i]);
+            std::printf("view %zu: ImpostorTree against the instanced quad FLIP %.5f\n", i, error);
+            EXPECT_LT(error, 0.002) << "view " << i;
+        }
+        compareWithGolden(trees[1], "oak-impostor-tree", 0.02);
+    }
+
+    // A missing asset parameter and an asset without the chunk are named.
+    TEST(Impostor, impostorTreeFactoryNamesWhatIsMissing)
+    {
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        try
+        {
+            r.getSceneManager().createMovableObject("no-asset", ImpostorTreeFactory::FACTORY_TYPE_NAME);
+            ADD_FAILURE() << "no asset parameter must throw";
+        }
+        catch (const Ogre::Exception& e)
+        {
+            EXPECT_NE(e.getDescription().find("parameter 'asset' is required"), std::string::npos) << e.getDescription();
+        }
+    }
+
     TEST(Impostor, instancesScaleCastAndReceiveShadows)
     {
         // Three trees in a row on a white ground, the middle one twice as big and farther: each
         // instance has its own place and scale. Under texture shadows the quads cast on the
         // ground (the caster faces the sun) and on themselves (the receiver faces the camera).
-        const ImpostorTree& t = oak();
+        const BakedOak& t = oak();
         OffscreenRenderer& r = OgreEnvironment::renderer();
         const float h = t.model.boundsMax.y - t.model.boundsMin.y;
         const std::vector<Ogre::Vector4> row = {Ogre::Vector4(-2.0f * h, 0, 0, 1), Ogre::Vector4(0, 0, -0.5f * h, 2),

@@ -310,7 +310,7 @@ namespace TreeLod
 
     std::vector<ForestBand> Forest::getAutoBands()
     {
-        return {ForestBand{"lodf", 160.0f}, ForestBand{"billboard-cloud", 24.0f}, ForestBand{"impostor", 0.0f}};
+        return {ForestBand{"lodf", 160.0f}, ForestBand{"billboard-cloud", 24.0f}, ForestBand{FLOOR_TECHNIQUE, 0.0f}};
     }
 
     std::vector<ForestLevel> Forest::levelsForBands(TreeAsset& asset, const std::vector<ForestBand>& bands)

@@ -38,7 +38,7 @@ namespace TreeLod
 
         void registerReference(TechniqueRegistry& registry)
         {
-            registry.add({"mesh", "polygonal reference: bark with MeshLodGenerator levels, every leaf", REFERENCE_CHUNK,
+            registry.add({REFERENCE_TECHNIQUE, "polygonal reference: bark with MeshLodGenerator levels, every leaf", REFERENCE_CHUNK,
                           Ogre::EntityFactory::FACTORY_TYPE_NAME,
                           [](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset,
                              const Ogre::NameValuePairList&) {

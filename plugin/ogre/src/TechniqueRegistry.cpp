@@ -54,7 +54,7 @@ namespace TreeLod
         // Static initialisation runs the registrations in link order: list "mesh", the reference
         // every comparison is made against, first, then the others by name.
         std::stable_sort(mTechniques.begin(), mTechniques.end(), [](const TechniqueInfo& a, const TechniqueInfo& b) {
-            return std::make_pair(a.name != "mesh", a.name) < std::make_pair(b.name != "mesh", b.name);
+            return std::make_pair(a.name != REFERENCE_TECHNIQUE, a.name) < std::make_pair(b.name != REFERENCE_TECHNIQUE, b.name);
         });
     }
 

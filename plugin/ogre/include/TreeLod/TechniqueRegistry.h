@@ -31,6 +31,11 @@ namespace TreeLod
 {
     class TreeAsset;
 
+    /// The technique every measurement compares against: the polygonal reference (an Entity).
+    constexpr const char* REFERENCE_TECHNIQUE = "mesh";
+    /// The cheapest technique: the bench's floor and a Forest's far level.
+    constexpr const char* FLOOR_TECHNIQUE = "impostor";
+
     /// One line of an object's state for the sample browser: label, a bar filled to `fraction`
     /// (none when < 0), suffix; e.g. {"leaves ", 0.25, " 300/1200"}.
     struct TechniqueStateLine
