@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 
 namespace TreeLod
@@ -29,6 +30,7 @@ namespace TreeLod
             std::string output;
             std::vector<std::string> techniques;
             std::vector<std::string> leafMaterials;
+            std::vector<std::string> options; ///< TECHNIQUE.NAME=VALUE
             bool quiet = false;
         };
 
@@ -46,6 +48,28 @@ namespace TreeLod
                 if (std::find(techniques.begin(), techniques.end(), t) == techniques.end())
                     techniques.push_back(t);
             }
+
+            // --option TECHNIQUE.NAME=VALUE, for a technique being baked and an option it declares.
+            std::map<const BakeTechnique*, BakeOptions> options;
+            nlohmann::json optionsJson = {{"leafMaterials", args.leafMaterials}};
+            for (const std::string& option : args.options)
+            {
+                const std::size_t dot = option.find('.'), equals = option.find('=');
+                if (dot == std::string::npos || equals == std::string::npos || dot > equals)
+                    return printError(fail("", "option --option '" + option + "'", "expected TECHNIQUE.NAME=VALUE"));
+                const std::string technique = option.substr(0, dot);
+                const std::string name = option.substr(dot + 1, equals - dot - 1);
+                const std::string value = option.substr(equals + 1);
+                const BakeTechnique* t = findBakeTechnique(technique);
+                if (!t || std::find(techniques.begin(), techniques.end(), t) == techniques.end())
+                    return printError(fail("", "option --option '" + option + "'",
+                                           "'" + technique + "' is not a technique being baked"));
+                options[t][name] = value;
+                optionsJson[technique][name] = value;
+            }
+            for (const auto& [technique, values] : options)
+                if (Result<void> checked = checkBakeOptions(*technique, values, args.output); !checked)
+                    return printError(checked.error());
 
             // Fail before the import, not after it, when the output cannot be written.
             const std::filesystem::path outDir = std::filesystem::path(args.output).parent_path();
@@ -72,11 +96,10 @@ namespace TreeLod
             PackageMeta meta;
             meta.source = std::filesystem::path(args.input).filename().string();
             meta.sourceHash = hash.value();
-            meta.optionsJson = nlohmann::json{{"leafMaterials", args.leafMaterials}}.dump(
-                -1, ' ', false, nlohmann::json::error_handler_t::replace);
+            meta.optionsJson = optionsJson.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
             for (const BakeTechnique* t : techniques)
             {
-                Result<void> baked = t->bake(writer, model.value(), args.output, progress);
+                Result<void> baked = t->bake(writer, model.value(), options[t], args.output, progress);
                 if (!baked)
                     return printError(baked.error());
                 meta.techniques.push_back(t->name);
@@ -110,8 +133,14 @@ namespace TreeLod
     {
         auto args = std::make_shared<BakeArgs>();
         std::string help = "technique to bake (repeatable; default reference). Known:";
+        std::string optionHelp = "a baker's option, TECHNIQUE.NAME=VALUE (repeatable). Known:";
         for (const BakeTechnique& t : bakeTechniques())
+        {
             help += std::string("\n  ") + t.name + ": " + t.description;
+            for (const BakeOptionInfo& o : t.options)
+                optionHelp += std::string("\n  ") + t.name + "." + o.name + " (default " + o.defaultValue + "): " +
+                              o.description;
+        }
         CLI::App* cmd = app.add_subcommand("bake", "bake a .glb/.gltf tree into a .treelod package");
         cmd->add_option("input", args->input, ".glb or .gltf file")->required();
         cmd->add_option("-o,--output", args->output, ".treelod file to write (atomically)")->required();
@@ -119,6 +148,7 @@ namespace TreeLod
         cmd->add_option("--leaf-material", args->leafMaterials,
                         "materials with this name are leaves (repeatable; default: alphaMode MASK/BLEND)")
             ->allow_extra_args(false);
+        cmd->add_option("--option", args->options, optionHelp)->allow_extra_args(false);
         cmd->add_flag("-q,--quiet", args->quiet, "no progress display");
         cmd->callback([args]() { setExitCode(runBake(*args)); });
     }

@@ -55,7 +55,7 @@ namespace TreeLod
             const BakeTechnique* technique = findBakeTechnique(chunk);
             if (!technique)
                 return fail(path, "", "no baker for chunk '" + chunk + "' (known: " + knownBakeTechniques() + ")");
-            Result<void> added = technique->bake(writer, input.model, input.name, progress);
+            Result<void> added = technique->bake(writer, input.model, {}, input.name, progress);
             if (!added)
                 return added.error();
         }

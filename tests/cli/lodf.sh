@@ -32,4 +32,20 @@ set +e
 "$treelod" bake "$src/media/birch.glb" --technique nosuch -o "$out/bad.treelod" 2> "$out/bad2.txt"; code=$?
 set -e
 [ "$code" = 2 ] && [ ! -e "$out/bad.treelod" ] || { echo "unknown technique not refused"; exit 1; }
+# Bake options: --option lodf.clusterSize=16 gives more clusters than the default 64 (recorded in the
+# package's meta); an undeclared option, a value out of range or a technique not being baked exit 2
+# naming the option, and write nothing.
+"$treelod" bake "$src/media/oak.glb" --technique lodf --option lodf.clusterSize=16 -q -o "$out/oak16.treelod"
+clusters() { "$treelod" info "$1" --json | python3 -c 'import json,sys; print(json.load(sys.stdin)["lodf"]["clusters"])'; }
+[ "$(clusters "$out/oak16.treelod")" -gt "$(clusters "$out/oak.treelod")" ] \
+  || { echo "clusterSize=16 did not give more clusters"; exit 1; }
+"$treelod" info "$out/oak16.treelod" --json | grep -q '"clusterSize"' || { echo "options not recorded in meta"; exit 1; }
+for bad in lodf.nosuch=1 lodf.clusterSize=0 impostor.resolution=64 lodf.clusterSize; do
+  set +e
+  "$treelod" bake "$src/media/oak.glb" --technique lodf --option "$bad" -q -o "$out/badopt.treelod" 2> "$out/badopt.txt"
+  code=$?
+  set -e
+  [ "$code" = 2 ] && [ ! -e "$out/badopt.treelod" ] || { echo "--option $bad not refused"; exit 1; }
+  grep -q "option" "$out/badopt.txt" || { echo "--option $bad: error does not name the option:"; cat "$out/badopt.txt"; exit 1; }
+done
 echo "lodf CLI ok"

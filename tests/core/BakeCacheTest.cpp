@@ -390,6 +390,40 @@ TEST(BakeCache, LeafMaterialsOptionReachesTheImporter)
     EXPECT_EQ(chunkBytes(named.path, REFERENCE_CHUNK), reference);
 }
 
+// A baker's options (BakeTechniques.h) under the technique's key: checked against what the baker
+// declares before anything is read, part of the key, and they reach the baker.
+TEST(BakeCache, TechniqueOptionsReachTheBaker)
+{
+    const std::string dir = testDir("technique-options");
+    const std::string glb = writeTinyGlb(dir, "oak.glb");
+    const BakeCache cache(dir + "/cache");
+
+    for (const char* bad : {"{\"lodf\": {\"nosuch\": 1}}", "{\"lodf\": {\"clusterSize\": 0}}",
+                            "{\"lodf\": 16}", "{\"lodf\": {\"clusterSize\": [16]}}"})
+    {
+        Result<BakeCacheEntry> refused = cache.require(glb, {"lodf"}, bad);
+        ASSERT_FALSE(refused.ok()) << bad;
+        EXPECT_EQ(refused.error().file, glb);
+        EXPECT_FALSE(std::filesystem::exists(dir + "/cache")) << bad << ": nothing written";
+    }
+    Result<BakeCacheEntry> unknown = cache.require(glb, {"lodf"}, "{\"lodf\": {\"nosuch\": 1}}");
+    ASSERT_FALSE(unknown.ok());
+    EXPECT_EQ(unknown.error().element, "option 'lodf.nosuch'");
+    EXPECT_NE(unknown.error().reason.find("known: clusterSize, costBands"), std::string::npos)
+        << unknown.error().message();
+
+    const BakeCacheEntry byDefault = requireOk(cache, glb, {"lodf"});
+    const BakeCacheEntry small = requireOk(cache, glb, {"lodf"}, "{\"lodf\": {\"clusterSize\": 8}}");
+    EXPECT_NE(small.path, byDefault.path);
+    Result<FoliageLodData> a = decodeFoliageLodChunk(chunkBytes(byDefault.path, FOLIAGE_LOD_CHUNK), "default");
+    Result<FoliageLodData> b = decodeFoliageLodChunk(chunkBytes(small.path, FOLIAGE_LOD_CHUNK), "small");
+    ASSERT_TRUE(a.ok() && b.ok());
+    EXPECT_GT(b->clusters.size(), a->clusters.size()) << "clusters of 8 leaves instead of 64";
+    // A string and a number spell the same option.
+    const BakeCacheEntry asText = requireOk(cache, glb, {"lodf"}, "{\"lodf\": {\"clusterSize\": \"8\"}}");
+    EXPECT_EQ(chunkBytes(asText.path, FOLIAGE_LOD_CHUNK), chunkBytes(small.path, FOLIAGE_LOD_CHUNK));
+}
+
 TEST(BakeCache, BadRequestsNameWhatIsWrong)
 {
     const std::string dir = testDir("errors");

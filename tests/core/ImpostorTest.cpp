@@ -480,7 +480,7 @@ namespace TreeLod
         ASSERT_NE(technique, nullptr) << knownBakeTechniques();
         PackageWriter writer;
         std::vector<std::string> steps;
-        Result<void> baked = technique->bake(writer, oneLeaf({0.3f, 1.0f, 0.0f}, {0, 0, 1}, 0.2f), "leaf.treelod",
+        Result<void> baked = technique->bake(writer, oneLeaf({0.3f, 1.0f, 0.0f}, {0, 0, 1}, 0.2f), {}, "leaf.treelod",
                                              [&](const std::string& step, float) {
                                                  if (steps.empty() || steps.back() != step)
                                                      steps.push_back(step);

@@ -41,7 +41,7 @@ namespace TreeLod
         for (const BakeTechnique& baker : bakeTechniques())
         {
             PackageWriter writer;
-            Result<void> baked = baker.bake(writer, tree, "oak", {});
+            Result<void> baked = baker.bake(writer, tree, {}, "oak", {});
             ASSERT_TRUE(baked.ok()) << baker.name << ": " << baked.error().message();
             Result<PackageReader> reader = PackageReader::fromMemory(writer.toBytes(), "oak.treelod");
             ASSERT_TRUE(reader.ok()) << reader.error().message();

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <map>
 #include <cctype>
 #include <chrono>
 #include <cstdio>
@@ -201,6 +202,33 @@ namespace TreeLod
             return names.get<std::vector<std::string>>();
         }
 
+        /// The options of baker `technique` in the bake options (key technique.name: an object of
+        /// strings, numbers or booleans), checked against what it declares.
+        Result<BakeOptions> techniqueOptions(const std::string& source, const std::string& options,
+                                             const BakeTechnique& technique)
+        {
+            const nlohmann::json json = nlohmann::json::parse(options);
+            BakeOptions values;
+            if (!json.contains(technique.name))
+                return values;
+            const nlohmann::json& object = json[technique.name];
+            if (!object.is_object())
+                return fail(source, "bake options", "\"" + std::string(technique.name) + "\" must be an object");
+            for (const auto& [name, value] : object.items())
+            {
+                if (value.is_string())
+                    values[name] = value.get<std::string>();
+                else if (value.is_number() || value.is_boolean())
+                    values[name] = value.dump();
+                else
+                    return fail(source, "bake options",
+                                "\"" + std::string(technique.name) + "." + name + "\" must be a string, number or boolean");
+            }
+            if (Result<void> checked = checkBakeOptions(technique, values, source); !checked)
+                return checked.error();
+            return values;
+        }
+
         std::string joined(const std::vector<std::string>& names)
         {
             std::string out;
@@ -381,6 +409,14 @@ namespace TreeLod
         Result<std::vector<std::string>> leafMaterials = leafMaterialsOption(source, key.options);
         if (!leafMaterials)
             return leafMaterials.error();
+        std::map<const BakeTechnique*, BakeOptions> options;
+        for (const BakeTechnique* technique : requested)
+        {
+            Result<BakeOptions> given = techniqueOptions(source, key.options, *technique);
+            if (!given)
+                return given.error();
+            options[technique] = std::move(given.value());
+        }
 
         // What the cache holds; an unusable file is baked again from scratch. Only the chunks this
         // request returns are verified here; the others are read when the package is rewritten.
@@ -451,7 +487,7 @@ namespace TreeLod
         PackageWriter writer;
         for (const BakeTechnique* technique : missing)
         {
-            Result<void> baked = technique->bake(writer, model.value(), source,
+            Result<void> baked = technique->bake(writer, model.value(), options[technique], source,
                                                  prefixed(progress, key.name + " " + technique->name));
             if (!baked)
                 return baked.error();

@@ -9,13 +9,61 @@ namespace TreeLod
 {
     namespace
     {
+        /// The options both clouds read, into `options`.
+        Result<void> readOptions(const BakeOptions& given, const char* technique, const std::string& label,
+                                 BillboardCloudOptions& options)
+        {
+            Result<double> billboards =
+                bakeOptionNumber(given, technique, "billboardCount", options.billboardCount, 0, 65535, label);
+            Result<double> listFactor =
+                bakeOptionNumber(given, technique, "listFactor", options.listFactor, 0.0, 64.0, label);
+            Result<double> aoRays = bakeOptionNumber(given, technique, "aoRays", options.aoRays, 0, 4096, label);
+            Result<bool> compress = bakeOptionFlag(given, technique, "compress", options.compress, label);
+            for (const Result<double>* r : {&billboards, &listFactor, &aoRays})
+                if (!*r)
+                    return r->error();
+            if (!compress)
+                return compress.error();
+            options.billboardCount = std::uint32_t(billboards.value());
+            options.listFactor = float(listFactor.value());
+            options.aoRays = int(aoRays.value());
+            options.compress = compress.value();
+            return {};
+        }
+
+        Result<void> bakeLayered(PackageWriter& writer, const TreeModel& model, const BakeOptions& given,
+                                 const std::string& label, const ProgressCallback& progress)
+        {
+            BillboardCloudOptions options;
+            if (Result<void> read = readOptions(given, BILLBOARD_CLOUD_CHUNK, label, options); !read)
+                return read;
+            return addBillboardCloudChunk(writer, model, options, label, progress);
+        }
+
+        Result<void> bakeClassic(PackageWriter& writer, const TreeModel& model, const BakeOptions& given,
+                                 const std::string& label, const ProgressCallback& progress)
+        {
+            ClassicBillboardCloudOptions options;
+            if (Result<void> read = readOptions(given, CLASSIC_BILLBOARD_CLOUD_CHUNK, label, options.cloud); !read)
+                return read;
+            return addClassicBillboardCloudChunk(writer, model, options, label, progress);
+        }
+
+        std::vector<BakeOptionInfo> cloudOptions()
+        {
+            return {{"billboardCount", "billboards of the finest cloud, 0 (from the leaf count) to 65535", "0"},
+                    {"listFactor", "shader LoD: list entries per pixel of projected cell diagonal, 0 to 64", "4"},
+                    {"aoRays", "ambient occlusion rays per leaf vertex, 0 to 4096", "32"},
+                    {"compress", "DXT-compressed textures (true) or RGBA8 (false)", "true"}};
+        }
+
         const BakeTechniqueRegistration layered(
             {BILLBOARD_CLOUD_CHUNK,
-             "billboard cloud, multi-layered indirect texturing, García et al. 2007 (adds reference)",
-             &addBillboardCloudChunk});
+             "billboard cloud, multi-layered indirect texturing, García et al. 2007 (adds reference)", &bakeLayered,
+             cloudOptions()});
         const BakeTechniqueRegistration classic(
             {CLASSIC_BILLBOARD_CLOUD_CHUNK,
-             "classic billboard cloud at equal memory, García et al. 2007 Fig. 13 (adds reference)",
-             &addClassicBillboardCloudChunk});
+             "classic billboard cloud at equal memory, García et al. 2007 Fig. 13 (adds reference)", &bakeClassic,
+             cloudOptions()});
     }
 }

@@ -1303,10 +1303,16 @@ namespace TreeLod
     Result<void> addBillboardCloudChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
                                         const ProgressCallback& progress)
     {
+        return addBillboardCloudChunk(writer, model, BillboardCloudOptions{}, label, progress);
+    }
+
+    Result<void> addBillboardCloudChunk(PackageWriter& writer, const TreeModel& model,
+                                        const BillboardCloudOptions& options, const std::string& label,
+                                        const ProgressCallback& progress)
+    {
         return addCloudChunk(writer, model, label, progress, BILLBOARD_CLOUD_CHUNK, [&]() {
             BillboardCloudStats stats;
-            Result<BillboardCloudData> data =
-                bakeBillboardCloud(model, BillboardCloudOptions{}, label, progress, &stats);
+            Result<BillboardCloudData> data = bakeBillboardCloud(model, options, label, progress, &stats);
             // Truncated lists are not an error (the front and back ends are kept) but must not be silent.
             if (data && stats.truncatedCells > 0)
                 report(progress,
@@ -1321,11 +1327,19 @@ namespace TreeLod
     Result<void> addClassicBillboardCloudChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
                                                const ProgressCallback& progress)
     {
+        return addClassicBillboardCloudChunk(writer, model, ClassicBillboardCloudOptions{}, label, progress);
+    }
+
+    Result<void> addClassicBillboardCloudChunk(PackageWriter& writer, const TreeModel& model,
+                                               const ClassicBillboardCloudOptions& classic, const std::string& label,
+                                               const ProgressCallback& progress)
+    {
         return addCloudChunk(writer, model, label, progress, CLASSIC_BILLBOARD_CLOUD_CHUNK, [&]() {
-            ClassicBillboardCloudOptions options;
-            // Fig. 13: the layered cloud's memory; a layered chunk baked with the default options
-            // already in the package gives it without baking again.
-            if (const std::vector<std::uint8_t>* layered = writer.chunkBytes(BILLBOARD_CLOUD_CHUNK, 0))
+            ClassicBillboardCloudOptions options = classic;
+            // Fig. 13: the layered cloud's memory; a layered chunk already in the package gives it
+            // without baking again.
+            if (const std::vector<std::uint8_t>* layered =
+                    options.memoryBytes == 0 ? writer.chunkBytes(BILLBOARD_CLOUD_CHUNK, 0) : nullptr)
             {
                 Result<BillboardCloudData> decoded = decodeBillboardCloudChunk(*layered, label);
                 if (decoded && decoded->gpuBytes() > 0)

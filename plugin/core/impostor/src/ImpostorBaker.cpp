@@ -257,13 +257,19 @@ namespace TreeLod
     Result<void> addImpostorChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
                                   const ProgressCallback& progress)
     {
+        return addImpostorChunk(writer, model, ImpostorOptions{}, label, progress);
+    }
+
+    Result<void> addImpostorChunk(PackageWriter& writer, const TreeModel& model, const ImpostorOptions& options,
+                                  const std::string& label, const ProgressCallback& progress)
+    {
         if (!writer.hasChunk(REFERENCE_CHUNK, 0))
         {
             Result<void> added = addReferenceChunk(writer, model, label, progress);
             if (!added)
                 return added;
         }
-        Result<ImpostorData> data = bakeImpostor(model, ImpostorOptions{}, label, progress);
+        Result<ImpostorData> data = bakeImpostor(model, options, label, progress);
         if (!data)
             return data.error();
         Result<void> added =

@@ -7,8 +7,28 @@ namespace TreeLod
 {
     namespace
     {
+        Result<void> bake(PackageWriter& writer, const TreeModel& model, const BakeOptions& given,
+                          const std::string& label, const ProgressCallback& progress)
+        {
+            FoliageLodOptions options;
+            Result<double> clusterSize =
+                bakeOptionNumber(given, FOLIAGE_LOD_CHUNK, "clusterSize", options.clusterSize, 1, 4096, label);
+            if (!clusterSize)
+                return clusterSize.error();
+            Result<double> costBands =
+                bakeOptionNumber(given, FOLIAGE_LOD_CHUNK, "costBands", options.costBands, 0, 64, label);
+            if (!costBands)
+                return costBands.error();
+            options.clusterSize = std::uint32_t(clusterSize.value());
+            options.costBands = std::uint32_t(costBands.value());
+            return addFoliageLodChunk(writer, model, options, label, progress);
+        }
+
         const BakeTechniqueRegistration registration(
-            {FOLIAGE_LOD_CHUNK, "LoDF continuous foliage by leaf collapse, Rebollo et al. 2006 (adds reference)",
-             static_cast<BakeFunction>(&addFoliageLodChunk)});
+            {FOLIAGE_LOD_CHUNK,
+             "LoDF continuous foliage by leaf collapse, Rebollo et al. 2006 (adds reference)",
+             &bake,
+             {{"clusterSize", "leaves per independent cluster, 1 to 4096", "64"},
+              {"costBands", "bands of Changed_group, 0 (the paper's global order) to 64", "4"}}});
     }
 }

@@ -107,7 +107,9 @@ namespace TreeLod
 
         /// A package at path() holding the chunks of every technique in `techniques` (names of
         /// BakeTechniques.h; duplicates ignored) for `source` baked with `optionsJson` (a JSON
-        /// object; "" means {}; key order and spacing do not matter). Chunks already cached are
+        /// object; "" means {}; key order and spacing do not matter: "leafMaterials" for the
+        /// importer, and per technique an object of its BakeOptions, {"lodf": {"clusterSize": 32}},
+        /// checked against what the baker declares before anything is read). Chunks already cached are
         /// reused, the others baked from one import of the source. `import` reads file formats
         /// other than glTF. `progress` sees the importer's and bakers' steps, prefixed with the
         /// source's name and technique ("oak.glb lodf: collapse"); "warning: ..." steps keep

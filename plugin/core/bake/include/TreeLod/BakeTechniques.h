@@ -7,21 +7,36 @@
 
 #include "TreeLod/PackageWriter.h"
 
+#include <map>
 #include <string>
 #include <vector>
 
 namespace TreeLod
 {
+    /// The values given for one baker's options, by option name, as text (`treelod bake --option
+    /// lodf.clusterSize=32`; in a bake cache's options JSON, {"lodf": {"clusterSize": 32}}).
+    using BakeOptions = std::map<std::string, std::string>;
+
     /// Adds a technique's chunks for `model` to the package (and the chunks it needs, such as the
-    /// reference, when missing); `label` names the output in errors.
-    using BakeFunction = Result<void> (*)(PackageWriter& writer, const TreeModel& model, const std::string& label,
-                                          const ProgressCallback& progress);
+    /// reference, when missing), with `options` (checked by checkBakeOptions: only declared names);
+    /// `label` names the output in errors.
+    using BakeFunction = Result<void> (*)(PackageWriter& writer, const TreeModel& model, const BakeOptions& options,
+                                          const std::string& label, const ProgressCallback& progress);
+
+    /// One option a baker reads.
+    struct BakeOptionInfo
+    {
+        std::string name;
+        std::string description; ///< with its range and unit
+        std::string defaultValue;
+    };
 
     struct BakeTechnique
     {
         const char* name; ///< the chunk's technique name ("reference", "lodf", ...)
         const char* description;
         BakeFunction bake;
+        std::vector<BakeOptionInfo> options; ///< what `options` may hold
     };
 
     /// Add (or replace, by name) a baker. Registration happens during static initialisation.
@@ -31,6 +46,17 @@ namespace TreeLod
     const BakeTechnique* findBakeTechnique(const std::string& name);
     /// "reference, lodf" for messages.
     std::string knownBakeTechniques();
+
+    /// An error naming `label` and "option '<technique>.<name>'" for a name `technique` does not
+    /// declare (the declared ones listed).
+    Result<void> checkBakeOptions(const BakeTechnique& technique, const BakeOptions& options, const std::string& label);
+    /// Option `name` of `options` as a number in [lo, hi], `fallback` when absent; errors name `label`
+    /// and "option '<technique>.<name>'".
+    Result<double> bakeOptionNumber(const BakeOptions& options, const std::string& technique, const std::string& name,
+                                    double fallback, double lo, double hi, const std::string& label);
+    /// Option `name` as true or false, `fallback` when absent.
+    Result<bool> bakeOptionFlag(const BakeOptions& options, const std::string& technique, const std::string& name,
+                                bool fallback, const std::string& label);
 
     /// Registers a baker when constructed: one namespace-scope instance per technique.
     struct BakeTechniqueRegistration

@@ -96,4 +96,12 @@ namespace TreeLod
                                         const ProgressCallback& progress = {});
     Result<void> addClassicBillboardCloudChunk(PackageWriter& writer, const TreeModel& model,
                                                const std::string& label, const ProgressCallback& progress = {});
+    /// The same with `options` (the classic cloud's memory: options.memoryBytes, else the layered
+    /// chunk's in the writer, else the layered cloud's with the same options).
+    Result<void> addBillboardCloudChunk(PackageWriter& writer, const TreeModel& model,
+                                        const BillboardCloudOptions& options, const std::string& label,
+                                        const ProgressCallback& progress = {});
+    Result<void> addClassicBillboardCloudChunk(PackageWriter& writer, const TreeModel& model,
+                                               const ClassicBillboardCloudOptions& options, const std::string& label,
+                                               const ProgressCallback& progress = {});
 }

@@ -51,4 +51,7 @@ namespace TreeLod
     /// (the Forest takes the tree's bounds from it) and the impostor chunk, default options.
     Result<void> addImpostorChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
                                   const ProgressCallback& progress = {});
+    /// The same with `options`.
+    Result<void> addImpostorChunk(PackageWriter& writer, const TreeModel& model, const ImpostorOptions& options,
+                                  const std::string& label, const ProgressCallback& progress = {});
 }
