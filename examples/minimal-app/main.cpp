@@ -69,7 +69,7 @@ namespace
         camera->setFarClipDistance(10.0f * radius);
         Ogre::SceneNode* cameraNode = scene->getRootSceneNode()->createChildSceneNode();
         cameraNode->attachObject(camera);
-        cameraNode->setPosition(centre + Ogre::Vector3(0.0f, 0.3f * radius, 2.5f * radius));
+        cameraNode->setPosition(centre + Ogre::Vector3(0.0f, 0.15f * radius, 1.7f * radius));
         cameraNode->lookAt(centre, Ogre::Node::TS_WORLD);
 
         Ogre::TexturePtr target = Ogre::TextureManager::getSingleton().createManual(
