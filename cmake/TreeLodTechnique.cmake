@@ -8,7 +8,18 @@
 # registration object registers the technique; it is linked whole (WHOLE_ARCHIVE) into the
 # aggregates TreeLodTechniques (runtime halves), TreeLodBakeTechniques (bake halves) and into
 # Plugin_TreeLod (Ogre halves), so that registration runs wherever the aggregate is linked.
-# Nothing else in the build names a technique.
+# Nothing else in the build names a technique. The halves and aggregates are installed and exported
+# by cmake/TreeLodInstall.cmake (it reads TREELOD_TECHNIQUE_TARGETS).
+
+# treelod_link_whole(<aggregate> <library>): <aggregate> links <library> whole, in the build tree and
+# in the installed package. install(EXPORT) does not put its namespace on a target named inside
+# $<LINK_LIBRARY:...>, so the installed form names TreeLod::<library> itself.
+function(treelod_link_whole aggregate library)
+  target_link_libraries(${aggregate} INTERFACE
+    "$<BUILD_INTERFACE:$<LINK_LIBRARY:WHOLE_ARCHIVE,${library}>>"
+    "$<INSTALL_INTERFACE:$<LINK_LIBRARY:WHOLE_ARCHIVE,TreeLod::${library}>>")
+endfunction()
+
 function(treelod_add_technique name)
   cmake_parse_arguments(T "" "" "RUNTIME_SOURCES;RUNTIME_LIBS;BAKE_SOURCES;BAKE_LIBS;OGRE_SOURCES;OGRE_LIBS" ${ARGN})
   set(include $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include> $<INSTALL_INTERFACE:include>)
@@ -16,16 +27,16 @@ function(treelod_add_technique name)
     add_library(TreeLod${name}Runtime STATIC ${T_RUNTIME_SOURCES})
     target_include_directories(TreeLod${name}Runtime PUBLIC ${include})
     target_link_libraries(TreeLod${name}Runtime PUBLIC TreeLodRuntime ${T_RUNTIME_LIBS}
-      PRIVATE nlohmann_json::nlohmann_json treelod_warnings)
-    target_link_libraries(TreeLodTechniques INTERFACE "$<LINK_LIBRARY:WHOLE_ARCHIVE,TreeLod${name}Runtime>")
+      PRIVATE nlohmann_json::nlohmann_json $<BUILD_INTERFACE:treelod_warnings>)
+    treelod_link_whole(TreeLodTechniques TreeLod${name}Runtime)
     set_property(GLOBAL APPEND PROPERTY TREELOD_TECHNIQUE_TARGETS TreeLod${name}Runtime)
   endif()
   if(T_BAKE_SOURCES)
     add_library(TreeLod${name}Bake STATIC ${T_BAKE_SOURCES})
     target_include_directories(TreeLod${name}Bake PUBLIC ${include})
     target_link_libraries(TreeLod${name}Bake PUBLIC TreeLodBake TreeLodTechniques ${T_BAKE_LIBS}
-      PRIVATE nlohmann_json::nlohmann_json treelod_warnings)
-    target_link_libraries(TreeLodBakeTechniques INTERFACE "$<LINK_LIBRARY:WHOLE_ARCHIVE,TreeLod${name}Bake>")
+      PRIVATE nlohmann_json::nlohmann_json $<BUILD_INTERFACE:treelod_warnings>)
+    treelod_link_whole(TreeLodBakeTechniques TreeLod${name}Bake)
     set_property(GLOBAL APPEND PROPERTY TREELOD_TECHNIQUE_TARGETS TreeLod${name}Bake)
   endif()
   if(T_OGRE_SOURCES AND TARGET Plugin_TreeLod)

@@ -42,6 +42,7 @@
 #include "TreeLod/ForestScene.h"
 #include "TreeLod/Image.h"
 #include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/OgreBootstrap.h"
 #include "TreeLod/TechniqueRegistry.h"
 
 #include <cerrno>
@@ -204,12 +205,13 @@ namespace TreeLod
 
         int runProcess(const std::vector<std::string>& argv, bool searchPath = false, bool silent = false);
 
-        /// bench/plot.py: $TREELOD_PLOT_SCRIPT, else the one in the source tree this was built from.
+        /// bench/plot.py: $TREELOD_PLOT_SCRIPT, else share/TreeLod/plot.py beside this executable
+        /// (installed, or the build tree's link to bench/plot.py).
         std::string plotScript()
         {
             if (const char* env = std::getenv("TREELOD_PLOT_SCRIPT"); env && *env)
                 return env;
-            return TREELOD_PLOT_SCRIPT;
+            return dataDirectory() + "/plot.py";
         }
 
         /// Draw DIR/plots.json's plots with bench/plot.py when python3 has matplotlib; otherwise one

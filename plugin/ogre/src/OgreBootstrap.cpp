@@ -20,7 +20,15 @@ namespace TreeLod
 
     std::string ogreMediaDirectory() { return envOr("TREELOD_OGRE_MEDIA_DIR", TREELOD_OGRE_MEDIA_DIR); }
 
-    std::string materialsDirectory() { return envOr("TREELOD_MATERIALS_DIR", TREELOD_DEFAULT_MATERIALS_DIR); }
+    std::string dataDirectory()
+    {
+        std::error_code ec;
+        const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+        const std::filesystem::path bin = ec ? std::filesystem::current_path(ec) : self.parent_path();
+        return (bin / TREELOD_DATADIR_FROM_BINDIR).lexically_normal().string();
+    }
+
+    std::string materialsDirectory() { return envOr("TREELOD_MATERIALS_DIR", dataDirectory() + "/media"); }
 
     std::unique_ptr<Ogre::LogManager> createLogManager(const std::string& logFile, bool verbose)
     {

@@ -30,7 +30,7 @@ namespace TreeLod
         std::string logFile = "";      ///< "" = no log file (messages dropped unless verbose)
         bool verbose = false;          ///< also echo Ogre's log to stdout
         std::string pluginPath = "";   ///< "" = install TreeLodPlugin in-process; else loadPlugin(path)
-        std::string materialsDir = ""; ///< "" = $TREELOD_MATERIALS_DIR or the source tree's materials/
+        std::string materialsDir = ""; ///< "" = materialsDirectory() (OgreBootstrap.h)
     };
 
     /// An RGBA8 picture, rows top to bottom (PNG order).

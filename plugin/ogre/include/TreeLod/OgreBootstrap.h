@@ -3,10 +3,12 @@
 // materials are, a log that stays off stdout, the plugins TreeLod renders with, TreeLod's
 // resource locations, and the hidden window that owns the GL context when nothing is shown.
 //
-// Folders: the environment first, else those of the build (the OGRE it found, this source tree):
+// Folders: the environment first, else those of the OGRE the build found, and TreeLod's own data
+// beside the running executable (bin/../share/TreeLod: installed, and in the build tree, whose
+// share/TreeLod links to the sources):
 //   $OGRE_PLUGIN_DIR_OVERRIDE  OGRE's plugins (RenderSystem_GL3Plus.so, Codec_STBI.so)
 //   $TREELOD_OGRE_MEDIA_DIR    OGRE's media (ShadowVolume, RTShaderLib, packs/SdkTrays.zip)
-//   $TREELOD_MATERIALS_DIR     TreeLod's materials/ (and materials/GLSL)
+//   $TREELOD_MATERIALS_DIR     TreeLod's material scripts and shaders (share/TreeLod/media, and its GLSL/)
 // Part of TreeLodOffscreen, not of Plugin_TreeLod.
 #pragma once
 
@@ -25,7 +27,11 @@ namespace TreeLod
     /// OGRE's media folder: $TREELOD_OGRE_MEDIA_DIR, else the build's.
     std::string ogreMediaDirectory();
 
-    /// TreeLod's materials folder: $TREELOD_MATERIALS_DIR, else the source tree's materials/.
+    /// TreeLod's data folder, `share/TreeLod` beside the running executable's `bin/` (installed:
+    /// <prefix>/share/TreeLod; build tree: build/share/TreeLod, linking to the sources).
+    std::string dataDirectory();
+
+    /// TreeLod's material scripts and shaders: $TREELOD_MATERIALS_DIR, else dataDirectory()/media.
     std::string materialsDirectory();
 
     /// An own LogManager, created before the Root (else Ogre logs to stdout, OGRE-NOTES.md), with
