@@ -760,9 +760,14 @@ namespace TreeLod
                      "and plots (speed against the polygonal reference and the one-quad floor, error, temporal noise)");
         cmd->add_option("scene", args->scene, "scene script (samples/scenes/*.json)")->required();
         cmd->add_option("-o,--output", args->output, "output directory")->required();
+#ifdef TREELOD_WITH_OGRE
+        const std::string known = knownSceneTechniques();
+#else
+        const std::string known = "(none: this build has no Ogre plugin)";
+#endif
         cmd->add_option("--techniques", args->techniques,
                         "comma-separated techniques besides the reference (mesh) and the floor (impostor): auto (the "
-                        "script's choice), lodf, billboard-cloud, classic-billboard-cloud")
+                        "script's choice) or any of " + known)
             ->capture_default_str();
         cmd->add_option("--lod-bias", args->lodBiases, "comma-separated LoD biases (< 1 = less detail)")
             ->capture_default_str();

@@ -21,8 +21,8 @@ technique | FLIP difference image), and the forest of the scene script.
   menu.png                  the sample menu
   forest-NNN.png            the forest sample at --frames frames spread evenly along the
                             scene's camera path (NNN = 000, 001, ...)
-  split-TECHNIQUE.png       each technique sample's split view (mesh, lodf, billboard-cloud,
-                            classic-billboard-cloud, ...), the tree framed whole
+  split-TECHNIQUE.png       each technique sample's split view (every registered technique:
+                            treelod render --help lists them), the tree framed whole
 Layout: a 270-pixel column of controls and stats on the left; the split view divides the rest
 into three equal panels.
 Needs an X server (xvfb-run -a -s "-screen 0 1280x1024x24" treelod_browser --headless ...).

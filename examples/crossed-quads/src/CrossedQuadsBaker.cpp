@@ -158,13 +158,20 @@ namespace TreeLod
     Result<void> addCrossedQuadsChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
                                       const ProgressCallback& progress)
     {
+        return addCrossedQuadsChunk(writer, model, CrossedQuadsOptions{}, label, progress);
+    }
+
+    Result<void> addCrossedQuadsChunk(PackageWriter& writer, const TreeModel& model,
+                                      const CrossedQuadsOptions& options, const std::string& label,
+                                      const ProgressCallback& progress)
+    {
         if (!writer.hasChunk(REFERENCE_CHUNK, 0))
         {
             Result<void> added = addReferenceChunk(writer, model, label, progress);
             if (!added)
                 return added;
         }
-        Result<CrossedQuadsData> data = bakeCrossedQuads(model, CrossedQuadsOptions{}, label, progress);
+        Result<CrossedQuadsData> data = bakeCrossedQuads(model, options, label, progress);
         if (!data)
             return data.error();
         Result<void> added = writer.addChunk(CROSSED_QUADS_CHUNK, 0, CROSSED_QUADS_CHUNK_FORMAT_VERSION,

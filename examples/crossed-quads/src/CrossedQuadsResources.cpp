@@ -2,6 +2,7 @@
 #include "TreeLod/CrossedQuadsResources.h"
 
 #include "TreeLod/CrossedQuadsData.h"
+#include "TreeLod/TechniqueSupport.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreException.h>
@@ -17,37 +18,6 @@ namespace TreeLod
 {
     namespace
     {
-        // The plugin's own helpers for this (uploadTexture, cloneBaseMaterial) are private to it
-        // (plugin/ogre/src/TreeAssetSupport.h): small versions of them here.
-
-        /// Upload `texture` with every baked mip level, in its own format, as `name` in `group`.
-        void uploadTexture(const Ogre::String& name, const Ogre::String& group, const GpuTexture& texture)
-        {
-            const Ogre::PixelFormat format = texture.format == GpuTextureFormat::DXT5 ? Ogre::PF_DXT5 : Ogre::PF_BYTE_RGBA;
-            const std::uint32_t mips = texture.mipCount - 1; // validated: mipCount >= 1
-            Ogre::Image image;
-            image.loadDynamicImage(const_cast<Ogre::uchar*>(texture.data.data()), texture.width, texture.height, 1,
-                                   format, false, 1, mips);
-            Ogre::TextureManager::getSingleton().loadImage(name, group, image, Ogre::TEX_TYPE_2D, int(mips));
-        }
-
-        /// A clone of TreeLod's material `base` as `name` in `group`; throws naming `asset` when
-        /// TreeLod's materials are not in a resource group.
-        Ogre::MaterialPtr cloneBase(const Ogre::String& base, const Ogre::String& name, const Ogre::String& group,
-                                    const Ogre::String& asset)
-        {
-            Ogre::MaterialPtr parent = Ogre::MaterialManager::getSingleton().getByName(base, Ogre::RGN_DEFAULT);
-            if (!parent)
-                parent = Ogre::MaterialManager::getSingleton().getByName(base);
-            if (!parent)
-                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
-                            "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
-                            "CrossedQuadsResources of TreeAsset '" + asset + "'");
-            Ogre::MaterialPtr clone = parent->clone(name, true, group);
-            clone->load();
-            return clone;
-        }
-
         /// Texture unit 0 shows `texture`; the leaf shader's constants make albedo = texture (white
         /// base and back colour) and alpha-test at `cutoff` (as TreeAsset::getModelMaterials sets them).
         void configure(const Ogre::MaterialPtr& material, const Ogre::String& texture, float cutoff)
@@ -158,13 +128,16 @@ namespace TreeLod
                 part.casterMaterial = name + "/Caster";
                 gpu->parts.push_back(part); // named before anything is made, for removeParts
                 uploadTexture(part.texture, mAsset.getGroup(), q.colour);
-                Ogre::MaterialPtr plain = cloneBase("TreeLod/Leaf", part.material, mAsset.getGroup(), mAsset.getName());
+                Ogre::MaterialPtr plain = cloneBaseMaterial("TreeLod/Leaf", part.material, mAsset.getGroup(), mAsset.getName());
                 Ogre::MaterialPtr shadowed =
-                    cloneBase("TreeLod/LeafShadowed", part.shadowedMaterial, mAsset.getGroup(), mAsset.getName());
+                    cloneBaseMaterial("TreeLod/LeafShadowed", part.shadowedMaterial, mAsset.getGroup(), mAsset.getName());
                 Ogre::MaterialPtr caster =
-                    cloneBase("TreeLod/LeafCaster", part.casterMaterial, mAsset.getGroup(), mAsset.getName());
+                    cloneBaseMaterial("TreeLod/LeafCaster", part.casterMaterial, mAsset.getGroup(), mAsset.getName());
                 for (const Ogre::MaterialPtr& m : {plain, shadowed, caster})
+                {
+                    m->load();
                     configure(m, part.texture, data.alphaCutoff);
+                }
                 // The caster alpha-tests the same texture, so shadows have the quads' leaf shapes.
                 plain->getTechnique(0)->setShadowCasterMaterial(caster);
                 shadowed->getTechnique(0)->setShadowCasterMaterial(caster);

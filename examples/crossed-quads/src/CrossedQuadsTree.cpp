@@ -2,6 +2,7 @@
 #include "TreeLod/CrossedQuadsTree.h"
 
 #include "TreeLod/CrossedQuadsResources.h"
+#include "TreeLod/ObjectParams.h"
 #include "TreeLod/TreeAssetManager.h"
 
 #include <OgreException.h>
@@ -97,21 +98,7 @@ namespace TreeLod
     Ogre::MovableObject* CrossedQuadsTreeFactory::createInstanceImpl(const Ogre::String& name,
                                                                      const Ogre::NameValuePairList* params)
     {
-        // The plugin's ObjectParams is private to it: the two parameters read here directly.
-        const auto find = [params](const char* key) -> const Ogre::String* {
-            if (!params)
-                return nullptr;
-            const auto it = params->find(key);
-            return it == params->end() ? nullptr : &it->second;
-        };
-        const Ogre::String* asset = find("asset");
-        if (!asset)
-            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
-                        "CrossedQuadsTree '" + name + "': parameter 'asset' is required",
-                        "CrossedQuadsTreeFactory::createInstanceImpl");
-        const Ogre::String* group = find("group");
-        return new CrossedQuadsTree(
-            name, TreeAssetManager::getSingleton().load(
-                      *asset, group ? *group : Ogre::ResourceGroupManager::AUTODETECT_RESOURCE_GROUP_NAME));
+        const ObjectParams p(params, "CrossedQuadsTreeFactory::createInstanceImpl");
+        return new CrossedQuadsTree(name, p.loadAsset(name, "CrossedQuadsTree"));
     }
 }

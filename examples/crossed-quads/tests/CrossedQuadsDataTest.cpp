@@ -185,7 +185,7 @@ namespace TreeLod
         ASSERT_NE(baker, nullptr) << "the bake half registers itself (TreeLodBakeTechniques)";
         EXPECT_NE(knownBakeTechniques().find(CROSSED_QUADS_CHUNK), std::string::npos);
         PackageWriter writer;
-        Result<void> added = baker->bake(writer, test::generatedOak(300), "small", {});
+        Result<void> added = baker->bake(writer, test::generatedOak(300), {}, "small", {});
         ASSERT_TRUE(added.ok()) << added.error().message();
         EXPECT_TRUE(writer.hasChunk(REFERENCE_CHUNK, 0)) << "the reference is added when missing";
         ASSERT_TRUE(writer.hasChunk(CROSSED_QUADS_CHUNK, 0));

@@ -1,6 +1,6 @@
 #include "TreeLod/BillboardCloudResources.h"
 
-#include "TreeAssetSupport.h"
+#include "TreeLod/TechniqueSupport.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreGpuProgramParams.h>

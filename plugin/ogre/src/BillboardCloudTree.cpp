@@ -2,7 +2,7 @@
 // §5, §6). See BillboardCloudTree.h for the LoD rules.
 #include "TreeLod/BillboardCloudTree.h"
 
-#include "ObjectParams.h"
+#include "TreeLod/ObjectParams.h"
 #include "TreePart.h"
 
 #include "TreeLod/TreeAssetManager.h"

@@ -1,6 +1,6 @@
 #include "TreeLod/FoliageLodTree.h"
 
-#include "ObjectParams.h"
+#include "TreeLod/ObjectParams.h"
 #include "TreePart.h"
 
 #include "TreeLod/FoliageLodResources.h"

@@ -2,7 +2,7 @@
 // (ForestInstances::cull) and drawn with hardware instancing. See Forest.h.
 #include "TreeLod/Forest.h"
 
-#include "ObjectParams.h"
+#include "TreeLod/ObjectParams.h"
 
 #include "TreeLod/TechniqueRegistry.h"
 

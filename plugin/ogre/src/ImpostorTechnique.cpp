@@ -17,7 +17,7 @@ namespace TreeLod
         public:
             std::vector<ForestLevelSpan> getSpans(TreeAsset& asset, const Ogre::String& technique) override
             {
-                ImpostorResources::of(asset).getGpu();
+                ImpostorResources::of(asset).getData();
                 return {{ForestLevel{technique, 0, false, 0.0f}, ForestLevelSpan::NO_UPPER}};
             }
 
@@ -28,7 +28,7 @@ namespace TreeLod
                 if (level.lowRes)
                     OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, "lowRes is for billboard-cloud levels only",
                                 "ImpostorLevels::checkLevel");
-                ImpostorResources::of(asset).getGpu(); // one quad: always resident, the fallback of last resort
+                ImpostorResources::of(asset).getData(); // decoded and checked
             }
 
             void buildParts(TreeAsset& asset, const ForestLevel&, ForestPartBuilder& parts) override

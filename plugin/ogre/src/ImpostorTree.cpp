@@ -1,6 +1,6 @@
 #include "TreeLod/ImpostorTree.h"
 
-#include "ObjectParams.h"
+#include "TreeLod/ObjectParams.h"
 
 #include "TreeLod/ImpostorResources.h"
 

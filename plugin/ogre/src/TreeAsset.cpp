@@ -1,6 +1,6 @@
 #include "TreeLod/TreeAsset.h"
 
-#include "TreeAssetSupport.h"
+#include "TreeLod/TechniqueSupport.h"
 #include "TreeLod/TechniqueDescriptor.h"
 #include "TreeLod/TreeMeshBuilder.h"
 

@@ -46,4 +46,8 @@ namespace TreeLod
     /// (the Forest takes the tree's bounds from it) and the crossed-quads chunk, default options.
     Result<void> addCrossedQuadsChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
                                       const ProgressCallback& progress = {});
+    /// The same with `options`.
+    Result<void> addCrossedQuadsChunk(PackageWriter& writer, const TreeModel& model,
+                                      const CrossedQuadsOptions& options, const std::string& label,
+                                      const ProgressCallback& progress = {});
 }

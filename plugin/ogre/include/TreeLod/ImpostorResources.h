@@ -2,6 +2,7 @@
 // the GPU, shared by every ImpostorTree and Forest level drawing it.
 #pragma once
 
+#include "TreeLod/ImpostorData.h"
 #include "TreeLod/TechniqueResources.h"
 
 #include <OgreHardwareIndexBuffer.h>
@@ -40,14 +41,17 @@ namespace TreeLod
         explicit ImpostorResources(TreeAsset& asset) : mAsset(asset) {}
         ~ImpostorResources() override;
 
-        /// The impostor, built on first call; throws naming the asset when the package lacks the
-        /// chunk or has another format version.
+        /// The decoded chunk (on first call); throws naming the asset when the package lacks the
+        /// chunk, has another format version or a broken one.
+        const ImpostorData& getData();
+        /// The impostor on the GPU, built on first call (nothing is left behind when it throws).
         const ImpostorGpu& getGpu();
 
         std::uint64_t getGpuBytes() const override { return mGpu ? mGpu->gpuBytes : 0; }
 
     private:
         TreeAsset& mAsset;
+        std::unique_ptr<ImpostorData> mData;
         std::unique_ptr<ImpostorGpu> mGpu;
     };
 }

@@ -1,5 +1,6 @@
-// TreeAssetSupport: what TreeAsset.cpp and TreeAssetImpostor.cpp both need to put a package's
-// textures and materials on the GPU (internal to the Ogre plugin, not installed).
+// TechniqueSupport: what a technique's Ogre half (its TechniqueResources) uses to put its chunk's
+// textures and materials on the GPU: the Ogre format of a baked texture, its upload with every
+// baked mip, and a clone of one of TreeLod's base materials.
 #pragma once
 
 #include "TreeLod/ModelChunk.h"

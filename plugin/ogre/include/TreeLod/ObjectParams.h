@@ -1,5 +1,5 @@
 // ObjectParams: reading the createMovableObject parameters of the tree objects' factories
-// (FoliageLodTree, BillboardCloudTree): one wording for every bad parameter
+// (FoliageLodTree, BillboardCloudTree, ImpostorTree, a technique's own): one wording for every bad parameter
 // ("parameter 'key': 'value' is not ...") and one way to load the `asset` in `group`.
 #pragma once
 
