@@ -124,18 +124,8 @@ namespace TreeLod
                         albedo[t] = glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b));
                     }
                 bleedValues(albedo, covered, int(W), int(H), BLEED_RINGS, glm::vec3(0.2f));
-                TextureImage image;
-                image.name = "crossed-quads " + std::to_string(i);
-                image.width = int(W);
-                image.height = int(H);
-                image.rgba.resize(count * 4);
-                for (std::size_t t = 0; t < count; ++t)
-                {
-                    image.rgba[4 * t + 0] = linearToSrgbByte(albedo[t].r);
-                    image.rgba[4 * t + 1] = linearToSrgbByte(albedo[t].g);
-                    image.rgba[4 * t + 2] = linearToSrgbByte(albedo[t].b);
-                    image.rgba[4 * t + 3] = unitToByte(images.alpha[t]);
-                }
+                const TextureImage image =
+                    albedoTexture("crossed-quads " + std::to_string(i), int(W), int(H), albedo, images.alpha);
                 MipChainOptions mips;
                 mips.preserveAlphaCoverage = true;
                 mips.alphaCutoff = options.alphaCutoff;

@@ -16,28 +16,6 @@
 
 namespace TreeLod
 {
-    namespace
-    {
-        /// Texture unit 0 shows `texture`; the leaf shader's constants make albedo = texture (white
-        /// base and back colour) and alpha-test at `cutoff` (as TreeAsset::getModelMaterials sets them).
-        void configure(const Ogre::MaterialPtr& material, const Ogre::String& texture, float cutoff)
-        {
-            for (Ogre::Technique* tech : material->getTechniques())
-                for (Ogre::Pass* pass : tech->getPasses())
-                {
-                    if (pass->getNumTextureUnitStates() > 0)
-                        pass->getTextureUnitState(0)->setTextureName(texture);
-                    if (!pass->hasFragmentProgram())
-                        continue;
-                    Ogre::GpuProgramParametersSharedPtr p = pass->getFragmentProgramParameters();
-                    p->setIgnoreMissingParams(true);
-                    p->setNamedConstant("baseColour", Ogre::ColourValue::White);
-                    p->setNamedConstant("backColour", Ogre::ColourValue::White);
-                    p->setNamedConstant("alphaCutoff", cutoff);
-                }
-        }
-    }
-
     CrossedQuadsResources& CrossedQuadsResources::of(TreeAsset& asset)
     {
         return asset.getResources<CrossedQuadsResources>(
@@ -133,11 +111,10 @@ namespace TreeLod
                     cloneBaseMaterial("TreeLod/LeafShadowed", part.shadowedMaterial, mAsset.getGroup(), mAsset.getName());
                 Ogre::MaterialPtr caster =
                     cloneBaseMaterial("TreeLod/LeafCaster", part.casterMaterial, mAsset.getGroup(), mAsset.getName());
+                // Albedo = the texture (white base and back colour), alpha-tested at the chunk's cutoff.
                 for (const Ogre::MaterialPtr& m : {plain, shadowed, caster})
-                {
-                    m->load();
-                    configure(m, part.texture, data.alphaCutoff);
-                }
+                    configureModelMaterial(m, part.texture, Ogre::ColourValue::White, Ogre::ColourValue::White,
+                                           data.alphaCutoff);
                 // The caster alpha-tests the same texture, so shadows have the quads' leaf shapes.
                 plain->getTechnique(0)->setShadowCasterMaterial(caster);
                 shadowed->getTechnique(0)->setShadowCasterMaterial(caster);

@@ -203,21 +203,10 @@ namespace TreeLod
             glm::vec3 back = src.backColour == glm::vec3(0.0f) ? glm::vec3(src.baseColour) : src.backColour;
 
             auto configure = [&](const Ogre::MaterialPtr& m) {
-                m->load();
-                for (Ogre::Technique* tech : m->getTechniques())
-                    for (Ogre::Pass* pass : tech->getPasses())
-                    {
-                        if (pass->getNumTextureUnitStates() > 0)
-                            pass->getTextureUnitState(0)->setTextureName(texture);
-                        if (!pass->hasFragmentProgram())
-                            continue;
-                        Ogre::GpuProgramParametersSharedPtr p = pass->getFragmentProgramParameters();
-                        p->setIgnoreMissingParams(true);
-                        p->setNamedConstant("baseColour", Ogre::ColourValue(src.baseColour.r, src.baseColour.g,
-                                                                          src.baseColour.b, src.baseColour.a));
-                        p->setNamedConstant("backColour", Ogre::ColourValue(back.r, back.g, back.b, 1.0f));
-                        p->setNamedConstant("alphaCutoff", src.alphaCutoff);
-                    }
+                configureModelMaterial(m, texture,
+                                       Ogre::ColourValue(src.baseColour.r, src.baseColour.g, src.baseColour.b,
+                                                         src.baseColour.a),
+                                       Ogre::ColourValue(back.r, back.g, back.b, 1.0f), src.alphaCutoff);
             };
             configure(mat);
             // The shadow caster alpha-tests the same texture.

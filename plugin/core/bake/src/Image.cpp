@@ -195,4 +195,23 @@ namespace TreeLod
             if (!filled[i])
                 values[i] = mean;
     }
+
+    TextureImage albedoTexture(const std::string& name, int width, int height, const std::vector<glm::vec3>& albedo,
+                               const std::vector<float>& alpha)
+    {
+        const std::size_t count = std::size_t(std::max(width, 0)) * std::size_t(std::max(height, 0));
+        TextureImage image;
+        image.name = name;
+        image.width = width;
+        image.height = height;
+        image.rgba.resize(count * 4);
+        for (std::size_t i = 0; i < count && i < albedo.size() && i < alpha.size(); ++i)
+        {
+            image.rgba[4 * i + 0] = linearToSrgbByte(albedo[i].r);
+            image.rgba[4 * i + 1] = linearToSrgbByte(albedo[i].g);
+            image.rgba[4 * i + 2] = linearToSrgbByte(albedo[i].b);
+            image.rgba[4 * i + 3] = unitToByte(alpha[i]);
+        }
+        return image;
+    }
 }

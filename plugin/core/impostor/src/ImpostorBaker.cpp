@@ -223,18 +223,7 @@ namespace TreeLod
         bleedValues(albedo, covered, int(W), int(H), BLEED_RINGS, glm::vec3(0.2f));
         bleedValues(normalAo, covered, int(W), int(H), BLEED_RINGS, glm::vec3(0.0f, 0.0f, 1.0f));
 
-        TextureImage colourImage;
-        colourImage.name = "impostor colour";
-        colourImage.width = int(W);
-        colourImage.height = int(H);
-        colourImage.rgba.resize(count * 4);
-        for (std::size_t i = 0; i < count; ++i)
-        {
-            colourImage.rgba[4 * i + 0] = linearToSrgbByte(albedo[i].r);
-            colourImage.rgba[4 * i + 1] = linearToSrgbByte(albedo[i].g);
-            colourImage.rgba[4 * i + 2] = linearToSrgbByte(albedo[i].b);
-            colourImage.rgba[4 * i + 3] = unitToByte(plain.alpha[i]);
-        }
+        const TextureImage colourImage = albedoTexture("impostor colour", int(W), int(H), albedo, plain.alpha);
         MipChainOptions mips;
         mips.preserveAlphaCoverage = true;
         mips.alphaCutoff = options.alphaCutoff;

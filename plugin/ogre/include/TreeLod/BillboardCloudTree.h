@@ -2,7 +2,7 @@
 // (García et al. 2007), or as the classic billboard cloud it is compared with. MovableObject type
 // "BillboardCloudTree".
 //
-// Foliage: the asset's billboard cloud chunk (TreeAsset::getBillboardCloudGpu): the quads of
+// Foliage: the asset's billboard cloud chunk (BillboardCloudResources::getGpu): the quads of
 // all levels in one vertex buffer, one draw of one level's index range (§6). The fragment
 // shader (materials/GLSL/TreeLodBillboardCloud.frag) walks the hash/lists atlases (§5) with
 // shader LoD (§5.1); far away the material's LoD switches to the low-res technique.

@@ -1,7 +1,7 @@
 // FoliageLodTree: a tree drawn with LoDF, continuous foliage level of detail by leaf collapse
 // (Rebollo et al. 2006). MovableObject type "FoliageLodTree".
 //
-// Every leaf vertex lives on the GPU once per asset (TreeAsset::getLeafVertexData); each
+// Every leaf vertex lives on the GPU once per asset (FoliageLodResources::getLeafVertexData); each
 // instance owns one index buffer holding every cluster's region (FoliageLodData). When the
 // leaf count changes, FoliageLodState walks Changed_group (§3.3) and only the regions of the
 // clusters that changed are rewritten, with partial buffer writes (§4); one draw per leaf
@@ -20,7 +20,7 @@
 // factory), group, leaves (a fixed leaf count instead of the curve), pixelsPerLeaf (default 4),
 // quantise (N: snap to N geometric levels, see FoliageLodState::quantise; 0 = continuous).
 // A quantised instance owns no index buffer: it draws the asset's shared level
-// (TreeAsset::getFoliageLodLevel), so changing level uploads nothing and instances at one
+// (FoliageLodResources::getFoliageLodLevel), so changing level uploads nothing and instances at one
 // level draw identical geometry (what a Forest instances).
 #pragma once
 

@@ -9,6 +9,8 @@
 #include <OgreImage.h>
 #include <OgreMaterial.h>
 #include <OgreMaterialManager.h>
+#include <OgrePass.h>
+#include <OgreTechnique.h>
 #include <OgreTextureManager.h>
 
 #include <cstdint>
@@ -61,5 +63,28 @@ namespace TreeLod
                         "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
                         "TreeAsset '" + assetName + "'");
         return parent->clone(name, true, group);
+    }
+
+    /// Set every pass of `material` (loaded first) as TreeLod's Bark/Leaf programs read it: texture
+    /// unit 0 shows `texture`, fragment constants baseColour, backColour (the back face of a
+    /// leaf) and alphaCutoff.
+    inline void configureModelMaterial(const Ogre::MaterialPtr& material, const Ogre::String& texture,
+                                       const Ogre::ColourValue& baseColour, const Ogre::ColourValue& backColour,
+                                       float alphaCutoff)
+    {
+        material->load();
+        for (Ogre::Technique* tech : material->getTechniques())
+            for (Ogre::Pass* pass : tech->getPasses())
+            {
+                if (pass->getNumTextureUnitStates() > 0)
+                    pass->getTextureUnitState(0)->setTextureName(texture);
+                if (!pass->hasFragmentProgram())
+                    continue;
+                Ogre::GpuProgramParametersSharedPtr p = pass->getFragmentProgramParameters();
+                p->setIgnoreMissingParams(true);
+                p->setNamedConstant("baseColour", baseColour);
+                p->setNamedConstant("backColour", backColour);
+                p->setNamedConstant("alphaCutoff", alphaCutoff);
+            }
     }
 }

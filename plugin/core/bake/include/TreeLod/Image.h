@@ -6,6 +6,7 @@
 #include "TreeLod/Colour.h" // srgbToLinear, linearToSrgb, unitToByte: colours as the images hold them
 #include "TreeLod/GreyImage.h"
 #include "TreeLod/Result.h"
+#include "TreeLod/TreeModel.h"
 
 #include <glm/glm.hpp>
 
@@ -53,4 +54,9 @@ namespace TreeLod
     /// proportional to the texels filled. Deterministic.
     void bleedValues(std::vector<glm::vec3>& values, const std::vector<std::uint8_t>& known, int width, int height,
                      int rings, const glm::vec3& fallback);
+
+    /// A width x height RGBA8 texture `name` of linear albedo (stored as sRGB) and coverage
+    /// `alpha` in [0, 1] (stored linear), row-major: what the impostor-like bakers upload.
+    TextureImage albedoTexture(const std::string& name, int width, int height, const std::vector<glm::vec3>& albedo,
+                               const std::vector<float>& alpha);
 }

@@ -1,6 +1,6 @@
 // ImpostorData: the one-quad impostor, package chunk "impostor": the cheapest representation
-// of a tree (the Forest's "quad" level, the speed floor of `treelod bench`). The baker is
-// ImpostorBaker.h, the GPU side TreeAsset::getImpostorGpu and materials/TreeLodImpostor.*.
+// of a tree (the Forest's far level, the speed floor of `treelod bench`). The baker is
+// ImpostorBaker.h, the GPU side ImpostorResources::getGpu and materials/TreeLodImpostor.*.
 //
 // ---- The quad ---------------------------------------------------------------------------
 // A rectangle in the tree's local x-y plane, metres: x in [-halfWidth, halfWidth], y in
