@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 7's GPU benchmarks in three steps, for a session lent the device (../shared/gpu/README.md).
+# The bench's GPU runs in three steps, for a session lent the device (../shared/gpu/README.md).
 # The device gives 15 minutes in all (start-up included) and 10 minutes a command, so everything
 # that can run here does: baking, bundling, the image metrics and the plots.
 #
