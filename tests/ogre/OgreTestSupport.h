@@ -153,9 +153,12 @@ namespace TreeLod
         return double(covered) / double(image.pixels.size());
     }
 
-    inline void compareWithGolden(const Image& actual, const std::string& name, double bound)
+    /// `actual` against the golden image `golden` (a path), FLIP mean below `bound`; written to the
+    /// output folder as NAME.png (and NAME.flip.png when it fails). TREELOD_GOLDEN=update rewrites
+    /// the golden instead.
+    inline void compareWithGoldenFile(const Image& actual, const std::string& golden, const std::string& name,
+                                      double bound)
     {
-        const std::string golden = OgreEnvironment::sourcePath("tests/golden/" + name + ".png");
         const std::string actualPath = OgreEnvironment::outDir() + "/" + name + ".png";
         ASSERT_TRUE(writePng(actualPath, actual).ok());
         const char* mode = std::getenv("TREELOD_GOLDEN");
@@ -174,5 +177,11 @@ namespace TreeLod
         if (flipped->mean >= bound)
             writePng(OgreEnvironment::outDir() + "/" + name + ".flip.png", flipHeatmap(flipped.value()));
         EXPECT_LT(flipped->mean, bound) << name << ": see " << actualPath;
+    }
+
+    /// compareWithGoldenFile with tests/golden/NAME.png.
+    inline void compareWithGolden(const Image& actual, const std::string& name, double bound)
+    {
+        compareWithGoldenFile(actual, OgreEnvironment::sourcePath("tests/golden/" + name + ".png"), name, bound);
     }
 }

@@ -56,23 +56,10 @@ namespace TreeLod
             return tree;
         }
 
-        /// Golden images of this example live beside it (examples/crossed-quads/golden/NAME.png);
-        /// the same switch as tests/golden: TREELOD_GOLDEN=update rewrites them.
+        /// Golden images of this example live beside it (examples/crossed-quads/golden/NAME.png).
         void compareWithExampleGolden(const Image& actual, const std::string& name, double bound)
         {
-            const std::string golden = std::string(TREELOD_EXAMPLE_DIR) + "/golden/" + name + ".png";
-            const std::string actualPath = OgreEnvironment::outDir() + "/" + name + ".png";
-            ASSERT_TRUE(writePng(actualPath, actual).ok());
-            const char* mode = std::getenv("TREELOD_GOLDEN");
-            if (mode && std::string(mode) == "update")
-            {
-                ASSERT_TRUE(writePng(golden, actual).ok());
-                GTEST_SKIP() << "golden updated: " << golden << " (open it and look before committing)";
-            }
-            Result<Image> expected = readImage(golden);
-            ASSERT_TRUE(expected.ok()) << expected.error().message() << " (run with TREELOD_GOLDEN=update)";
-            const double error = flipMean(expected.value(), actual);
-            EXPECT_LT(error, bound) << name << ": see " << actualPath;
+            compareWithGoldenFile(actual, std::string(TREELOD_EXAMPLE_DIR) + "/golden/" + name + ".png", name, bound);
         }
 
         /// Pixels that are not background in `a`, in `b`, in both.
