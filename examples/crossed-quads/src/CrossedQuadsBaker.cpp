@@ -95,21 +95,8 @@ namespace TreeLod
                 // 2. Render along -n, white ambient light only: colour = albedo.
                 const float depth = hi.z - lo.z, pad = 0.1f * extent + 0.1f * depth;
                 const glm::vec3 middle = centre.x * r + glm::vec3(0.0f, centre.y, 0.0f);
-                CameraSpec camera;
-                camera.orthographic = true;
-                camera.position = middle + (hi.z + pad) * n;
-                camera.target = middle + (lo.z - pad) * n;
-                camera.up = glm::vec3(0.0f, 1.0f, 0.0f);
-                camera.orthoHeight = quad.top - quad.bottom;
-                camera.nearClip = 0.5f * pad;
-                camera.farClip = depth + 1.5f * pad;
-                RenderOptions render;
-                render.width = int(W);
-                render.height = int(H);
-                render.samplesPerPixel = options.samplesPerPixel;
-                render.lighting.sunColour = glm::vec3(0.0f);
-                render.lighting.ambientColour = glm::vec3(1.0f);
-                render.transparentBackground = true;
+                const CameraSpec camera = sideViewCamera(middle, n, lo.z, hi.z, quad.top - quad.bottom, pad);
+                const RenderOptions render = albedoRenderOptions(int(W), int(H), options.samplesPerPixel);
                 const RenderImages images = renderer.render(camera, render);
 
                 // 3. Bleed in linear light, then the mip chain (coverage kept) and compression.

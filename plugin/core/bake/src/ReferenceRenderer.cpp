@@ -233,4 +233,30 @@ namespace TreeLod
         });
         return out;
     }
+
+    CameraSpec sideViewCamera(const glm::vec3& middle, const glm::vec3& towards, float nearDepth, float farDepth,
+                              float height, float pad)
+    {
+        CameraSpec camera;
+        camera.orthographic = true;
+        camera.position = middle + (farDepth + pad) * towards;
+        camera.target = middle + (nearDepth - pad) * towards;
+        camera.up = glm::vec3(0.0f, 1.0f, 0.0f);
+        camera.orthoHeight = height;
+        camera.nearClip = 0.5f * pad;
+        camera.farClip = (farDepth - nearDepth) + 1.5f * pad;
+        return camera;
+    }
+
+    RenderOptions albedoRenderOptions(int width, int height, int samplesPerPixel)
+    {
+        RenderOptions render;
+        render.width = width;
+        render.height = height;
+        render.samplesPerPixel = samplesPerPixel;
+        render.lighting.sunColour = glm::vec3(0.0f);
+        render.lighting.ambientColour = glm::vec3(1.0f);
+        render.transparentBackground = true;
+        return render;
+    }
 }

@@ -153,21 +153,9 @@ namespace TreeLod
 
         // 2. Render, orthographic along -Z: white ambient light only, so colour = albedo (x AO).
         const float depth = hi.z - lo.z, pad = 0.1f * extent + 0.1f * depth;
-        CameraSpec camera;
-        camera.orthographic = true;
-        camera.position = glm::vec3(0.0f, centreY, hi.z + pad);
-        camera.target = glm::vec3(0.0f, centreY, lo.z - pad);
-        camera.up = glm::vec3(0.0f, 1.0f, 0.0f);
-        camera.orthoHeight = data.top - data.bottom;
-        camera.nearClip = 0.5f * pad;
-        camera.farClip = depth + 1.5f * pad;
-        RenderOptions render;
-        render.width = int(W);
-        render.height = int(H);
-        render.samplesPerPixel = options.samplesPerPixel;
-        render.lighting.sunColour = glm::vec3(0.0f);
-        render.lighting.ambientColour = glm::vec3(1.0f);
-        render.transparentBackground = true;
+        const CameraSpec camera = sideViewCamera(glm::vec3(0.0f, centreY, 0.0f), glm::vec3(0.0f, 0.0f, 1.0f), lo.z,
+                                                 hi.z, data.top - data.bottom, pad);
+        RenderOptions render = albedoRenderOptions(int(W), int(H), options.samplesPerPixel);
 
         AmbientOcclusion ao;
         if (options.aoRays > 0)

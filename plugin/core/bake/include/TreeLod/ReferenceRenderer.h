@@ -93,6 +93,16 @@ namespace TreeLod
         int height = 0;
     };
 
+    /// The orthographic side view that impostor-like bakers render a tree with: looking along
+    /// -`towards` (unit, horizontal) at the box whose extent along `towards` is [nearDepth,
+    /// farDepth] (farDepth nearest the camera), through `middle` (on the view axis, depth 0),
+    /// `height` metres tall, with `pad` metres of clearance in front and behind.
+    CameraSpec sideViewCamera(const glm::vec3& middle, const glm::vec3& towards, float nearDepth, float farDepth,
+                              float height, float pad);
+    /// Render options whose colour is albedo: white ambient light, no sun, a transparent
+    /// background (colour.a = coverage), `width` x `height`, `samplesPerPixel` samples.
+    RenderOptions albedoRenderOptions(int width, int height, int samplesPerPixel);
+
     /// Renders one TreeModel; build once, render many views.
     class ReferenceRenderer
     {
