@@ -3,8 +3,9 @@
 // uv4 = position (the Forest's local space) + uniform scale, uv5 = cos, sin of the rotation
 // about +Y, unused: the quad (vertex.xy, metres, facing +Z) turns about the instance's +Y axis
 // until its +Z faces the camera (a cylindrical billboard), so the tree's rotation cannot show.
-// The quad frame (right, up, towards the camera) goes to the fragment stage in world space,
-// where the baked normal is turned with it.
+// The sun's direction goes to the fragment stage in the quad frame (x right, y up, z towards
+// the camera), the frame of the baked normals: one value per quad, so the fragment stage lights
+// without turning or normalising anything.
 // CASTER: faces the light: the shadow camera's view +z (a directional light's direction) instead
 // of the camera position; passes clip z and w on.
 // SHADOW_RECEIVER: the position in the sun's shadow texture.
@@ -15,9 +16,8 @@ uniform mat4 view;
 out vec2 vClipZW;
 #else
 uniform vec4 cameraPosition; // in the Forest's local space
-out vec3 vRight;
-out vec3 vUp;
-out vec3 vTowards;
+uniform vec4 sunDirection;   // world space, towards the sun (w = 0 for a directional light)
+out vec3 vSunInQuad;
 #endif
 #ifdef SHADOW_RECEIVER
 uniform mat4 texViewProj; // the sun's shadow camera, clip space to texture space
@@ -50,9 +50,9 @@ void main()
     vClipZW = gl_Position.zw;
 #else
     mat3 toWorld = mat3(world);
-    vRight = toWorld * right;
-    vUp = toWorld * vec3(0.0, 1.0, 0.0);
-    vTowards = toWorld * towards;
+    vec3 sun = normalize(sunDirection.xyz);
+    vSunInQuad = vec3(dot(sun, normalize(toWorld * right)), dot(sun, normalize(toWorld * vec3(0.0, 1.0, 0.0))),
+                      dot(sun, normalize(toWorld * towards)));
 #endif
 #ifdef SHADOW_RECEIVER
     vShadowPos = texViewProj * (world * position);

@@ -1,10 +1,10 @@
 // treelod bench SCENE.json -o DIR [--techniques a,b] [--lod-bias 1,0.5,0.25] [--frames N] [--scale S]
 //
 // Scripted scene benchmark: the scene's camera path rendered headless for each
-// technique and LoD bias, with the polygonal reference ("mesh") and three floors in the same run:
+// technique and LoD bias, with the polygonal reference ("mesh") and four floors in the same run:
 // the Forest's one-quad level ("impostor"), one plain Ogre Entity per tree ("entities": what Ogre users
-// pay today) and every tree's quad merged into a few static batches ("merged-quads": the cheapest
-// possible drawing). The bench bakes what the runs draw (BakeCache), writes the package list and
+// pay today), every tree's quad merged into a few static batches ("merged-quads") and a plain Ogre
+// BillboardSet per species, unlit ("billboard-set": what an Ogre user writes by hand, the honest floor). The bench bakes what the runs draw (BakeCache), writes the package list and
 // runs treelod_frames, which renders and times the frames and links no baker (docs/architecture.md, "Runtime
 // vs bake"); then it compares the frames treelod_frames saved. Per frame: CPU time (until the
 // frame's commands are submitted), frame time bounded by a one-pixel read-back (Ogre's GL3Plus
@@ -147,7 +147,8 @@ namespace TreeLod
                 {REFERENCE_TECHNIQUE, "polygonal reference (mesh, 1 spp)"},
                 {FLOOR_TECHNIQUE, "floor: the Forest's one-quad level"},
                 {"entities", "floor: one Ogre entity per tree (a quad)"},
-                {"merged-quads", "floor: quads merged into a few batches"}};
+                {"merged-quads", "floor: quads merged into a few batches"},
+                {"billboard-set", "floor: a plain Ogre BillboardSet (unlit)"}};
             return runs;
         }
         bool isComparisonRun(const std::string& technique)

@@ -12,7 +12,7 @@
 //
 // Runs per tree count: the polygonal reference ("mesh"), the floors ("impostor": the Forest's one-quad
 // level; "entities": one Ogre Entity per tree; "merged-quads": all quads merged into a few static
-// batches), then every technique at every LoD bias. Writes DIR/timings.json (per run: per frame
+// batches; "billboard-set": a plain Ogre BillboardSet per species, unlit), then every technique at every LoD bias. Writes DIR/timings.json (per run: per frame
 // CPU ms, frame ms (bounded by a one-pixel read-back), batches, triangles, visible trees, trees per
 // level, bytes uploaded, pending levels; run totals: GPU bytes, instance bytes, resident memory) and,
 // on sampled frames, PNGs under DIR/images: the reference supersampled 2x2 and every run at one
@@ -125,8 +125,6 @@ namespace TreeLod
             return std::to_string(trees) + "-" + technique + "-" + biasText(bias) + "-" + std::to_string(frame);
         }
 
-        bool isFloor(const std::string& technique) { return technique == "entities" || technique == "merged-quads"; }
-
         int runFrames(const FramesArgs& args)
         {
             // The renderer first: readGreyImageOgre (heightfields) needs Ogre's image codecs.
@@ -155,7 +153,7 @@ namespace TreeLod
                 if (t != "auto" && bakeTechniqueOf(t).empty())
                     return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: " +
                                                                    knownSceneTechniques() + ")"));
-                if (args.skipComparisons || (t != REFERENCE_TECHNIQUE && t != FLOOR_TECHNIQUE && !isFloor(t)))
+                if (args.skipComparisons || (t != REFERENCE_TECHNIQUE && t != FLOOR_TECHNIQUE && !isQuadFloor(t)))
                     techniques.push_back(t); // otherwise run once below, with the comparisons
             }
             std::vector<std::uint32_t> counts = script.counts;
@@ -233,7 +231,8 @@ namespace TreeLod
                 options.uploadBudget = args.uploadBudget;
                 std::vector<std::pair<std::string, std::vector<float>>> plan;
                 if (!args.skipComparisons)
-                    plan = {{REFERENCE_TECHNIQUE, {1.0f}}, {FLOOR_TECHNIQUE, {1.0f}}, {"entities", {1.0f}}, {"merged-quads", {1.0f}}};
+                    plan = {{REFERENCE_TECHNIQUE, {1.0f}}, {FLOOR_TECHNIQUE, {1.0f}}, {"entities", {1.0f}}, {"merged-quads", {1.0f}},
+                            {"billboard-set", {1.0f}}};
                 for (const std::string& t : techniques)
                     plan.push_back({t, biases});
                 for (const auto& [technique, runBiases] : plan)
@@ -300,7 +299,7 @@ namespace TreeLod
                                 row["frameMs"] = timing.frameMilliseconds;
                                 row["batches"] = timing.batches;
                                 row["triangles"] = timing.triangles;
-                                if (!isFloor(technique))
+                                if (!isQuadFloor(technique))
                                 {
                                     row["visible"] = stats.visibleInstances;
                                     row["levels"] = levelHistogram(scene->getForest());
@@ -369,7 +368,7 @@ int main(int argc, char** argv)
     app.add_option("--packages", args.packages, "package list written by `treelod bench` (packages.json)")->required();
     app.add_option("-o,--output", args.output, "output directory (timings.json, images/)")->required();
     app.add_option("--techniques", args.techniques,
-                   "techniques besides the reference (mesh) and the floors (quad, entities, merged-quads)")
+                   "techniques besides the reference (mesh) and the floors (impostor, entities, merged-quads, billboard-set)")
         ->capture_default_str();
     app.add_option("--lod-bias", args.lodBiases, "comma-separated LoD biases")->capture_default_str();
     app.add_option("--frames", args.frames, "frames along the path (default: the script's)");

@@ -22,15 +22,15 @@ plot() {
   if [ $plotted = 1 ]; then png "$dir/$name.png"; fi
 }
 
-# 1. One tree: reference, the three floors and auto at two biases over 6 frames.
+# 1. One tree: reference, the four floors and auto at two biases over 6 frames.
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/single" --frames 6 --size 160x90 \
   --techniques auto --lod-bias 1,0.5 --samples 2 --upload-budget 1 --cache "$cache" -q
 for f in frames.csv summary.json plots.json; do [ -s "$out/single/$f" ] || fail "single/$f missing"; done
-# frame time: the reference, 3 floors and auto at bias 1, 6 frames each; trade: 4 points + auto at 2 biases.
-plot "$out/single" frame-time 30; plot "$out/single" trade 6
+# frame time: the reference, 4 floors and auto at bias 1, 6 frames each; trade: 5 points + auto at 2 biases.
+plot "$out/single" frame-time 36; plot "$out/single" trade 7
 rows=$(($(wc -l < "$out/single/frames.csv") - 1))
-[ "$rows" = 36 ] || fail "frames.csv has $rows rows, expected (mesh + 3 floors + auto x 2 biases) x 6 = 36"
-for t in mesh impostor entities merged-quads auto; do
+[ "$rows" = 42 ] || fail "frames.csv has $rows rows, expected (mesh + 4 floors + auto x 2 biases) x 6 = 42"
+for t in mesh impostor entities merged-quads billboard-set auto; do
   n=$(awk -F, -v t=$t 'NR > 1 && $2 == t' "$out/single/frames.csv" | wc -l)
   want=6; [ $t = auto ] && want=12
   [ "$n" = "$want" ] || fail "technique $t has $n rows, expected $want"
@@ -40,15 +40,15 @@ awk -F, 'NR > 1 && ($6 != 1 || $9 < 1 || $8 <= 0) { bad = 1; print } END { exit 
   || fail "untimed or empty frames above"
 # Sampled frames carry FLIP for every technique; the floor's error is larger than auto's at bias 1.
 n=$(awk -F, 'NR > 1 && $13 != ""' "$out/single/frames.csv" | wc -l)
-[ "$n" = 12 ] || fail "$n frames with FLIP, expected 2 samples x 6 runs = 12"
+[ "$n" = 14 ] || fail "$n frames with FLIP, expected 2 samples x 7 runs = 14"
 grep -q '"technique": "auto"' "$out/single/summary.json" || fail "summary lacks auto"
 grep -q '"speedupVsReference": [0-9]' "$out/single/summary.json" || fail "summary has no measured speedup"
 grep -q '"ratioToFloor": [0-9]' "$out/single/summary.json" || fail "summary has no ratio to the floor"
-[ "$(grep -c '"lodBias"' "$out/single/summary.json")" = 6 ] || fail "summary should have 6 results"
+[ "$(grep -c '"lodBias"' "$out/single/summary.json")" = 7 ] || fail "summary should have 7 results"
 # The frames came from treelod_frames (which links no baker) through the package list.
 for f in packages.json timings.json; do [ -s "$out/single/$f" ] || fail "single/$f missing"; done
 grep -q '"format": "treelod-package-list"' "$out/single/packages.json" || fail "packages.json is not a package list"
-for floor in impostor entities merged-quads; do
+for floor in impostor entities merged-quads billboard-set; do
   grep -q "\"$floor\": [0-9]" "$out/single/summary.json" || fail "summary has no ratio to the $floor floor"
 done
 grep -q '"worstFrame": {' "$out/single/summary.json" || fail "summary does not record the worst frame"
@@ -87,13 +87,13 @@ grep -q '"bake"' "$out/single2/summary.json" && ! grep -q ': baked' "$out/single
 "$treelod" bench "$src/samples/scenes/table2.json" -o "$out/table2" --scale 0.1 --counts 1,50 --frames 3 \
   --size 128x96 --techniques billboard-cloud --lod-bias 1 --samples 1 --cache "$cache" -q
 for f in frames.csv summary.json plots.json; do [ -s "$out/table2/$f" ] || fail "table2/$f missing"; done
-plot "$out/table2" trees 10 # 5 runs at bias 1 x 2 counts
+plot "$out/table2" trees 12 # 6 runs at bias 1 x 2 counts
 counts=$(awk -F, 'NR > 1 { print $1 }' "$out/table2/frames.csv" | sort -n | uniq)
 [ "$(echo $counts)" = "1 6" ] || fail "tree counts '$(echo $counts)', expected '1 6'"
 for c in $counts; do
   n=$(awk -F, -v c=$c 'NR > 1 && $1 == c' "$out/table2/frames.csv" | wc -l)
-  [ "$n" = 15 ] || fail "$c trees: $n rows, expected 5 runs x 3 frames"
-  plot "$out/table2" trade-$c 5; plot "$out/table2" frame-time-$c 15
+  [ "$n" = 18 ] || fail "$c trees: $n rows, expected 6 runs x 3 frames"
+  plot "$out/table2" trade-$c 6; plot "$out/table2" frame-time-$c 18
   grep -Eq "\"trees\": $c,?\$" "$out/table2/summary.json" || fail "summary lacks $c trees"
 done
 

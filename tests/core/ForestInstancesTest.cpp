@@ -484,6 +484,53 @@ namespace TreeLod
         }
     }
 
+    TEST(ForestInstances, bucketsComeNearFirst)
+    {
+        // Within each bucket, instances are ordered by distance class: a later one is never nearer
+        // than an earlier one by more than a class spans (sqrt(1.25) in distance), so drawing a bucket
+        // in order lets the depth test reject what nearer trees hide.
+        std::mt19937 rng(21);
+        ForestInstances forest;
+        addKinds(forest);
+        ASSERT_TRUE(forest.add(randomInstances(rng, 4000, 1500.0f, forest.getKindCount())));
+        const glm::vec3 eye(-700.0f, 30.0f, 100.0f);
+        const glm::mat4 view = glm::lookAt(eye, glm::vec3(500.0f, 0.0f, -200.0f), glm::vec3(0, 1, 0));
+        ForestVisibility vis;
+        ASSERT_TRUE(forest.cull(
+            CullCamera::fromMatrices(view, glm::perspective(glm::radians(70.0f), 1.5f, 0.5f, 5000.0f), 768, 512), 1.0f,
+            vis));
+        ASSERT_GT(vis.getVisibleCount(), 800u);
+        const float classSpan = std::sqrt(1.25f) * 1.0001f;
+        std::size_t checked = 0, bucketsChecked = 0;
+        for (std::size_t b = 0; b < vis.getBucketCount(); ++b)
+        {
+            const ForestBucket& bucket = vis.getBucket(b);
+            const std::uint32_t* indices = vis.getBucketIndices(b);
+            float farthest = 0.0f;
+            for (std::uint32_t j = 0; j < bucket.count; ++j)
+            {
+                const float d = glm::length(forest.getAt(indices[j]).position - eye);
+                EXPECT_GE(std::max(d, 1.0f) * classSpan, farthest) << "bucket " << b << " position " << j;
+                farthest = std::max(farthest, d);
+                ++checked;
+            }
+            bucketsChecked += bucket.count > 10;
+        }
+        EXPECT_EQ(checked, vis.getVisibleCount());
+        EXPECT_GE(bucketsChecked, 2u);
+        // Input order is not near first (the test would pass trivially otherwise).
+        const std::vector<ForestInstance> all = [&] {
+            std::vector<ForestInstance> out;
+            for (std::size_t i = 0; i < forest.size(); ++i)
+                out.push_back(forest.getAt(i));
+            return out;
+        }();
+        std::size_t inversions = 0;
+        for (std::size_t i = 1; i < all.size(); ++i)
+            inversions += glm::length(all[i].position - eye) * classSpan < glm::length(all[i - 1].position - eye);
+        EXPECT_GT(inversions, all.size() / 10);
+    }
+
     TEST(ForestInstances, secondCullWithTheSameCountsAllocatesNothing)
     {
         std::mt19937 rng(9);

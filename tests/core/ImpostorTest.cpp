@@ -436,24 +436,28 @@ namespace TreeLod
         }
     }
 
-    TEST(ImpostorBaker, defaultBakeIsDxtSmallAndKeepsTheCoverage)
+    TEST(ImpostorBaker, defaultBakeIsRgba8AndDxtKeepsTheCoverage)
     {
         ImpostorOptions options;
         options.aoRays = 4; // the default's AO costs time, not bytes
         const TreeModel& m = generatedOak(1500);
+        const ImpostorData raw = bakeOrFail(m, options);
+        EXPECT_EQ(raw.colour.format, GpuTextureFormat::RGBA8);
+        EXPECT_EQ(raw.normal.format, GpuTextureFormat::RGBA8);
+        EXPECT_EQ(std::max(raw.colour.width, raw.colour.height), 256u);
+        EXPECT_EQ(raw.colour.mipCount, fullMipCount(raw.colour.width, raw.colour.height));
+        EXPECT_EQ(raw.gpuBytes(), raw.colour.data.size() + raw.normal.data.size());
+        EXPECT_LT(raw.gpuBytes(), 800u * 1024u);
+
+        // compress = true: DXT5 + DXT1, a quarter of the bytes, keeping the alpha test's answer:
+        // level 0 decompressed against the default RGBA8 bake.
+        options.compress = true;
         const ImpostorData d = bakeOrFail(m, options);
         EXPECT_EQ(d.colour.format, GpuTextureFormat::DXT5);
         EXPECT_EQ(d.normal.format, GpuTextureFormat::DXT1);
-        EXPECT_EQ(std::max(d.colour.width, d.colour.height), 256u);
-        EXPECT_EQ(d.colour.mipCount, fullMipCount(d.colour.width, d.colour.height));
-        EXPECT_EQ(d.gpuBytes(), d.colour.data.size() + d.normal.data.size());
         EXPECT_LT(d.gpuBytes(), 200u * 1024u);
-        std::cout << "[ bytes    ] default impostor " << d.colour.width << "x" << d.colour.height << ": "
-                  << d.gpuBytes() << " bytes\n";
-
-        // DXT5 keeps the alpha test's answer: level 0 decompressed against the same bake in RGBA8.
-        options.compress = false;
-        const ImpostorData raw = bakeOrFail(m, options);
+        std::cout << "[ bytes    ] impostor " << d.colour.width << "x" << d.colour.height << ": " << raw.gpuBytes()
+                  << " bytes RGBA8 (default), " << d.gpuBytes() << " bytes DXT\n";
         ASSERT_EQ(raw.colour.width, d.colour.width);
         GpuTexture colour = raw.colour, normal = raw.normal;
         squish::DecompressImage(colour.data.data(), int(d.colour.width), int(d.colour.height), d.colour.data.data(),
@@ -498,6 +502,6 @@ namespace TreeLod
         ASSERT_TRUE(bytes.ok());
         Result<ImpostorData> decoded = decodeImpostorChunk(bytes.value(), "leaf.treelod");
         ASSERT_TRUE(decoded.ok()) << decoded.error().message();
-        EXPECT_EQ(decoded->colour.format, GpuTextureFormat::DXT5);
+        EXPECT_EQ(decoded->colour.format, GpuTextureFormat::RGBA8);
     }
 }

@@ -1092,6 +1092,81 @@ namespace TreeLod
         }
     }
 
+    TEST(Forest, billboardSetFloorCoversWhatTheQuadLevelCovers)
+    {
+        // The plain Ogre BillboardSet floor: the impostor's colour unlit, so its shading differs,
+        // but its quads stand where the quad level's stand: the same pixels covered.
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+        const CameraSpec view = look(glm::vec3(1.5f * h, 3.0f * h, 5.5f * h), glm::vec3(0.0f, 0.2f * h, 0.0f));
+        std::vector<ForestInstance> trees = grid(4, 1.3f * h);
+        for (std::size_t i = 0; i < trees.size(); ++i)
+            trees[i].scale = 0.8f + 0.05f * float(i % 8); // per-billboard sizes
+        Forest* forest = placeForest();
+        forest->addSpecies(tree.asset, {ForestLevel{"impostor", 0, false, 0.0f}});
+        forest->addInstances(trees);
+        const Image quads = toImage(r.render(view, 256, 192, 1));
+        r.clearContent();
+        Ogre::SceneManager& sm = r.getSceneManager();
+        Image sets;
+        {
+            BillboardSetFloor floor(sm, r.getContentNode(), {tree.asset}, trees);
+            ASSERT_EQ(floor.getSetCount(), 1u);
+            EXPECT_EQ(floor.getSet(0).getNumBillboards(), int(trees.size()));
+            EXPECT_FALSE(floor.getSet(0).getCastShadows());
+            EXPECT_GT(floor.getGpuBytes(), trees.size() * 4 * 24);
+            sets = toImage(r.render(view, 256, 192, 1));
+        }
+        writePng(OgreEnvironment::outDir() + "/forest-billboard-set-floor.png", sideBySide({quads, sets}));
+        std::size_t both = 0, either = 0;
+        for (std::size_t i = 0; i < quads.pixels.size(); ++i)
+        {
+            const bool a = glm::length(glm::vec3(quads.pixels[i]) - BACKGROUND) > 0.02f;
+            const bool b = glm::length(glm::vec3(sets.pixels[i]) - BACKGROUND) > 0.02f;
+            both += a && b;
+            either += a || b;
+        }
+        ASSERT_GT(either, 0u);
+        const double overlap = double(both) / double(either);
+        std::printf("billboard-set floor vs quad level: covered pixels overlap %.4f\n", overlap);
+        EXPECT_GT(treeCoverage(sets, BACKGROUND), 0.1);
+        EXPECT_GE(overlap, 0.97);
+        compareWithGolden(sets, "forest-billboard-set", 0.02);
+
+        // Sets of at most MAX_SET_TREES billboards; two species; none; an unknown species.
+        const std::vector<ForestInstance> many = grid(130, 1.3f * h); // 16,900 trees
+        std::vector<ForestInstance> two = many;
+        for (std::size_t i = 0; i < two.size(); i += 2)
+            two[i].kind = 1;
+        {
+            BillboardSetFloor floor(sm, r.getContentNode(), {tree.asset}, many);
+            EXPECT_EQ(floor.getSetCount(), 2u);
+            std::size_t billboards = 0;
+            for (std::size_t i = 0; i < floor.getSetCount(); ++i)
+            {
+                EXPECT_LE(std::size_t(floor.getSet(i).getNumBillboards()), BillboardSetFloor::MAX_SET_TREES);
+                billboards += std::size_t(floor.getSet(i).getNumBillboards());
+            }
+            EXPECT_EQ(billboards, many.size());
+        }
+        {
+            BillboardSetFloor floor(sm, r.getContentNode(), {tree.asset, tree.asset}, two);
+            EXPECT_EQ(floor.getSetCount(), 2u);
+            BillboardSetFloor none(sm, r.getContentNode(), {tree.asset}, {});
+            EXPECT_EQ(none.getSetCount(), 0u);
+        }
+        try
+        {
+            BillboardSetFloor floor(sm, r.getContentNode(), {tree.asset}, two);
+            ADD_FAILURE() << "species 1 of 1 was accepted";
+        }
+        catch (const Ogre::Exception& e)
+        {
+            EXPECT_NE(e.getDescription().find("species 1 of 1"), std::string::npos) << e.getDescription();
+        }
+    }
+
     TEST(Forest, levelsBecomeResidentWithinTheUploadBudget)
     {
         const ForestTree& tree = oak();

@@ -9,6 +9,7 @@
 #include "TreeLod/ImpostorData.h"
 #include "TreeLod/ImpostorResources.h"
 #include "TreeLod/ImpostorTree.h"
+#include "TreeLod/TechniqueSupport.h"
 #include "TreeLod/PackageWriter.h"
 #include "TreeLod/TreeAssetManager.h"
 #include "TreeLod/TreeGenerator.h"
@@ -205,7 +206,7 @@ namespace TreeLod
         ASSERT_TRUE(gpu.indexBuffer);
         EXPECT_EQ(gpu.indexBuffer->getNumIndexes(), 6u);
         EXPECT_EQ(gpu.gpuBytes, t.data.gpuBytes() + 4 * 5 * sizeof(float) + 6 * 2);
-        EXPECT_LT(gpu.gpuBytes, 200u * 1024u);
+        EXPECT_LT(gpu.gpuBytes, 800u * 1024u); // RGBA8 by default (ImpostorOptions::compress)
 
         for (const auto& [name, chunk] : {std::make_pair(gpu.texture, &t.data.colour),
                                           std::make_pair(gpu.normalTexture, &t.data.normal)})
@@ -215,7 +216,7 @@ namespace TreeLod
             EXPECT_EQ(texture->getWidth(), chunk->width);
             EXPECT_EQ(texture->getHeight(), chunk->height);
             EXPECT_EQ(texture->getNumMipmaps() + 1, chunk->mipCount);
-            EXPECT_EQ(texture->getFormat(), chunk == &t.data.colour ? Ogre::PF_DXT5 : Ogre::PF_DXT1);
+            EXPECT_EQ(texture->getFormat(), ogreFormat(chunk->format));
         }
         for (const Ogre::String& name : {gpu.material, gpu.shadowedMaterial})
         {
@@ -359,6 +360,42 @@ namespace TreeLod
             EXPECT_LT(error, 0.002) << "view " << i;
         }
         compareWithGolden(trees[1], "oak-impostor-tree", 0.02);
+    }
+
+    // The DXT-compressed impostor (ImpostorOptions::compress, off by default) draws what the
+    // default RGBA8 one draws, through the same materials.
+    TEST(Impostor, compressedImpostorDrawsWhatTheDefaultDraws)
+    {
+        const BakedOak& t = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        r.setShadows(false);
+        ImpostorOptions options;
+        options.aoRays = 8;
+        options.compress = true;
+        Result<ImpostorData> data = bakeImpostor(t.model, options, "oak");
+        ASSERT_TRUE(data.ok()) << data.error().message();
+        ASSERT_EQ(data->colour.format, GpuTextureFormat::DXT5);
+        PackageWriter writer;
+        ASSERT_TRUE(addReferenceChunk(writer, t.model, "oak").ok());
+        ASSERT_TRUE(writer.addChunk(IMPOSTOR_CHUNK, 0, IMPOSTOR_CHUNK_FORMAT_VERSION, encodeImpostorChunk(*data)).ok());
+        TreeAssetPtr dxt =
+            TreeAssetManager::getSingleton().loadFromBytes("oak-dxt.impostor-test", Ogre::RGN_DEFAULT, writer.toBytes());
+        const CameraSpec camera = view(t.model, 120.0f);
+        std::vector<Image> images;
+        for (const TreeAssetPtr& asset : {t.asset, dxt})
+        {
+            const Ogre::NameValuePairList params = {{"asset", asset->getName()}, {"group", asset->getGroup()}};
+            r.getContentNode().attachObject(r.getSceneManager().createMovableObject(
+                "oak-impostor-format", ImpostorTreeFactory::FACTORY_TYPE_NAME, &params));
+            images.push_back(toImage(r.render(camera, 160, 160, 2)));
+            r.clearContent();
+        }
+        TreeAssetManager::getSingleton().remove(dxt);
+        writePng(OgreEnvironment::outDir() + "/impostor-rgba8-vs-dxt.png", sideBySide(images));
+        EXPECT_GT(treeCoverage(images[1], BACKGROUND), 0.08);
+        const double error = flipMean(images[0], images[1]);
+        std::printf("DXT against RGBA8 impostor: FLIP %.4f\n", error);
+        EXPECT_LT(error, 0.03);
     }
 
     // A missing asset parameter and an asset without the chunk are named.

@@ -81,7 +81,10 @@ namespace TreeLod
         return info && info->forestLevels ? info->chunkTechnique : "";
     }
 
-    bool isQuadFloor(const std::string& technique) { return technique == "entities" || technique == "merged-quads"; }
+    bool isQuadFloor(const std::string& technique)
+    {
+        return technique == "entities" || technique == "merged-quads" || technique == "billboard-set";
+    }
 
     std::string knownSceneTechniques()
     {
@@ -89,7 +92,7 @@ namespace TreeLod
         for (const TechniqueInfo& t : TechniqueRegistry::getSingleton().getTechniques())
             if (t.forestLevels)
                 known += t.name + ", ";
-        return known + "entities, merged-quads";
+        return known + "entities, merged-quads, billboard-set";
     }
 
     std::map<std::string, std::vector<std::string>> scenePackages(const SceneScript& script,
@@ -277,6 +280,8 @@ namespace TreeLod
             mEntityFloor = std::make_unique<EntityFloor>(mSceneManager, *mForestNode, mAssets, instances);
         else if (mTechnique == "merged-quads")
             mMergedQuadFloor = std::make_unique<MergedQuadFloor>(mSceneManager, *mForestNode, mAssets, instances);
+        else if (mTechnique == "billboard-set")
+            mBillboardSetFloor = std::make_unique<BillboardSetFloor>(mSceneManager, *mForestNode, mAssets, instances);
         else
             mForest->addInstances(instances);
     }
@@ -285,6 +290,7 @@ namespace TreeLod
     {
         mEntityFloor.reset();
         mMergedQuadFloor.reset();
+        mBillboardSetFloor.reset();
         if (mForest)
         {
             mForestNode->detachAllObjects();
@@ -365,6 +371,8 @@ namespace TreeLod
             return mEntityFloor->getGpuBytes();
         if (mMergedQuadFloor)
             return mMergedQuadFloor->getGpuBytes();
+        if (mBillboardSetFloor)
+            return mBillboardSetFloor->getGpuBytes();
         return mForest ? mForest->getGpuBytes() : 0;
     }
 }

@@ -1,12 +1,17 @@
 #include "TreeLod/QuadFloors.h"
 
 #include "TreeLod/ImpostorResources.h"
+#include "TreeLod/TechniqueSupport.h"
 
+#include <OgreBillboard.h>
 #include <OgreEntity.h>
 #include <OgreHardwareBufferManager.h>
+#include <OgreMaterialManager.h>
 #include <OgreMeshManager.h>
+#include <OgrePass.h>
 #include <OgreSceneNode.h>
 #include <OgreSubMesh.h>
+#include <OgreTechnique.h>
 
 #include <algorithm>
 #include <cmath>
@@ -100,6 +105,37 @@ namespace TreeLod
             return mesh;
         }
 
+        /// The trees of species `kind` in batches of at most `maxTrees`, each a compact patch: sorted
+        /// into square cells holding about maxTrees trees each (row by row), then cut in order, so
+        /// that culling skips whole batches.
+        std::vector<std::vector<const ForestInstance*>> spatialBatches(const std::vector<ForestInstance>& instances,
+                                                                       std::size_t kind, std::size_t maxTrees)
+        {
+            std::vector<const ForestInstance*> trees;
+            glm::vec2 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+            for (const ForestInstance& tree : instances)
+                if (tree.kind == kind)
+                {
+                    trees.push_back(&tree);
+                    lo = glm::min(lo, glm::vec2(tree.position.x, tree.position.z));
+                    hi = glm::max(hi, glm::vec2(tree.position.x, tree.position.z));
+                }
+            const float cells = std::max(1.0f, std::sqrt(float(trees.size()) / float(maxTrees)));
+            const glm::vec2 cell = glm::max((hi - lo) / cells, glm::vec2(1e-3f));
+            auto key = [&](const ForestInstance* t) {
+                const int x = std::min(int(cells) - 1, int((t->position.x - lo.x) / cell.x));
+                const int z = std::min(int(cells) - 1, int((t->position.z - lo.y) / cell.y));
+                return z * int(cells) + x;
+            };
+            std::stable_sort(trees.begin(), trees.end(),
+                             [&](const ForestInstance* a, const ForestInstance* b) { return key(a) < key(b); });
+            std::vector<std::vector<const ForestInstance*>> batches;
+            for (std::size_t i = 0; i < trees.size(); i += maxTrees)
+                batches.emplace_back(trees.begin() + std::ptrdiff_t(i),
+                                     trees.begin() + std::ptrdiff_t(std::min(trees.size(), i + maxTrees)));
+            return batches;
+        }
+
         std::uint64_t meshBytes(const Ogre::MeshPtr& mesh)
         {
             const Ogre::SubMesh* sub = mesh->getSubMesh(0);
@@ -179,47 +215,15 @@ namespace TreeLod
         const bool shadowed = useShadowedMaterials(sceneManager);
         mGpuBytes = textureBytes(gpus);
         mNode = parent.createChildSceneNode();
-        // Trees of a species sorted into square cells holding about BATCH_TREES trees each (row by
-        // row), then cut into batches: a batch covers a compact patch, so culling skips batches.
         for (std::size_t s = 0; s < assets.size(); ++s)
-        {
-            std::vector<const ForestInstance*> trees;
-            glm::vec2 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-            for (const ForestInstance& tree : instances)
-                if (tree.kind == s)
-                {
-                    trees.push_back(&tree);
-                    lo = glm::min(lo, glm::vec2(tree.position.x, tree.position.z));
-                    hi = glm::max(hi, glm::vec2(tree.position.x, tree.position.z));
-                }
-            const float cells = std::max(1.0f, std::sqrt(float(trees.size()) / float(BATCH_TREES)));
-            const glm::vec2 cell = glm::max((hi - lo) / cells, glm::vec2(1e-3f));
-            auto key = [&](const ForestInstance* t) {
-                const int x = std::min(int(cells) - 1, int((t->position.x - lo.x) / cell.x));
-                const int z = std::min(int(cells) - 1, int((t->position.z - lo.y) / cell.y));
-                return z * int(cells) + x;
-            };
-            std::stable_sort(trees.begin(), trees.end(),
-                             [&](const ForestInstance* a, const ForestInstance* b) { return key(a) < key(b); });
-            std::vector<const ForestInstance*> batch;
-            auto flush = [&] {
-                if (batch.empty())
-                    return;
+            for (const std::vector<const ForestInstance*>& batch : spatialBatches(instances, s, BATCH_TREES))
+            {
                 mMeshes.push_back(buildQuadMesh(uniqueName("MergedQuads"), assets[s]->getGroup(), *gpus[s], batch,
                                                 shadowed ? gpus[s]->shadowedMaterial : gpus[s]->material));
                 mGpuBytes += meshBytes(mMeshes.back());
                 mEntities.push_back(sceneManager.createEntity(mMeshes.back()));
                 mNode->attachObject(mEntities.back());
-                batch.clear();
-            };
-            for (const ForestInstance* tree : trees)
-            {
-                batch.push_back(tree);
-                if (batch.size() == BATCH_TREES)
-                    flush();
             }
-            flush();
-        }
     }
 
     MergedQuadFloor::~MergedQuadFloor()
@@ -230,5 +234,84 @@ namespace TreeLod
         mSceneManager.destroySceneNode(mNode);
         for (const Ogre::MeshPtr& mesh : mMeshes)
             Ogre::MeshManager::getSingleton().remove(mesh);
+    }
+
+    BillboardSetFloor::BillboardSetFloor(Ogre::SceneManager& sceneManager, Ogre::SceneNode& parent,
+                                         const std::vector<TreeAssetPtr>& assets,
+                                         const std::vector<ForestInstance>& instances)
+        : mSceneManager(sceneManager)
+    {
+        const std::vector<const ImpostorGpu*> gpus = impostors(assets, instances, "BillboardSetFloor");
+        mNode = parent.createChildSceneNode();
+        try
+        {
+            for (std::size_t s = 0; s < assets.size(); ++s)
+            {
+                // The impostor's colour as a plain (not sRGB) texture: written as it is read, unlit.
+                const ImpostorData& data = ImpostorResources::of(*assets[s]).getData();
+                const Ogre::String texture = uniqueName("BillboardSetFloorColour");
+                uploadTexture(texture, assets[s]->getGroup(), data.colour);
+                mTextures.push_back(Ogre::TextureManager::getSingleton().getByName(texture, assets[s]->getGroup()));
+                mGpuBytes += data.colour.data.size();
+                mMaterials.push_back(cloneBaseMaterial("TreeLod/BillboardSetFloor", uniqueName("BillboardSetFloor"),
+                                                       assets[s]->getGroup(), assets[s]->getName()));
+                Ogre::Pass* pass = mMaterials.back()->getTechnique(0)->getPass(0);
+                pass->getTextureUnitState("Colour")->setTexture(mTextures.back());
+                pass->setAlphaRejectSettings(Ogre::CMPF_GREATER_EQUAL,
+                                             std::uint8_t(std::lround(255.0f * data.alphaCutoff)));
+                pass->getFragmentProgramParameters()->setNamedConstant("alphaCutoff", data.alphaCutoff);
+                mMaterials.back()->load();
+
+                const float width = 2.0f * gpus[s]->halfWidth, height = gpus[s]->top - gpus[s]->bottom;
+                const float centre = 0.5f * (gpus[s]->top + gpus[s]->bottom);
+                for (const std::vector<const ForestInstance*>& trees : spatialBatches(instances, s, MAX_SET_TREES))
+                {
+                    Ogre::BillboardSet* set = sceneManager.createBillboardSet(unsigned(trees.size()));
+                    mSets.push_back(set);
+                    set->setAutoextend(false);
+                    set->setBillboardType(Ogre::BBT_ORIENTED_COMMON); // upright, turned towards the camera
+                    set->setCommonDirection(Ogre::Vector3::UNIT_Y);
+                    set->setUseAccurateFacing(true); // towards the camera's position, as the quad level
+                    set->setBillboardOrigin(Ogre::BBO_CENTER);
+                    set->setCastShadows(false);
+                    set->setMaterial(mMaterials.back());
+                    float largest = 0.0f;
+                    for (const ForestInstance* tree : trees)
+                        largest = std::max(largest, tree->scale);
+                    set->setDefaultDimensions(largest * width, largest * height); // bounds of the set
+                    for (const ForestInstance* tree : trees)
+                        set->createBillboard(tree->position.x, tree->position.y + tree->scale * centre, tree->position.z)
+                            ->setDimensions(tree->scale * width, tree->scale * height);
+                    mNode->attachObject(set);
+                    // Position, colour, uv per vertex; four vertices and six 16-bit indices per billboard.
+                    mGpuBytes += trees.size() * (4 * (3 * sizeof(float) + 4 + 2 * sizeof(float)) + 6 * 2);
+                }
+            }
+        }
+        catch (...)
+        {
+            release();
+            throw;
+        }
+    }
+
+    BillboardSetFloor::~BillboardSetFloor() { release(); }
+
+    void BillboardSetFloor::release()
+    {
+        if (!mNode)
+            return;
+        mNode->detachAllObjects();
+        for (Ogre::BillboardSet* set : mSets)
+            mSceneManager.destroyBillboardSet(set);
+        mSets.clear();
+        mSceneManager.destroySceneNode(mNode);
+        mNode = nullptr;
+        for (const Ogre::MaterialPtr& material : mMaterials)
+            Ogre::MaterialManager::getSingleton().remove(material);
+        mMaterials.clear();
+        for (const Ogre::TexturePtr& texture : mTextures)
+            Ogre::TextureManager::getSingleton().remove(texture);
+        mTextures.clear();
     }
 }

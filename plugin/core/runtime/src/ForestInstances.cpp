@@ -4,8 +4,10 @@
 #include <glm/gtc/constants.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
@@ -108,8 +110,10 @@ namespace TreeLod
     std::size_t ForestVisibility::getCapacityBytes() const
     {
         return mBuckets.capacity() * sizeof(ForestBucket) +
-               (mIndices.capacity() + mVisible.capacity() + mVisibleBucket.capacity() + mCursor.capacity()) *
+               (mIndices.capacity() + mVisible.capacity() + mVisibleBucket.capacity() + mCursor.capacity() +
+                mNearFirst.capacity()) *
                    sizeof(std::uint32_t) +
+               mVisibleClass.capacity() +
                mTransforms.capacity() * sizeof(float);
     }
 
@@ -437,6 +441,8 @@ namespace TreeLod
         {
             out.mVisible.resize(n);
             out.mVisibleBucket.resize(n);
+            out.mVisibleClass.resize(n);
+            out.mNearFirst.resize(n);
         }
         out.mBuckets.resize(mBucketCount);
         out.mCursor.assign(mBucketCount, 0u);
@@ -465,6 +471,8 @@ namespace TreeLod
         const float* tables = mKindTable.data();
         std::uint32_t* visible = out.mVisible.data();
         std::uint32_t* visibleBucket = out.mVisibleBucket.data();
+        std::uint8_t* visibleClass = out.mVisibleClass.data();
+        std::array<std::uint32_t, ForestVisibility::DISTANCE_CLASSES> classCounts{};
         std::uint32_t* counts = out.mCursor.data();
         std::uint32_t visibleCount = 0;
         const float* blocks = mBlockBounds.data();
@@ -501,10 +509,18 @@ namespace TreeLod
             if (!visibleSphere)
                 continue;
             const float dx = px[i] - eye.x, dy = py[i] - eye.y, dz = pz[i] - eye.z;
-            const float key = lodKey(dx * dx + dy * dy + dz * dz, r, kindDistance[kind] != 0, c);
+            const float d2 = dx * dx + dy * dy + dz * dz;
+            const float key = lodKey(d2, r, kindDistance[kind] != 0, c);
             const std::uint32_t bucket = kindFirst[kind] + levelForKey(tables + kind * MAX_THRESHOLDS, key);
+            // Distance class: the exponent and top two mantissa bits of d^2 (monotonic for d^2 >= 0).
+            std::uint32_t bits;
+            std::memcpy(&bits, &d2, sizeof bits);
+            const std::uint8_t distanceClass = std::uint8_t(
+                std::clamp(int(bits >> 21) - 127 * 4, 0, ForestVisibility::DISTANCE_CLASSES - 1));
             visible[visibleCount] = std::uint32_t(i);
             visibleBucket[visibleCount] = bucket;
+            visibleClass[visibleCount] = distanceClass;
+            ++classCounts[distanceClass];
             ++counts[bucket];
             ++visibleCount;
         }
@@ -520,7 +536,19 @@ namespace TreeLod
                 counts[b] = out.mBuckets[b].first;
             }
 
-        // Pass 2: fill indices and world matrices, bucket by bucket in input order.
+        // Near first: the visible instances counting-sorted by distance class (stable).
+        std::uint32_t* nearFirst = out.mNearFirst.data();
+        std::uint32_t at = 0;
+        for (std::uint32_t& count : classCounts)
+        {
+            const std::uint32_t size = count;
+            count = at;
+            at += size;
+        }
+        for (std::uint32_t j = 0; j < visibleCount; ++j)
+            nearFirst[classCounts[visibleClass[j]]++] = j;
+
+        // Pass 2: fill indices and world matrices, bucket by bucket, near first.
         if (out.mIndices.size() < visibleCount)
         {
             out.mIndices.resize(visibleCount);
@@ -528,8 +556,9 @@ namespace TreeLod
         }
         std::uint32_t* indices = out.mIndices.data();
         float* transforms = out.mTransforms.data();
-        for (std::uint32_t j = 0; j < visibleCount; ++j)
+        for (std::uint32_t k = 0; k < visibleCount; ++k)
         {
+            const std::uint32_t j = nearFirst[k];
             const std::uint32_t i = visible[j];
             const std::uint32_t slot = counts[visibleBucket[j]]++;
             indices[slot] = i;

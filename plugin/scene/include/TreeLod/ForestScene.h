@@ -34,11 +34,12 @@ namespace TreeLod
     std::string speciesSource(const SceneSpecies& species);
 
     /// The bake technique (chunk) an Ogre-side technique draws from: mesh -> reference,
-    /// quad, entities, merged-quads -> impostor, others their own name. Empty for an unknown technique.
+    /// quad, entities, merged-quads, billboard-set -> impostor, others their own name. Empty for an unknown technique.
     std::string bakeTechniqueOf(const std::string& technique);
 
     /// The speed floors drawn without the Forest (QuadFloors.h): "entities" (one Ogre Entity per
-    /// tree) and "merged-quads" (every tree's quad in a few static batches).
+    /// tree), "merged-quads" (every tree's quad in a few static batches) and "billboard-set" (a
+    /// plain Ogre BillboardSet per species, unlit).
     bool isQuadFloor(const std::string& technique);
 
     /// The techniques bakeTechniqueOf knows, for messages: "mesh, lodf, billboard-cloud, ...".
@@ -55,7 +56,7 @@ namespace TreeLod
     struct ForestSceneOptions
     {
         /// "" = the script's technique choice; else every species drawn with this technique alone;
-        /// "entities" / "merged-quads": a speed floor (QuadFloors.h) instead of the Forest, whose
+        /// "entities" / "merged-quads" / "billboard-set": a speed floor (QuadFloors.h) instead of the Forest, whose
         /// getForest() then holds no species.
         std::string technique;
         PlacementOptions placement;
@@ -127,6 +128,7 @@ namespace TreeLod
         Forest* mForest = nullptr;
         std::unique_ptr<EntityFloor> mEntityFloor;
         std::unique_ptr<MergedQuadFloor> mMergedQuadFloor;
+        std::unique_ptr<BillboardSetFloor> mBillboardSetFloor;
         Ogre::SceneNode* mForestNode = nullptr;
         Ogre::ManualObject* mGround = nullptr;
         Ogre::SceneNode* mGroundNode = nullptr;

@@ -1,6 +1,7 @@
-// QuadFloors: the two speed floors `treelod bench` measures the Forest against, both
-// drawing each tree as the one camera-facing quad of its baked impostor (ImpostorResources::getGpu,
-// materials/GLSL/TreeLodImpostor.vert), so all three give the same picture:
+// QuadFloors: the speed floors `treelod bench` measures the Forest against, each drawing a tree
+// as one camera-facing quad of its baked impostor (ImpostorResources::getGpu). The first two use
+// the impostor's own materials (materials/GLSL/TreeLodImpostor.vert), so they and the Forest's
+// quad level give the same picture:
 // - EntityFloor: one Ogre Entity on its own SceneNode per tree, one draw each: what Ogre users
 //   pay today (measured with a minimal Ogre program: 10,000 one-quad entities cost 16 ms on an
 //   H100, all of it Ogre's per-object CPU cost).
@@ -11,11 +12,16 @@
 // entity (its node places it), the tree's own for a merged quad. Materials: the impostor's, its
 // shadow-receiving variant when the scene manager has integrated texture shadows at construction
 // (as the Forest picks), casting with the impostor's light-facing caster.
+// - BillboardSetFloor: one plain Ogre BillboardSet per species, the impostor's colour texture
+//   unlit and alpha tested (TreeLod/BillboardSetFloor): what an Ogre user writes by hand in twenty
+//   lines, the honest floor. It neither casts nor receives shadows and is not lit, so its picture
+//   differs from the others in shading only (same pixels covered).
 #pragma once
 
 #include "TreeLod/ForestInstances.h"
 #include "TreeLod/TreeAsset.h"
 
+#include <OgreBillboardSet.h>
 #include <OgreSceneManager.h>
 
 #include <cstdint>
@@ -67,6 +73,38 @@ namespace TreeLod
         Ogre::SceneNode* mNode = nullptr;
         std::vector<Ogre::MeshPtr> mMeshes;
         std::vector<Ogre::Entity*> mEntities;
+        std::uint64_t mGpuBytes = 0;
+    };
+
+    /// One Ogre BillboardSet per species (per MAX_SET_TREES trees): quads turned about +Y towards the camera
+    /// (BBT_ORIENTED_COMMON), sized and placed as the impostor's quad, the material a clone of
+    /// TreeLod/BillboardSetFloor with the impostor's colour texture and alpha cutoff.
+    class BillboardSetFloor
+    {
+    public:
+        /// Billboards per set: Ogre 1.12's BillboardSet indexes its vertices with 16 bits. A
+        /// species with more trees gets several sets, each a compact patch (culled by its bounds).
+        static constexpr std::size_t MAX_SET_TREES = 16384;
+
+        BillboardSetFloor(Ogre::SceneManager& sceneManager, Ogre::SceneNode& parent,
+                          const std::vector<TreeAssetPtr>& assets, const std::vector<ForestInstance>& instances);
+        ~BillboardSetFloor();
+        BillboardSetFloor(const BillboardSetFloor&) = delete;
+        BillboardSetFloor& operator=(const BillboardSetFloor&) = delete;
+
+        std::size_t getSetCount() const { return mSets.size(); }
+        const Ogre::BillboardSet& getSet(std::size_t i) const { return *mSets[i]; }
+        /// The floor's colour textures (one per species) + the sets' vertex buffers (4 vertices per billboard).
+        std::uint64_t getGpuBytes() const { return mGpuBytes; }
+
+    private:
+        void release();
+
+        Ogre::SceneManager& mSceneManager;
+        Ogre::SceneNode* mNode = nullptr;
+        std::vector<Ogre::BillboardSet*> mSets;
+        std::vector<Ogre::MaterialPtr> mMaterials;
+        std::vector<Ogre::TexturePtr> mTextures; ///< per species: the impostor's colour, plain RGBA (not sRGB)
         std::uint64_t mGpuBytes = 0;
     };
 }

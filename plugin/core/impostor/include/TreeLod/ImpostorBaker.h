@@ -10,7 +10,8 @@
 //   3. Bleed colour, normal and AO into the uncovered texels (bleedValues), then mip chains:
 //      colour with the coverage of level 0 kept (buildMipChain), normal and AO weighted by
 //      coverage.
-//   4. Compress (compressTexture): colour DXT5, normal + AO DXT1. 256 texels: 87 KB + 44 KB.
+//   4. Optionally compress (compressTexture): colour DXT5, normal + AO DXT1. 256 texels: 87 KB +
+//      44 KB instead of 2 x 230 KB of RGBA8.
 // Every size is relative to the model's bounds, so a 0.5 m and a 500 m tree give the same
 // textures. Deterministic for any thread count.
 #pragma once
@@ -37,7 +38,11 @@ namespace TreeLod
         int samplesPerPixel = 16;  ///< per texel, a square in [1, 256] (coverage in 1/n steps)
         int aoRays = 32;           ///< per vertex (AmbientOcclusion.h); 0 = no AO (B = 1)
         float alphaCutoff = 0.5f;  ///< the quad's alpha test, in (0, 1]
-        bool compress = true;      ///< DXT5 colour, DXT1 normal (libsquish); else RGBA8
+        /// DXT5 colour, DXT1 normal (libsquish); else RGBA8, the default: the far level of every
+        /// forest samples it on every fragment, and llvmpipe decodes DXT in software (the quad
+        /// level draws 1.6x faster from RGBA8 there, docs/impostor.md "Cost"), while the four
+        /// times larger textures stay small: one pair per species, 460 KB at 256 texels.
+        bool compress = false;
     };
 
     /// Bake the impostor. Errors name `label`: an invalid model or options, and a model with

@@ -10,7 +10,11 @@
 // Each frame `cull` tests every instance's world bounding sphere against the six frustum
 // planes, picks the visible ones' level from their kind's table, and counting-sorts them into
 // buckets (kind, level) with one packed 3x4 world matrix per instance, ready to be copied into
-// an instance vertex buffer (Ogre's hardware instancing reads three float4 rows).
+// an instance vertex buffer (Ogre's hardware instancing reads three float4 rows). Within a
+// bucket, instances come near first: counting-sorted by distance class (ForestVisibility::
+// DISTANCE_CLASSES), so a bucket drawn in order lets the depth test reject
+// what nearer trees hide before the fragment shader runs, alpha-tested levels included (their
+// depth test can still come first; only the write waits for the alpha test).
 //
 // LoD value (the units of Ogre's AbsolutePixelCountLodStrategy, as in BillboardCloudTree):
 //   perspective:  value = pi * R^2 * (W * H * P00 * P11) / d^2 * bias
@@ -113,13 +117,18 @@ namespace TreeLod
     {
     public:
         static constexpr std::size_t TRANSFORM_FLOATS = 12; ///< 3x4 world matrix, row-major
+        /// Near-first order within a bucket: classes of the squared distance, 4 per octave (its
+        /// float exponent and top two mantissa bits: a class spans at most 12 % of its distance),
+        /// the first up to 1 m, the last from 2^32 m; instances of one class keep their input order.
+        static constexpr int DISTANCE_CLASSES = 256;
 
         /// One bucket per (kind, level), kind-major, including empty ones.
         const std::vector<ForestBucket>& getBuckets() const { return mBuckets; }
         std::size_t getBucketCount() const { return mBuckets.size(); }
         const ForestBucket& getBucket(std::size_t bucket) const { return mBuckets[bucket]; }
 
-        /// Instance indices (ForestInstances' dense indices), grouped by bucket: getVisibleCount() of them.
+        /// Instance indices (ForestInstances' dense indices), grouped by bucket, near first within
+        /// a bucket: getVisibleCount() of them.
         const std::uint32_t* getIndices() const { return mIndices.data(); }
         /// 12 floats per visible instance, same order as getIndices(): rows of the world matrix
         /// [R*s | t]: (m00 m01 m02 tx) (m10 m11 m12 ty) (m20 m21 m22 tz).
@@ -146,6 +155,8 @@ namespace TreeLod
         std::vector<float> mTransforms;          // grown to 12 x the largest visible count so far
         std::vector<std::uint32_t> mVisible;     // scratch: visible instances in input order
         std::vector<std::uint32_t> mVisibleBucket; // scratch: their buckets
+        std::vector<std::uint8_t> mVisibleClass;   // scratch: their distance classes
+        std::vector<std::uint32_t> mNearFirst;     // scratch: positions in mVisible, near first
         std::vector<std::uint32_t> mCursor;      // scratch: fill position per bucket
         std::uint32_t mVisibleCount = 0;
         std::uint32_t mCulledCount = 0;
