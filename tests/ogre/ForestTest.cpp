@@ -420,15 +420,7 @@ namespace TreeLod
         const Image meshes = toImage(r.render(view, 256, 192, 2));
         // The quads stand where the trees stand (their look is the impostor's business,
         // ImpostorTest): the pixels they cover overlap the polygonal trees'.
-        std::size_t both = 0, either = 0;
-        for (std::size_t i = 0; i < quads.pixels.size(); ++i)
-        {
-            const bool q = glm::length(glm::vec3(quads.pixels[i]) - BACKGROUND) > 0.02f;
-            const bool m = glm::length(glm::vec3(meshes.pixels[i]) - BACKGROUND) > 0.02f;
-            both += q && m;
-            either += q || m;
-        }
-        const double overlap = double(both) / double(std::max<std::size_t>(either, 1));
+        const double overlap = coveredOverlap(quads, meshes, BACKGROUND);
         std::printf("quad vs mesh forest: covered pixels in common %.3f, FLIP %.4f\n", overlap,
                     flipMean(meshes, quads));
         EXPECT_GT(overlap, 0.6);
@@ -1119,16 +1111,7 @@ namespace TreeLod
             sets = toImage(r.render(view, 256, 192, 1));
         }
         writePng(OgreEnvironment::outDir() + "/forest-billboard-set-floor.png", sideBySide({quads, sets}));
-        std::size_t both = 0, either = 0;
-        for (std::size_t i = 0; i < quads.pixels.size(); ++i)
-        {
-            const bool a = glm::length(glm::vec3(quads.pixels[i]) - BACKGROUND) > 0.02f;
-            const bool b = glm::length(glm::vec3(sets.pixels[i]) - BACKGROUND) > 0.02f;
-            both += a && b;
-            either += a || b;
-        }
-        ASSERT_GT(either, 0u);
-        const double overlap = double(both) / double(either);
+        const double overlap = coveredOverlap(quads, sets, BACKGROUND);
         std::printf("billboard-set floor vs quad level: covered pixels overlap %.4f\n", overlap);
         EXPECT_GT(treeCoverage(sets, BACKGROUND), 0.1);
         EXPECT_GE(overlap, 0.97);

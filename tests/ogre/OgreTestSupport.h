@@ -153,6 +153,21 @@ namespace TreeLod
         return double(covered) / double(image.pixels.size());
     }
 
+    /// Pixels both images cover (differ from the background) over the pixels either covers; 0
+    /// when neither covers any.
+    inline double coveredOverlap(const Image& a, const Image& b, const glm::vec3& background)
+    {
+        std::size_t both = 0, either = 0;
+        for (std::size_t i = 0; i < a.pixels.size() && i < b.pixels.size(); ++i)
+        {
+            const bool inA = glm::length(glm::vec3(a.pixels[i]) - background) > 0.02f;
+            const bool inB = glm::length(glm::vec3(b.pixels[i]) - background) > 0.02f;
+            both += inA && inB;
+            either += inA || inB;
+        }
+        return either ? double(both) / double(either) : 0.0;
+    }
+
     /// `actual` against the golden image `golden` (a path), FLIP mean below `bound`; written to the
     /// output folder as NAME.png (and NAME.flip.png when it fails). TREELOD_GOLDEN=update rewrites
     /// the golden instead.
