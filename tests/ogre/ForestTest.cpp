@@ -1020,6 +1020,22 @@ namespace TreeLod
 
     // The bench's floors (QuadFloors.h) draw the Forest's quad level as plain Ogre objects: one
     // entity per tree, and merged static batches. Same impostor, same program: the same picture.
+    namespace
+    {
+        /// The Forest's quad level drawing `trees` of `tree` from `view` (256 x 192, 1 spp); the
+        /// content is cleared afterwards, for a floor to draw the same trees.
+        Image quadLevelImage(const ForestTree& tree, const std::vector<ForestInstance>& trees, const CameraSpec& view)
+        {
+            Forest* forest = placeForest();
+            forest->addSpecies(tree.asset, {ForestLevel{"impostor", 0, false, 0.0f}});
+            forest->addInstances(trees);
+            OffscreenRenderer& r = OgreEnvironment::renderer();
+            const Image image = toImage(r.render(view, 256, 192, 1));
+            r.clearContent();
+            return image;
+        }
+    }
+
     TEST(Forest, quadFloorsDrawWhatTheQuadLevelDraws)
     {
         const ForestTree& tree = oak();
@@ -1027,11 +1043,7 @@ namespace TreeLod
         const float h = treeHeight(tree.model);
         const CameraSpec view = look(glm::vec3(1.5f * h, 3.0f * h, 5.5f * h), glm::vec3(0.0f, 0.2f * h, 0.0f));
         const std::vector<ForestInstance> trees = grid(4, 1.3f * h);
-        Forest* forest = placeForest();
-        forest->addSpecies(tree.asset, {ForestLevel{"impostor", 0, false, 0.0f}});
-        forest->addInstances(trees);
-        const Image quads = toImage(r.render(view, 256, 192, 1));
-        r.clearContent();
+        const Image quads = quadLevelImage(tree, trees, view);
         Ogre::SceneManager& sm = r.getSceneManager();
         Image entities, merged;
         {
@@ -1095,11 +1107,7 @@ namespace TreeLod
         std::vector<ForestInstance> trees = grid(4, 1.3f * h);
         for (std::size_t i = 0; i < trees.size(); ++i)
             trees[i].scale = 0.8f + 0.05f * float(i % 8); // per-billboard sizes
-        Forest* forest = placeForest();
-        forest->addSpecies(tree.asset, {ForestLevel{"impostor", 0, false, 0.0f}});
-        forest->addInstances(trees);
-        const Image quads = toImage(r.render(view, 256, 192, 1));
-        r.clearContent();
+        const Image quads = quadLevelImage(tree, trees, view);
         Ogre::SceneManager& sm = r.getSceneManager();
         Image sets;
         {
