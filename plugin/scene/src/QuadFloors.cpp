@@ -29,17 +29,18 @@ namespace TreeLod
             return sceneManager.isShadowTechniqueTextureBased() && sceneManager.isShadowTechniqueIntegrated();
         }
 
-        /// The impostor of every species (built on first use), checking each instance's kind.
-        std::vector<const ImpostorGpu*> impostors(const std::vector<TreeAssetPtr>& assets,
-                                                  const std::vector<ForestInstance>& instances, const char* who)
+        /// The impostor chunk of every species, decoded (throws naming an asset without it or a
+        /// missing asset), checking each instance's kind.
+        std::vector<const ImpostorData*> impostorData(const std::vector<TreeAssetPtr>& assets,
+                                                      const std::vector<ForestInstance>& instances, const char* who)
         {
-            std::vector<const ImpostorGpu*> out;
+            std::vector<const ImpostorData*> out;
             for (const TreeAssetPtr& asset : assets)
             {
                 if (!asset)
                     OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, "species " + std::to_string(out.size()) +
                                                                         " has no asset", who);
-                out.push_back(&ImpostorResources::of(*asset).getGpu()); // throws naming the asset without the chunk
+                out.push_back(&ImpostorResources::of(*asset).getData());
             }
             for (std::size_t i = 0; i < instances.size(); ++i)
                 if (instances[i].kind >= assets.size())
@@ -47,6 +48,17 @@ namespace TreeLod
                                 "instance " + std::to_string(i) + ": species " + std::to_string(instances[i].kind) +
                                     " of " + std::to_string(assets.size()),
                                 who);
+            return out;
+        }
+
+        /// The impostor of every species on the GPU (built on first use), checked as impostorData.
+        std::vector<const ImpostorGpu*> impostors(const std::vector<TreeAssetPtr>& assets,
+                                                  const std::vector<ForestInstance>& instances, const char* who)
+        {
+            impostorData(assets, instances, who);
+            std::vector<const ImpostorGpu*> out;
+            for (const TreeAssetPtr& asset : assets)
+                out.push_back(&ImpostorResources::of(*asset).getGpu());
             return out;
         }
 
@@ -241,14 +253,15 @@ namespace TreeLod
                                          const std::vector<ForestInstance>& instances)
         : mSceneManager(sceneManager)
     {
-        const std::vector<const ImpostorGpu*> gpus = impostors(assets, instances, "BillboardSetFloor");
+        // The chunk's data only: the floor draws none of the impostor's GPU resources.
+        const std::vector<const ImpostorData*> impostors = impostorData(assets, instances, "BillboardSetFloor");
         mNode = parent.createChildSceneNode();
         try
         {
             for (std::size_t s = 0; s < assets.size(); ++s)
             {
-                // The impostor's colour as a plain (not sRGB) texture: written as it is read, unlit.
-                const ImpostorData& data = ImpostorResources::of(*assets[s]).getData();
+                // The impostor's colour texture, written as it is read (sRGB), unlit.
+                const ImpostorData& data = *impostors[s];
                 const Ogre::String texture = uniqueName("BillboardSetFloorColour");
                 uploadTexture(texture, assets[s]->getGroup(), data.colour);
                 mTextures.push_back(Ogre::TextureManager::getSingleton().getByName(texture, assets[s]->getGroup()));
@@ -262,8 +275,8 @@ namespace TreeLod
                 pass->getFragmentProgramParameters()->setNamedConstant("alphaCutoff", data.alphaCutoff);
                 mMaterials.back()->load();
 
-                const float width = 2.0f * gpus[s]->halfWidth, height = gpus[s]->top - gpus[s]->bottom;
-                const float centre = 0.5f * (gpus[s]->top + gpus[s]->bottom);
+                const float width = 2.0f * data.halfWidth, height = data.top - data.bottom;
+                const float centre = 0.5f * (data.top + data.bottom);
                 for (const std::vector<const ForestInstance*>& trees : spatialBatches(instances, s, MAX_SET_TREES))
                 {
                     Ogre::BillboardSet* set = sceneManager.createBillboardSet(unsigned(trees.size()));
