@@ -13,7 +13,7 @@ to write, the CSV columns on the x and y axes, the title, axis labels and log ax
 Each CSV has a header line, a `series` column (rows of one series form one line, in file order)
 and a `label` column (its legend text). An empty or non-finite value is a gap in the line, and on
 a log axis so is a value <= 0. A row whose `marker` column (optional) is not empty is a single
-labelled point drawn with that matplotlib marker (o, s, ^, x) in black, not part of a line:
+labelled point drawn with that matplotlib marker (o, s, ^, x, D) in black, not part of a line:
 the trade plot's polygonal reference and floors. A plot without data still gets its axes and
 title, and reads "no data".
 

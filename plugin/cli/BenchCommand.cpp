@@ -140,21 +140,27 @@ namespace TreeLod
             bool hasPicture = false;
         };
 
-        /// Runs that stand for something every technique is compared with, and what the plots call them.
-        const std::vector<std::pair<std::string, std::string>>& comparisonRuns()
+        /// A run that stands for something every technique is compared with.
+        struct ComparisonRun
         {
-            static const std::vector<std::pair<std::string, std::string>> runs = {
-                {REFERENCE_TECHNIQUE, "polygonal reference (mesh, 1 spp)"},
-                {FLOOR_TECHNIQUE, "floor: the Forest's one-quad level"},
-                {"entities", "floor: one Ogre entity per tree (a quad)"},
-                {"merged-quads", "floor: quads merged into a few batches"},
-                {"billboard-set", "floor: a plain Ogre BillboardSet (unlit)"}};
+            std::string technique;
+            std::string label; ///< what the plots call it
+            char marker;       ///< its point in the trade plot (a matplotlib marker)
+        };
+        const std::vector<ComparisonRun>& comparisonRuns()
+        {
+            static const std::vector<ComparisonRun> runs = {
+                {REFERENCE_TECHNIQUE, "polygonal reference (mesh, 1 spp)", 'o'},
+                {FLOOR_TECHNIQUE, "floor: the Forest's one-quad level", 's'},
+                {"entities", "floor: one Ogre entity per tree (a quad)", '^'},
+                {"merged-quads", "floor: quads merged into a few batches", 'x'},
+                {"billboard-set", "floor: a plain Ogre BillboardSet (unlit)", 'D'}};
             return runs;
         }
         bool isComparisonRun(const std::string& technique)
         {
-            for (const auto& [name, label] : comparisonRuns())
-                if (name == technique)
+            for (const ComparisonRun& run : comparisonRuns())
+                if (run.technique == technique)
                     return true;
             return false;
         }
@@ -350,11 +356,11 @@ namespace TreeLod
                 auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
                 // Ratios of medians measured in this run (the floors' own medians over their timed frames).
                 json ratios = json::object();
-                for (const auto& [floor, label] : comparisonRuns())
-                    if (floor != REFERENCE_TECHNIQUE)
+                for (const ComparisonRun& c : comparisonRuns())
+                    if (c.technique != REFERENCE_TECHNIQUE)
                         for (const Run& other : runs)
-                            if (other.count == run.count && other.technique == floor)
-                                ratios[floor] = num(frameStats.median / medianOver(other, nullptr));
+                            if (other.count == run.count && other.technique == c.technique)
+                                ratios[c.technique] = num(frameStats.median / medianOver(other, nullptr));
                 results.push_back({{"trees", run.count},
                                    {"technique", run.technique},
                                    {"lodBias", run.lodBias},
@@ -406,7 +412,7 @@ namespace TreeLod
                 // where the frame was not timed (a gap in the line).
                 std::string timeCsv = "series,label,time_s,frame_ms\n";
                 // trade: one curve per technique over the biases; the comparisons are single points
-                // drawn with their `marker` (matplotlib's o, s, ^, x).
+                // drawn with their `marker` (ComparisonRun::marker).
                 std::string tradeCsv = "series,label,lod_bias,median_frame_ms,mean_flip,marker\n";
                 std::vector<std::string> curveRows;
                 for (const Run& run : runs)
@@ -426,12 +432,11 @@ namespace TreeLod
                     const double meanFlip = statsOf(flips).mean;
                     if (isComparisonRun(run.technique))
                     {
-                        static const char shapes[] = {'o', 's', '^', 'x'};
-                        for (std::size_t c = 0; c < comparisonRuns().size(); ++c)
-                            if (comparisonRuns()[c].first == run.technique)
-                                tradeCsv += csvField(run.technique) + "," + csvField(comparisonRuns()[c].second) +
-                                            "," + number(run.lodBias, 3) + "," + number(median, 6) + "," +
-                                            number(meanFlip, 6) + "," + std::string(1, shapes[c]) + "\n";
+                        for (const ComparisonRun& c : comparisonRuns())
+                            if (c.technique == run.technique)
+                                tradeCsv += csvField(run.technique) + "," + csvField(c.label) + "," +
+                                            number(run.lodBias, 3) + "," + number(median, 6) + "," +
+                                            number(meanFlip, 6) + "," + std::string(1, c.marker) + "\n";
                     }
                     else
                         curveRows.push_back(csvField(run.technique) + "," +
@@ -441,9 +446,9 @@ namespace TreeLod
                     if (run.lodBias == 1.0f || isComparisonRun(run.technique))
                     {
                         std::string label = run.technique;
-                        for (const auto& [name, text] : comparisonRuns())
-                            if (name == run.technique)
-                                label = text;
+                        for (const ComparisonRun& c : comparisonRuns())
+                            if (c.technique == run.technique)
+                                label = c.label;
                         if (std::none_of(run.frames.begin(), run.frames.end(),
                                          [](const FrameRecord& r) { return r.timed; }))
                             label += ": every frame over the triangle budget, skipped";

@@ -28,6 +28,9 @@ plot() {
 for f in frames.csv summary.json plots.json; do [ -s "$out/single/$f" ] || fail "single/$f missing"; done
 # frame time: the reference, 4 floors and auto at bias 1, 6 frames each; trade: 5 points + auto at 2 biases.
 plot "$out/single" frame-time 36; plot "$out/single" trade 7
+# Every comparison run is a marked point in the trade plot; only auto's two biases form a curve.
+n=$(awk -F, 'NR > 1 && $NF == ""' "$out/single/trade.csv" | wc -l)
+[ "$n" = 2 ] || fail "trade.csv has $n unmarked rows, expected auto's 2"
 rows=$(($(wc -l < "$out/single/frames.csv") - 1))
 [ "$rows" = 42 ] || fail "frames.csv has $rows rows, expected (mesh + 4 floors + auto x 2 biases) x 6 = 42"
 for t in mesh impostor entities merged-quads billboard-set auto; do
