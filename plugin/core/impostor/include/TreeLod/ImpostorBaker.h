@@ -40,8 +40,8 @@ namespace TreeLod
         float alphaCutoff = 0.5f;  ///< the quad's alpha test, in (0, 1]
         /// DXT5 colour, DXT1 normal (libsquish); else RGBA8, the default: the far level of every
         /// forest samples it on every fragment, and llvmpipe decodes DXT in software (the quad
-        /// level draws 1.6x faster from RGBA8 there, docs/impostor.md "Cost"), while the four
-        /// times larger textures stay small: one pair per species, 460 KB at 256 texels.
+        /// level draws 1.6-1.9x faster from RGBA8 there, docs/impostor.md "Cost"), while the four
+        /// times larger textures stay small: one pair per species, at most 700 KB at 256 texels.
         bool compress = false;
     };
 
