@@ -12,7 +12,8 @@
 //
 // Runs per tree count: the polygonal reference ("mesh"), the floors ("impostor": the Forest's one-quad
 // level; "entities": one Ogre Entity per tree; "merged-quads": all quads merged into a few static
-// batches; "billboard-set": a plain Ogre BillboardSet per species, unlit), then every technique at every LoD bias. Writes DIR/timings.json (per run: per frame
+// batches; "billboard-set": a plain Ogre BillboardSet per species, unlit), then every technique
+// at every LoD bias. Writes DIR/timings.json (per run: per frame
 // CPU ms, frame ms (bounded by a one-pixel read-back), batches, triangles, visible trees, trees per
 // level, bytes uploaded, pending levels; run totals: GPU bytes, instance bytes, resident memory) and,
 // on sampled frames, PNGs under DIR/images: the reference supersampled 2x2 and every run at one
