@@ -45,7 +45,7 @@ namespace TreeLod
 
             std::atomic<bool> fail{false};
             std::atomic<int> finished{0};
-            std::thread::id lastThread;
+            std::atomic<std::thread::id> lastThread{};
 
             Ogre::String requirePackage(const Ogre::String& source, const std::vector<Ogre::String>&) override
             {
@@ -140,7 +140,7 @@ namespace TreeLod
         EXPECT_EQ(baker.finished, 0);
         baker.open();
         ASSERT_TRUE(waitFor([&] { return request->isReady(); }));
-        EXPECT_NE(baker.lastThread, std::this_thread::get_id()) << "the bake ran on the calling thread";
+        EXPECT_NE(baker.lastThread.load(), std::this_thread::get_id()) << "the bake ran on the calling thread";
         TreeAssetPtr asset = request->get();
         ASSERT_TRUE(asset);
         EXPECT_TRUE(asset->isLoaded());

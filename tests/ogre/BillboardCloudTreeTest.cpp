@@ -85,8 +85,8 @@ namespace TreeLod
 
         const BakedTree& bundled(const std::string& name)
         {
-            OgreEnvironment::renderer(); // first: the Root must outlive the assets held below
-            static std::map<std::string, BakedTree> trees;
+            auto& trees = OgreEnvironment::keep<std::map<std::string, BakedTree>>(
+                "billboard-cloud.bundled", [] { return std::map<std::string, BakedTree>(); });
             auto found = trees.find(name);
             if (found != trees.end())
                 return found->second;
@@ -101,7 +101,7 @@ namespace TreeLod
         /// The 50k-leaf generated oak (TreeGenerator, oak preset).
         const BakedTree& generated50k()
         {
-            static BakedTree tree = [] {
+            return OgreEnvironment::keep<BakedTree>("billboard-cloud.oak50k", [] {
                 BakedTree t;
                 GeneratorOptions options;
                 options.preset = TreePreset::Oak;
@@ -112,8 +112,7 @@ namespace TreeLod
                 t.model = std::move(model.value());
                 t.asset = bake(t.model, "oak50k", false);
                 return t;
-            }();
-            return tree;
+            });
         }
 
         /// A fresh object of `technique` for `asset` under the content node (content cleared).

@@ -41,15 +41,14 @@ namespace TreeLod
 
         const LodfTree& bundledOak()
         {
-            static LodfTree tree = [] {
+            return OgreEnvironment::keep<LodfTree>("lodf.oak", [] {
                 LodfTree t;
                 Result<TreeModel> model = importGltf(OgreEnvironment::sourcePath("media/oak.glb"));
                 EXPECT_TRUE(model.ok());
                 t.model = std::move(model.value());
                 t.asset = loadLodf(t.model, "oak.lodf-test");
                 return t;
-            }();
-            return tree;
+            });
         }
 
         /// A fresh FoliageLodTree for `asset` under the content node (the content is cleared).

@@ -39,8 +39,7 @@ namespace TreeLod
         /// A generated oak with the reference and impostor chunks, loaded as asset `name`.
         const BakedOak& oak()
         {
-            OgreEnvironment::renderer(); // first: the Root must outlive the asset
-            static BakedOak tree = [] {
+            return OgreEnvironment::keep<BakedOak>("impostor.oak", [] {
                 BakedOak t;
                 GeneratorOptions generator;
                 generator.leafCount = 3000;
@@ -60,8 +59,7 @@ namespace TreeLod
                 t.asset = TreeAssetManager::getSingleton().loadFromBytes("oak.impostor-test", Ogre::RGN_DEFAULT,
                                                                          writer.toBytes());
                 return t;
-            }();
-            return tree;
+            });
         }
 
         /// The impostor's quad drawn instanced, as the Forest draws it: instance buffer in
@@ -131,8 +129,8 @@ namespace TreeLod
         /// The drawn impostors: owned here, no factory, so detached before clearContent.
         std::unique_ptr<InstancedImpostor>& drawn()
         {
-            static std::unique_ptr<InstancedImpostor> quads;
-            return quads;
+            return OgreEnvironment::keep<std::unique_ptr<InstancedImpostor>>(
+                "impostor.drawn", [] { return std::unique_ptr<InstancedImpostor>(); });
         }
 
         void clearContent()

@@ -27,18 +27,46 @@
 
 namespace TreeLod
 {
-    class OgreEnvironment
+    /// The Ogre test binaries' environment (OgreTestMain.cpp registers it): the headless
+    /// renderer, created on first use, and the objects tests keep across tests (baked assets,
+    /// placed objects). TearDown destroys the kept objects, newest first, and then the renderer,
+    /// before main() returns: nothing Ogre owns is left to static destruction.
+    class OgreEnvironment : public ::testing::Environment
     {
     public:
         static OffscreenRenderer& renderer()
         {
-            static std::unique_ptr<OffscreenRenderer> instance = [] {
+            State& s = state();
+            if (!s.renderer)
+            {
                 OffscreenOptions options;
                 options.pluginPath = TREELOD_PLUGIN_PATH;
-                options.logFile = outDir() + "/ogre-test.log";
-                return std::make_unique<OffscreenRenderer>(options);
-            }();
-            return *instance;
+                options.logFile = outDir() + "/" + logName();
+                s.renderer = std::make_unique<OffscreenRenderer>(options);
+            }
+            return *s.renderer;
+        }
+
+        /// The object kept under `key`, made by `make` on first use (after the renderer, so
+        /// the Root outlives it) and destroyed in TearDown before the renderer.
+        template <typename T, typename Make> static T& keep(const std::string& key, Make&& make)
+        {
+            renderer();
+            State& s = state();
+            for (const auto& [name, object] : s.kept)
+                if (name == key)
+                    return *static_cast<T*>(object.get());
+            std::shared_ptr<T> object = std::make_shared<T>(make());
+            s.kept.emplace_back(key, object);
+            return *object;
+        }
+
+        void TearDown() override
+        {
+            State& s = state();
+            while (!s.kept.empty())
+                s.kept.pop_back();
+            s.renderer.reset();
         }
 
         static std::string outDir()
@@ -51,6 +79,31 @@ namespace TreeLod
         static std::string sourcePath(const std::string& relative)
         {
             return std::string(TREELOD_SOURCE_DIR) + "/" + relative;
+        }
+
+    private:
+        struct State
+        {
+            std::unique_ptr<OffscreenRenderer> renderer;
+            std::vector<std::pair<std::string, std::shared_ptr<void>>> kept;
+        };
+
+        static State& state()
+        {
+            static State s;
+            return s;
+        }
+
+        /// One Ogre log per process (ctest runs test processes in parallel): named after the
+        /// test that started the renderer, "ogre-Forest.drawsTrees.log", plus the process id
+        /// when more than one test runs in the process.
+        static std::string logName()
+        {
+            const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
+            std::string name = test ? std::string(test->test_suite_name()) + "." + test->name() : "startup";
+            if (::testing::UnitTest::GetInstance()->test_to_run_count() != 1)
+                name += "." + std::to_string(::getpid());
+            return "ogre-" + name + ".log";
         }
     };
 

@@ -34,8 +34,7 @@ namespace TreeLod
         /// `treelod bake --technique crossed-quads` writes them), loaded as "oak.crossed-quads-test".
         const Oak& oak()
         {
-            OgreEnvironment::renderer(); // first: the Root must outlive the asset
-            static Oak tree = [] {
+            return OgreEnvironment::keep<Oak>("crossed-quads.oak", [] {
                 Oak t;
                 GeneratorOptions generator;
                 generator.leafCount = 3000;
@@ -52,8 +51,7 @@ namespace TreeLod
                 t.asset = TreeAssetManager::getSingleton().loadFromBytes("oak.crossed-quads-test", Ogre::RGN_DEFAULT,
                                                                          bytes);
                 return t;
-            }();
-            return tree;
+            });
         }
 
         /// Golden images of this example live beside it (examples/crossed-quads/golden/NAME.png).
