@@ -1,30 +1,82 @@
 #!/usr/bin/env bash
-# Build and run every test: unit tests, headless Ogre and golden-image tests (under Xvfb),
-# then each libFuzzer target for a few seconds. CI (.ci/run) calls exactly this.
+# Build and run every test, once each (a failure is a failure: nothing is retried):
+#  1. the Release tree: unit, headless Ogre, golden-image, CLI and browser tests (under Xvfb);
+#  2. a clang tree with ASan + UBSan: the same tests (the install test aside), then each
+#     libFuzzer target for a few seconds;
+#  3. a clang tree with TSan: the multi-threaded paths (bakers, bake cache, async baker).
+# A test process that dies leaves its core dump and backtrace in <tree>/test-out/cores/.
+# CI (.ci/run) calls exactly this. TREELOD_SANITIZE=0 runs stage 1 only.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${TREELOD_BUILD_DIR:-$root/build}
+asan=${TREELOD_ASAN_BUILD_DIR:-$root/build-asan}
+tsan=${TREELOD_TSAN_BUILD_DIR:-$root/build-tsan}
+jobs=$(nproc)
 "$root/.ci/deps.sh" --with-fuzzers
-cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DTREELOD_BUILD_TESTS=ON >/dev/null
-cmake --build "$build" -j"$(nproc)"
-export XDG_CACHE_HOME=$build/test-cache
-# --repeat until-pass:2: a test process that dies is run once more. Headless GL start-up under
-# Xvfb crashed about once in six full runs (a SegFault 0.25 s into a test, before its first
-# frame; never reproduced alone); a real failure fails twice and stays red.
-(cd "$build" && xvfb-run -a -s "-screen 0 1280x1024x24" ctest --output-on-failure -j"$(nproc)" --timeout 300 \
-  --repeat until-pass:2)
 
-# Fuzzers: clang + libFuzzer + ASan in their own build tree; a short run each.
-fuzz=${TREELOD_FUZZ_BUILD_DIR:-$root/build-fuzz}
-CXX=clang++ cmake -S "$root" -B "$fuzz" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTREELOD_BUILD_FUZZERS=ON \
-  -DTREELOD_BUILD_TESTS=ON -DTREELOD_BUILD_BENCHMARKS=OFF -DTREELOD_BUILD_SAMPLES=OFF >/dev/null
-cmake --build "$fuzz" -j"$(nproc)" --target FuzzGltfImporter FuzzPackageReader
-for target in FuzzGltfImporter:gltf FuzzPackageReader:package; do
+# Core dumps of crashing tests: kept where the kernel writes them into the test's folder.
+ulimit -c unlimited 2>/dev/null || true
+pattern=$(cat /proc/sys/kernel/core_pattern 2>/dev/null || echo core)
+[[ $pattern == \|* ]] && echo "note: core dumps go to '$pattern', not to the test folders"
+
+# collect_cores TREE: move core files under TREE to TREE/test-out/cores with a backtrace each.
+collect_cores() {
+  local tree=$1 core exe
+  while IFS= read -r core; do
+    mkdir -p "$tree/test-out/cores"
+    exe=$(file -b "$core" | sed -n "s/.*execfn: '\([^']*\)'.*/\1/p")
+    mv "$core" "$tree/test-out/cores/"
+    core=$tree/test-out/cores/$(basename "$core")
+    echo "core dump: $core (${exe:-unknown executable})"
+    if [ -n "$exe" ] && command -v gdb >/dev/null; then
+      gdb -batch -ex "thread apply all bt 30" "$exe" "$core" 2>/dev/null | tee "$core.backtrace.txt" | head -n 60
+    fi
+  done < <(find "$tree" -path "$tree/test-out/cores" -prune -o -type f \( -name core -o -name 'core.[0-9]*' \) -print)
+}
+
+# run_ctest TREE [ctest arguments]: every test once under Xvfb; cores collected on failure.
+run_ctest() {
+  local tree=$1; shift
+  local rc=0
+  (cd "$tree" && XDG_CACHE_HOME=$tree/test-cache xvfb-run -a -s "-screen 0 1280x1024x24" \
+    ctest --output-on-failure -j"$jobs" --timeout 300 "$@") || rc=$?
+  collect_cores "$tree"
+  return $rc
+}
+
+# ---- 1. Release ------------------------------------------------------------------------
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DTREELOD_BUILD_TESTS=ON >/dev/null
+cmake --build "$build" -j"$jobs"
+run_ctest "$build"
+[ "${TREELOD_SANITIZE:-1}" = 0 ] && { echo "all tests passed (sanitizer trees skipped)"; exit 0; }
+
+# ---- 2. ASan + UBSan, fuzzers ------------------------------------------------------------
+# LSan reports leaks of our code; the suppressions name the uninstrumented libraries (Mesa, X,
+# fontconfig) whose one-time allocations live until exit.
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+export LSAN_OPTIONS=suppressions=$root/tests/sanitizers/lsan.supp:print_suppressions=0
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+CXX=clang++ cmake -S "$root" -B "$asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
+  -DTREELOD_SANITIZERS=address,undefined -DTREELOD_BUILD_FUZZERS=ON -DTREELOD_BUILD_TESTS=ON \
+  -DTREELOD_BUILD_BENCHMARKS=OFF -DTREELOD_BUILD_SAMPLES=OFF >/dev/null
+cmake --build "$asan" -j"$jobs"
+run_ctest "$asan" -E '^install\.'
+
+fuzzers=(FuzzGltfImporter:gltf FuzzPackageReader:package)
+for target in "${fuzzers[@]}"; do
   bin=${target%%:*}; corpus=$root/tests/fuzz/corpus/${target#*:}
   work=$(mktemp -d)
   cp -r "$corpus"/. "$work"/ 2>/dev/null || true
   echo "fuzzing $bin for ${TREELOD_FUZZ_SECONDS:-10} s"
-  "$fuzz/bin/$bin" -max_total_time="${TREELOD_FUZZ_SECONDS:-10}" -max_len=65536 -rss_limit_mb=2048 "$work" 2>&1 | tail -n 3
+  "$asan/bin/$bin" -max_total_time="${TREELOD_FUZZ_SECONDS:-10}" -max_len=65536 -rss_limit_mb=2048 "$work" 2>&1 | tail -n 3
   rm -rf "$work"
 done
+
+# ---- 3. TSan -------------------------------------------------------------------------------
+export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1:suppressions=$root/tests/sanitizers/tsan.supp
+CXX=clang++ cmake -S "$root" -B "$tsan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
+  -DTREELOD_SANITIZERS=thread \
+  -DTREELOD_BUILD_TESTS=ON -DTREELOD_BUILD_BENCHMARKS=OFF -DTREELOD_BUILD_SAMPLES=OFF >/dev/null
+cmake --build "$tsan" -j"$jobs" --target test_bakecache test_lodf test_billboardcloud test_renderer test_async_bake
+run_ctest "$tsan" -R '^(BakeCache|LodfBuild|BillboardCloudBaker|ReferenceRenderer|AmbientOcclusion|AsyncBake)\.'
 echo "all tests passed"
