@@ -22,6 +22,7 @@
 #include "Commands.h"
 
 #include "TreeLod/ImageMetrics.h"
+#include "TreeLod/ProcessMemory.h"
 #include "TreeLod/SceneScript.h"
 
 #include <nlohmann/json.hpp>
@@ -103,9 +104,11 @@ namespace TreeLod
             return s;
         }
 
+        /// A number for summary.json: null when not finite (not measured).
+        nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
         nlohmann::json toJson(const Stats& s)
         {
-            auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
             return {{"mean", num(s.mean)}, {"median", num(s.median)}, {"p95", num(s.p95)}, {"max", num(s.max)},
                     {"count", s.count}};
         }
@@ -316,6 +319,16 @@ namespace TreeLod
             for (const BakeCacheEntry& e : baker.getEntries())
                 bakes.push_back(e.describe());
             summary["bake"] = bakes;
+            // Peak resident memory: of the frame timer (its largest over the runs) and of this
+            // process (bakes, reference images, metrics).
+            double framesPeakMiB = NAN;
+            for (const Run& run : runs)
+                framesPeakMiB = std::fmax(framesPeakMiB, run.peakRssMiB); // NaN: not measured
+            const double benchPeakMiB = residentMemory().peakMiB;
+            summary["peakRssMiB"] = {{"frameTimer", num(framesPeakMiB)}, {"bench", num(benchPeakMiB)}};
+            if (!args.quiet)
+                std::printf("peak resident memory: frame timer %.0f MiB, bench %.0f MiB\n", framesPeakMiB,
+                            benchPeakMiB);
             json results = json::array();
             for (const Run& run : runs)
             {
@@ -353,7 +366,6 @@ namespace TreeLod
                 const Stats frameStats = statsOf(frameMs);
                 const double techniqueOnShared = reference ? medianOver(run, reference) : NAN;
                 const double referenceOnShared = reference ? medianOver(*reference, &run) : NAN;
-                auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
                 // Ratios of medians measured in this run (the floors' own medians over their timed frames).
                 json ratios = json::object();
                 for (const ComparisonRun& c : comparisonRuns())

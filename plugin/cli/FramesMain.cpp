@@ -24,6 +24,7 @@
 #include "TreeLod/ForestScene.h"
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/PackageListBaker.h"
+#include "TreeLod/ProcessMemory.h"
 #include "TreeLod/SceneScript.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
@@ -64,22 +65,6 @@ namespace TreeLod
             bool skipComparisons = false; // only the techniques: no reference, no floors (memory of one scene)
             bool quiet = false;
         };
-
-        /// Resident and peak resident memory of this process in MiB (/proc/self/status), NaN elsewhere.
-        std::pair<double, double> residentMiB()
-        {
-            std::ifstream in("/proc/self/status");
-            std::string line;
-            double rss = NAN, peak = NAN;
-            while (std::getline(in, line))
-            {
-                if (line.rfind("VmRSS:", 0) == 0)
-                    rss = std::strtod(line.c_str() + 6, nullptr) / 1024.0;
-                else if (line.rfind("VmHWM:", 0) == 0)
-                    peak = std::strtod(line.c_str() + 6, nullptr) / 1024.0;
-            }
-            return {rss, peak};
-        }
 
         /// Triangles the polygonal reference would submit from `camera`: visible trees times their
         /// reference triangle counts (exact, not a guess at time: the budget is in triangles).
@@ -339,7 +324,7 @@ namespace TreeLod
                             frameRows.push_back(std::move(row));
                         }
                         progress(label, 1.0f);
-                        const auto [rss, peak] = residentMiB();
+                        const auto [rss, peak] = residentMemory();
                         run["frames"] = std::move(frameRows);
                         run["gpuBytes"] = scene->getGpuBytes();
                         run["instanceBytes"] = scene->getForest().getInstances().getMemoryBytes();

@@ -23,6 +23,10 @@ technique | FLIP difference image), and the forest of the scene script.
                             scene's camera path (NNN = 000, 001, ...)
   split-TECHNIQUE.png       each technique sample's split view (every registered technique:
                             treelod render --help lists them), the tree framed whole
+--headless --soak N switches N times between samples and techniques as a user does (the menu,
+the technique menu), each drawn until it has settled, then prints resident memory after the
+first pass over every sample and technique, at the end, and the peak; --screenshots may be left
+out.
 Layout: a 270-pixel column of controls and stats on the left; the split view divides the rest
 into three equal panels.
 Needs an X server (xvfb-run -a -s "-screen 0 1280x1024x24" treelod_browser --headless ...).
@@ -73,6 +77,8 @@ Bad arguments exit 2; a failure while running exits 1.)";
                        "(default media/oak.glb)");
         app.add_option("--screenshots", o.screenshots, "with --headless: folder for the PNGs (created)");
         app.add_option("--frames", o.frames, "with --headless: forest frames along the camera path (default 4)");
+        app.add_option("--soak", o.soak,
+                       "with --headless: N switches between samples and techniques, then report resident memory");
         app.add_option("--size", size, "WxH window or image size, 320x240 .. 8192x8192 (default 1280x720)");
         app.add_option("--cache", o.cacheDirectory, "bake cache folder (default $XDG_CACHE_HOME/treelod)");
         bool noGrab = false;
@@ -97,8 +103,10 @@ Bad arguments exit 2; a failure while running exits 1.)";
             return bad("--size: '" + size + "' is not WxH with 320x240 .. 8192x8192");
         if (o.frames < 1)
             return bad("--frames: must be at least 1");
-        if (o.headless && o.screenshots.empty())
-            return bad("--headless needs --screenshots DIR");
+        if (o.headless && o.screenshots.empty() && o.soak == 0)
+            return bad("--headless needs --screenshots DIR or --soak N");
+        if (!o.headless && o.soak > 0)
+            return bad("--soak needs --headless");
         if (!o.headless && !o.screenshots.empty())
             return bad("--screenshots needs --headless");
         std::error_code ec;

@@ -12,6 +12,7 @@ namespace TreeLod
         std::string tree;          ///< source of the single-tree samples: a tree file or "preset:NAME?..."
         std::string screenshots;   ///< headless: folder for the PNGs (created)
         unsigned frames = 4;       ///< headless: forest frames along the scene's camera path, >= 1
+        unsigned soak = 0;         ///< headless: > 0 = that many sample and technique switches, then memory
         int width = 1280;          ///< window (or headless image) size in pixels
         int height = 720;
         std::string cacheDirectory; ///< bake cache; "" = defaultBakeCacheDirectory()
@@ -31,7 +32,7 @@ namespace TreeLod
 
     /// Parse argv. Defaults resolve against `sourceDir` (the TreeLod source tree):
     /// scene samples/scenes/single-tree.json, tree media/oak.glb. Checks that the scene and a
-    /// tree file exist and that --headless has --screenshots; the scene's content is checked
+    /// tree file exist and that --headless has --screenshots or --soak; the scene's content is checked
     /// when it loads.
     BrowserOptionsResult parseBrowserOptions(int argc, char** argv, const std::string& sourceDir);
 }

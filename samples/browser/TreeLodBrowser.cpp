@@ -5,6 +5,7 @@
 #include "TechniqueSample.h"
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/OgreBootstrap.h"
+#include "TreeLod/ProcessMemory.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 #include "TreeLod/TreeLodPlugin.h"
@@ -524,6 +525,10 @@ namespace TreeLod
         std::snprintf(fps, sizeof fps, "%.1f (%.1f ms)", mFrameSeconds > 0.0 ? 1.0 / mFrameSeconds : 0.0,
                       mFrameSeconds * 1000.0);
         stats.insert(stats.begin(), {"FPS (render)", fps});
+        const ResidentMemory memory = residentMemory();
+        char resident[48];
+        std::snprintf(resident, sizeof resident, "%.0f MiB (peak %.0f)", memory.currentMiB, memory.peakMiB);
+        stats.push_back({"Memory (resident)", resident});
         Ogre::StringVector names, values;
         for (const auto& [name, value] : stats)
         {
@@ -619,6 +624,49 @@ namespace TreeLod
             }
         }
         return written;
+    }
+
+    TreeLodBrowser::SoakReport TreeLodBrowser::soak(unsigned switches)
+    {
+        SoakReport report;
+        auto settle = [&] {
+            for (int f = 0; f < 200 && mCurrent >= 0 && !mSamples[std::size_t(mCurrent)]->isSettled(); ++f)
+                mRoot->renderOneFrame();
+            mRoot->renderOneFrame();
+            ++report.switches;
+        };
+        while (report.switches < switches)
+        {
+            for (std::size_t i = 0; i < mSamples.size() && report.switches < switches; ++i)
+            {
+                mPendingScreen = MENU_SCREEN;
+                mRoot->renderOneFrame();
+                mPendingScreen = int(i);
+                settle();
+                // Through the technique menu, as the N key does: a split view moves to that
+                // technique's sample, the forest switches in place.
+                const std::size_t techniques = mTechniqueMenu ? mTechniqueMenu->getNumItems() : 0;
+                for (std::size_t t = 1; t < techniques && report.switches < switches; ++t)
+                {
+                    mTechniqueMenu->selectItem((std::size_t(mTechniqueMenu->getSelectionIndex()) + 1) % techniques);
+                    settle();
+                }
+            }
+            if (report.warmUpSwitches == 0)
+            {
+                report.warmUpSwitches = report.switches;
+                report.afterWarmUpMiB = residentMemory().currentMiB;
+            }
+        }
+        const ResidentMemory end = residentMemory();
+        report.endMiB = end.currentMiB;
+        report.peakMiB = end.peakMiB;
+        std::printf("soak: %u switches; resident after the first pass (%u switches) %.1f MiB, at the end %.1f MiB "
+                    "(%+.1f MiB), peak %.1f MiB\n",
+                    report.switches, report.warmUpSwitches, report.afterWarmUpMiB, report.endMiB,
+                    report.endMiB - report.afterWarmUpMiB, report.peakMiB);
+        std::fflush(stdout);
+        return report;
     }
 
     void TreeLodBrowser::savePng(const std::string& path)

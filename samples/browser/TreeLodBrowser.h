@@ -58,6 +58,20 @@ namespace TreeLod
         /// Headless: write the screenshots (see --help) into options.screenshots; returns their paths.
         std::vector<std::string> writeScreenshots();
 
+        /// Resident memory of a soak run (MiB).
+        struct SoakReport
+        {
+            unsigned switches = 0;       ///< made in all
+            unsigned warmUpSwitches = 0; ///< the first pass over every sample and technique
+            double afterWarmUpMiB = 0.0; ///< resident after the first pass
+            double endMiB = 0.0;         ///< resident at the end
+            double peakMiB = 0.0;        ///< the process's peak
+        };
+        /// Headless: `switches` changes of screen as a user makes them (the menu and a sample in
+        /// turn, then each entry of its technique menu), each drawn until it has settled; prints
+        /// and returns resident memory after the first pass and at the end.
+        SoakReport soak(unsigned switches);
+
         // ApplicationContext
         void createRoot() override;
         bool oneTimeConfig() override;

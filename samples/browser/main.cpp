@@ -40,8 +40,10 @@ int main(int argc, char** argv)
     try
     {
         browser.initApp();
-        if (options.headless)
+        if (options.headless && !options.screenshots.empty())
             browser.writeScreenshots();
+        if (options.headless && options.soak > 0)
+            browser.soak(options.soak);
         else
             browser.getRoot()->startRendering();
     }

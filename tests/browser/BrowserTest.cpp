@@ -11,6 +11,7 @@
 
 #include <sys/wait.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -136,6 +137,40 @@ namespace TreeLod
         EXPECT_GT(spread(menu), 0.3f);
     }
 
+    // Memory over a long session: after the first pass over every sample and technique (bakes
+    // loaded, levels built, shaders compiled), a few hundred more switches leave resident memory
+    // where it was, within SOAK_GROWTH_MIB.
+    TEST(BrowserHeadless, SoakKeepsMemory)
+    {
+        constexpr unsigned SWITCHES = 300;
+        constexpr double SOAK_GROWTH_MIB = 16.0;
+        std::string errors;
+        ASSERT_EQ(runBrowser("--headless --soak " + std::to_string(SWITCHES) + " --scene " +
+                                 std::string(TREELOD_SOURCE_DIR) + "/samples/scenes/single-tree.json --size 320x240",
+                             errors),
+                  0)
+            << errors;
+        std::ifstream in(outDir() + "/stdout.txt");
+        std::string line, report;
+        while (std::getline(in, line))
+            if (line.rfind("soak: ", 0) == 0)
+                report = line;
+        unsigned switches = 0, warmUp = 0;
+        double afterWarmUp = 0.0, end = 0.0, growth = 0.0, peak = 0.0;
+        ASSERT_EQ(std::sscanf(report.c_str(),
+                              "soak: %u switches; resident after the first pass (%u switches) %lf MiB, at the end "
+                              "%lf MiB (%lf MiB), peak %lf MiB",
+                              &switches, &warmUp, &afterWarmUp, &end, &growth, &peak),
+                  6)
+            << "no soak report in stdout: '" << report << "'";
+        EXPECT_EQ(switches, SWITCHES);
+        EXPECT_GT(warmUp, 5u) << "a pass visits every sample and technique";
+        EXPECT_LT(warmUp * 2, SWITCHES) << "too few switches after the first pass to see a leak";
+        EXPECT_GT(afterWarmUp, 10.0);
+        EXPECT_LE(end - afterWarmUp, SOAK_GROWTH_MIB) << report;
+        EXPECT_GE(peak, end);
+    }
+
     // Bad arguments: a message naming the argument, exit 2, nothing written.
     TEST(BrowserArguments, BadArgumentsExitTwo)
     {
@@ -151,6 +186,7 @@ namespace TreeLod
             {"--headless --screenshots " + shots + " --size 10x10", "--size"},
             {"--headless --screenshots " + shots + " --frames 0", "--frames"},
             {"--headless", "--screenshots"},
+            {"--soak 5", "--soak"},
             {"--nosuch", "--nosuch"},
             {"--headless --screenshots " + shots + " --scene /nonexistent/scene.json", "/nonexistent/scene.json"},
             {"--headless --screenshots " + shots + " --tree /nonexistent/tree.glb --scene " + scene, "/nonexistent/tree.glb"},
