@@ -88,8 +88,7 @@ namespace TreeLod
         /// media/oak.glb with every chunk the Forest draws, loaded as "oak.forest-test".
         const ForestTree& oak()
         {
-            OgreEnvironment::renderer(); // first: the Root must outlive the asset
-            static ForestTree tree = [] {
+            return OgreEnvironment::keep<ForestTree>("forest.oak", [] {
                 ForestTree t;
                 Result<TreeModel> model = importGltf(OgreEnvironment::sourcePath("media/oak.glb"));
                 EXPECT_TRUE(model.ok()) << (model.ok() ? "" : model.error().message());
@@ -98,8 +97,7 @@ namespace TreeLod
                     cachedPackage("forest", "oak", [&] { return bakePackage(t.model, "oak"); });
                 t.asset = TreeAssetManager::getSingleton().loadFromBytes("oak.forest-test", Ogre::RGN_DEFAULT, bytes);
                 return t;
-            }();
-            return tree;
+            });
         }
 
         const glm::vec3 BACKGROUND = LightingSpec().background;
@@ -592,6 +590,50 @@ namespace TreeLod
         r.render(back, 256, 192, 1);
         EXPECT_NE(flatCounts(*forest), before) << "unfrozen, the far view drops detail";
         EXPECT_EQ(forest->getStats().visibleInstances, 25u);
+    }
+
+    TEST(Forest, aThousandKilometresAway)
+    {
+        // A camera 10^6 m from the forest (far clip beyond it): every tree culled or at the last
+        // level, nothing NaN, nothing built but that level.
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+        Forest* forest = placeForest();
+        const std::vector<ForestLevel> levels = Forest::levelsForBands(*tree.asset, Forest::getAutoBands());
+        forest->addSpecies(tree.asset, levels);
+        forest->addInstances(grid(5, 1.4f * h));
+        CameraSpec distant = look(glm::vec3(1.0e6f, 1.0e6f, 1.0e6f), glm::vec3(0.0f), 1.0f);
+        distant.farClip = 3.0e6f;
+        distant.nearClip = 10.0f;
+        const Image far = toImage(r.render(distant, 64, 64, 1));
+        const ForestStats& stats = forest->getStats();
+        EXPECT_EQ(stats.visibleInstances, stats.levelCounts[0].back());
+        EXPECT_TRUE(std::isfinite(stats.cullMilliseconds));
+        for (std::size_t l = 0; l + 1 < levels.size(); ++l)
+            EXPECT_FALSE(forest->isResident(0, std::uint32_t(l))) << "level " << l << " built for a view from 1000 km";
+        for (const glm::vec4& p : far.pixels)
+            ASSERT_TRUE(std::isfinite(p.r) && std::isfinite(p.g) && std::isfinite(p.b));
+
+        // The forest and the camera both 10^6 m from the origin (floats step by 6 cm there):
+        // the picture of a tree seen from 2 heights is the one at the origin.
+        forest = placeForest();
+        forest->addSpecies(tree.asset, levels);
+        const glm::vec3 offset(1.0e6f, 0.0f, -1.0e6f);
+        const CameraSpec nearView = look(glm::vec3(0.0f, 0.6f * h, 2.0f * h), glm::vec3(0.0f, 0.5f * h, 0.0f));
+        forest->addInstances({instance(0.0f, 0.0f, 0.0f)});
+        const Image atOrigin = toImage(r.render(nearView, 128, 128, 1));
+        forest = placeForest();
+        forest->addSpecies(tree.asset, levels);
+        forest->addInstances({instance(offset.x, offset.y, offset.z)});
+        CameraSpec moved = nearView;
+        moved.position += offset;
+        moved.target += offset;
+        const Image away = toImage(r.render(moved, 128, 128, 1));
+        writePng(OgreEnvironment::outDir() + "/forest-1000km.png", sideBySide({atOrigin, away}));
+        EXPECT_GT(treeCoverage(atOrigin, BACKGROUND), 0.1);
+        EXPECT_GT(coveredOverlap(atOrigin, away, BACKGROUND), 0.9);
+        EXPECT_LT(flipMean(atOrigin, away), 0.1);
     }
 
     TEST(Forest, castsAndReceivesTextureShadows)
