@@ -1,5 +1,7 @@
 // The *.treelod package: writer -> reader round trips, determinism, corrupt and hostile
 // files, the reference chunk, and GPU-ready mip chains.
+#include "AllocationTracker.h"
+
 #include "TreeLod/Crc32.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
@@ -527,6 +529,31 @@ TEST(Package, HostileTableEntriesAreRejected)
     r = PackageReader::fromMemory(count, "p");
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().element, "chunk table");
+}
+
+TEST(AllocationTracker, SeesTheLargestRequestOfNewAndMallocWhileAlive)
+{
+    // The tests below rely on the tracker seeing big requests; this one shows that it does.
+    if (!test::AllocationTracker::available())
+        GTEST_SKIP() << "allocation tracking needs glibc and no sanitizer";
+    static void* volatile sink = nullptr; // keeps the allocations from being optimised away
+    {
+        test::AllocationTracker tracker;
+        sink = ::operator new(3u << 20);
+        ::operator delete(sink);
+        EXPECT_EQ(tracker.largest(), 3u << 20);
+        sink = new std::uint8_t[5u << 20];
+        delete[] static_cast<std::uint8_t*>(sink);
+        EXPECT_EQ(tracker.largest(), 5u << 20);
+        sink = std::malloc(7u << 20);
+        std::free(sink);
+        EXPECT_EQ(tracker.largest(), 7u << 20);
+        sink = std::calloc(1u << 20, 9);
+        std::free(sink);
+        EXPECT_EQ(tracker.largest(), 9u << 20);
+    }
+    test::AllocationTracker fresh;
+    EXPECT_EQ(fresh.largest(), 0u);
 }
 
 TEST(ModelChunk, ZeroLeafAndEmptyModelsRoundTrip)
