@@ -982,3 +982,65 @@ TEST(GltfImporter, ImageHeaderClaimingAHugeSizeIsRefusedBeforeDecoding)
         }
     }
 }
+
+TEST(GltfImporter, TenMillionClaimedVerticesOverAFewBytesAreRefusedAtTheAccessor)
+{
+    // A leaf quad whose accessors in turn claim 10 000 000 elements over views of 24 to 48 bytes:
+    // refused at the accessor with the claim and the view's size, before anything proportional to
+    // the claim is allocated (10 M vertices would take 320 MB): the largest single allocation
+    // stays under 1 MiB.
+    auto quad = [](GltfBuilder& b) {
+        PrimitiveData d;
+        d.material = b.addMaterial("Leaf", "MASK");
+        d.add(unitQuad({0, 0, 0}));
+        d.normals.assign(4, glm::vec3(0, 0, 1));
+        b.addMeshNode("Leaves", d);
+    };
+    struct Case
+    {
+        int accessor; ///< GltfBuilder::primitive writes POSITION, NORMAL, TEXCOORD_0, indices
+        std::string role;
+        std::string overrun;
+    };
+    const std::vector<Case> cases = {
+        {0, "POSITION", "10000000 elements of 12 bytes (stride 12) at offset 0 overrun bufferView 0 (48 bytes)"},
+        {1, "NORMAL", "10000000 elements of 12 bytes (stride 12) at offset 0 overrun bufferView 1 (48 bytes)"},
+        {2, "TEXCOORD_0", "10000000 elements of 8 bytes (stride 8) at offset 0 overrun bufferView 2 (32 bytes)"},
+        {3, "indices", "10000000 elements of 4 bytes (stride 4) at offset 0 overrun bufferView 3 (24 bytes)"},
+    };
+    for (const Case& c : cases)
+    {
+        GltfBuilder b;
+        quad(b);
+        ASSERT_TRUE(importBuilt(b)) << "the quad itself imports";
+        b.json()["accessors"][std::size_t(c.accessor)]["count"] = 10000000;
+        std::size_t largest = 0;
+        auto model = importTracked([&] { return importBuilt(b); }, largest);
+        ASSERT_FALSE(model) << c.role;
+        EXPECT_EQ(model.error().file, "test.glb");
+        EXPECT_EQ(model.error().element,
+                  "mesh 0 'Leaves' primitive 0 accessor " + std::to_string(c.accessor) + " (" + c.role + ")");
+        EXPECT_EQ(model.error().reason, c.overrun);
+        if (test::AllocationTracker::available())
+        {
+            EXPECT_LT(largest, kHostileAllocationBound) << c.role;
+        }
+    }
+
+    // The view claims 120 MB too, so the 10 M positions fit it; the buffer holds 152 bytes.
+    GltfBuilder b;
+    quad(b);
+    const std::size_t bufferBytes = b.bin().size();
+    b.json()["accessors"][0]["count"] = 10000000;
+    b.json()["bufferViews"][0]["byteLength"] = 120000000;
+    std::size_t largest = 0;
+    auto model = importTracked([&] { return importBuilt(b); }, largest);
+    ASSERT_FALSE(model);
+    EXPECT_EQ(model.error().element, "mesh 0 'Leaves' primitive 0 accessor 0 (POSITION) bufferView 0");
+    EXPECT_EQ(model.error().reason,
+              "byte range 0 + 120000000 exceeds buffer 0 (" + std::to_string(bufferBytes) + " bytes)");
+    if (test::AllocationTracker::available())
+    {
+        EXPECT_LT(largest, kHostileAllocationBound);
+    }
+}
