@@ -4,11 +4,13 @@
 #include "TreeLod/Image.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 namespace TreeLod
 {
@@ -739,5 +741,202 @@ namespace TreeLod
         EXPECT_GE(highest, 1500.0);
         EXPECT_LT(lowest, 2.0);
         EXPECT_GT(double(s->camera.farClip), highest * 2.0); // the far side of the forest from the overview
+    }
+
+    // ---- hostile numbers ----------------------------------------------------------------
+
+    namespace
+    {
+        /// A script that gives every numeric key of the format a value (docs/scene-format.md,
+        /// "Keys"): a heightfield ground, preset species with bands by distance and by pixels
+        /// and both forms of "scale", positions of 2, 3 and 4 numbers, random placements by
+        /// count and by density over rect, disc and ring areas and exclusions, sun, shadows,
+        /// camera, resolution, frames and counts. The sun's "direction" excludes its azimuth and
+        /// elevation, so the test gives it in a second script.
+        const std::string EVERY_NUMBER = R"({
+  "name": "every number",
+  "ground": {"kind": "heightfield", "size": 400, "image": "ground.png", "heightScale": 12.5},
+  "species": [
+    {"name": "oak", "source": "preset:oak", "seed": 7, "leaves": 2000, "height": 9.5, "scale": 1.25,
+     "techniques": [{"technique": "mesh", "maxDistance": 30}, {"technique": "lodf", "maxDistance": 300},
+                    {"technique": "billboard-cloud"}]},
+    {"name": "birch", "source": "preset:birch", "scale": [0.8, 1.2],
+     "techniques": [{"technique": "mesh", "minPixels": 400}, {"technique": "impostor"}]}
+  ],
+  "placements": [
+    {"species": "oak", "positions": [[0, 0], [12, -5, 90], [20, 10, -45, 1.5]]},
+    {"species": ["oak", "birch"], "random": {"seed": 3, "count": 50, "area": {"rect": [-150, -150, -50, -50]},
+     "exclude": [{"disc": [-100, -100, 20], "innerRadius": 5}], "clumping": 0.3}},
+    {"species": "birch", "random": {"seed": 4, "density": 20, "area": {"disc": [100, 100, 60], "innerRadius": 10},
+     "exclude": [{"rect": [90, 90, 110, 110]}]}}
+  ],
+  "sun": {"azimuth": 30, "elevation": 50, "colour": [1, 0.9, 0.8], "ambient": [0.3, 0.35, 0.4]},
+  "shadows": {"enabled": true, "textureSize": 2048, "camera": "focused", "lodBias": 0.5},
+  "camera": {"fovY": 50, "near": 0.1, "far": 5000, "interpolation": "catmull-rom",
+             "keyframes": [{"time": 0, "position": [-20, 1.7, 20], "target": [0, 4, 0]},
+                           {"time": 10, "position": [10, 1.7, 15], "target": [0, 4, -60]}]},
+  "resolution": [1280, 720],
+  "frames": 200,
+  "counts": [10, 100]
+})";
+
+        /// The heightfield EVERY_NUMBER's ground reads: 2 x 2 pixels.
+        Result<GreyImage> groundGrey(const std::string&) { return GreyImage{2, 2, {0.0f, 0.5f, 0.5f, 1.0f}}; }
+
+        /// JSON pointers of every number in `j` (depth first).
+        void numberPointers(const nlohmann::json& j, const std::string& pointer, std::vector<std::string>& out)
+        {
+            if (j.is_number())
+                out.push_back(pointer);
+            else if (j.is_object())
+                for (auto it = j.begin(); it != j.end(); ++it)
+                    numberPointers(it.value(), pointer + "/" + it.key(), out);
+            else if (j.is_array())
+                for (std::size_t i = 0; i < j.size(); ++i)
+                    numberPointers(j[i], pointer + "/" + std::to_string(i), out);
+        }
+
+        /// A script's text with one value replaced: keyAt is the offset errors about it point at
+        /// (the key's quote for an object member, the value for an array element), valueAt that
+        /// of the replacement.
+        struct Substitution
+        {
+            std::string target, replacement, text;
+            std::size_t keyAt = 0, valueAt = 0;
+        };
+
+        /// Appends `j` (at `pointer`) to s.text, one object member a line, writing the value at
+        /// s.target as s.replacement.
+        void writeWith(const nlohmann::json& j, const std::string& pointer, int depth, Substitution& s)
+        {
+            if (pointer == s.target)
+            {
+                s.valueAt = s.text.size();
+                s.text += s.replacement;
+                return;
+            }
+            const std::string indent(std::size_t(2 * depth + 2), ' ');
+            if (j.is_object())
+            {
+                s.text += "{\n";
+                for (auto it = j.begin(); it != j.end(); ++it)
+                {
+                    s.text += indent;
+                    const std::string member = pointer + "/" + it.key();
+                    if (member == s.target)
+                        s.keyAt = s.text.size();
+                    s.text += nlohmann::json(it.key()).dump() + ": ";
+                    writeWith(it.value(), member, depth + 1, s);
+                    s.text += std::next(it) == j.end() ? "\n" : ",\n";
+                }
+                s.text += std::string(std::size_t(2 * depth), ' ') + "}";
+            }
+            else if (j.is_array())
+            {
+                s.text += "[";
+                for (std::size_t i = 0; i < j.size(); ++i)
+                {
+                    const std::string element = pointer + "/" + std::to_string(i);
+                    s.text += i ? ", " : "";
+                    if (element == s.target)
+                        s.keyAt = s.text.size();
+                    writeWith(j[i], element, depth + 1, s);
+                }
+                s.text += "]";
+            }
+            else
+                s.text += j.dump();
+        }
+
+        /// The pointer with every array index replaced by '#': "/species/#/scale/#".
+        std::string pointerShape(const std::string& pointer)
+        {
+            std::string out;
+            std::size_t at = 0;
+            while (at < pointer.size())
+            {
+                std::size_t next = pointer.find('/', at + 1);
+                const std::string token = pointer.substr(at + 1, next == std::string::npos ? next : next - at - 1);
+                const bool index = !token.empty() && token.find_first_not_of("0123456789") == std::string::npos;
+                out += "/" + (index ? std::string("#") : token);
+                at = next == std::string::npos ? pointer.size() : next;
+            }
+            return out;
+        }
+    }
+
+    TEST(SceneScript, nonFiniteInputInEveryNumericKeyIsAnErrorAtItsKey)
+    {
+        // JSON has no NaN: a user may write NaN or Infinity (a syntax error, at the line and
+        // column of the word) or 1e999 / -1e999 (overflows to an infinity; an error naming line,
+        // column and key). Each number of the scripts in turn, found by walking them.
+        nlohmann::json base = nlohmann::json::parse(EVERY_NUMBER);
+        nlohmann::json withDirection = base;
+        withDirection["sun"] = {{"direction", {0.3, 0.8, 0.2}}, {"colour", {1, 1, 1}}};
+        std::vector<std::pair<const nlohmann::json*, std::string>> targets; // the second script: its sun only
+        std::set<std::string> seen, shapes;
+        for (const nlohmann::json* script : {&base, &withDirection})
+        {
+            Result<SceneScript> valid = parseSceneScript(script->dump(), "test.json", "", groundGrey);
+            ASSERT_TRUE(valid.ok()) << valid.error().message();
+            std::vector<std::string> pointers;
+            numberPointers(*script, "", pointers);
+            for (const std::string& p : pointers)
+                if (seen.insert(p).second)
+                {
+                    targets.emplace_back(script, p);
+                    shapes.insert(pointerShape(p));
+                }
+        }
+        // The fixture uses every numeric key of docs/scene-format.md.
+        const std::set<std::string> formatKeys = {
+            "/ground/size", "/ground/heightScale", "/species/#/seed", "/species/#/leaves", "/species/#/height",
+            "/species/#/techniques/#/maxDistance", "/species/#/techniques/#/minPixels", "/species/#/scale",
+            "/species/#/scale/#", "/placements/#/positions/#/#", "/placements/#/random/seed",
+            "/placements/#/random/count", "/placements/#/random/density", "/placements/#/random/area/rect/#",
+            "/placements/#/random/area/disc/#", "/placements/#/random/area/innerRadius",
+            "/placements/#/random/exclude/#/rect/#", "/placements/#/random/exclude/#/disc/#",
+            "/placements/#/random/exclude/#/innerRadius", "/placements/#/random/clumping", "/sun/azimuth",
+            "/sun/elevation", "/sun/direction/#", "/sun/colour/#", "/sun/ambient/#", "/shadows/textureSize",
+            "/shadows/lodBias", "/camera/fovY", "/camera/near", "/camera/far", "/camera/keyframes/#/time",
+            "/camera/keyframes/#/position/#", "/camera/keyframes/#/target/#", "/resolution/#", "/frames",
+            "/counts/#"};
+        EXPECT_EQ(shapes, formatKeys);
+
+        auto lineColumn = [](const std::string& text, std::size_t offset) {
+            std::size_t line = 1, column = 1;
+            for (std::size_t i = 0; i < offset; ++i)
+            {
+                column = text[i] == '\n' ? 1 : column + 1;
+                line += text[i] == '\n';
+            }
+            return "line " + std::to_string(line) + ", column " + std::to_string(column);
+        };
+        std::size_t checked = 0;
+        for (const auto& [script, pointer] : targets)
+            for (const char* replacement : {"NaN", "Infinity", "1e999", "-1e999"})
+            {
+                Substitution s;
+                s.target = pointer;
+                s.replacement = replacement;
+                writeWith(*script, "", 0, s);
+                Result<SceneScript> r = parseSceneScript(s.text, "test.json", "", groundGrey);
+                ASSERT_FALSE(r.ok()) << pointer << " = " << replacement << " was accepted";
+                const std::string message = r.error().message();
+                const bool syntax = replacement[0] != '1' && replacement[0] != '-';
+                if (syntax)
+                {
+                    const std::string expected = "test.json: " + lineColumn(s.text, s.valueAt) + ": ";
+                    EXPECT_EQ(message.substr(0, expected.size()), expected) << pointer << " = " << replacement;
+                    EXPECT_NE(message.find("syntax error"), std::string::npos) << message;
+                }
+                else
+                {
+                    EXPECT_EQ(message, "test.json: " + lineColumn(s.text, s.keyAt) + ", key " + pointer + ": " +
+                                           replacement + " is not a finite number (beyond the range of a double)");
+                }
+                ++checked;
+            }
+        EXPECT_GE(checked, 4u * 70u);
     }
 }
