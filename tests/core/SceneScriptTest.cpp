@@ -939,4 +939,32 @@ namespace TreeLod
             }
         EXPECT_GE(checked, 4u * 70u);
     }
+
+    TEST(SceneScript, instanceFileRefusesEveryNonFiniteFormInEveryNumericColumn)
+    {
+        // std::from_chars reads "nan", "inf", "infinity" (any case, signed) as numbers; 1e999
+        // overflows. In each numeric column each form is an error naming the file, line and column.
+        const std::vector<std::string> columns = {"x", "z", "rotation", "scale", "y"};
+        std::string header = "x,z,species,rotation,scale,y\n";
+        for (const std::string& column : columns)
+            for (const char* bad : {"nan", "NaN", "-nan", "+nan", "nan(123)", "inf", "-inf", "+inf", "INF",
+                                    "infinity", "-Infinity", "1e999", "-1e999"})
+            {
+                std::string row;
+                for (const char* c : {"x", "z", "species", "rotation", "scale", "y"})
+                {
+                    const std::string name = c;
+                    row += row.empty() ? "" : ",";
+                    row += name == column ? std::string(bad) : name == "species" ? "a" : name == "scale" ? "1" : "2";
+                }
+                const std::string csv = header + "# one good row, then the bad one\n2,2,b,0,1,0\n" + row + "\n";
+                Result<SceneScript> r = parseWithCsv("csv-non-finite", csv);
+                ASSERT_FALSE(r.ok()) << row;
+                const Error& e = r.error();
+                EXPECT_EQ(std::filesystem::path(e.file), (testDir("csv-non-finite") / "trees.csv").lexically_normal())
+                    << e.message();
+                EXPECT_EQ(e.element, "line 4, column " + column) << row;
+                EXPECT_EQ(e.reason.rfind(std::string(bad) + " must be finite", 0), 0u) << e.message();
+            }
+    }
 }
