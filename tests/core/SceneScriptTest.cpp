@@ -1,6 +1,7 @@
 // SceneScript: the shipped scenes, error positions, placements and the camera path.
 #include "TreeLod/SceneScript.h"
 
+#include "TreeLod/ForestInstances.h"
 #include "TreeLod/Image.h"
 
 #include <gtest/gtest.h>
@@ -743,7 +744,7 @@ namespace TreeLod
         EXPECT_GT(double(s->camera.farClip), highest * 2.0); // the far side of the forest from the overview
     }
 
-    // ---- hostile numbers ----------------------------------------------------------------
+    // ---- hostile numbers and a million trees -----------------------------------------------
 
     namespace
     {
@@ -966,5 +967,75 @@ namespace TreeLod
                 EXPECT_EQ(e.element, "line 4, column " + column) << row;
                 EXPECT_EQ(e.reason.rfind(std::string(bad) + " must be finite", 0), 0u) << e.message();
             }
+    }
+
+    TEST(SceneScript, aMillionTreesParsePlaceAndFillAForest)
+    {
+        // A random placement of 1 000 000 trees and an instance file of 1 000 000 lines: each
+        // parses, generatePlacements gives every tree, and ForestInstances holds and culls them
+        // at the documented memory per tree: 5 floats, the 16-bit kind and the two 32-bit handle
+        // maps (30 bytes) plus a box of 6 floats per block of 256, and per visible tree
+        // 12 floats of transform, 4 index arrays and a distance-class byte (65 bytes).
+        constexpr std::size_t MILLION = 1000000;
+        const std::filesystem::path dir = testDir("million");
+        {
+            std::ofstream csv(dir / "trees.csv", std::ios::binary);
+            csv << "x,z,species,rotation,scale\n";
+            for (std::size_t i = 0; i < MILLION; ++i)
+                csv << (int(i % 1000) - 500) << "," << (int(i / 1000) - 500) << "," << (i % 3 ? "a" : "b") << ","
+                    << (i % 360) << ",1." << (i % 10) << "\n";
+        }
+        const std::string random = replaced(replaced(replaced(MINIMAL, "\"count\": 10", "\"count\": 1000000"),
+                                                     "[-10, -10, 10, 10]", "[-500, -500, 500, 500]"),
+                                            "\"size\": 100", "\"size\": 1200");
+        const std::string file = replaced(withInstanceFile(), "\"size\": 100", "\"size\": 1200");
+        for (const std::string& text : {random, file})
+        {
+            Result<SceneScript> script = parseSceneScript(text, "test.json", dir.string());
+            ASSERT_TRUE(script.ok()) << script.error().message();
+            const std::vector<PlacedTree> trees = generatePlacements(*script);
+            ASSERT_EQ(trees.size(), MILLION);
+
+            ForestInstances forest;
+            for (std::size_t k = 0; k < script->species.size(); ++k)
+            {
+                ForestKind kind;
+                kind.name = script->species[k].name;
+                kind.boundsCentre = glm::vec3(0.0f, 8.0f, 0.0f);
+                kind.boundsRadius = 9.0f;
+                kind.thresholds = {2e5f, 2e4f, 2e3f};
+                ASSERT_TRUE(forest.addKind(kind));
+            }
+            std::vector<ForestInstance> instances(trees.size());
+            for (std::size_t i = 0; i < trees.size(); ++i)
+                instances[i] = ForestInstance{trees[i].position, trees[i].rotation, trees[i].scale, trees[i].species};
+            ASSERT_TRUE(forest.add(instances));
+            ASSERT_EQ(forest.size(), MILLION);
+            const std::size_t blocks = (MILLION + ForestInstances::BLOCK_SIZE - 1) / ForestInstances::BLOCK_SIZE;
+            const std::size_t storeBound = MILLION * (5 * sizeof(float) + sizeof(std::uint16_t) +
+                                                      2 * sizeof(ForestHandle)) +
+                                           blocks * 6 * sizeof(float);
+            std::printf("%s: %.2f bytes per tree in ForestInstances\n", script->placements[0].random ? "random" : "file",
+                        double(forest.getMemoryBytes()) / double(MILLION));
+            EXPECT_LE(forest.getMemoryBytes(), storeBound);
+
+            // From 3 km up, all in view; a second cull at the same counts allocates nothing.
+            CameraSpec overview;
+            overview.position = glm::vec3(0.0f, 3000.0f, 1.0f);
+            overview.target = glm::vec3(0.0f);
+            overview.farClip = 5000.0f;
+            const CullCamera camera = CullCamera::fromSpec(overview, 1920.0f, 1080.0f);
+            ForestVisibility vis;
+            ASSERT_TRUE(forest.cull(camera, 1.0f, vis));
+            EXPECT_EQ(vis.getVisibleCount(), MILLION);
+            const std::size_t perVisible = ForestVisibility::TRANSFORM_FLOATS * sizeof(float) +
+                                           4 * sizeof(std::uint32_t) + sizeof(std::uint8_t);
+            const std::size_t visibilityBound = MILLION * perVisible +
+                                                forest.getBucketCount() * (sizeof(ForestBucket) + sizeof(std::uint32_t));
+            EXPECT_LE(vis.getCapacityBytes(), visibilityBound);
+            const std::size_t capacity = vis.getCapacityBytes();
+            ASSERT_TRUE(forest.cull(camera, 1.0f, vis));
+            EXPECT_EQ(vis.getCapacityBytes(), capacity);
+        }
     }
 }
