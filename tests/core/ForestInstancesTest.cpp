@@ -825,4 +825,97 @@ namespace TreeLod
         }
         EXPECT_GT(seen, 10000u);
     }
+
+    // Cameras at the extremes: 1000 km out on every axis looking at the forest, and inside a
+    // tree's bounding sphere. No NaN reaches the selection: every visible instance has a valid
+    // level and a finite LoD value; the far forest is at each kind's last level (or culled by a
+    // near far plane), the tree around the camera at its first.
+    TEST(ForestInstances, camerasAMillionMetresOutAndInsideATreeSelectValidLevels)
+    {
+        std::mt19937 rng(29);
+        ForestInstances forest;
+        addKinds(forest);
+        std::vector<ForestInstance> instances = randomInstances(rng, 20000, 2000.0f, forest.getKindCount());
+        // One tree of each kind around the origin, where the second camera stands.
+        for (std::uint32_t k = 0; k < forest.getKindCount(); ++k)
+            instances[k] = ForestInstance{glm::vec3(0.0f), 0.3f * float(k), 1.0f, k};
+        ASSERT_TRUE(forest.add(instances));
+
+        // Every visible instance: a level of its kind and a finite, non-negative LoD value.
+        auto checkSelection = [&](const CullCamera& camera, const ForestVisibility& vis,
+                                  const std::string& what) -> std::vector<int> {
+            const std::vector<int> level = levelsFromBuckets(forest, vis);
+            std::size_t bad = 0;
+            for (std::size_t i = 0; i < forest.size(); ++i)
+            {
+                if (level[i] < 0)
+                    continue;
+                const float value = forest.lodValue(i, camera, 1.0f);
+                const std::uint32_t kind = forest.getAt(i).kind;
+                bad += std::isfinite(value) && value >= 0.0f && std::uint32_t(level[i]) < forest.getLevelCount(kind) &&
+                               forest.levelForValue(kind, value) == std::uint32_t(level[i])
+                           ? 0
+                           : 1;
+            }
+            EXPECT_EQ(bad, 0u) << what;
+            std::size_t nonFinite = 0;
+            for (std::size_t f = 0; f < ForestVisibility::TRANSFORM_FLOATS * vis.getVisibleCount(); ++f)
+                nonFinite += std::isfinite(vis.getTransforms()[f]) ? 0 : 1;
+            EXPECT_EQ(nonFinite, 0u) << what;
+            return level;
+        };
+
+        // 1000 km out on every axis, looking at the forest: it fills a few pixels, all of it at each
+        // kind's last level, with a far plane beyond it (finite or at infinity); culled whole by a
+        // far plane at 10 km.
+        CameraSpec spec;
+        spec.position = glm::vec3(1e6f);
+        spec.target = glm::vec3(0.0f);
+        spec.nearClip = 1.0f;
+        spec.farClip = 1e7f;
+        const glm::mat4 view = spec.viewMatrix();
+        const std::vector<std::pair<std::string, CullCamera>> farCameras = {
+            {"far 1e7", CullCamera::fromSpec(spec, 1920.0f, 1080.0f)},
+            {"far at infinity",
+             CullCamera::fromMatrices(view, glm::infinitePerspective(glm::radians(45.0f), 16.0f / 9.0f, 1.0f), 1920.0f,
+                                      1080.0f)},
+            {"orthographic 8 km",
+             CullCamera::fromMatrices(view, glm::ortho(-4000.0f, 4000.0f, -4000.0f, 4000.0f, 1.0f, 1e7f), 1024.0f,
+                                      1024.0f)}};
+        ForestVisibility vis;
+        for (const auto& [what, camera] : farCameras)
+        {
+            ASSERT_TRUE(forest.cull(camera, 1.0f, vis)) << what;
+            EXPECT_EQ(vis.getVisibleCount(), forest.size()) << what;
+            const std::vector<int> level = checkSelection(camera, vis, what);
+            if (what == "orthographic 8 km")
+                continue; // an orthographic size does not fall with distance
+            std::size_t notLast = 0;
+            for (std::size_t i = 0; i < forest.size(); ++i)
+                notLast += std::uint32_t(level[i]) + 1 == forest.getLevelCount(forest.getAt(i).kind) ? 0 : 1;
+            EXPECT_EQ(notLast, 0u) << what;
+        }
+        spec.farClip = 1e4f;
+        ASSERT_TRUE(forest.cull(CullCamera::fromSpec(spec, 1920.0f, 1080.0f), 1.0f, vis));
+        EXPECT_EQ(vis.getVisibleCount(), 0u);
+
+        // Inside the trees at the origin (their spheres: centre (0.3, 5, -0.2) turned, radius 6),
+        // looking out in six directions, and at their common origin: each is drawn, at level 0.
+        for (const glm::vec3& eye : {glm::vec3(0.0f, 5.0f, 0.0f), glm::vec3(0.0f), glm::vec3(1.0f, 2.0f, -1.0f)})
+            for (const glm::vec3& look : {glm::vec3(1, 0, 0), glm::vec3(-1, 0, 0), glm::vec3(0, 0, 1),
+                                          glm::vec3(0, 0, -1), glm::vec3(0.1f, 0.99f, 0), glm::vec3(0.1f, -0.99f, 0)})
+            {
+                CameraSpec inside;
+                inside.position = eye;
+                inside.target = eye + look;
+                const CullCamera camera = CullCamera::fromSpec(inside, 1280.0f, 720.0f);
+                ASSERT_TRUE(forest.cull(camera, 1.0f, vis));
+                const std::string what = "eye " + std::to_string(eye.x) + "," + std::to_string(eye.y) + "," +
+                                         std::to_string(eye.z) + " looking " + std::to_string(look.x) + "," +
+                                         std::to_string(look.y) + "," + std::to_string(look.z);
+                const std::vector<int> level = checkSelection(camera, vis, what);
+                for (std::uint32_t k = 0; k < forest.getKindCount(); ++k)
+                    EXPECT_EQ(level[k], 0) << what << ", kind " << k;
+            }
+    }
 }

@@ -1,4 +1,5 @@
 // glTF import: tiny files built in code (GltfTestUtil), one behaviour per test.
+#include "AllocationTracker.h"
 #include "GltfTestUtil.h"
 
 #include "TreeLod/GltfExporter.h"
@@ -890,4 +891,156 @@ TEST(GltfImporter, TruncatedPngIsAnErrorNamingTheImage)
     ASSERT_FALSE(model);
     EXPECT_EQ(model.error().element, "image 0 ''");
     EXPECT_TRUE(contains(model.error().reason, "truncated PNG")) << model.error().reason;
+}
+
+// ---- hostile sizes: claims refused before anything of their size is allocated ------------
+
+namespace
+{
+    /// Largest single allocation allowed while importing a hostile file of under 1 KiB.
+    constexpr std::size_t kHostileAllocationBound = std::size_t(1) << 20;
+
+    /// Imports with the allocation tracker on; `largest` gets the largest single allocation.
+    template <typename Import> Result<TreeModel> importTracked(Import import, std::size_t& largest)
+    {
+        Result<TreeModel> model = TreeModel();
+        test::AllocationTracker tracker;
+        model = import();
+        largest = tracker.largest();
+        return model;
+    }
+}
+
+TEST(GltfImporter, ImageHeaderClaimingAHugeSizeIsRefusedBeforeDecoding)
+{
+    // A few bytes whose PNG IHDR or JPEG frame header claims a huge image (65536 x 65536 RGBA8
+    // would be 16 GiB; a JPEG says at most 65535), embedded in a .glb and as a file beside a
+    // .gltf: refused from the header with the image and the limit. Nothing near the claimed size
+    // is allocated: the largest single allocation stays under 1 MiB.
+    const std::vector<std::uint8_t> png = makeRgbaPng(2, 1, kTwoPixels);
+    struct Case
+    {
+        std::string extension;
+        std::vector<std::uint8_t> bytes;
+        std::string claim;
+    };
+    const std::vector<Case> cases = {
+        {"png", withPngSize(png, 65536, 65536), "PNG header declares 65536x65536 pixels"},
+        {"png", withPngSize(png, 0x7fffffff, 1), "PNG header declares 2147483647x1 pixels"},
+        {"png", withPngSize(png, 16385, 1), "PNG header declares 16385x1 pixels"},
+        {"png", withPngSize(png, 1, 16385), "PNG header declares 1x16385 pixels"},
+        {"png", withPngSize(png, 8193, 8193), "PNG header declares 8193x8193 pixels"}, // > 64 Mpixel
+        {"jpg", makeJpegHeader(65535, 65535, false), "JPEG header declares 65535x65535 pixels"},
+        {"jpg", makeJpegHeader(65500, 65500, true), "JPEG header declares 65500x65500 pixels"},
+        {"jpg", makeJpegHeader(16384, 4097, true), "JPEG header declares 16384x4097 pixels"},
+    };
+    const std::string limit = ", larger than the limit (16384 per side, 64 Mpixel); not decoded";
+    for (const Case& c : cases)
+    {
+        GltfBuilder embedded;
+        const int image = embedded.addImageEmbedded(c.bytes);
+        embedded.json()["images"][std::size_t(image)]["name"] = "huge";
+        addTexturedLeaves(embedded, image);
+        std::size_t largest = 0;
+        auto model = importTracked([&] { return importBuilt(embedded); }, largest);
+        ASSERT_FALSE(model) << c.claim;
+        EXPECT_EQ(model.error().file, "test.glb");
+        EXPECT_EQ(model.error().element, "image 0 'huge'");
+        EXPECT_EQ(model.error().reason, c.claim + limit);
+        if (test::AllocationTracker::available())
+        {
+            EXPECT_LT(largest, kHostileAllocationBound) << c.claim;
+        }
+
+        const std::string dir = testDir("huge-image");
+        ASSERT_TRUE(writeBytes(dir + "/huge." + c.extension, c.bytes));
+        GltfBuilder external;
+        addTexturedLeaves(external, external.addImageUri("huge." + c.extension));
+        ASSERT_TRUE(external.writeGltf(dir + "/tree.gltf"));
+        model = importTracked([&] { return importGltf(dir + "/tree.gltf"); }, largest);
+        ASSERT_FALSE(model) << c.claim;
+        EXPECT_EQ(model.error().file, dir + "/tree.gltf");
+        EXPECT_EQ(model.error().element, "image 0 ''");
+        EXPECT_EQ(model.error().reason, c.claim + limit);
+        if (test::AllocationTracker::available())
+        {
+            EXPECT_LT(largest, kHostileAllocationBound) << c.claim;
+        }
+    }
+
+    // At the limit of a side the header passes; what follows is the decoder's business (these
+    // bytes hold no such image, so it may fail, but not on the size).
+    for (const auto& atLimit : {withPngSize(png, 16384, 1), withPngSize(png, 1, 16384),
+                                makeJpegHeader(16384, 1, false), makeJpegHeader(1, 16384, true)})
+    {
+        GltfBuilder b;
+        addTexturedLeaves(b, b.addImageEmbedded(atLimit));
+        auto model = importBuilt(b);
+        if (!model)
+        {
+            EXPECT_FALSE(contains(model.error().reason, "header declares")) << model.error().message();
+        }
+    }
+}
+
+TEST(GltfImporter, TenMillionClaimedVerticesOverAFewBytesAreRefusedAtTheAccessor)
+{
+    // A leaf quad whose accessors in turn claim 10 000 000 elements over views of 24 to 48 bytes:
+    // refused at the accessor with the claim and the view's size, before anything proportional to
+    // the claim is allocated (10 M vertices would take 320 MB): the largest single allocation
+    // stays under 1 MiB.
+    auto quad = [](GltfBuilder& b) {
+        PrimitiveData d;
+        d.material = b.addMaterial("Leaf", "MASK");
+        d.add(unitQuad({0, 0, 0}));
+        d.normals.assign(4, glm::vec3(0, 0, 1));
+        b.addMeshNode("Leaves", d);
+    };
+    struct Case
+    {
+        int accessor; ///< GltfBuilder::primitive writes POSITION, NORMAL, TEXCOORD_0, indices
+        std::string role;
+        std::string overrun;
+    };
+    const std::vector<Case> cases = {
+        {0, "POSITION", "10000000 elements of 12 bytes (stride 12) at offset 0 overrun bufferView 0 (48 bytes)"},
+        {1, "NORMAL", "10000000 elements of 12 bytes (stride 12) at offset 0 overrun bufferView 1 (48 bytes)"},
+        {2, "TEXCOORD_0", "10000000 elements of 8 bytes (stride 8) at offset 0 overrun bufferView 2 (32 bytes)"},
+        {3, "indices", "10000000 elements of 4 bytes (stride 4) at offset 0 overrun bufferView 3 (24 bytes)"},
+    };
+    for (const Case& c : cases)
+    {
+        GltfBuilder b;
+        quad(b);
+        ASSERT_TRUE(importBuilt(b)) << "the quad itself imports";
+        b.json()["accessors"][std::size_t(c.accessor)]["count"] = 10000000;
+        std::size_t largest = 0;
+        auto model = importTracked([&] { return importBuilt(b); }, largest);
+        ASSERT_FALSE(model) << c.role;
+        EXPECT_EQ(model.error().file, "test.glb");
+        EXPECT_EQ(model.error().element,
+                  "mesh 0 'Leaves' primitive 0 accessor " + std::to_string(c.accessor) + " (" + c.role + ")");
+        EXPECT_EQ(model.error().reason, c.overrun);
+        if (test::AllocationTracker::available())
+        {
+            EXPECT_LT(largest, kHostileAllocationBound) << c.role;
+        }
+    }
+
+    // The view claims 120 MB too, so the 10 M positions fit it; the buffer holds 152 bytes.
+    GltfBuilder b;
+    quad(b);
+    const std::size_t bufferBytes = b.bin().size();
+    b.json()["accessors"][0]["count"] = 10000000;
+    b.json()["bufferViews"][0]["byteLength"] = 120000000;
+    std::size_t largest = 0;
+    auto model = importTracked([&] { return importBuilt(b); }, largest);
+    ASSERT_FALSE(model);
+    EXPECT_EQ(model.error().element, "mesh 0 'Leaves' primitive 0 accessor 0 (POSITION) bufferView 0");
+    EXPECT_EQ(model.error().reason,
+              "byte range 0 + 120000000 exceeds buffer 0 (" + std::to_string(bufferBytes) + " bytes)");
+    if (test::AllocationTracker::available())
+    {
+        EXPECT_LT(largest, kHostileAllocationBound);
+    }
 }

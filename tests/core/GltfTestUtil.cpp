@@ -139,6 +139,47 @@ namespace TreeLod
             return makePng(width, height, 6, 8, rgba);
         }
 
+        std::vector<std::uint8_t> withPngSize(std::vector<std::uint8_t> png, std::uint32_t width,
+                                              std::uint32_t height)
+        {
+            // Signature (8), IHDR length (4), "IHDR" at 12, width at 16, height at 20, CRC at 29.
+            for (int i = 0; i < 4; ++i)
+            {
+                png[16 + i] = std::uint8_t(width >> (24 - 8 * i));
+                png[20 + i] = std::uint8_t(height >> (24 - 8 * i));
+            }
+            const std::uint32_t crc = crc32(png.data() + 12, 17);
+            for (int i = 0; i < 4; ++i)
+                png[29 + i] = std::uint8_t(crc >> (24 - 8 * i));
+            return png;
+        }
+
+        std::vector<std::uint8_t> makeJpegHeader(std::uint16_t width, std::uint16_t height, bool progressive)
+        {
+            std::vector<std::uint8_t> j = {0xFF, 0xD8};
+            auto segment = [&](std::uint8_t marker, const std::vector<std::uint8_t>& body) {
+                const std::size_t length = body.size() + 2;
+                j.insert(j.end(), {0xFF, marker, std::uint8_t(length >> 8), std::uint8_t(length & 0xFF)});
+                j.insert(j.end(), body.begin(), body.end());
+            };
+            std::vector<std::uint8_t> dqt = {0x00}; // 8-bit table 0
+            dqt.resize(65, 1);
+            segment(0xDB, dqt);
+            segment(progressive ? 0xC2 : 0xC0,
+                    {8, std::uint8_t(height >> 8), std::uint8_t(height & 0xFF), std::uint8_t(width >> 8),
+                     std::uint8_t(width & 0xFF), 1, 1, 0x11, 0}); // one component: id 1, 1x1, table 0
+            for (std::uint8_t tableClass : {0x00, 0x10}) // DC 0, AC 0: one 1-bit code for symbol 0
+            {
+                std::vector<std::uint8_t> dht = {tableClass, 1};
+                dht.resize(17, 0);
+                dht.push_back(0);
+                segment(0xC4, dht);
+            }
+            segment(0xDA, {1, 1, 0x00, 0, std::uint8_t(progressive ? 0 : 63), 0});
+            j.insert(j.end(), {0x00, 0x00, 0x00, 0x00});
+            return j;
+        }
+
         std::string base64(const std::vector<std::uint8_t>& bytes)
         {
             static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";

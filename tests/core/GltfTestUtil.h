@@ -35,6 +35,17 @@ namespace TreeLod
         /// An 8-bit RGBA PNG.
         std::vector<std::uint8_t> makeRgbaPng(int width, int height, const std::vector<std::uint8_t>& rgba);
 
+        /// `png` with the width and height in its IHDR replaced (CRC updated); the pixel data
+        /// stays what it was, so the file claims a size its bytes do not hold.
+        std::vector<std::uint8_t> withPngSize(std::vector<std::uint8_t> png, std::uint32_t width,
+                                              std::uint32_t height);
+
+        /// The start of a greyscale JPEG claiming width x height (at most 65535 each): SOI, a
+        /// quantisation table, a baseline (SOF0) or progressive (SOF2) frame header, Huffman
+        /// tables, the first scan header and four bytes of scan data; no end. Enough for a
+        /// decoder to read the header, not an image.
+        std::vector<std::uint8_t> makeJpegHeader(std::uint16_t width, std::uint16_t height, bool progressive);
+
         /// Base64 (for data URIs).
         std::string base64(const std::vector<std::uint8_t>& bytes);
 

@@ -1,5 +1,7 @@
 // The *.treelod package: writer -> reader round trips, determinism, corrupt and hostile
 // files, the reference chunk, and GPU-ready mip chains.
+#include "AllocationTracker.h"
+
 #include "TreeLod/Crc32.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
@@ -7,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -187,6 +190,12 @@ namespace
     {
         for (int i = 0; i < 4; ++i)
             b[at + i] = std::uint8_t(v >> (8 * i));
+    }
+
+    void putU64(std::vector<std::uint8_t>& b, std::size_t at, std::uint64_t v)
+    {
+        putU32(b, at, std::uint32_t(v));
+        putU32(b, at + 4, std::uint32_t(v >> 32));
     }
 
     /// Recompute the table and header checksums after a test edited them, so that the
@@ -527,6 +536,145 @@ TEST(Package, HostileTableEntriesAreRejected)
     r = PackageReader::fromMemory(count, "p");
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().element, "chunk table");
+}
+
+TEST(AllocationTracker, SeesTheLargestRequestOfNewAndMallocWhileAlive)
+{
+    // The tests below rely on the tracker seeing big requests; this one shows that it does.
+    if (!test::AllocationTracker::available())
+        GTEST_SKIP() << "allocation tracking needs glibc and no sanitizer";
+    static void* volatile sink = nullptr; // keeps the allocations from being optimised away
+    {
+        test::AllocationTracker tracker;
+        sink = ::operator new(3u << 20);
+        ::operator delete(sink);
+        EXPECT_EQ(tracker.largest(), 3u << 20);
+        sink = new std::uint8_t[5u << 20];
+        delete[] static_cast<std::uint8_t*>(sink);
+        EXPECT_EQ(tracker.largest(), 5u << 20);
+        sink = std::malloc(7u << 20);
+        std::free(sink);
+        EXPECT_EQ(tracker.largest(), 7u << 20);
+        sink = std::calloc(1u << 20, 9);
+        std::free(sink);
+        EXPECT_EQ(tracker.largest(), 9u << 20);
+    }
+    test::AllocationTracker fresh;
+    EXPECT_EQ(fresh.largest(), 0u);
+}
+
+TEST(Package, GigabyteClaimsInASmallFileAreRefusedBeforeAllocating)
+{
+    // Table entries, a chunk count and a table offset that claim about 4 GiB (or, for the count,
+    // 4 billion 64-byte entries) in a package of 1.4 KB, checksums resealed: each is
+    // refused from the header and table alone. Bound on the largest single allocation while the
+    // reader opens it: 2 x the file size + 8 KiB (the table, the chunk list and, from disk, the
+    // file stream's buffer); reading a claimed payload would need 4 GiB.
+    const std::vector<std::uint8_t> clean = packageOf(makeTree());
+    Result<PackageReader> cleanReader = PackageReader::fromMemory(clean, "clean");
+    ASSERT_TRUE(cleanReader);
+    ASSERT_EQ(cleanReader->chunks()[1].technique, REFERENCE_CHUNK);
+    const std::uint64_t refOffset = cleanReader->chunks()[1].offset, refSize = cleanReader->chunks()[1].size;
+    const std::size_t entry1 = 32 + 64;
+    const std::string fileHas = ", file has " + std::to_string(clean.size());
+    const std::string refEntry = "chunk table entry 1 (chunk 'reference' level 0)";
+
+    struct Case
+    {
+        std::string what;
+        std::vector<std::uint8_t> bytes;
+        std::string element, reason;
+    };
+    std::vector<Case> cases;
+    auto edited = [&](auto edit, bool table) {
+        std::vector<std::uint8_t> b = clean;
+        edit(b);
+        reseal(b, table);
+        return b;
+    };
+    cases.push_back({"chunk size 4 GiB - 16",
+                     edited([&](auto& b) { putU64(b, entry1 + 48, 0xfffffff0ull); }, true), refEntry,
+                     "truncated: needs 4294967280 bytes at offset " + std::to_string(refOffset) + fileHas});
+    cases.push_back({"chunk offset 4 GiB",
+                     edited([&](auto& b) { putU64(b, entry1 + 40, 0x100000000ull); }, true), refEntry,
+                     "truncated: needs " + std::to_string(refSize) + " bytes at offset 4294967296" + fileHas});
+    cases.push_back({"chunk offset and size 4 GiB",
+                     edited([&](auto& b) {
+                         putU64(b, entry1 + 40, 0x100000000ull);
+                         putU64(b, entry1 + 48, 0x100000000ull);
+                     }, true),
+                     refEntry, "truncated: needs 4294967296 bytes at offset 4294967296" + fileHas});
+    cases.push_back({"4294967295 chunks", edited([&](auto& b) { putU32(b, 8, 0xffffffffu); }, false),
+                     "chunk table", "truncated: needs 274877906880 bytes at offset 32" + fileHas});
+    cases.push_back({"table offset 4 GiB", edited([&](auto& b) { putU64(b, 16, 0x100000000ull); }, false),
+                     "chunk table", "truncated: needs 128 bytes at offset 4294967296" + fileHas});
+
+    const bool tracked = test::AllocationTracker::available();
+    const std::size_t bound = 2 * clean.size() + 8192;
+    for (Case& c : cases)
+    {
+        const std::string path = outDir() + "/claims-4gib.treelod";
+        {
+            std::ofstream out(path, std::ios::binary | std::ios::trunc);
+            out.write(reinterpret_cast<const char*>(c.bytes.data()), std::streamsize(c.bytes.size()));
+        }
+        for (bool fromDisk : {false, true})
+        {
+            const std::string label = fromDisk ? path : "claims-4gib";
+            std::vector<std::uint8_t> bytes = c.bytes; // copied before tracking: fromMemory takes it
+            std::size_t largest = 0;
+            Result<PackageReader> r = PackageReader();
+            {
+                test::AllocationTracker tracker;
+                r = fromDisk ? PackageReader::open(path) : PackageReader::fromMemory(std::move(bytes), label);
+                largest = tracker.largest();
+            }
+            const std::string where = c.what + (fromDisk ? " (file)" : " (memory)");
+            ASSERT_FALSE(r) << where;
+            EXPECT_EQ(r.error().file, label) << where;
+            EXPECT_EQ(r.error().element, c.element) << where;
+            EXPECT_EQ(r.error().reason, c.reason) << where;
+            if (tracked)
+            {
+                EXPECT_LE(largest, bound) << where << ": largest allocation " << largest << " bytes";
+            }
+        }
+    }
+
+    // Inside a well-formed package, the reference chunk's leaf texture claims 16384 x 16384 with
+    // all 15 mip levels (1.4 GB of texels): refused from its header, nothing of that size asked for.
+    std::vector<std::uint8_t> chunk = encodeReferenceChunk(makeReferenceChunk(makeTree()));
+    const std::vector<std::uint8_t> named = {8, 0, 0, 0, 'l', 'e', 'a', 'f', '.', 'p', 'n', 'g'};
+    auto found = std::search(chunk.begin(), chunk.end(), named.begin(), named.end());
+    ASSERT_NE(found, chunk.end());
+    const std::size_t fields = std::size_t(found - chunk.begin()) + named.size(); // format, w, h, mips, bytes
+    const GpuTextureFormat format = GpuTextureFormat(getU32(chunk, fields));
+    const std::uint64_t claimed = gpuTextureBytes(format, 16384, 16384, 15);
+    ASSERT_GT(claimed, std::uint64_t(1) << 30);
+    putU32(chunk, fields + 4, 16384);
+    putU32(chunk, fields + 8, 16384);
+    putU32(chunk, fields + 12, 15);
+    putU64(chunk, fields + 16, claimed);
+    PackageWriter writer;
+    ASSERT_TRUE(writer.addChunk(REFERENCE_CHUNK, 0, REFERENCE_CHUNK_FORMAT_VERSION, chunk));
+    std::vector<std::uint8_t> package = writer.toBytes();
+    std::size_t largest = 0;
+    Result<ReferenceChunk> decoded = ReferenceChunk();
+    {
+        test::AllocationTracker tracker;
+        decoded = decodeFrom(package);
+        largest = tracker.largest();
+    }
+    ASSERT_FALSE(decoded);
+    EXPECT_EQ(decoded.error().file, "mem.treelod");
+    EXPECT_EQ(decoded.error().element, "chunk 'reference' level 0, texture 1 'leaf.png'");
+    EXPECT_EQ(decoded.error().reason.rfind("truncated: needs " + std::to_string(claimed) + " bytes", 0), 0u)
+        << decoded.error().message();
+    if (tracked)
+    {
+        // fromMemory copies the package, readChunk copies the payload: each at most the package.
+        EXPECT_LE(largest, 2 * package.size() + 8192) << "largest allocation " << largest << " bytes";
+    }
 }
 
 TEST(ModelChunk, ZeroLeafAndEmptyModelsRoundTrip)

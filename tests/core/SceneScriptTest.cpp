@@ -1,14 +1,17 @@
 // SceneScript: the shipped scenes, error positions, placements and the camera path.
 #include "TreeLod/SceneScript.h"
 
+#include "TreeLod/ForestInstances.h"
 #include "TreeLod/Image.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 namespace TreeLod
 {
@@ -739,5 +742,300 @@ namespace TreeLod
         EXPECT_GE(highest, 1500.0);
         EXPECT_LT(lowest, 2.0);
         EXPECT_GT(double(s->camera.farClip), highest * 2.0); // the far side of the forest from the overview
+    }
+
+    // ---- hostile numbers and a million trees -----------------------------------------------
+
+    namespace
+    {
+        /// A script that gives every numeric key of the format a value (docs/scene-format.md,
+        /// "Keys"): a heightfield ground, preset species with bands by distance and by pixels
+        /// and both forms of "scale", positions of 2, 3 and 4 numbers, random placements by
+        /// count and by density over rect, disc and ring areas and exclusions, sun, shadows,
+        /// camera, resolution, frames and counts. The sun's "direction" excludes its azimuth and
+        /// elevation, so the test gives it in a second script.
+        const std::string EVERY_NUMBER = R"({
+  "name": "every number",
+  "ground": {"kind": "heightfield", "size": 400, "image": "ground.png", "heightScale": 12.5},
+  "species": [
+    {"name": "oak", "source": "preset:oak", "seed": 7, "leaves": 2000, "height": 9.5, "scale": 1.25,
+     "techniques": [{"technique": "mesh", "maxDistance": 30}, {"technique": "lodf", "maxDistance": 300},
+                    {"technique": "billboard-cloud"}]},
+    {"name": "birch", "source": "preset:birch", "scale": [0.8, 1.2],
+     "techniques": [{"technique": "mesh", "minPixels": 400}, {"technique": "impostor"}]}
+  ],
+  "placements": [
+    {"species": "oak", "positions": [[0, 0], [12, -5, 90], [20, 10, -45, 1.5]]},
+    {"species": ["oak", "birch"], "random": {"seed": 3, "count": 50, "area": {"rect": [-150, -150, -50, -50]},
+     "exclude": [{"disc": [-100, -100, 20], "innerRadius": 5}], "clumping": 0.3}},
+    {"species": "birch", "random": {"seed": 4, "density": 20, "area": {"disc": [100, 100, 60], "innerRadius": 10},
+     "exclude": [{"rect": [90, 90, 110, 110]}]}}
+  ],
+  "sun": {"azimuth": 30, "elevation": 50, "colour": [1, 0.9, 0.8], "ambient": [0.3, 0.35, 0.4]},
+  "shadows": {"enabled": true, "textureSize": 2048, "camera": "focused", "lodBias": 0.5},
+  "camera": {"fovY": 50, "near": 0.1, "far": 5000, "interpolation": "catmull-rom",
+             "keyframes": [{"time": 0, "position": [-20, 1.7, 20], "target": [0, 4, 0]},
+                           {"time": 10, "position": [10, 1.7, 15], "target": [0, 4, -60]}]},
+  "resolution": [1280, 720],
+  "frames": 200,
+  "counts": [10, 100]
+})";
+
+        /// The heightfield EVERY_NUMBER's ground reads: 2 x 2 pixels.
+        Result<GreyImage> groundGrey(const std::string&) { return GreyImage{2, 2, {0.0f, 0.5f, 0.5f, 1.0f}}; }
+
+        /// JSON pointers of every number in `j` (depth first).
+        void numberPointers(const nlohmann::json& j, const std::string& pointer, std::vector<std::string>& out)
+        {
+            if (j.is_number())
+                out.push_back(pointer);
+            else if (j.is_object())
+                for (auto it = j.begin(); it != j.end(); ++it)
+                    numberPointers(it.value(), pointer + "/" + it.key(), out);
+            else if (j.is_array())
+                for (std::size_t i = 0; i < j.size(); ++i)
+                    numberPointers(j[i], pointer + "/" + std::to_string(i), out);
+        }
+
+        /// A script's text with one value replaced: keyAt is the offset errors about it point at
+        /// (the key's quote for an object member, the value for an array element), valueAt that
+        /// of the replacement.
+        struct Substitution
+        {
+            std::string target, replacement, text;
+            std::size_t keyAt = 0, valueAt = 0;
+        };
+
+        /// Appends `j` (at `pointer`) to s.text, one object member a line, writing the value at
+        /// s.target as s.replacement.
+        void writeWith(const nlohmann::json& j, const std::string& pointer, int depth, Substitution& s)
+        {
+            if (pointer == s.target)
+            {
+                s.valueAt = s.text.size();
+                s.text += s.replacement;
+                return;
+            }
+            const std::string indent(std::size_t(2 * depth + 2), ' ');
+            if (j.is_object())
+            {
+                s.text += "{\n";
+                for (auto it = j.begin(); it != j.end(); ++it)
+                {
+                    s.text += indent;
+                    const std::string member = pointer + "/" + it.key();
+                    if (member == s.target)
+                        s.keyAt = s.text.size();
+                    s.text += nlohmann::json(it.key()).dump() + ": ";
+                    writeWith(it.value(), member, depth + 1, s);
+                    s.text += std::next(it) == j.end() ? "\n" : ",\n";
+                }
+                s.text += std::string(std::size_t(2 * depth), ' ') + "}";
+            }
+            else if (j.is_array())
+            {
+                s.text += "[";
+                for (std::size_t i = 0; i < j.size(); ++i)
+                {
+                    const std::string element = pointer + "/" + std::to_string(i);
+                    s.text += i ? ", " : "";
+                    if (element == s.target)
+                        s.keyAt = s.text.size();
+                    writeWith(j[i], element, depth + 1, s);
+                }
+                s.text += "]";
+            }
+            else
+                s.text += j.dump();
+        }
+
+        /// The pointer with every array index replaced by '#': "/species/#/scale/#".
+        std::string pointerShape(const std::string& pointer)
+        {
+            std::string out;
+            std::size_t at = 0;
+            while (at < pointer.size())
+            {
+                std::size_t next = pointer.find('/', at + 1);
+                const std::string token = pointer.substr(at + 1, next == std::string::npos ? next : next - at - 1);
+                const bool index = !token.empty() && token.find_first_not_of("0123456789") == std::string::npos;
+                out += "/" + (index ? std::string("#") : token);
+                at = next == std::string::npos ? pointer.size() : next;
+            }
+            return out;
+        }
+    }
+
+    TEST(SceneScript, nonFiniteInputInEveryNumericKeyIsAnErrorAtItsKey)
+    {
+        // JSON has no NaN: a user may write NaN or Infinity (a syntax error, at the line and
+        // column of the word) or 1e999 / -1e999 (overflows to an infinity; an error naming line,
+        // column and key). Each number of the scripts in turn, found by walking them.
+        nlohmann::json base = nlohmann::json::parse(EVERY_NUMBER);
+        nlohmann::json withDirection = base;
+        withDirection["sun"] = {{"direction", {0.3, 0.8, 0.2}}, {"colour", {1, 1, 1}}};
+        std::vector<std::pair<const nlohmann::json*, std::string>> targets; // the second script: its sun only
+        std::set<std::string> seen, shapes;
+        for (const nlohmann::json* script : {&base, &withDirection})
+        {
+            Result<SceneScript> valid = parseSceneScript(script->dump(), "test.json", "", groundGrey);
+            ASSERT_TRUE(valid.ok()) << valid.error().message();
+            std::vector<std::string> pointers;
+            numberPointers(*script, "", pointers);
+            for (const std::string& p : pointers)
+                if (seen.insert(p).second)
+                {
+                    targets.emplace_back(script, p);
+                    shapes.insert(pointerShape(p));
+                }
+        }
+        // The fixture uses every numeric key of docs/scene-format.md.
+        const std::set<std::string> formatKeys = {
+            "/ground/size", "/ground/heightScale", "/species/#/seed", "/species/#/leaves", "/species/#/height",
+            "/species/#/techniques/#/maxDistance", "/species/#/techniques/#/minPixels", "/species/#/scale",
+            "/species/#/scale/#", "/placements/#/positions/#/#", "/placements/#/random/seed",
+            "/placements/#/random/count", "/placements/#/random/density", "/placements/#/random/area/rect/#",
+            "/placements/#/random/area/disc/#", "/placements/#/random/area/innerRadius",
+            "/placements/#/random/exclude/#/rect/#", "/placements/#/random/exclude/#/disc/#",
+            "/placements/#/random/exclude/#/innerRadius", "/placements/#/random/clumping", "/sun/azimuth",
+            "/sun/elevation", "/sun/direction/#", "/sun/colour/#", "/sun/ambient/#", "/shadows/textureSize",
+            "/shadows/lodBias", "/camera/fovY", "/camera/near", "/camera/far", "/camera/keyframes/#/time",
+            "/camera/keyframes/#/position/#", "/camera/keyframes/#/target/#", "/resolution/#", "/frames",
+            "/counts/#"};
+        EXPECT_EQ(shapes, formatKeys);
+
+        auto lineColumn = [](const std::string& text, std::size_t offset) {
+            std::size_t line = 1, column = 1;
+            for (std::size_t i = 0; i < offset; ++i)
+            {
+                column = text[i] == '\n' ? 1 : column + 1;
+                line += text[i] == '\n';
+            }
+            return "line " + std::to_string(line) + ", column " + std::to_string(column);
+        };
+        std::size_t checked = 0;
+        for (const auto& [script, pointer] : targets)
+            for (const char* replacement : {"NaN", "Infinity", "1e999", "-1e999"})
+            {
+                Substitution s;
+                s.target = pointer;
+                s.replacement = replacement;
+                writeWith(*script, "", 0, s);
+                Result<SceneScript> r = parseSceneScript(s.text, "test.json", "", groundGrey);
+                ASSERT_FALSE(r.ok()) << pointer << " = " << replacement << " was accepted";
+                const std::string message = r.error().message();
+                const bool syntax = replacement[0] != '1' && replacement[0] != '-';
+                if (syntax)
+                {
+                    const std::string expected = "test.json: " + lineColumn(s.text, s.valueAt) + ": ";
+                    EXPECT_EQ(message.substr(0, expected.size()), expected) << pointer << " = " << replacement;
+                    EXPECT_NE(message.find("syntax error"), std::string::npos) << message;
+                }
+                else
+                {
+                    EXPECT_EQ(message, "test.json: " + lineColumn(s.text, s.keyAt) + ", key " + pointer + ": " +
+                                           replacement + " is not a finite number (beyond the range of a double)");
+                }
+                ++checked;
+            }
+        EXPECT_GE(checked, 4u * 70u);
+    }
+
+    TEST(SceneScript, instanceFileRefusesEveryNonFiniteFormInEveryNumericColumn)
+    {
+        // std::from_chars reads "nan", "inf", "infinity" (any case, signed) as numbers; 1e999
+        // overflows. In each numeric column each form is an error naming the file, line and column.
+        const std::vector<std::string> columns = {"x", "z", "rotation", "scale", "y"};
+        std::string header = "x,z,species,rotation,scale,y\n";
+        for (const std::string& column : columns)
+            for (const char* bad : {"nan", "NaN", "-nan", "+nan", "nan(123)", "inf", "-inf", "+inf", "INF",
+                                    "infinity", "-Infinity", "1e999", "-1e999"})
+            {
+                std::string row;
+                for (const char* c : {"x", "z", "species", "rotation", "scale", "y"})
+                {
+                    const std::string name = c;
+                    row += row.empty() ? "" : ",";
+                    row += name == column ? std::string(bad) : name == "species" ? "a" : name == "scale" ? "1" : "2";
+                }
+                const std::string csv = header + "# one good row, then the bad one\n2,2,b,0,1,0\n" + row + "\n";
+                Result<SceneScript> r = parseWithCsv("csv-non-finite", csv);
+                ASSERT_FALSE(r.ok()) << row;
+                const Error& e = r.error();
+                EXPECT_EQ(std::filesystem::path(e.file), (testDir("csv-non-finite") / "trees.csv").lexically_normal())
+                    << e.message();
+                EXPECT_EQ(e.element, "line 4, column " + column) << row;
+                EXPECT_EQ(e.reason.rfind(std::string(bad) + " must be finite", 0), 0u) << e.message();
+            }
+    }
+
+    TEST(SceneScript, aMillionTreesParsePlaceAndFillAForest)
+    {
+        // A random placement of 1 000 000 trees and an instance file of 1 000 000 lines: each
+        // parses, generatePlacements gives every tree, and ForestInstances holds and culls them
+        // at the documented memory per tree: 5 floats, the 16-bit kind and the two 32-bit handle
+        // maps (30 bytes) plus a box of 6 floats per block of 256, and per visible tree
+        // 12 floats of transform, 4 index arrays and a distance-class byte (65 bytes).
+        constexpr std::size_t MILLION = 1000000;
+        const std::filesystem::path dir = testDir("million");
+        {
+            std::ofstream csv(dir / "trees.csv", std::ios::binary);
+            csv << "x,z,species,rotation,scale\n";
+            for (std::size_t i = 0; i < MILLION; ++i)
+                csv << (int(i % 1000) - 500) << "," << (int(i / 1000) - 500) << "," << (i % 3 ? "a" : "b") << ","
+                    << (i % 360) << ",1." << (i % 10) << "\n";
+        }
+        const std::string random = replaced(replaced(replaced(MINIMAL, "\"count\": 10", "\"count\": 1000000"),
+                                                     "[-10, -10, 10, 10]", "[-500, -500, 500, 500]"),
+                                            "\"size\": 100", "\"size\": 1200");
+        const std::string file = replaced(withInstanceFile(), "\"size\": 100", "\"size\": 1200");
+        for (const std::string& text : {random, file})
+        {
+            Result<SceneScript> script = parseSceneScript(text, "test.json", dir.string());
+            ASSERT_TRUE(script.ok()) << script.error().message();
+            const std::vector<PlacedTree> trees = generatePlacements(*script);
+            ASSERT_EQ(trees.size(), MILLION);
+
+            ForestInstances forest;
+            for (std::size_t k = 0; k < script->species.size(); ++k)
+            {
+                ForestKind kind;
+                kind.name = script->species[k].name;
+                kind.boundsCentre = glm::vec3(0.0f, 8.0f, 0.0f);
+                kind.boundsRadius = 9.0f;
+                kind.thresholds = {2e5f, 2e4f, 2e3f};
+                ASSERT_TRUE(forest.addKind(kind));
+            }
+            std::vector<ForestInstance> instances(trees.size());
+            for (std::size_t i = 0; i < trees.size(); ++i)
+                instances[i] = ForestInstance{trees[i].position, trees[i].rotation, trees[i].scale, trees[i].species};
+            ASSERT_TRUE(forest.add(instances));
+            ASSERT_EQ(forest.size(), MILLION);
+            const std::size_t blocks = (MILLION + ForestInstances::BLOCK_SIZE - 1) / ForestInstances::BLOCK_SIZE;
+            const std::size_t storeBound = MILLION * (5 * sizeof(float) + sizeof(std::uint16_t) +
+                                                      2 * sizeof(ForestHandle)) +
+                                           blocks * 6 * sizeof(float);
+            std::printf("%s: %.2f bytes per tree in ForestInstances\n", script->placements[0].random ? "random" : "file",
+                        double(forest.getMemoryBytes()) / double(MILLION));
+            EXPECT_LE(forest.getMemoryBytes(), storeBound);
+
+            // From 3 km up, all in view; a second cull at the same counts allocates nothing.
+            CameraSpec overview;
+            overview.position = glm::vec3(0.0f, 3000.0f, 1.0f);
+            overview.target = glm::vec3(0.0f);
+            overview.farClip = 5000.0f;
+            const CullCamera camera = CullCamera::fromSpec(overview, 1920.0f, 1080.0f);
+            ForestVisibility vis;
+            ASSERT_TRUE(forest.cull(camera, 1.0f, vis));
+            EXPECT_EQ(vis.getVisibleCount(), MILLION);
+            const std::size_t perVisible = ForestVisibility::TRANSFORM_FLOATS * sizeof(float) +
+                                           4 * sizeof(std::uint32_t) + sizeof(std::uint8_t);
+            const std::size_t visibilityBound = MILLION * perVisible +
+                                                forest.getBucketCount() * (sizeof(ForestBucket) + sizeof(std::uint32_t));
+            EXPECT_LE(vis.getCapacityBytes(), visibilityBound);
+            const std::size_t capacity = vis.getCapacityBytes();
+            ASSERT_TRUE(forest.cull(camera, 1.0f, vis));
+            EXPECT_EQ(vis.getCapacityBytes(), capacity);
+        }
     }
 }

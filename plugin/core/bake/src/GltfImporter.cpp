@@ -371,6 +371,61 @@ namespace TreeLod
             }
         }
 
+        /// Width and height an image's header declares, read without decoding: the PNG's IHDR
+        /// (its first chunk), or a JPEG's first start-of-frame marker (SOF0..SOF15; C4, C8 and CC
+        /// are other markers). False when the header does not say; the decoder then reports why.
+        bool declaredSize(const std::uint8_t* data, std::size_t size, bool png, std::uint64_t& width,
+                          std::uint64_t& height)
+        {
+            if (png)
+            {
+                if (size < 24 || std::memcmp(data + 12, "IHDR", 4) != 0)
+                    return false;
+                width = readU32BE(data + 16);
+                height = readU32BE(data + 20);
+                return true;
+            }
+            auto u16 = [&](std::size_t at) { return std::uint64_t(data[at]) << 8 | data[at + 1]; };
+            std::size_t pos = 2; // after SOI
+            while (pos + 4 <= size && data[pos] == 0xFF)
+            {
+                const std::uint8_t marker = data[pos + 1];
+                if (marker == 0xFF) // fill byte
+                    ++pos;
+                else if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD8)) // no length field
+                    pos += 2;
+                else if (marker == 0xD9 || marker == 0xDA) // end of image or a scan: no frame before
+                    return false;
+                else if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC)
+                {
+                    if (pos + 9 > size) // length, precision, height, width
+                        return false;
+                    height = u16(pos + 5);
+                    width = u16(pos + 7);
+                    return true;
+                }
+                else
+                {
+                    const std::size_t length = std::size_t(u16(pos + 2));
+                    if (length < 2)
+                        return false;
+                    pos += 2 + length;
+                }
+            }
+            return false;
+        }
+
+        bool beyondSizeLimit(std::uint64_t width, std::uint64_t height)
+        {
+            return width > std::uint64_t(kMaxImageSide) || height > std::uint64_t(kMaxImageSide) ||
+                   width * height > kMaxImagePixels;
+        }
+
+        std::string sizeLimit()
+        {
+            return "the limit (" + std::to_string(kMaxImageSide) + " per side, 64 Mpixel)";
+        }
+
         /// Decode PNG or JPEG bytes to RGBA8 (straight alpha; grey and RGB get alpha 255).
         Result<TextureImage> decodeImage(const std::uint8_t* data, std::size_t size, const std::string& file,
                                          const std::string& where)
@@ -387,6 +442,16 @@ namespace TreeLod
                 format = "jpeg";
             else
                 return fail(file, where, "unsupported image format (not PNG or JPEG)");
+
+            // The size the header claims is checked before the decoder sees the bytes: opening a
+            // progressive JPEG that claims 65500 x 65500 has libjpeg allocate 1 GB for its frame.
+            const bool png = std::strcmp(format, "png") == 0;
+            std::uint64_t declaredWidth = 0, declaredHeight = 0;
+            if (declaredSize(data, size, png, declaredWidth, declaredHeight) &&
+                beyondSizeLimit(declaredWidth, declaredHeight))
+                return fail(file, where, std::string(png ? "PNG" : "JPEG") + " header declares " +
+                                             std::to_string(declaredWidth) + "x" + std::to_string(declaredHeight) +
+                                             " pixels, larger than " + sizeLimit() + "; not decoded");
 
             OIIO::Filesystem::IOMemReader reader(data, size);
             auto input = OIIO::ImageInput::create(format);
@@ -405,12 +470,11 @@ namespace TreeLod
                 return fail(file, where, "unusable image layout " + std::to_string(w) + "x" + std::to_string(h) + " with " +
                                              std::to_string(channels) + " channels");
             }
-            if (w > kMaxImageSide || h > kMaxImageSide || std::uint64_t(w) * std::uint64_t(h) > kMaxImagePixels)
+            if (beyondSizeLimit(std::uint64_t(w), std::uint64_t(h)))
             {
                 input->close();
                 return fail(file, where, "image of " + std::to_string(w) + "x" + std::to_string(h) +
-                                             " pixels is larger than the limit (" + std::to_string(kMaxImageSide) +
-                                             " per side, 64 Mpixel)");
+                                             " pixels is larger than " + sizeLimit());
             }
             std::vector<std::uint8_t> pixels(std::size_t(w) * h * channels);
             if (!input->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, pixels.data()))

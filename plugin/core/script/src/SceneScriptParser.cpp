@@ -15,6 +15,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <optional>
 
 namespace TreeLod
 {
@@ -69,6 +70,9 @@ namespace TreeLod
             void run() { value(""); }
 
             std::map<std::string, std::size_t> offsets;
+            /// If set before run(), tokenAt gets the pointer of the first scalar spelt exactly `token`.
+            std::string token;
+            std::optional<std::string> tokenAt;
 
         private:
             const std::string& mText;
@@ -148,8 +152,11 @@ namespace TreeLod
                     string();
                     return;
                 }
+                const std::size_t start = mAt;
                 while (mAt < mText.size() && std::string(",]} \t\r\n/").find(mText[mAt]) == std::string::npos)
                     ++mAt;
+                if (!tokenAt && !token.empty() && mText.compare(start, mAt - start, token) == 0)
+                    tokenAt = pointer;
             }
         };
 
@@ -760,6 +767,7 @@ namespace TreeLod
                                          const GreyImageReader& readImage)
     {
         Json root;
+        std::string overflow; // the number nlohmann found too large, as written
         try
         {
             root = Json::parse(text, nullptr, true, true);
@@ -773,10 +781,23 @@ namespace TreeLod
             std::string reason = reasonAt == std::string::npos ? what : what.substr(reasonAt + 2);
             return fail(label, lineColumn(text, e.byte > 0 ? e.byte - 1 : 0), reason);
         }
+        catch (const Json::out_of_range& e)
+        {
+            // A number beyond a double ("number overflow parsing '1e999'"), refused without its
+            // position: the scan below finds the first number written so.
+            std::string what = e.what();
+            std::size_t open = what.find("parsing '"), close = what.rfind('\'');
+            if (open == std::string::npos || close <= open + 9)
+                return fail(label, "", what);
+            overflow = what.substr(open + 9, close - open - 9);
+        }
         PositionScan scan(text);
+        scan.token = overflow;
         try
         {
             scan.run();
+            if (!overflow.empty())
+                bad(scan.tokenAt.value_or(""), overflow + " is not a finite number (beyond the range of a double)");
             SceneScript script = readScript(root, baseDir, readImage);
             script.file = label;
             return script;

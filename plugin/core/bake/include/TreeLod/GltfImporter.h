@@ -36,6 +36,12 @@
 // PNG or JPEG or larger than 16384 per side / 64 Mpixel, JSON nested deeper than 128.
 // Ignored: skins, morph targets, cameras, lights, KHR_texture_transform, samplers.
 //
+// Hostile input: counts and sizes are checked before anything is allocated for them. An
+// accessor's count must fit its buffer view and the view its buffer (10 million claimed
+// vertices over a few bytes are refused at the accessor); an image's size is read from its
+// PNG IHDR or JPEG start-of-frame header and checked against the limit above before a decoder
+// sees it, so what an image costs is bounded by the limit, whatever its header claims.
+//
 // Errors name the file, the element ("mesh 1 'Leaves' primitive 0 accessor 3 (indices)",
 // "image 2 'bark'", "node 4", "glb header") and the reason. Nothing is partially returned.
 // Bad geometry is an Error (index out of range, NaN/Inf position, accessor overrunning its

@@ -6,7 +6,8 @@
 //   +Y up; the ground is a square of `size` metres centred at the origin.
 // - Errors name the file, the line and column (1-based, columns count bytes) and the key as
 //   a JSON pointer: "scene.json: line 12, column 9, key /placements/0/random/count: must be
-//   >= 1". JSON syntax errors give line and column only. Unknown keys, duplicate keys, wrong
+//   >= 1". JSON syntax errors give line and column only (NaN and Infinity are not JSON); a
+//   number beyond a double (1e999) is an error at its key. Unknown keys, duplicate keys, wrong
 //   types, out-of-range values and keyframe times that do not increase are errors. A missing
 //   required key is reported at the object that lacks it. Comments (// and /* */) are allowed.
 // - Paths (species sources, the heightfield image, instance files) are relative to the script's
