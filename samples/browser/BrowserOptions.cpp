@@ -79,6 +79,9 @@ Bad arguments exit 2; a failure while running exits 1.)";
         app.add_option("--frames", o.frames, "with --headless: forest frames along the camera path (default 4)");
         app.add_option("--soak", o.soak,
                        "with --headless: N switches between samples and techniques, then report resident memory");
+        app.add_option("--shadow-size", o.shadowSize,
+                       "shadow map side of every sample, a power of two 256 .. 16384 (default: the scene's, "
+                       "2048 for the single tree)");
         app.add_option("--size", size, "WxH window or image size, 320x240 .. 8192x8192 (default 1280x720)");
         app.add_option("--cache", o.cacheDirectory, "bake cache folder (default $XDG_CACHE_HOME/treelod)");
         bool noGrab = false;
@@ -105,6 +108,8 @@ Bad arguments exit 2; a failure while running exits 1.)";
             return bad("--frames: must be at least 1");
         if (o.headless && o.screenshots.empty() && o.soak == 0)
             return bad("--headless needs --screenshots DIR or --soak N");
+        if (o.shadowSize != 0 && (o.shadowSize < 256 || o.shadowSize > 16384 || (o.shadowSize & (o.shadowSize - 1))))
+            return bad("--shadow-size: " + std::to_string(o.shadowSize) + " is not a power of two in 256 .. 16384");
         if (!o.headless && o.soak > 0)
             return bad("--soak needs --headless");
         if (!o.headless && !o.screenshots.empty())

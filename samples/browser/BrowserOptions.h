@@ -12,6 +12,7 @@ namespace TreeLod
         std::string tree;          ///< source of the single-tree samples: a tree file or "preset:NAME?..."
         std::string screenshots;   ///< headless: folder for the PNGs (created)
         unsigned frames = 4;       ///< headless: forest frames along the scene's camera path, >= 1
+        unsigned shadowSize = 0;   ///< > 0: every sample's shadow map side (else the script's; 2048 single trees)
         unsigned soak = 0;         ///< headless: > 0 = that many sample and technique switches, then memory
         int width = 1280;          ///< window (or headless image) size in pixels
         int height = 720;

@@ -69,7 +69,8 @@ namespace TreeLod
         bool operator!=(const Signature& o) const { return !(*this == o); }
     };
 
-    SingleTreeView::SingleTreeView(Ogre::Root& root, std::string source) : mRoot(root), mSource(std::move(source))
+    SingleTreeView::SingleTreeView(Ogre::Root& root, std::string source, unsigned shadowSize)
+        : mRoot(root), mSource(std::move(source)), mShadowSize(shadowSize)
     {
         const LightingSpec lighting;
         mBackground = Ogre::ColourValue(lighting.background.r, lighting.background.g, lighting.background.b);
@@ -465,7 +466,7 @@ namespace TreeLod
     void SingleTreeView::setShadows(bool enabled)
     {
         mShadows = enabled;
-        applyTextureShadows(*mSceneManager, *mSun, enabled, 2048, ShadowCamera::Focused);
+        applyTextureShadows(*mSceneManager, *mSun, enabled, mShadowSize, ShadowCamera::Focused);
         useShadowedMaterials(*mReference, *mAsset, enabled);
         if (auto* mesh = dynamic_cast<Ogre::Entity*>(mTechniques[REFERENCE_TECHNIQUE]))
             useShadowedMaterials(*mesh, *mAsset, enabled);

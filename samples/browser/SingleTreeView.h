@@ -38,8 +38,9 @@ namespace TreeLod
         /// Seconds the view must stay unchanged before the difference is recomputed.
         static constexpr double RECOMPUTE_DELAY = 0.3;
 
-        /// `source`: a tree file or a generator source (TreeBaker.h).
-        SingleTreeView(Ogre::Root& root, std::string source);
+        /// `source`: a tree file or a generator source (TreeBaker.h); `shadowSize`: the shadow
+        /// map's side in texels.
+        SingleTreeView(Ogre::Root& root, std::string source, unsigned shadowSize = 2048);
         ~SingleTreeView();
 
         /// Bake (through TreeAssetManager::require and the registered baker) the chunks of every
@@ -93,6 +94,7 @@ namespace TreeLod
 
         Ogre::Root& mRoot;
         std::string mSource;
+        unsigned mShadowSize;
         TreeAssetPtr mAsset;
         Ogre::SceneManager* mSceneManager = nullptr;
         Ogre::Camera* mCamera = nullptr;

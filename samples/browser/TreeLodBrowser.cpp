@@ -18,6 +18,8 @@
 #include <OgreOverlaySystem.h>
 #include <OgreRTShaderSystem.h>
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -258,8 +260,11 @@ namespace TreeLod
     void TreeLodBrowser::buildSamples()
     {
         mProgressBar = mTrays->createProgressBar(OgreBites::TL_CENTER, "Progress", "Preparing the samples", 480, 320);
-        mSamples.push_back(std::make_unique<ForestSample>(*mRoot, mScript));
-        auto view = std::make_shared<SingleTreeView>(*mRoot, mOptions.tree);
+        SceneScript script = mScript;
+        if (mOptions.shadowSize > 0)
+            script.shadows.textureSize = int(mOptions.shadowSize);
+        mSamples.push_back(std::make_unique<ForestSample>(*mRoot, script));
+        auto view = std::make_shared<SingleTreeView>(*mRoot, mOptions.tree, mOptions.shadowSize > 0 ? mOptions.shadowSize : 2048);
         for (const TechniqueInfo& info : TechniqueRegistry::getSingleton().getTechniques())
             mSamples.push_back(std::make_unique<TechniqueSample>(view, info.name));
         auto progress = [this](const std::string& step, float fraction) { showProgress(step, fraction); };
@@ -626,14 +631,27 @@ namespace TreeLod
         return written;
     }
 
+    TreeLodBrowser::SoakMemory TreeLodBrowser::measureMemory()
+    {
+        // Free memory the allocator holds (glibc keeps freed blocks, and each thread's arena, resident)
+        // is returned first: what stays is what the process holds.
+        malloc_trim(0);
+        const struct mallinfo2 heap = mallinfo2();
+        return {residentMemory().currentMiB, double(heap.uordblks + heap.hblkhd) / (1024.0 * 1024.0)};
+    }
+
     TreeLodBrowser::SoakReport TreeLodBrowser::soak(unsigned switches)
     {
         SoakReport report;
+        const auto start = std::chrono::steady_clock::now();
         auto settle = [&] {
-            for (int f = 0; f < 200 && mCurrent >= 0 && !mSamples[std::size_t(mCurrent)]->isSettled(); ++f)
+            int frames = 1;
+            for (; frames < 200 && mCurrent >= 0 && !mSamples[std::size_t(mCurrent)]->isSettled(); ++frames)
                 mRoot->renderOneFrame();
             mRoot->renderOneFrame();
-            ++report.switches;
+            if (++report.switches % 25 == 0)
+                std::fprintf(stderr, "soak: %u of %u switches, %.1f s (%s: %d frames)\n", report.switches, switches,
+                             secondsSince(start), mSamples[std::size_t(mCurrent)]->getTitle().c_str(), frames);
         };
         while (report.switches < switches)
         {
@@ -655,16 +673,17 @@ namespace TreeLod
             if (report.warmUpSwitches == 0)
             {
                 report.warmUpSwitches = report.switches;
-                report.afterWarmUpMiB = residentMemory().currentMiB;
+                report.afterWarmUp = measureMemory();
             }
         }
-        const ResidentMemory end = residentMemory();
-        report.endMiB = end.currentMiB;
-        report.peakMiB = end.peakMiB;
-        std::printf("soak: %u switches; resident after the first pass (%u switches) %.1f MiB, at the end %.1f MiB "
-                    "(%+.1f MiB), peak %.1f MiB\n",
-                    report.switches, report.warmUpSwitches, report.afterWarmUpMiB, report.endMiB,
-                    report.endMiB - report.afterWarmUpMiB, report.peakMiB);
+        report.end = measureMemory();
+        report.peakMiB = residentMemory().peakMiB;
+        std::printf("soak: %u switches; after the first pass (%u switches) %.1f MiB resident, %.1f MiB heap in use; "
+                    "at the end %.1f MiB resident (%+.1f), %.1f MiB heap in use (%+.1f); peak %.1f MiB resident\n",
+                    report.switches, report.warmUpSwitches, report.afterWarmUp.residentMiB,
+                    report.afterWarmUp.heapMiB, report.end.residentMiB,
+                    report.end.residentMiB - report.afterWarmUp.residentMiB, report.end.heapMiB,
+                    report.end.heapMiB - report.afterWarmUp.heapMiB, report.peakMiB);
         std::fflush(stdout);
         return report;
     }

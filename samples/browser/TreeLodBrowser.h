@@ -58,18 +58,23 @@ namespace TreeLod
         /// Headless: write the screenshots (see --help) into options.screenshots; returns their paths.
         std::vector<std::string> writeScreenshots();
 
-        /// Resident memory of a soak run (MiB).
+        /// Memory at one point of a soak run (MiB), after returning the allocator's free memory.
+        struct SoakMemory
+        {
+            double residentMiB = 0.0; ///< VmRSS
+            double heapMiB = 0.0;     ///< malloc'd and not freed (mallinfo2), the GL driver's included
+        };
         struct SoakReport
         {
             unsigned switches = 0;       ///< made in all
             unsigned warmUpSwitches = 0; ///< the first pass over every sample and technique
-            double afterWarmUpMiB = 0.0; ///< resident after the first pass
-            double endMiB = 0.0;         ///< resident at the end
-            double peakMiB = 0.0;        ///< the process's peak
+            SoakMemory afterWarmUp;      ///< after the first pass
+            SoakMemory end;              ///< at the end
+            double peakMiB = 0.0;        ///< the process's peak resident memory
         };
         /// Headless: `switches` changes of screen as a user makes them (the menu and a sample in
         /// turn, then each entry of its technique menu), each drawn until it has settled; prints
-        /// and returns resident memory after the first pass and at the end.
+        /// and returns memory after the first pass and at the end.
         SoakReport soak(unsigned switches);
 
         // ApplicationContext
@@ -120,6 +125,7 @@ namespace TreeLod
         Ogre::Vector2 cursorPosition() const;
         void setLodBiasExponent(int exponent);
         void savePng(const std::string& path);
+        static SoakMemory measureMemory();
 
         BrowserOptions mOptions;
         SceneScript mScript;
