@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Build and run every test, once each (a failure is a failure: nothing is retried):
 #  1. the Release tree: unit, headless Ogre, golden-image, CLI and browser tests (under Xvfb);
-#  2. a clang tree with ASan + UBSan: the same tests (the install test aside), then each
-#     libFuzzer target for a few seconds;
+#  2. a clang tree with ASan + UBSan: the same gtest binaries, then each libFuzzer target for a
+#     few seconds;
 #  3. a clang tree with TSan: the multi-threaded paths (bakers, bake cache, async baker).
 # A test process that dies leaves its core dump and backtrace in <tree>/test-out/cores/.
 # CI (.ci/run) calls exactly this. TREELOD_SANITIZE=0 runs stage 1 only.
@@ -59,8 +59,8 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 CXX=clang++ cmake -S "$root" -B "$asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
   -DTREELOD_SANITIZERS=address,undefined -DTREELOD_BUILD_FUZZERS=ON -DTREELOD_BUILD_TESTS=ON \
   -DTREELOD_BUILD_BENCHMARKS=OFF -DTREELOD_BUILD_SAMPLES=OFF >/dev/null
-cmake --build "$asan" -j"$jobs"
-run_ctest "$asan" -E '^install\.'
+cmake --build "$asan" -j"$jobs" --target treelod_tests treelod_fuzzers
+run_ctest "$asan" -E '^(install|cli|bench)\.' # the gtest binaries; the tools' scripts ran in stage 1
 
 fuzzers=(FuzzGltfImporter:gltf FuzzPackageReader:package)
 for target in "${fuzzers[@]}"; do
