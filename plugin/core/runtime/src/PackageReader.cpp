@@ -8,9 +8,12 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <numeric>
 #include <tuple>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace TreeLod
 {
@@ -50,25 +53,44 @@ namespace TreeLod
             return printable ? hex + " \"" + text + "\"" : hex;
         }
 
-        /// Read `size` bytes at `offset` of an open file; error if fewer are there.
-        Result<std::vector<std::uint8_t>> readFileRange(const std::string& path, std::uint64_t offset,
+        /// Read `size` bytes at `offset` of the open file `fd`; error if fewer are there.
+        Result<std::vector<std::uint8_t>> readFileRange(const std::string& path, int fd, std::uint64_t offset,
                                                         std::uint64_t size, const std::string& element)
         {
-            std::ifstream in(path, std::ios::binary);
-            if (!in)
-                return fail(path, element, std::string("cannot open: ") + std::strerror(errno));
-            in.seekg(0, std::ios::end);
-            const std::uint64_t fileSize = std::uint64_t(std::streamoff(in.tellg()));
+            struct stat status;
+            if (::fstat(fd, &status) != 0)
+                return fail(path, element, std::string("cannot read the file size: ") + std::strerror(errno));
+            const std::uint64_t fileSize = std::uint64_t(status.st_size);
             if (offset > fileSize || size > fileSize - offset)
                 return fail(path, element, truncated(size, offset, fileSize) + " (file changed since it was opened?)");
             std::vector<std::uint8_t> bytes(size);
-            in.seekg(std::streamoff(offset));
-            in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size));
-            if (!in || std::uint64_t(in.gcount()) != size)
-                return fail(path, element, "read error at offset " + std::to_string(offset));
+            std::uint64_t done = 0;
+            while (done < size)
+            {
+                const ssize_t n = ::pread(fd, bytes.data() + done, size - done, off_t(offset + done));
+                if (n < 0 && errno == EINTR)
+                    continue;
+                if (n < 0)
+                    return fail(path, element, "read error at offset " + std::to_string(offset + done) + ": " +
+                                                   std::strerror(errno));
+                if (n == 0)
+                    return fail(path, element, truncated(size, offset, offset + done) +
+                                                   " (file changed since it was opened?)");
+                done += std::uint64_t(n);
+            }
             return bytes;
         }
     }
+
+    struct PackageReader::OpenFile
+    {
+        int fd = -1;
+        ~OpenFile()
+        {
+            if (fd >= 0)
+                ::close(fd);
+        }
+    };
 
     std::string chunkElement(const std::string& technique, std::uint32_t level)
     {
@@ -84,20 +106,20 @@ namespace TreeLod
             return fail(path, "", "file does not exist");
         if (std::filesystem::is_directory(path, ec))
             return fail(path, "", "is a directory, not a file");
-        std::ifstream in(path, std::ios::binary);
-        if (!in)
+        auto file = std::make_shared<OpenFile>();
+        file->fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+        if (file->fd < 0)
             return fail(path, "", std::string("cannot open: ") + std::strerror(errno));
-        in.seekg(0, std::ios::end);
-        const std::streamoff end = in.tellg();
-        if (end < 0)
-            return fail(path, "", "cannot determine the file size");
+        struct stat status;
+        if (::fstat(file->fd, &status) != 0)
+            return fail(path, "", std::string("cannot determine the file size: ") + std::strerror(errno));
 
         PackageReader reader;
         reader.mLabel = path;
-        reader.mPath = path;
-        reader.mFileSize = std::uint64_t(end);
+        reader.mFile = file;
+        reader.mFileSize = std::uint64_t(status.st_size);
         Result<void> r = reader.parse([&](std::uint64_t offset, std::uint64_t size, const std::string& element) {
-            return readFileRange(path, offset, size, element);
+            return readFileRange(path, file->fd, offset, size, element);
         });
         if (!r)
             return r.error();
@@ -249,7 +271,7 @@ namespace TreeLod
         }
         else
         {
-            Result<std::vector<std::uint8_t>> r = readFileRange(mPath, c.offset, c.size, c.element());
+            Result<std::vector<std::uint8_t>> r = readFileRange(mLabel, mFile->fd, c.offset, c.size, c.element());
             if (!r)
                 return r.error();
             bytes = std::move(r.value());

@@ -23,16 +23,23 @@
 //   source string, so the string must spell every generator option that changes the tree.
 //
 // Failures: unknown technique, missing or unreadable source, import or bake errors return an
-// Error naming the source (or the cache file) and write nothing. A cached file that cannot be
-// used (truncated, checksum mismatch, foreign meta) is rebaked whole and the entry says why. A
-// request that finds everything verifies only the chunks it returns (its techniques' and the
-// reference); one that rewrites the package verifies every chunk it copies.
+// Error naming the source (or the cache file) and write nothing. A write that fails (a full
+// disk: EFBIG, ENOSPC) returns an Error naming the cache file and the OS's reason, leaves the
+// package cached before byte for byte as it was and no temporary file (AtomicFile.h); the next
+// request reuses what it holds. A cached file that cannot be used (truncated, checksum mismatch,
+// foreign meta) is rebaked whole and the entry says why. A request that finds everything
+// verifies only the chunks it returns (its techniques' and the reference); one that rewrites the
+// package verifies every chunk it copies.
 //
-// Concurrency: packages are written to a temporary file and renamed (PackageWriter::write), so
-// a reader sees an old or a new package, never a torn one. Two processes (or threads) baking
-// the same key both produce complete files and the last rename wins; if they asked for
+// Concurrency: packages are written to a temporary file of the writer's own (process id and
+// counter), synced and renamed (PackageWriter::write), so a reader sees an old or a new package,
+// never a torn one; and it reads the whole request from the file it opened (PackageReader), so a
+// package renamed over it meanwhile is not taken for a damaged one. Two processes (or threads)
+// baking the same key both produce complete files and the last rename wins; if they asked for
 // different techniques, one set may be lost and is baked again by the next request that needs
 // it. No lock is taken: the cost of a race is repeated work, not a corrupt cache.
+// tests/core/BakeCacheProcessTest.cpp checks both: a full disk in a child process (RLIMIT_FSIZE;
+// a small tmpfs where a mount namespace is allowed), and two processes baking at once.
 #pragma once
 
 #include "TreeLod/GltfImporter.h"

@@ -81,7 +81,9 @@ namespace TreeLod
     std::string chunkElement(const std::string& technique, std::uint32_t level);
 
     /// Reads a package's header and chunk table up front and chunk payloads on demand.
-    /// Copies are cheap and share the data (in-memory packages share one byte buffer).
+    /// Copies are cheap and share the data (in-memory packages share one byte buffer; file
+    /// packages the open file, which stays open while a copy lives: every read comes from the
+    /// file open() found, even once another is renamed over its path, as BakeCache does).
     /// Thread safety: const member functions may be called from several threads.
     class PackageReader
     {
@@ -109,7 +111,7 @@ namespace TreeLod
         int findChunk(const std::string& technique, std::uint32_t level) const;
 
         /// Payload of chunks()[index], its CRC-32 verified. Errors: index out of range,
-        /// read failure or file changed since open() ("truncated: ..."), "checksum mismatch";
+        /// read failure or file truncated since open() ("truncated: ..."), "checksum mismatch";
         /// the element is "chunk 'reference' level 0".
         Result<std::vector<std::uint8_t>> readChunk(std::size_t index) const;
 
@@ -128,8 +130,10 @@ namespace TreeLod
             std::uint64_t offset, std::uint64_t size, const std::string& element)>;
         Result<void> parse(const RangeReader& readRange);
 
+        struct OpenFile;
+
         std::string mLabel;
-        std::string mPath;                                    ///< empty for in-memory packages
+        std::shared_ptr<const OpenFile> mFile;                 ///< null for in-memory packages
         std::shared_ptr<const std::vector<std::uint8_t>> mBytes; ///< null for file packages
         std::uint64_t mFileSize = 0;
         std::uint32_t mVersion = 0;
