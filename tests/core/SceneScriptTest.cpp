@@ -296,6 +296,59 @@ namespace TreeLod
         EXPECT_NE(message.find("same measure"), std::string::npos) << message;
     }
 
+    TEST(SceneScript, sceneBoundsAreErrorsAtThePlacementThatPassesThem)
+    {
+        // 10,000,000 trees and 64 exclusion areas in all placements together (SceneScript.h).
+        const std::string first = "\"count\": 10, \"area\": {\"rect\": [-10, -10, 10, 10]}}}";
+        auto twoPlacements = [&](const std::string& count0, const std::string& random1) {
+            return replaced(MINIMAL, first,
+                            "\"count\": " + count0 + ", \"area\": {\"rect\": [-10, -10, 10, 10]}}}, "
+                            "{\"species\": \"a\", \"random\": {\"seed\": 2, " + random1 + "}}");
+        };
+        const std::string area = "\"area\": {\"rect\": [-10, -10, 10, 10]}";
+        EXPECT_EQ(parsed(twoPlacements("9999998", "\"count\": 2, " + area)).placements.size(), 2u);
+
+        std::string text = twoPlacements("9999999", "\"count\": 2, " + area);
+        std::string message = errorOf(text);
+        EXPECT_EQ(message.rfind("test.json: " + positionOf(text, "\"count\": 2") +
+                                    ", key /placements/1/random/count: the placements add up to 10000001 trees "
+                                    "(2 here), more than 10000000",
+                                0),
+                  0u)
+            << message;
+        // 50 trees per hectare of 400 m²: 2 trees, reported at the density
+        text = twoPlacements("9999999", "\"density\": 50, " + area);
+        message = errorOf(text);
+        EXPECT_NE(message.find(positionOf(text, "\"density\"") + ", key /placements/1/random/density: the "
+                                                                   "placements add up to 10000001 trees"),
+                  std::string::npos)
+            << message;
+
+        auto exclusions = [](int n) {
+            std::string list;
+            for (int i = 0; i < n; ++i)
+                list += std::string(i ? ", " : "") + "{\"disc\": [0, 0, 1]}";
+            return "\"exclude\": [" + list + "]";
+        };
+        EXPECT_EQ(parsed(twoPlacements("10, " + exclusions(40), "\"count\": 2, " + area + ", " + exclusions(24)))
+                      .placements[1]
+                      .exclude.size(),
+                  24u);
+        text = twoPlacements("10, " + exclusions(40), "\"count\": 2, " + area + ", " + exclusions(25));
+        message = errorOf(text);
+        // at the second placement's "exclude" (the first's comes earlier on the same line)
+        const std::string firstExclude = positionOf(text, "\"exclude\"");
+        const std::size_t column = std::stoul(firstExclude.substr(firstExclude.find("column ") + 7)) +
+                                   (text.find("\"exclude\"", text.find("\"seed\": 2")) - text.find("\"exclude\""));
+        EXPECT_EQ(message.rfind("test.json: " + firstExclude.substr(0, firstExclude.find("column ")) + "column " +
+                                    std::to_string(column) +
+                                    ", key /placements/1/random/exclude: the placements exclude 65 areas in all "
+                                    "(25 here), more than 64",
+                                0),
+                  0u)
+            << message;
+    }
+
     TEST(SceneScript, missingFileNamesThePath)
     {
         Result<SceneScript> r = loadSceneScript("/nonexistent/scene.json");

@@ -563,6 +563,13 @@ namespace TreeLod
             if (const Json* ex = find(*random, "exclude"))
             {
                 expectArray(*ex, child(rp, "exclude"));
+                std::size_t before = 0;
+                for (const ScenePlacement& earlier : script.placements)
+                    before += earlier.exclude.size();
+                if (before + ex->size() > MAX_EXCLUSIONS)
+                    bad(child(rp, "exclude"), "the placements exclude " + std::to_string(before + ex->size()) +
+                                                  " areas in all (" + std::to_string(ex->size()) +
+                                                  " here), more than " + std::to_string(MAX_EXCLUSIONS));
                 for (std::size_t i = 0; i < ex->size(); ++i)
                     p.exclude.push_back(readArea((*ex)[i], child(child(rp, "exclude"), i), script.ground.size));
             }
@@ -719,13 +726,28 @@ namespace TreeLod
 
             const Json& placements = need(root, "", "placements");
             expectArray(placements, "/placements", 1);
-            std::uint64_t explicitTrees = 0;
+            std::uint64_t explicitTrees = 0, totalTrees = 0;
             bool anyRandom = false;
             for (std::size_t i = 0; i < placements.size(); ++i)
             {
-                s.placements.push_back(readPlacement(placements[i], child("/placements", i), s, baseDir));
-                explicitTrees += s.placements.back().positions.size();
-                anyRandom = anyRandom || s.placements.back().random;
+                const std::string pointer = child("/placements", i);
+                s.placements.push_back(readPlacement(placements[i], pointer, s, baseDir));
+                const ScenePlacement& p = s.placements.back();
+                explicitTrees += p.positions.size();
+                anyRandom = anyRandom || p.random;
+                // generatePlacements() makes every tree at once: the whole scene has a bound, not
+                // only each placement.
+                const std::uint64_t trees = p.random ? p.count : p.positions.size();
+                totalTrees += trees;
+                if (totalTrees > MAX_TREES)
+                {
+                    const char* key = !p.random             ? (p.file.empty() ? "positions" : "file")
+                                      : p.density > 0.0f ? "density"
+                                                         : "count";
+                    bad(p.random ? child(child(pointer, "random"), key) : child(pointer, key),
+                        "the placements add up to " + std::to_string(totalTrees) + " trees (" +
+                            std::to_string(trees) + " here), more than " + std::to_string(MAX_TREES));
+                }
             }
 
             if (const Json* v = find(root, "sun"))
