@@ -160,6 +160,9 @@ namespace TreeLod
         // Shadow buffers so the data can be read back whatever the render system.
         mesh->setVertexBufferPolicy(Ogre::HardwareBuffer::HBU_STATIC, true);
         mesh->setIndexBufferPolicy(Ogre::HardwareBuffer::HBU_STATIC, true);
+        // Loaded while still empty (a manual mesh without a loader loads nothing): a Mesh frees
+        // its submeshes, buffers and animations when it unloads, and unloads only when loaded.
+        mesh->load();
         struct Remover
         {
             Ogre::MeshPtr mesh;
