@@ -249,6 +249,11 @@ namespace TreeLod
              "/shadows/lodBias", "must be > 0"},
             {"\"frames\": 2", "\"frames\": 2, \"shadows\": {\"enabled\": true, \"lodBias\": \"low\"}", "\"lodBias\"",
              "/shadows/lodBias", "expected a number"},
+            // a sun above the horizon only before rounding to floats
+            {"\"frames\": 2", "\"frames\": 2, \"sun\": {\"azimuth\": 0, \"elevation\": 1e-300}", "\"elevation\"",
+             "/sun/elevation", "rounds to the horizon"},
+            {"\"frames\": 2", "\"frames\": 2, \"sun\": {\"direction\": [1e9, 1e-38, 0]}", "\"direction\"",
+             "/sun/direction", "above the horizon"},
         };
         for (const Case& c : cases)
         {

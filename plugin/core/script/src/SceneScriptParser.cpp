@@ -612,10 +612,10 @@ namespace TreeLod
                 bad(child(pointer, az ? "azimuth" : "elevation"), "give direction or azimuth/elevation, not both");
             if (dir)
             {
-                glm::vec3 d = vec3(*dir, child(pointer, "direction"));
-                if (!(d.y > 0.0f))
+                // y > 0 after normalising: [1e9, 1e-38, 0] is above the horizon only in doubles
+                sun.direction = glm::normalize(vec3(*dir, child(pointer, "direction")));
+                if (!(sun.direction.y > 0.0f))
                     bad(child(pointer, "direction"), "the sun must be above the horizon (y > 0, towards the sun)");
-                sun.direction = glm::normalize(d);
             }
             else
             {
@@ -628,6 +628,8 @@ namespace TreeLod
                 // Azimuth as in CameraSpec::framing: 0 = from +Z, 90 = from +X.
                 sun.direction = glm::vec3(float(std::sin(a) * std::cos(e)), float(std::sin(e)),
                                           float(std::cos(a) * std::cos(e)));
+                if (!(sun.direction.y > 0.0f))
+                    bad(child(pointer, "elevation"), "so low that the sun's direction rounds to the horizon (y = 0)");
             }
             if (const Json* c = find(j, "colour"))
                 sun.colour = vec3(*c, child(pointer, "colour"), 0.0, 100.0);
