@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -263,6 +264,20 @@ namespace TreeLod
             EXPECT_EQ(message.rfind(expected, 0), 0u) << "expected '" << expected << "' in\n" << message;
             EXPECT_NE(message.find(c.reason), std::string::npos) << message;
         }
+    }
+
+    TEST(SceneScript, keyPositionsFollowTheJsonReader)
+    {
+        // Comments end where nlohmann ends them (a carriage return, a NUL), and a byte order
+        // mark is skipped: the key positions must not lose step with the parsed JSON.
+        std::string crOnly = "{ // carriage returns only\r" + MINIMAL.substr(1);
+        std::replace(crOnly.begin(), crOnly.end(), '\n', '\r');
+        EXPECT_EQ(parsed(crOnly).name, "t");
+        EXPECT_EQ(parsed(std::string("{ // ends at a NUL") + '\0' + MINIMAL.substr(1)).name, "t");
+
+        const std::string bom = "\xEF\xBB\xBF" + replaced(MINIMAL, "\"size\": 100", "\"size\": \"big\"");
+        const std::string message = errorOf(bom);
+        EXPECT_EQ(message.rfind("test.json: " + positionOf(bom, "\"size\"") + ", key /ground/size: ", 0), 0u) << message;
     }
 
     TEST(SceneScript, shadowsTakeACasterLodBias)

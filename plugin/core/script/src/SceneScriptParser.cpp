@@ -66,7 +66,12 @@ namespace TreeLod
         public:
             explicit PositionScan(const std::string& text) : mText(text) {}
 
-            void run() { value(""); }
+            void run()
+            {
+                if (mText.compare(0, 3, "\xEF\xBB\xBF") == 0)
+                    mAt = 3; // nlohmann skips a UTF-8 byte order mark
+                value("");
+            }
 
             std::map<std::string, std::size_t> offsets;
 
@@ -84,8 +89,15 @@ namespace TreeLod
                     if (c == ' ' || c == '\t' || c == '\n' || c == '\r')
                         ++mAt;
                     else if (c == '/' && mAt + 1 < mText.size() && mText[mAt + 1] == '/')
-                        while (mAt < mText.size() && mText[mAt] != '\n')
+                    {
+                        // As nlohmann ends it: at a line feed, a carriage return or a NUL, which
+                        // belongs to the comment.
+                        mAt += 2;
+                        while (mAt < mText.size() && mText[mAt] != '\n' && mText[mAt] != '\r' && mText[mAt] != '\0')
                             ++mAt;
+                        if (mAt < mText.size())
+                            ++mAt;
+                    }
                     else if (c == '/' && mAt + 1 < mText.size() && mText[mAt + 1] == '*')
                     {
                         std::size_t end = mText.find("*/", mAt + 2);
