@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -252,6 +253,11 @@ namespace TreeLod
              "/shadows/lodBias", "must be > 0"},
             {"\"frames\": 2", "\"frames\": 2, \"shadows\": {\"enabled\": true, \"lodBias\": \"low\"}", "\"lodBias\"",
              "/shadows/lodBias", "expected a number"},
+            // a sun above the horizon only before rounding to floats
+            {"\"frames\": 2", "\"frames\": 2, \"sun\": {\"azimuth\": 0, \"elevation\": 1e-300}", "\"elevation\"",
+             "/sun/elevation", "rounds to the horizon"},
+            {"\"frames\": 2", "\"frames\": 2, \"sun\": {\"direction\": [1e9, 1e-38, 0]}", "\"direction\"",
+             "/sun/direction", "above the horizon"},
         };
         for (const Case& c : cases)
         {
@@ -261,6 +267,20 @@ namespace TreeLod
             EXPECT_EQ(message.rfind(expected, 0), 0u) << "expected '" << expected << "' in\n" << message;
             EXPECT_NE(message.find(c.reason), std::string::npos) << message;
         }
+    }
+
+    TEST(SceneScript, keyPositionsFollowTheJsonReader)
+    {
+        // Comments end where nlohmann ends them (a carriage return, a NUL), and a byte order
+        // mark is skipped: the key positions must not lose step with the parsed JSON.
+        std::string crOnly = "{ // carriage returns only\r" + MINIMAL.substr(1);
+        std::replace(crOnly.begin(), crOnly.end(), '\n', '\r');
+        EXPECT_EQ(parsed(crOnly).name, "t");
+        EXPECT_EQ(parsed(std::string("{ // ends at a NUL") + '\0' + MINIMAL.substr(1)).name, "t");
+
+        const std::string bom = "\xEF\xBB\xBF" + replaced(MINIMAL, "\"size\": 100", "\"size\": \"big\"");
+        const std::string message = errorOf(bom);
+        EXPECT_EQ(message.rfind("test.json: " + positionOf(bom, "\"size\"") + ", key /ground/size: ", 0), 0u) << message;
     }
 
     TEST(SceneScript, shadowsTakeACasterLodBias)
@@ -297,6 +317,59 @@ namespace TreeLod
                                    "\"techniques\": [{\"technique\": \"mesh\", \"maxDistance\": 20}, "
                                    "{\"technique\": \"lodf\", \"minPixels\": 10}]"));
         EXPECT_NE(message.find("same measure"), std::string::npos) << message;
+    }
+
+    TEST(SceneScript, sceneBoundsAreErrorsAtThePlacementThatPassesThem)
+    {
+        // 10,000,000 trees and 64 exclusion areas in all placements together (SceneScript.h).
+        const std::string first = "\"count\": 10, \"area\": {\"rect\": [-10, -10, 10, 10]}}}";
+        auto twoPlacements = [&](const std::string& count0, const std::string& random1) {
+            return replaced(MINIMAL, first,
+                            "\"count\": " + count0 + ", \"area\": {\"rect\": [-10, -10, 10, 10]}}}, "
+                            "{\"species\": \"a\", \"random\": {\"seed\": 2, " + random1 + "}}");
+        };
+        const std::string area = "\"area\": {\"rect\": [-10, -10, 10, 10]}";
+        EXPECT_EQ(parsed(twoPlacements("9999998", "\"count\": 2, " + area)).placements.size(), 2u);
+
+        std::string text = twoPlacements("9999999", "\"count\": 2, " + area);
+        std::string message = errorOf(text);
+        EXPECT_EQ(message.rfind("test.json: " + positionOf(text, "\"count\": 2") +
+                                    ", key /placements/1/random/count: the placements add up to 10000001 trees "
+                                    "(2 here), more than 10000000",
+                                0),
+                  0u)
+            << message;
+        // 50 trees per hectare of 400 m²: 2 trees, reported at the density
+        text = twoPlacements("9999999", "\"density\": 50, " + area);
+        message = errorOf(text);
+        EXPECT_NE(message.find(positionOf(text, "\"density\"") + ", key /placements/1/random/density: the "
+                                                                   "placements add up to 10000001 trees"),
+                  std::string::npos)
+            << message;
+
+        auto exclusions = [](int n) {
+            std::string list;
+            for (int i = 0; i < n; ++i)
+                list += std::string(i ? ", " : "") + "{\"disc\": [0, 0, 1]}";
+            return "\"exclude\": [" + list + "]";
+        };
+        EXPECT_EQ(parsed(twoPlacements("10, " + exclusions(40), "\"count\": 2, " + area + ", " + exclusions(24)))
+                      .placements[1]
+                      .exclude.size(),
+                  24u);
+        text = twoPlacements("10, " + exclusions(40), "\"count\": 2, " + area + ", " + exclusions(25));
+        message = errorOf(text);
+        // at the second placement's "exclude" (the first's comes earlier on the same line)
+        const std::string firstExclude = positionOf(text, "\"exclude\"");
+        const std::size_t column = std::stoul(firstExclude.substr(firstExclude.find("column ") + 7)) +
+                                   (text.find("\"exclude\"", text.find("\"seed\": 2")) - text.find("\"exclude\""));
+        EXPECT_EQ(message.rfind("test.json: " + firstExclude.substr(0, firstExclude.find("column ")) + "column " +
+                                    std::to_string(column) +
+                                    ", key /placements/1/random/exclude: the placements exclude 65 areas in all "
+                                    "(25 here), more than 64",
+                                0),
+                  0u)
+            << message;
     }
 
     TEST(SceneScript, missingFileNamesThePath)

@@ -67,7 +67,12 @@ namespace TreeLod
         public:
             explicit PositionScan(const std::string& text) : mText(text) {}
 
-            void run() { value(""); }
+            void run()
+            {
+                if (mText.compare(0, 3, "\xEF\xBB\xBF") == 0)
+                    mAt = 3; // nlohmann skips a UTF-8 byte order mark
+                value("");
+            }
 
             std::map<std::string, std::size_t> offsets;
             /// If set before run(), tokenAt gets the pointer of the first scalar spelt exactly `token`.
@@ -88,8 +93,15 @@ namespace TreeLod
                     if (c == ' ' || c == '\t' || c == '\n' || c == '\r')
                         ++mAt;
                     else if (c == '/' && mAt + 1 < mText.size() && mText[mAt + 1] == '/')
-                        while (mAt < mText.size() && mText[mAt] != '\n')
+                    {
+                        // As nlohmann ends it: at a line feed, a carriage return or a NUL, which
+                        // belongs to the comment.
+                        mAt += 2;
+                        while (mAt < mText.size() && mText[mAt] != '\n' && mText[mAt] != '\r' && mText[mAt] != '\0')
                             ++mAt;
+                        if (mAt < mText.size())
+                            ++mAt;
+                    }
                     else if (c == '/' && mAt + 1 < mText.size() && mText[mAt + 1] == '*')
                     {
                         std::size_t end = mText.find("*/", mAt + 2);
@@ -570,6 +582,13 @@ namespace TreeLod
             if (const Json* ex = find(*random, "exclude"))
             {
                 expectArray(*ex, child(rp, "exclude"));
+                std::size_t before = 0;
+                for (const ScenePlacement& earlier : script.placements)
+                    before += earlier.exclude.size();
+                if (before + ex->size() > MAX_EXCLUSIONS)
+                    bad(child(rp, "exclude"), "the placements exclude " + std::to_string(before + ex->size()) +
+                                                  " areas in all (" + std::to_string(ex->size()) +
+                                                  " here), more than " + std::to_string(MAX_EXCLUSIONS));
                 for (std::size_t i = 0; i < ex->size(); ++i)
                     p.exclude.push_back(readArea((*ex)[i], child(child(rp, "exclude"), i), script.ground.size));
             }
@@ -612,10 +631,10 @@ namespace TreeLod
                 bad(child(pointer, az ? "azimuth" : "elevation"), "give direction or azimuth/elevation, not both");
             if (dir)
             {
-                glm::vec3 d = vec3(*dir, child(pointer, "direction"));
-                if (!(d.y > 0.0f))
+                // y > 0 after normalising: [1e9, 1e-38, 0] is above the horizon only in doubles
+                sun.direction = glm::normalize(vec3(*dir, child(pointer, "direction")));
+                if (!(sun.direction.y > 0.0f))
                     bad(child(pointer, "direction"), "the sun must be above the horizon (y > 0, towards the sun)");
-                sun.direction = glm::normalize(d);
             }
             else
             {
@@ -628,6 +647,8 @@ namespace TreeLod
                 // Azimuth as in CameraSpec::framing: 0 = from +Z, 90 = from +X.
                 sun.direction = glm::vec3(float(std::sin(a) * std::cos(e)), float(std::sin(e)),
                                           float(std::cos(a) * std::cos(e)));
+                if (!(sun.direction.y > 0.0f))
+                    bad(child(pointer, "elevation"), "so low that the sun's direction rounds to the horizon (y = 0)");
             }
             if (const Json* c = find(j, "colour"))
                 sun.colour = vec3(*c, child(pointer, "colour"), 0.0, 100.0);
@@ -726,13 +747,28 @@ namespace TreeLod
 
             const Json& placements = need(root, "", "placements");
             expectArray(placements, "/placements", 1);
-            std::uint64_t explicitTrees = 0;
+            std::uint64_t explicitTrees = 0, totalTrees = 0;
             bool anyRandom = false;
             for (std::size_t i = 0; i < placements.size(); ++i)
             {
-                s.placements.push_back(readPlacement(placements[i], child("/placements", i), s, baseDir));
-                explicitTrees += s.placements.back().positions.size();
-                anyRandom = anyRandom || s.placements.back().random;
+                const std::string pointer = child("/placements", i);
+                s.placements.push_back(readPlacement(placements[i], pointer, s, baseDir));
+                const ScenePlacement& p = s.placements.back();
+                explicitTrees += p.positions.size();
+                anyRandom = anyRandom || p.random;
+                // generatePlacements() makes every tree at once: the whole scene has a bound, not
+                // only each placement.
+                const std::uint64_t trees = p.random ? p.count : p.positions.size();
+                totalTrees += trees;
+                if (totalTrees > MAX_TREES)
+                {
+                    const char* key = !p.random             ? (p.file.empty() ? "positions" : "file")
+                                      : p.density > 0.0f ? "density"
+                                                         : "count";
+                    bad(p.random ? child(child(pointer, "random"), key) : child(pointer, key),
+                        "the placements add up to " + std::to_string(totalTrees) + " trees (" +
+                            std::to_string(trees) + " here), more than " + std::to_string(MAX_TREES));
+                }
             }
 
             if (const Json* v = find(root, "sun"))

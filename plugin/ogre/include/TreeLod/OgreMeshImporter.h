@@ -11,6 +11,15 @@
 // texture unit names an image found in a resource group, that image becomes the material's
 // texture; otherwise the material is untextured (a warning says which).
 // Needs a running Ogre::Root (MeshManager, HardwareBufferManager).
+//
+// Hostile input: Ogre's MeshSerializer trusts the file (a count of 2^32 vertices is allocated,
+// a short file read as garbage), so the importer first walks the file's chunks as Ogre will and
+// checks every length, count, size, bool and reference against the bytes present. It reads
+// formats [MeshSerializer_v1.100] and [MeshSerializer_v1.8] (older ones: upgrade them with
+// OgreMeshUpgrader), as Ogre's writer lays them out. Errors name the file, the chunk by name
+// and offset, and the reason: "tree.mesh: chunk M_GEOMETRY_VERTEX_BUFFER_DATA at offset 310:
+// 2147483647 vertices x 12 bytes need 25769803764 bytes at offset 316, the chunk has 36".
+// Ogre's own exceptions become errors too. A skeleton the file names is not loaded.
 #pragma once
 
 #include "TreeLod/Progress.h"

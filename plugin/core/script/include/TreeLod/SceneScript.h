@@ -18,6 +18,11 @@
 //   errors name the CSV file, the line (1-based) and the column by its header name:
 //   "trees.csv: line 12, column scale: 0 must be finite and > 0". One read of the file,
 //   std::from_chars per number: 0.2 s for a million lines (2-core test machine).
+// - Bounds on the whole scene, so no script costs more than about a GB and a few seconds:
+//   at most 10,000,000 trees in all placements together (generatePlacements makes them all at
+//   once) and 64 exclusion areas (each is tested against 512 x 512 points of its placement's
+//   area). The placement that passes a bound is the error, at its count, density, positions,
+//   file or exclude key.
 // - Placements are deterministic: the same script and options give the same trees on any
 //   machine (own sampling over std::mt19937, no std:: distributions, no threads).
 // - The camera path is a centripetal Catmull-Rom spline (alpha 0.5, Barry-Goldman form) through
