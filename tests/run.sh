@@ -62,7 +62,7 @@ CXX=clang++ cmake -S "$root" -B "$asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMA
 cmake --build "$asan" -j"$jobs" --target treelod_tests treelod_fuzzers
 run_ctest "$asan" -E '^(install|cli|bench)\.' # the gtest binaries; the tools' scripts ran in stage 1
 
-fuzzers=(FuzzGltfImporter:gltf FuzzPackageReader:package)
+fuzzers=(FuzzGltfImporter:gltf FuzzPackageReader:package FuzzSceneScript:scene FuzzInstanceFile:instances FuzzOgreMeshImport:ogremesh)
 for target in "${fuzzers[@]}"; do
   bin=${target%%:*}; corpus=$root/tests/fuzz/corpus/${target#*:}
   work=$(mktemp -d)
