@@ -65,6 +65,7 @@ namespace TreeLod
         // Two submeshes over one shared vertex buffer: a bark triangle and a leaf quad.
         OgreEnvironment::renderer();
         Ogre::MeshPtr mesh = Ogre::MeshManager::getSingleton().createManual("shared.mesh", Ogre::RGN_DEFAULT);
+        mesh->load(); // empty; Ogre frees a mesh's submeshes only when it unloads a loaded one
         mesh->sharedVertexData = new Ogre::VertexData();
         Ogre::VertexData* vd = mesh->sharedVertexData;
         vd->vertexDeclaration->addElement(0, 0, Ogre::VET_FLOAT3, Ogre::VES_POSITION);
@@ -398,6 +399,7 @@ namespace TreeLod
 
         // Shared vertices: a bark triangle and a leaf quad; a third submesh with its own quad.
         Ogre::MeshPtr mesh = Ogre::MeshManager::getSingleton().createManual("checked-chunks.mesh", Ogre::RGN_DEFAULT);
+        mesh->load(); // empty, as in acceptsSharedVertexData
         mesh->sharedVertexData = new Ogre::VertexData();
         mesh->sharedVertexData->vertexDeclaration->addElement(0, 0, Ogre::VET_FLOAT3, Ogre::VES_POSITION);
         mesh->sharedVertexData->vertexCount = 7;
