@@ -5,13 +5,14 @@
 // accepts must keep SceneScript.h's promises: as many trees as the placements (or the sweep)
 // ask for, each of a species of the script, on the ground square, with a finite height and
 // rotation and a scale > 0; a finite camera that sits on the first and last keyframes at their
-// times. The parser bounds a scene at 10,000,000 trees (SceneScript.h); above 20,000 the harness
-// places a counts sweep of 20,000 (TREE_BUDGET below) to keep each input fast.
+// times; a sun above the horizon. The parser bounds a scene at 10,000,000 trees (SceneScript.h);
+// above 20,000 the harness places a counts sweep of 20,000 (TREE_BUDGET) to keep inputs fast.
 //
-// Files: species sources and instance files resolve against <tmp>/treelod-fuzz-scene-XXXXXX/samples/scenes,
-// made once per process, whose ../../media holds the assets the shipped scenes name (empty files:
-// the parser only checks that they exist) and which holds trees.csv (oak and pine trees). The
-// heightfield reader returns the same 3 x 2 image for any path.
+// Files: species sources and instance files resolve against
+// <tmp>/treelod-fuzz-scene-XXXXXX/samples/scenes, made once per process, whose ../../media holds
+// the assets the shipped scenes name (empty files: the parser only checks that they exist) and
+// which holds trees.csv (oak and pine trees). The heightfield reader returns the same 3 x 2
+// image for any path.
 // Seeds: tests/fuzz/corpus/scene/. Run: FuzzSceneScript -max_total_time=30 corpus/scene
 #include "TreeLod/SceneScript.h"
 
