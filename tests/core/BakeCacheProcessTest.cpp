@@ -2,6 +2,8 @@
 // fills while a package is written, and two processes baking one key at once. A child process is
 // this test binary run again on BakeCacheChild.Run alone, which does nothing unless CHILD_ENV
 // holds its request (JSON); it prints its result as one JSON line.
+#include "TestOutput.h"
+
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/BakeCache.h"
 #include "TreeLod/BillboardCloudData.h"
@@ -53,16 +55,7 @@ namespace
     constexpr int GO_FD = 4;
 
     /// A fresh (emptied) directory for one test.
-    std::string testDir(const std::string& name)
-    {
-        const char* env = std::getenv("TREELOD_TEST_OUT");
-        std::filesystem::path dir = env && *env ? env : TREELOD_BINARY_DIR "/test-out";
-        dir = dir / "bakecache-process" / name;
-        std::error_code ec;
-        std::filesystem::remove_all(dir, ec);
-        std::filesystem::create_directories(dir);
-        return dir.string();
-    }
+    std::string testDir(const std::string& name) { return TreeLod::test::freshTestDir("bakecache-process", name); }
 
     /// dir/oak.glb, a tiny generated tree (100 leaves, 16-texel textures).
     std::string writeTinyGlb(const std::string& dir)

@@ -1,5 +1,7 @@
 // BakeCache: lazy baking into a content-keyed cache. Each test bakes a tiny generated tree
 // (100 leaves, 16-texel textures) into its own directory under TREELOD_TEST_OUT.
+#include "TestOutput.h"
+
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/BakeCache.h"
 #include "TreeLod/BillboardCloudData.h"
@@ -25,16 +27,7 @@ namespace
     using Strings = std::vector<std::string>;
 
     /// A fresh (emptied) directory for one test.
-    std::string testDir(const std::string& name)
-    {
-        const char* env = std::getenv("TREELOD_TEST_OUT");
-        std::filesystem::path dir = env && *env ? env : TREELOD_BINARY_DIR "/test-out";
-        dir = dir / "bakecache" / name;
-        std::error_code ec;
-        std::filesystem::remove_all(dir, ec);
-        std::filesystem::create_directories(dir);
-        return dir.string();
-    }
+    std::string testDir(const std::string& name) { return TreeLod::test::freshTestDir("bakecache", name); }
 
     Result<TreeModel> tinyTree(std::uint32_t seed)
     {

@@ -1,4 +1,5 @@
 #include "GltfTestUtil.h"
+#include "TestOutput.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,17 +12,7 @@ namespace TreeLod
 {
     namespace test
     {
-        std::string testDir(const std::string& name)
-        {
-            const char* out = std::getenv("TREELOD_TEST_OUT");
-            std::filesystem::path base = out && *out ? std::filesystem::path(out)
-                                                      : std::filesystem::path(TREELOD_BINARY_DIR) / "test-out";
-            std::filesystem::path dir = base / "gltf" / name;
-            std::error_code ec;
-            std::filesystem::remove_all(dir, ec);
-            std::filesystem::create_directories(dir, ec);
-            return dir.string();
-        }
+        std::string testDir(const std::string& name) { return freshTestDir("gltf", name); }
 
         bool writeBytes(const std::string& path, const std::vector<std::uint8_t>& bytes)
         {
