@@ -25,8 +25,9 @@ collect_cores() {
   while IFS= read -r core; do
     mkdir -p "$tree/test-out/cores"
     exe=$(file -b "$core" | sed -n "s/.*execfn: '\([^']*\)'.*/\1/p")
-    mv "$core" "$tree/test-out/cores/"
-    core=$tree/test-out/cores/$(basename "$core")
+    local kept=$tree/test-out/cores/$(basename "$core").$(date +%s%N)
+    mv "$core" "$kept"
+    core=$kept
     echo "core dump: $core (${exe:-unknown executable})"
     if [ -n "$exe" ] && command -v gdb >/dev/null; then
       gdb -batch -ex "thread apply all bt 30" "$exe" "$core" 2>/dev/null | tee "$core.backtrace.txt" | head -n 60
