@@ -7,6 +7,7 @@
 
 #include <OgreShadowCameraSetupFocused.h>
 #include <OgreShadowCameraSetupLiSPSM.h>
+#include <OgreWorkQueue.h>
 
 #include <algorithm>
 #include <chrono>
@@ -26,6 +27,11 @@ namespace TreeLod
         // Own LogManager first, else Ogre logs to stdout (OGRE-NOTES.md).
         mLogManager = createLogManager(options.logFile, options.verbose);
         mRoot = std::make_unique<Ogre::Root>("", "", "");
+        // No worker threads in Ogre's work queue: nothing here queues work (bakes run on
+        // TreeAssetManager's own threads), and Ogre's workers write the log as they start,
+        // beside the render thread, without a lock (Ogre::Log in Debian's build).
+        if (auto* queue = dynamic_cast<Ogre::DefaultWorkQueueBase*>(mRoot->getWorkQueue()))
+            queue->setWorkerThreadCount(0);
 
         const std::string pluginDir = loadRenderPlugins(*mRoot);
         if (options.pluginPath.empty())
