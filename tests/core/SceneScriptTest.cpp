@@ -216,6 +216,13 @@ namespace TreeLod
         std::string message = errorOf(text);
         EXPECT_EQ(message.rfind("test.json: line 3, column 10: ", 0), 0u) << message;
         EXPECT_NE(message.find("syntax error"), std::string::npos) << message;
+
+        // A number beyond a double and, after it, a line feed inside a string: nlohmann stops at
+        // the number, the first error in the text (found by FuzzSceneScript).
+        text = replaced(replaced(MINIMAL, "\"size\": 100", "\"size\": 1e999"), "\"frames\": 2",
+                        "\"frames\": 2, \"description\": \"a\nb\"");
+        message = errorOf(text);
+        EXPECT_EQ(message, "test.json: line 3, column 39: 1e999 is not a finite number (beyond the range of a double)");
     }
 
     TEST(SceneScript, semanticErrorsNameLineColumnAndKey)

@@ -851,6 +851,14 @@ namespace TreeLod
             std::size_t offset = scan.offsets.count(at) ? scan.offsets[at] : 0;
             return fail(label, lineColumn(text, offset) + ", key " + (e.pointer.empty() ? "/" : e.pointer), e.reason);
         }
+        catch (const Json::exception&)
+        {
+            // Only after an overflow (a text nlohmann parsed scans whole): a syntax error further
+            // on, which nlohmann did not reach. The number comes first in the text: report it.
+            const std::size_t at = text.find(overflow);
+            return fail(label, lineColumn(text, at == std::string::npos ? 0 : at),
+                        overflow + " is not a finite number (beyond the range of a double)");
+        }
     }
 
     Result<SceneScript> loadSceneScript(const std::string& path, const GreyImageReader& readImage)
