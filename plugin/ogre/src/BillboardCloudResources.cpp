@@ -168,7 +168,8 @@ namespace TreeLod
             if (width == 0 || height == 0)
                 width = height = 1;
             std::vector<std::uint8_t> padded(std::size_t(width) * height * texel, 0);
-            std::memcpy(padded.data(), bytes, std::min(byteCount, padded.size()));
+            if (byteCount > 0) // an empty cloud's lists: no bytes, maybe no pointer
+                std::memcpy(padded.data(), bytes, std::min(byteCount, padded.size()));
             const Ogre::String name = prefix + suffix;
             uploadTexture(name, mAsset.getGroup(), padded.data(), width, height, format, 1);
             gpu->textures.push_back(name);
