@@ -223,6 +223,10 @@ namespace TreeLod
                         "\"frames\": 2, \"description\": \"a\nb\"");
         message = errorOf(text);
         EXPECT_EQ(message, "test.json: line 3, column 39: 1e999 is not a finite number (beyond the range of a double)");
+        // ... and a text that ends inside an object after it (the position scan stays in bounds).
+        text = replaced(MINIMAL, "\"size\": 100", "\"size\": 1e999");
+        text.resize(text.find("\"frames\"") + 3);
+        EXPECT_EQ(errorOf(text), "test.json: line 3, column 39: 1e999 is not a finite number (beyond the range of a double)");
     }
 
     TEST(SceneScript, semanticErrorsNameLineColumnAndKey)

@@ -61,7 +61,8 @@ namespace TreeLod
         /// Walks text that nlohmann already accepted (so it is valid JSON with comments) and
         /// records where each JSON pointer starts: the key's opening quote for object members,
         /// the value for array elements and the root. Reports duplicate keys, which nlohmann
-        /// would silently collapse.
+        /// would silently collapse. After a number overflow nlohmann stops early, so the text may
+        /// be anything: every read stays in bounds, a bad string throws Json::exception.
         class PositionScan
         {
         public:
@@ -155,8 +156,10 @@ namespace TreeLod
                         else
                             value(child(pointer, index));
                         skipSpace();
-                        if (mText[mAt++] != ',')
-                            return; // '}' or ']'
+                        const char next = peek();
+                        ++mAt;
+                        if (next != ',')
+                            return; // '}' or ']' (or the end of a text nlohmann stopped short of)
                     }
                 }
                 if (c == '"')
