@@ -196,6 +196,17 @@ namespace TreeLod
 
         float treeHeight(const TreeModel& model) { return model.boundsMax.y - model.boundsMin.y; }
 
+        /// A Forest of `tree` over a 5 x 5 grid 1.4 tree heights apart, its levels (`levels`) the
+        /// automatic bands'.
+        Forest* autoBandsGrid(const ForestTree& tree, std::vector<ForestLevel>& levels)
+        {
+            Forest* forest = placeForest();
+            levels = Forest::levelsForBands(*tree.asset, Forest::getAutoBands());
+            forest->addSpecies(tree.asset, levels);
+            forest->addInstances(grid(5, 1.4f * treeHeight(tree.model)));
+            return forest;
+        }
+
         /// Perspective camera at `eye` looking at `target`.
         CameraSpec look(const glm::vec3& eye, const glm::vec3& target, float fov = 40.0f)
         {
@@ -530,10 +541,8 @@ namespace TreeLod
         const ForestTree& tree = oak();
         OffscreenRenderer& r = OgreEnvironment::renderer();
         const float h = treeHeight(tree.model);
-        Forest* forest = placeForest();
-        const std::vector<ForestLevel> levels = Forest::levelsForBands(*tree.asset, Forest::getAutoBands());
-        forest->addSpecies(tree.asset, levels);
-        forest->addInstances(grid(5, 1.4f * h));
+        std::vector<ForestLevel> levels;
+        Forest* forest = autoBandsGrid(tree, levels);
         const std::size_t last = levels.size() - 1;
 
         // 10 km away: everything at the last level (the quad), a few pixels.
@@ -599,10 +608,8 @@ namespace TreeLod
         const ForestTree& tree = oak();
         OffscreenRenderer& r = OgreEnvironment::renderer();
         const float h = treeHeight(tree.model);
-        Forest* forest = placeForest();
-        const std::vector<ForestLevel> levels = Forest::levelsForBands(*tree.asset, Forest::getAutoBands());
-        forest->addSpecies(tree.asset, levels);
-        forest->addInstances(grid(5, 1.4f * h));
+        std::vector<ForestLevel> levels;
+        Forest* forest = autoBandsGrid(tree, levels);
         CameraSpec distant = look(glm::vec3(1.0e6f, 1.0e6f, 1.0e6f), glm::vec3(0.0f), 1.0f);
         distant.farClip = 3.0e6f;
         distant.nearClip = 10.0f;
