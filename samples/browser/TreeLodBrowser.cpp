@@ -532,8 +532,8 @@ namespace TreeLod
         stats.insert(stats.begin(), {"FPS (render)", fps});
         const ResidentMemory memory = residentMemory();
         char resident[48];
-        std::snprintf(resident, sizeof resident, "%.0f MiB (peak %.0f)", memory.currentMiB, memory.peakMiB);
-        stats.push_back({"Memory (resident)", resident});
+        std::snprintf(resident, sizeof resident, "%.0f MiB, peak %.0f", memory.currentMiB, memory.peakMiB);
+        stats.push_back({"Resident", resident});
         Ogre::StringVector names, values;
         for (const auto& [name, value] : stats)
         {
