@@ -40,12 +40,12 @@ int main(int argc, char** argv)
     try
     {
         browser.initApp();
+        if (!options.headless)
+            browser.getRoot()->startRendering();
         if (options.headless && !options.screenshots.empty())
             browser.writeScreenshots();
         if (options.headless && options.soak > 0)
             browser.soak(options.soak);
-        else
-            browser.getRoot()->startRendering();
     }
     catch (const Ogre::Exception& e)
     {
