@@ -125,6 +125,7 @@ namespace TreeLod
             void value(const std::string& pointer)
             {
                 skipSpace();
+                mAt = std::min(mAt, mText.size()); // past a ':' or ',' the text did not have
                 offsets.emplace(pointer, mAt); // members already hold their key's offset
                 char c = peek();
                 if (c == '{' || c == '[')
