@@ -30,12 +30,20 @@ namespace TreeLod
             return dir;
         }
 
+        /// Where the running test's browser writes stdout: one file per test, since ctest runs the
+        /// tests of this binary as concurrent processes.
+        std::string outputFile(const char* stream)
+        {
+            return outDir() + "/" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + "-" + stream +
+                   ".txt";
+        }
+
         /// Run the browser with `args`; returns its exit code, stderr in `errors`.
         int runBrowser(const std::string& args, std::string& errors)
         {
-            const std::string errorFile = outDir() + "/stderr.txt";
-            const std::string command = std::string(TREELOD_BROWSER_PATH) + " " + args + " > " + outDir() +
-                                        "/stdout.txt 2> " + errorFile;
+            const std::string errorFile = outputFile("stderr");
+            const std::string command =
+                std::string(TREELOD_BROWSER_PATH) + " " + args + " > " + outputFile("stdout") + " 2> " + errorFile;
             const int status = std::system(command.c_str());
             std::ifstream in(errorFile);
             std::stringstream text;
@@ -153,7 +161,7 @@ namespace TreeLod
                              errors),
                   0)
             << errors;
-        std::ifstream in(outDir() + "/stdout.txt");
+        std::ifstream in(outputFile("stdout"));
         std::string line, report;
         while (std::getline(in, line))
             if (line.rfind("soak: ", 0) == 0)
