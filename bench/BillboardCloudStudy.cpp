@@ -19,7 +19,7 @@
 //    the same run, same camera, and their ratios.
 // Output in --out: summary.md, summary.json, error.csv, timing.csv, error-<view>.png.
 //
-// Needs an X server: xvfb-run -a -s "-screen 0 1280x1024x24" treelod_bc_study [options]
+// Needs an X server: xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" treelod_bc_study [options]
 // Errors print one line and exit 2. Timings on llvmpipe are CPU timings: compare ratios.
 #include "TreeLod/BillboardCloudBaker.h"
 #include "TreeLod/BillboardCloudTree.h"

@@ -57,11 +57,16 @@ namespace
         std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
         model.leafVertices.reserve(4 * kLeaves);
         model.leafIndices.reserve(6 * kLeaves);
+        // z, y, x in this order, named: the order of a call's arguments is unspecified.
+        const auto draw = [&] {
+            const float z = unit(rng);
+            const float y = unit(rng);
+            return glm::vec3(unit(rng), y, z);
+        };
         for (std::uint32_t i = 0; i < kLeaves; ++i)
         {
-            glm::vec3 c(unit(rng), unit(rng), unit(rng));
-            c = glm::vec3(0.0f, 6.0f, 0.0f) + 3.0f * c;
-            glm::vec3 n = glm::normalize(glm::vec3(unit(rng), unit(rng), unit(rng)) + glm::vec3(0.0f, 0.01f, 0.0f));
+            const glm::vec3 c = glm::vec3(0.0f, 6.0f, 0.0f) + 3.0f * draw();
+            glm::vec3 n = glm::normalize(draw() + glm::vec3(0.0f, 0.01f, 0.0f));
             glm::vec3 u = glm::normalize(glm::cross(n, std::abs(n.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0)));
             glm::vec3 v = glm::cross(n, u);
             u *= 0.025f;

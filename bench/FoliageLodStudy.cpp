@@ -23,7 +23,7 @@
 // (reference | lodf | discrete, full frame above, the tree magnified below) and
 // pop-worst.png (the discrete baseline's largest pop next to lodf at the same step).
 //
-// Needs an X server: xvfb-run -a -s "-screen 0 1280x1024x24" treelod_lodf_study [options]
+// Needs an X server: xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" treelod_lodf_study [options]
 // Errors print one line and exit 2. Timings on llvmpipe are CPU timings (docs/architecture.md,
 // "Measuring"): compare ratios, not milliseconds, across machines.
 #include "TreeLod/AtomicFile.h"
@@ -1058,7 +1058,7 @@ int main(int argc, char** argv)
     using TreeLod::StudyArgs;
     StudyArgs args;
     CLI::App app{"LoDF study (Rebollo et al. 2006): popping along a zoom, and frame time against the reference at equal FLIP. "
-                 "Run under xvfb-run -a -s \"-screen 0 1280x1024x24\"."};
+                 "Run under xvfb-run -a -s \"-screen 0 1280x1024x24 -noreset\"."};
     app.add_option("--tree", args.tree, "glTF tree (default: media/oak.glb of the source tree)");
     app.add_option("--leaves", args.leaves, "generate an oak preset with this many leaves instead (100..200000)");
     app.add_option("--seed", args.seed, "generator seed with --leaves")->capture_default_str();

@@ -61,7 +61,10 @@ namespace
             std::vector<ForestInstance> instances(kInstances);
             for (ForestInstance& i : instances)
             {
-                i.position = glm::vec3(kHalfExtent * u(rng), 2.0f * u(rng), kHalfExtent * u(rng));
+                // z, y, x in this order, named: the order of a call's arguments is unspecified.
+                const float z = kHalfExtent * u(rng);
+                const float y = 2.0f * u(rng);
+                i.position = glm::vec3(kHalfExtent * u(rng), y, z);
                 i.rotationY = 3.14159265f * u(rng);
                 i.scale = 1.0f + 0.3f * u(rng);
                 i.kind = std::uint32_t(rng() % 4);
@@ -106,8 +109,9 @@ namespace
             std::uniform_real_distribution<float> u(0.0f, 1.0f);
             for (int c = 0; c < 64; ++c)
             {
-                const glm::vec3 eye(kHalfExtent * (2.0f * u(rng) - 1.0f), 2.0f + 1498.0f * u(rng) * u(rng),
-                                    kHalfExtent * (2.0f * u(rng) - 1.0f));
+                const float z = kHalfExtent * (2.0f * u(rng) - 1.0f);
+                const float y = 2.0f + 1498.0f * u(rng) * u(rng);
+                const glm::vec3 eye(kHalfExtent * (2.0f * u(rng) - 1.0f), y, z);
                 const float heading = 6.2831853f * u(rng), pitch = -1.0471976f * u(rng);
                 const glm::vec3 forward(std::cos(pitch) * std::sin(heading), std::sin(pitch),
                                         std::cos(pitch) * std::cos(heading));

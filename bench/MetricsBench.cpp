@@ -16,10 +16,10 @@ namespace
     Image noiseImage(int size, std::uint32_t seed)
     {
         std::mt19937 rng(seed);
-        Image image(size, size);
+        Image image(size, size, glm::vec4(1.0f));
         for (glm::vec4& p : image.pixels)
-            p = glm::vec4(float(rng() >> 8) / float(1 << 24), float(rng() >> 8) / float(1 << 24),
-                          float(rng() >> 8) / float(1 << 24), 1.0f);
+            for (int c = 0; c < 3; ++c)
+                p[c] = float(rng() >> 8) / float(1 << 24);
         return image;
     }
 

@@ -16,7 +16,7 @@ args=("$@")
 if [ -n "${DISPLAY:-}" ]; then
   exec "$build/bin/treelod_browser" "${args[@]}"
 fi
-xvfb-run -a -s "-screen 0 1280x1024x24" "$build/bin/treelod_browser" --headless --screenshots "$out" "${args[@]}"
+xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" "$build/bin/treelod_browser" --headless --screenshots "$out" "${args[@]}"
 echo
 echo "No display: ran the browser headless; its screenshots are in $out:"
 ls -1 "$out"/*.png

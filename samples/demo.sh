@@ -13,7 +13,7 @@ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DTREELOD_BUILD_TESTS=OF
 cmake --build "$build" -j"$(nproc)" --target treelod
 mkdir -p "$out"
 export XDG_CACHE_HOME=${XDG_CACHE_HOME:-$build/cache}
-run() { xvfb-run -a -s "-screen 0 1280x1024x24" "$@"; }
+run() { xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" "$@"; }
 for tree in "$root"/media/*.glb; do
   name=$(basename "$tree" .glb)
   for view in "front:orbit:0,8,1.0" "side:orbit:90,20,1.0"; do

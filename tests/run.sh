@@ -40,7 +40,7 @@ collect_cores() {
 run_ctest() {
   local tree=$1; shift
   local rc=0
-  (cd "$tree" && XDG_CACHE_HOME=$tree/test-cache ${launch:-} xvfb-run -a -s "-screen 0 1280x1024x24" \
+  (cd "$tree" && XDG_CACHE_HOME=$tree/test-cache ${launch:-} xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" \
     ctest --output-on-failure -j"$jobs" --timeout 300 "$@") || rc=$?
   collect_cores "$tree"
   return $rc

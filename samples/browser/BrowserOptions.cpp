@@ -29,7 +29,7 @@ first pass over every sample and technique, at the end, and the peak; --screensh
 out.
 Layout: a 270-pixel column of controls and stats on the left; the split view divides the rest
 into three equal panels.
-Needs an X server (xvfb-run -a -s "-screen 0 1280x1024x24" treelod_browser --headless ...).
+Needs an X server (xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" treelod_browser --headless ...).
 Bad arguments exit 2; a failure while running exits 1.)";
 
         bool parseSize(const std::string& text, int& w, int& h)

@@ -31,7 +31,7 @@ int main(int argc, char** argv)
     if (!display || !*display)
     {
         std::cerr << "treelod_browser: no X display (DISPLAY is not set): run under "
-                     "xvfb-run -a -s \"-screen 0 1280x1024x24\" treelod_browser --headless ..."
+                     "xvfb-run -a -s \"-screen 0 1280x1024x24 -noreset\" treelod_browser --headless ..."
                   << std::endl;
         return 1;
     }

@@ -77,10 +77,16 @@ namespace TreeLod
             std::mt19937 rng(seed);
             std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
             std::vector<LeafAt> out(n);
+            // z, y, x in this order, named: the order of a call's arguments is unspecified.
+            const auto draw = [&] {
+                const float z = unit(rng);
+                const float y = unit(rng);
+                return glm::vec3(unit(rng), y, z);
+            };
             for (std::size_t i = 0; i < n; ++i)
             {
-                out[i].centre = glm::vec3(2.0f * unit(rng), 3.0f + 2.0f * unit(rng), 2.0f * unit(rng));
-                out[i].normal = glm::vec3(unit(rng), unit(rng), unit(rng)) + glm::vec3(0.0f, 0.01f, 0.0f);
+                out[i].centre = glm::vec3(0.0f, 3.0f, 0.0f) + 2.0f * draw();
+                out[i].normal = draw() + glm::vec3(0.0f, 0.01f, 0.0f);
                 out[i].size = 0.1f + 0.05f * unit(rng);
                 out[i].material = std::uint32_t(i % materials);
             }

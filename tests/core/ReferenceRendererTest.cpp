@@ -106,6 +106,13 @@ namespace
             return float((x ^ (x >> 31)) >> 40) / 16777216.0f;
         }
         float range(float lo, float hi) { return lo + (hi - lo) * next(); }
+        /// A point of [-1, 1]^3, drawn z, y, x (named: the order of a call's arguments is unspecified).
+        glm::vec3 inCube()
+        {
+            const float z = range(-1.0f, 1.0f);
+            const float y = range(-1.0f, 1.0f);
+            return glm::vec3(range(-1.0f, 1.0f), y, z);
+        }
     };
 
     /// A small tree about 5.8 * scale metres tall: a tapered trunk cylinder and `leafCount`
@@ -154,12 +161,12 @@ namespace
         {
             glm::vec3 p;
             do
-                p = glm::vec3(rng.range(-1, 1), rng.range(-1, 1), rng.range(-1, 1));
+                p = rng.inCube();
             while (glm::dot(p, p) > 1.0f);
             glm::vec3 centre = glm::vec3(0.0f, 4.2f, 0.0f) + p * glm::vec3(2.0f, 1.6f, 2.0f);
             glm::vec3 n;
             do
-                n = glm::vec3(rng.range(-1, 1), rng.range(-1, 1), rng.range(-1, 1));
+                n = rng.inCube();
             while (glm::dot(n, n) > 1.0f || glm::dot(n, n) < 1e-3f);
             n = glm::normalize(n);
             glm::vec3 t = glm::normalize(glm::cross(n, std::abs(n.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0)));

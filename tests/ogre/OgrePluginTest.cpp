@@ -43,6 +43,39 @@ namespace TreeLod
         }
     }
 
+    // A display that cannot be opened (as when Xvfb resets between two clients) is an exception
+    // that names the display and says why, readable after the failed start has unloaded the
+    // render system; and the process can start Ogre again afterwards.
+    TEST(OgrePlugin, failedStartIsAReadableErrorAndLeavesNothingBehind)
+    {
+        const std::string display = std::getenv("DISPLAY") ? std::getenv("DISPLAY") : "";
+        ASSERT_FALSE(display.empty()) << "run under xvfb-run";
+        ::setenv("DISPLAY", ":31999", 1);
+        std::string message;
+        try
+        {
+            OffscreenOptions options;
+            options.pluginPath = TREELOD_PLUGIN_PATH;
+            OffscreenRenderer failed(options);
+            ADD_FAILURE() << "Ogre started on a display that does not exist";
+        }
+        catch (const Ogre::RenderingAPIException& e)
+        {
+            message = e.what(); // the full description: type name, file and line, all ours
+        }
+        ::setenv("DISPLAY", display.c_str(), 1);
+        EXPECT_NE(message.find(":31999"), std::string::npos) << message;
+        EXPECT_NE(message.find("open X display"), std::string::npos) << message;
+        EXPECT_NE(message.find("OffscreenRenderer.cpp"), std::string::npos) << message;
+        EXPECT_EQ(Ogre::Root::getSingletonPtr(), nullptr);
+        EXPECT_EQ(Ogre::LogManager::getSingletonPtr(), nullptr);
+
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        EXPECT_NE(r.getRoot().getRenderSystem(), nullptr);
+        const RgbaImage image = r.render(CameraSpec{}, 8, 8);
+        EXPECT_EQ(image.pixels.size(), 8u * 8u * 4u);
+    }
+
     TEST(OgrePlugin, installsFromSharedLibrary)
     {
         // Loading the .so runs dllStartPlugin, which installs the plugin: the resource

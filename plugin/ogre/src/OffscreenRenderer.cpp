@@ -16,14 +16,73 @@
 
 namespace TreeLod
 {
+    namespace
+    {
+        /// The code OGRE_EXCEPT takes to throw an exception of e's type (Ogre 1.12 keeps no number).
+        Ogre::Exception::ExceptionCodes exceptionCode(const Ogre::Exception& e)
+        {
+            using E = Ogre::Exception;
+            if (dynamic_cast<const Ogre::RenderingAPIException*>(&e))
+                return E::ERR_RENDERINGAPI_ERROR;
+            if (dynamic_cast<const Ogre::FileNotFoundException*>(&e))
+                return E::ERR_FILE_NOT_FOUND;
+            if (dynamic_cast<const Ogre::IOException*>(&e))
+                return E::ERR_CANNOT_WRITE_TO_FILE;
+            if (dynamic_cast<const Ogre::InvalidStateException*>(&e))
+                return E::ERR_INVALID_STATE;
+            if (dynamic_cast<const Ogre::InvalidParametersException*>(&e))
+                return E::ERR_INVALIDPARAMS;
+            if (dynamic_cast<const Ogre::ItemIdentityException*>(&e))
+                return E::ERR_DUPLICATE_ITEM;
+            if (dynamic_cast<const Ogre::InvalidCallException*>(&e))
+                return E::ERR_INVALID_CALL;
+            if (dynamic_cast<const Ogre::UnimplementedException*>(&e))
+                return E::ERR_NOT_IMPLEMENTED;
+            return E::ERR_INTERNAL_ERROR;
+        }
+    }
+
     OffscreenRenderer::OffscreenRenderer(const OffscreenOptions& options)
     {
-        // Debian's OGRE is GLX only; fail before Ogre half-starts (its teardown then crashes).
+        // Debian's OGRE is GLX only; fail before Ogre half-starts.
         const char* display = std::getenv("DISPLAY");
         if (!display || !*display)
             OGRE_EXCEPT(Ogre::Exception::ERR_RENDERINGAPI_ERROR,
-                        "no X display (DISPLAY is not set): run under xvfb-run -a -s \"-screen 0 1280x1024x24\"",
+                        "no X display (DISPLAY is not set): run under xvfb-run -a -s \"-screen 0 1280x1024x24 -noreset\"",
                         "OffscreenRenderer");
+        // An exception thrown inside a render system plugin points at the plugin's code and
+        // strings (destructor, type name, file), which release() unloads: keep what it says, let
+        // it go, then release and throw again from here.
+        bool failed = false;
+        Ogre::Exception::ExceptionCodes code = Ogre::Exception::ERR_INTERNAL_ERROR;
+        std::string description, source;
+        try
+        {
+            start(options);
+        }
+        catch (const Ogre::Exception& e)
+        {
+            failed = true;
+            code = exceptionCode(e);
+            description = e.getDescription();
+            source = e.getSource();
+        }
+        catch (const std::exception& e)
+        {
+            failed = true;
+            description = e.what();
+            source = "OffscreenRenderer";
+        }
+        if (failed)
+        {
+            release();
+            OGRE_EXCEPT(code, "starting Ogre headless on display " + std::string(display) + ": " + description,
+                        source);
+        }
+    }
+
+    void OffscreenRenderer::start(const OffscreenOptions& options)
+    {
         // Own LogManager first, else Ogre logs to stdout (OGRE-NOTES.md).
         mLogManager = createLogManager(options.logFile, options.verbose);
         mRoot = std::make_unique<Ogre::Root>("", "", "");
@@ -85,16 +144,25 @@ namespace TreeLod
         mContentNode->removeAndDestroyAllChildren();
     }
 
-    OffscreenRenderer::~OffscreenRenderer()
+    OffscreenRenderer::~OffscreenRenderer() { release(); }
+
+    void OffscreenRenderer::release()
     {
         if (mTarget)
             Ogre::TextureManager::getSingleton().remove(mTarget);
         mTarget.reset();
-        if (mSceneManager)
-            mRoot->destroySceneManager(mSceneManager);
-        mRoot->shutdown();
-        if (mPlugin)
-            mRoot->uninstallPlugin(mPlugin.get());
+        if (mRoot)
+        {
+            if (mSceneManager)
+                mRoot->destroySceneManager(mSceneManager);
+            mSceneManager = nullptr;
+            mRoot->shutdown();
+            // The plugin leaves the Root before either is destroyed (Root's destructor would
+            // uninstall it again).
+            if (mPlugin && std::find(mRoot->getInstalledPlugins().begin(), mRoot->getInstalledPlugins().end(),
+                                     mPlugin.get()) != mRoot->getInstalledPlugins().end())
+                mRoot->uninstallPlugin(mPlugin.get());
+        }
         mRoot.reset();
         mPlugin.reset();
         mLogManager.reset();

@@ -758,8 +758,10 @@ namespace TreeLod
                     const Frame f = s.segments[s.segmentAt(t)];
                     const float phi = radians(rotation);
                     const glm::vec3 radial = f.x * std::cos(phi) + f.y * std::sin(phi);
-                    const glm::vec3 basePos = s.pointAt(t) + radial * (spread * std::sqrt(rnd.unit())) +
-                                              f.z * (0.5f * spread * rnd.spread(1.0f));
+                    // Two draws, in this order: operands of + are unsequenced, so they are named.
+                    const float along = 0.5f * spread * rnd.spread(1.0f);
+                    const float out = spread * std::sqrt(rnd.unit());
+                    const glm::vec3 basePos = s.pointAt(t) + radial * out + f.z * along;
 
                     // Leaf axis: off the stem by the leaf down angle, bent up or down.
                     const float down = radians(p.leafDownAngle + rnd.spread(p.leafDownAngleV));

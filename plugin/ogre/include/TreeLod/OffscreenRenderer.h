@@ -111,6 +111,9 @@ namespace TreeLod
         static void savePng(const RgbaImage& image, const std::string& path);
 
     private:
+        void start(const OffscreenOptions& options);
+        /// Destroys what start() made, in order; safe on a half-started renderer.
+        void release();
         void ensureTarget(int width, int height);
         void placeCamera(const CameraSpec& camera, int width, int height, int samplesPerAxis);
 
