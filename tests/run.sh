@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Build and run every test, once each (a failure is a failure: nothing is retried):
 #  1. the Release tree: unit, headless Ogre, golden-image, CLI and browser tests (under Xvfb);
-#  2. a clang tree with ASan + UBSan: the core gtest binaries (TREELOD_ASAN_OGRE=1: the Ogre ones
-#     too), then each libFuzzer target for a few seconds;
+#  2. a clang tree with ASan + UBSan: every gtest binary (core and Ogre), then each libFuzzer
+#     target for a few seconds;
 #  3. a clang tree with TSan: TreeLod's own threads (bake cache, async baker).
 # A test process that dies leaves its core dump and backtrace in <tree>/test-out/cores/.
 # CI (.ci/run) calls exactly this. TREELOD_SANITIZE=0 runs stage 1 only.
@@ -61,9 +61,9 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 CXX=clang++ cmake -S "$root" -B "$asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
   -DTREELOD_SANITIZERS=address,undefined -DTREELOD_BUILD_FUZZERS=ON -DTREELOD_BUILD_TESTS=ON \
   -DTREELOD_BUILD_BENCHMARKS=OFF -DTREELOD_BUILD_SAMPLES=OFF >/dev/null
-# The core gtest binaries (label "core"); TREELOD_ASAN_OGRE=1 adds the Ogre ones (label "ogre"),
-# not yet in CI: see docs/testing.md.
-if [ "${TREELOD_ASAN_OGRE:-0}" = 1 ]; then
+# Every gtest binary: the core ones (label "core") and the Ogre ones (label "ogre");
+# TREELOD_ASAN_OGRE=0 leaves the Ogre ones out.
+if [ "${TREELOD_ASAN_OGRE:-1}" = 1 ]; then
   cmake --build "$asan" -j"$jobs" --target treelod_tests treelod_fuzzers
   run_ctest "$asan" -E '^(install|cli|bench)\.' # the tools' scripts ran in stage 1
 else

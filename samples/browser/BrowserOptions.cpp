@@ -24,9 +24,9 @@ technique | FLIP difference image), and the forest of the scene script.
   split-TECHNIQUE.png       each technique sample's split view (every registered technique:
                             treelod render --help lists them), the tree framed whole
 --headless --soak N switches N times between samples and techniques as a user does (the menu,
-the technique menu), each drawn until it has settled, then prints resident memory after the
-first pass over every sample and technique, at the end, and the peak; --screenshots may be left
-out.
+the technique menu), each drawn until it has settled, and prints resident memory and the heap in
+use after each pass over every sample and technique; then after the warm-up (two passes), at the
+end, and the peak; --screenshots may be left out.
 Layout: a 270-pixel column of controls and stats on the left; the split view divides the rest
 into three equal panels.
 Needs an X server (xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" treelod_browser --headless ...).

@@ -566,7 +566,8 @@ namespace TreeLod
         mPendingScreen = NO_SCREEN;
         if (mCurrent >= 0)
         {
-            mSamples[std::size_t(mCurrent)]->frame(evt.timeSinceLastFrame);
+            mSamples[std::size_t(mCurrent)]->frame(mFixedFrameSeconds > 0.0 ? mFixedFrameSeconds
+                                                                             : double(evt.timeSinceLastFrame));
             updateStats();
         }
         mFrameStart = std::chrono::steady_clock::now();
@@ -644,11 +645,18 @@ namespace TreeLod
     {
         SoakReport report;
         const auto start = std::chrono::steady_clock::now();
+        // Every pass draws the same frames on any machine: each frame is 0.2 s of sample time, and
+        // each switch is drawn until the sample has settled (bakes done), then three frames more,
+        // as a user who stops to look sees it (a split view computes its difference image after
+        // SingleTreeView::RECOMPUTE_DELAY, 0.3 s, still).
+        mFixedFrameSeconds = 0.2;
+        unsigned passes = 0;
         auto settle = [&] {
-            int frames = 1;
+            int frames = 0;
             for (; frames < 200 && mCurrent >= 0 && !mSamples[std::size_t(mCurrent)]->isSettled(); ++frames)
                 mRoot->renderOneFrame();
-            mRoot->renderOneFrame();
+            for (int still = 0; still < 3; ++still, ++frames)
+                mRoot->renderOneFrame();
             if (++report.switches % 25 == 0)
                 std::fprintf(stderr, "soak: %u of %u switches, %.1f s (%s: %d frames)\n", report.switches, switches,
                              secondsSince(start), mSamples[std::size_t(mCurrent)]->getTitle().c_str(), frames);
@@ -670,15 +678,19 @@ namespace TreeLod
                     settle();
                 }
             }
-            if (report.warmUpSwitches == 0)
+            const SoakMemory pass = measureMemory();
+            std::fprintf(stderr, "soak: after %u switches %.1f MiB resident, %.1f MiB heap in use\n", report.switches,
+                         pass.residentMiB, pass.heapMiB);
+            if (++passes == SOAK_WARM_UP_PASSES)
             {
                 report.warmUpSwitches = report.switches;
-                report.afterWarmUp = measureMemory();
+                report.afterWarmUp = pass;
             }
         }
         report.end = measureMemory();
         report.peakMiB = residentMemory().peakMiB;
-        std::printf("soak: %u switches; after the first pass (%u switches) %.1f MiB resident, %.1f MiB heap in use; "
+        mFixedFrameSeconds = 0.0;
+        std::printf("soak: %u switches; after the warm-up (%u switches) %.1f MiB resident, %.1f MiB heap in use; "
                     "at the end %.1f MiB resident (%+.1f), %.1f MiB heap in use (%+.1f); peak %.1f MiB resident\n",
                     report.switches, report.warmUpSwitches, report.afterWarmUp.residentMiB,
                     report.afterWarmUp.heapMiB, report.end.residentMiB,

@@ -67,14 +67,18 @@ namespace TreeLod
         struct SoakReport
         {
             unsigned switches = 0;       ///< made in all
-            unsigned warmUpSwitches = 0; ///< the first pass over every sample and technique
-            SoakMemory afterWarmUp;      ///< after the first pass
+            unsigned warmUpSwitches = 0; ///< the first SOAK_WARM_UP_PASSES passes over every sample and technique
+            SoakMemory afterWarmUp;      ///< after them
             SoakMemory end;              ///< at the end
             double peakMiB = 0.0;        ///< the process's peak resident memory
         };
+        /// Passes over every sample and technique before the soak's baseline: the first bakes,
+        /// builds levels and compiles shaders; in the second the GL driver still compiles
+        /// variants for states it first meets there (docs/browser.md, "Memory").
+        static constexpr unsigned SOAK_WARM_UP_PASSES = 2;
         /// Headless: `switches` changes of screen as a user makes them (the menu and a sample in
         /// turn, then each entry of its technique menu), each drawn until it has settled; prints
-        /// and returns memory after the first pass and at the end.
+        /// memory after each pass, and returns it after the warm-up passes and at the end.
         SoakReport soak(unsigned switches);
 
         // ApplicationContext
@@ -163,6 +167,9 @@ namespace TreeLod
         bool mDragLook = false;
         double mFrameSeconds = 0.0;  ///< smoothed time of the last frames (rendering only)
         std::chrono::steady_clock::time_point mFrameStart;
+        /// Seconds each frame advances the samples (camera paths, delays); 0: the real frame time.
+        /// The soak sets it so that what it draws does not depend on the machine's speed.
+        double mFixedFrameSeconds = 0.0;
         double mProgressShownAt = -1.0;
         std::string mProgressStep;
     };

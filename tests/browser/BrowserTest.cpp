@@ -145,15 +145,16 @@ namespace TreeLod
         EXPECT_GT(spread(menu), 0.3f);
     }
 
-    // Memory over a long session: after the first pass over every sample and technique (bakes
-    // loaded, levels built, shaders compiled), a few hundred more switches leave the heap in use
-    // and resident memory (both measured after malloc_trim) within SOAK_GROWTH_MIB of where they
-    // were. Measured at 320x240 with 256-texel shadow maps (2048 costs 1 s a frame on llvmpipe):
+    // Memory over a long session: after the warm-up passes over every sample and technique (bakes
+    // loaded, levels built, shaders and driver variants compiled), a few hundred more switches
+    // leave the heap in use and resident memory (both measured after malloc_trim) within
+    // SOAK_GROWTH_MIB of where they were. Every frame is 0.2 s of sample time, so the same frames
+    // are drawn however loaded the machine is. Measured at 320x240 with 256-texel shadow maps (2048 costs 1 s a frame on llvmpipe):
     // docs/browser.md, "Memory".
     TEST(BrowserHeadless, SoakKeepsMemory)
     {
-        constexpr unsigned SWITCHES = 300;
-        constexpr double SOAK_GROWTH_MIB = 32.0;
+        constexpr unsigned SWITCHES = 400;
+        constexpr double SOAK_GROWTH_MIB = 40.0;
         std::string errors;
         ASSERT_EQ(runBrowser("--headless --soak " + std::to_string(SWITCHES) + " --scene " +
                                  std::string(TREELOD_SOURCE_DIR) +
@@ -170,7 +171,7 @@ namespace TreeLod
         double resident0 = 0.0, heap0 = 0.0, resident1 = 0.0, residentGrowth = 0.0, heap1 = 0.0, heapGrowth = 0.0,
                peak = 0.0;
         ASSERT_EQ(std::sscanf(report.c_str(),
-                              "soak: %u switches; after the first pass (%u switches) %lf MiB resident, %lf MiB heap "
+                              "soak: %u switches; after the warm-up (%u switches) %lf MiB resident, %lf MiB heap "
                               "in use; at the end %lf MiB resident (%lf), %lf MiB heap in use (%lf); peak %lf MiB "
                               "resident",
                               &switches, &warmUp, &resident0, &heap0, &resident1, &residentGrowth, &heap1,
@@ -179,8 +180,8 @@ namespace TreeLod
             << "no soak report in stdout: '" << report << "'";
         std::printf("%s\n", report.c_str());
         EXPECT_EQ(switches, SWITCHES);
-        EXPECT_GT(warmUp, 5u) << "a pass visits every sample and technique";
-        EXPECT_LT(warmUp * 4, SWITCHES) << "too few switches after the first pass to see a leak";
+        EXPECT_GT(warmUp, 10u) << "a pass visits every sample and technique";
+        EXPECT_LE(warmUp * 4, SWITCHES) << "too few switches after the warm-up to see a leak";
         EXPECT_GT(heap0, 10.0);
         EXPECT_LE(heap1 - heap0, SOAK_GROWTH_MIB) << report;
         EXPECT_LE(resident1 - resident0, SOAK_GROWTH_MIB) << report;
