@@ -566,8 +566,7 @@ namespace TreeLod
         mPendingScreen = NO_SCREEN;
         if (mCurrent >= 0)
         {
-            mSamples[std::size_t(mCurrent)]->frame(mFixedFrameSeconds > 0.0 ? mFixedFrameSeconds
-                                                                             : double(evt.timeSinceLastFrame));
+            mSamples[std::size_t(mCurrent)]->frame(mFixedFrameSeconds.value_or(double(evt.timeSinceLastFrame)));
             updateStats();
         }
         mFrameStart = std::chrono::steady_clock::now();
@@ -645,16 +644,18 @@ namespace TreeLod
     {
         SoakReport report;
         const auto start = std::chrono::steady_clock::now();
-        // Every pass draws the same frames on any machine: each frame is 0.2 s of sample time, and
-        // each switch is drawn until the sample has settled (bakes done), then three frames more,
-        // as a user who stops to look sees it (a split view computes its difference image after
+        // Every pass draws the same frames on any machine: each switch is drawn with the sample's
+        // time stopped until the sample has settled (bakes and level builds on worker threads
+        // take as long as they take), then three frames of 0.2 s each, as a user who stops to
+        // look sees it (a split view computes its difference image after
         // SingleTreeView::RECOMPUTE_DELAY, 0.3 s, still).
-        mFixedFrameSeconds = 0.2;
         unsigned passes = 0;
         auto settle = [&] {
             int frames = 0;
+            mFixedFrameSeconds = 0.0;
             for (; frames < 200 && mCurrent >= 0 && !mSamples[std::size_t(mCurrent)]->isSettled(); ++frames)
                 mRoot->renderOneFrame();
+            mFixedFrameSeconds = 0.2;
             for (int still = 0; still < 3; ++still, ++frames)
                 mRoot->renderOneFrame();
             if (++report.switches % 25 == 0)
@@ -689,7 +690,7 @@ namespace TreeLod
         }
         report.end = measureMemory();
         report.peakMiB = residentMemory().peakMiB;
-        mFixedFrameSeconds = 0.0;
+        mFixedFrameSeconds.reset();
         std::printf("soak: %u switches; after the warm-up (%u switches) %.1f MiB resident, %.1f MiB heap in use; "
                     "at the end %.1f MiB resident (%+.1f), %.1f MiB heap in use (%+.1f); peak %.1f MiB resident\n",
                     report.switches, report.warmUpSwitches, report.afterWarmUp.residentMiB,

@@ -31,6 +31,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -167,9 +168,9 @@ namespace TreeLod
         bool mDragLook = false;
         double mFrameSeconds = 0.0;  ///< smoothed time of the last frames (rendering only)
         std::chrono::steady_clock::time_point mFrameStart;
-        /// Seconds each frame advances the samples (camera paths, delays); 0: the real frame time.
-        /// The soak sets it so that what it draws does not depend on the machine's speed.
-        double mFixedFrameSeconds = 0.0;
+        /// Seconds each frame advances the samples (camera paths, delays); none: the real frame
+        /// time. The soak sets it so that what it draws does not depend on the machine's speed.
+        std::optional<double> mFixedFrameSeconds;
         double mProgressShownAt = -1.0;
         std::string mProgressStep;
     };

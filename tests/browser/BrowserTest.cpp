@@ -154,7 +154,7 @@ namespace TreeLod
     TEST(BrowserHeadless, SoakKeepsMemory)
     {
         constexpr unsigned SWITCHES = 400;
-        constexpr double SOAK_GROWTH_MIB = 40.0;
+        constexpr double SOAK_GROWTH_MIB = 48.0;
         std::string errors;
         ASSERT_EQ(runBrowser("--headless --soak " + std::to_string(SWITCHES) + " --scene " +
                                  std::string(TREELOD_SOURCE_DIR) +
