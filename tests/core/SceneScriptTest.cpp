@@ -269,6 +269,8 @@ namespace TreeLod
              "/sun/elevation", "rounds to the horizon"},
             {"\"frames\": 2", "\"frames\": 2, \"sun\": {\"direction\": [1e9, 1e-38, 0]}", "\"direction\"",
              "/sun/direction", "above the horizon"},
+            {"\"frames\": 2", "\"frames\": 2, \"sun\": {\"direction\": [0, 0, 0]}", "\"direction\"",
+             "/sun/direction", "zero vector"},
         };
         for (const Case& c : cases)
         {
@@ -605,6 +607,12 @@ namespace TreeLod
         ASSERT_TRUE(r.ok()) << r.error().message();
         EXPECT_NEAR(sceneLighting(*r).sunDirection.x, 0.0f, 1e-6f);
         EXPECT_NEAR(sceneLighting(*r).sunDirection.z, std::sqrt(3.0f) / 2.0f, 1e-6f);
+
+        // A direction too short for floats is normalised in doubles (FuzzSceneScript found NaN here).
+        r = parseSceneScript(replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"sun\": {\"direction\": [0, 1e-38, 0]}"),
+                             "test.json", ".");
+        ASSERT_TRUE(r.ok()) << r.error().message();
+        EXPECT_EQ(sceneLighting(*r).sunDirection, glm::vec3(0.0f, 1.0f, 0.0f));
     }
 
     namespace

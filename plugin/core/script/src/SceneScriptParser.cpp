@@ -635,8 +635,15 @@ namespace TreeLod
                 bad(child(pointer, az ? "azimuth" : "elevation"), "give direction or azimuth/elevation, not both");
             if (dir)
             {
-                // y > 0 after normalising: [1e9, 1e-38, 0] is above the horizon only in doubles
-                sun.direction = glm::normalize(vec3(*dir, child(pointer, "direction")));
+                // Normalised in doubles, then y > 0 in floats: [0, 1e-38, 0] has no length in
+                // floats (normalising there gives NaN), and [1e9, 1e-38, 0] is above the horizon
+                // only in doubles.
+                const std::vector<double> d = numbers(*dir, child(pointer, "direction"), 3, -1e9, 1e9);
+                const glm::dvec3 v(d[0], d[1], d[2]);
+                const double length = glm::length(v);
+                if (!(length > 0.0))
+                    bad(child(pointer, "direction"), "a zero vector has no direction");
+                sun.direction = glm::vec3(v / length);
                 if (!(sun.direction.y > 0.0f))
                     bad(child(pointer, "direction"), "the sun must be above the horizon (y > 0, towards the sun)");
             }
