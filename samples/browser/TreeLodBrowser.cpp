@@ -646,15 +646,25 @@ namespace TreeLod
         const auto start = std::chrono::steady_clock::now();
         // Every pass draws the same frames on any machine: each switch is drawn with the sample's
         // time stopped until the sample has settled (bakes and level builds on worker threads
-        // take as long as they take), then three frames of 0.2 s each, as a user who stops to
-        // look sees it (a split view computes its difference image after
+        // take as long as they take: no frame count limits the wait, so no load carries over
+        // into the next switch), then three frames of 0.2 s each, as a user who stops to look
+        // sees it (a split view computes its difference image after
         // SingleTreeView::RECOMPUTE_DELAY, 0.3 s, still).
+        constexpr double SETTLE_LIMIT_SECONDS = 600.0;
         unsigned passes = 0;
         auto settle = [&] {
             int frames = 0;
             mFixedFrameSeconds = 0.0;
-            for (; frames < 200 && mCurrent >= 0 && !mSamples[std::size_t(mCurrent)]->isSettled(); ++frames)
+            const auto switched = std::chrono::steady_clock::now();
+            for (; mCurrent >= 0 && !mSamples[std::size_t(mCurrent)]->isSettled(); ++frames)
+            {
+                if (secondsSince(switched) > SETTLE_LIMIT_SECONDS)
+                    OGRE_EXCEPT(Ogre::Exception::ERR_INVALID_STATE,
+                                "soak: '" + mSamples[std::size_t(mCurrent)]->getTitle() + "' did not settle in " +
+                                    std::to_string(int(SETTLE_LIMIT_SECONDS)) + " s",
+                                "TreeLodBrowser::soak");
                 mRoot->renderOneFrame();
+            }
             mFixedFrameSeconds = 0.2;
             for (int still = 0; still < 3; ++still, ++frames)
                 mRoot->renderOneFrame();
