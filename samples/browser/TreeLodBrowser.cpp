@@ -701,6 +701,13 @@ namespace TreeLod
         report.end = measureMemory();
         report.peakMiB = residentMemory().peakMiB;
         mFixedFrameSeconds.reset();
+        if (passes < SOAK_WARM_UP_PASSES)
+        {
+            std::fprintf(stderr, "soak: %u switches end within the warm-up (%u passes): growth is from the end\n",
+                         report.switches, SOAK_WARM_UP_PASSES);
+            report.warmUpSwitches = report.switches;
+            report.afterWarmUp = report.end;
+        }
         std::printf("soak: %u switches; after the warm-up (%u switches) %.1f MiB resident, %.1f MiB heap in use; "
                     "at the end %.1f MiB resident (%+.1f), %.1f MiB heap in use (%+.1f); peak %.1f MiB resident\n",
                     report.switches, report.warmUpSwitches, report.afterWarmUp.residentMiB,
