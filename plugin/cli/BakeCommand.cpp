@@ -1,4 +1,4 @@
-// treelod bake INPUT.glb -o OUT.treelod [--technique NAME]... [--leaf-material NAME]... [-q]
+// treelod bake INPUT.glb -o OUT.treelod [--technique NAME]... [--leaf-material NAME]... [--error-curves] [-q]
 // Imports the tree, bakes one chunk set per technique plus the "meta" chunk (source file
 // name, its sourceHashOf() as the bake cache records it, options) and writes the package atomically:
 // on any error nothing is written and the exit code is 2.
@@ -8,9 +8,15 @@
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/BakeCache.h"
 #include "TreeLod/BakeTechniques.h"
+#include "TreeLod/ErrorCurves.h"
 #include "TreeLod/GltfImporter.h"
 #include "TreeLod/Package.h"
 #include "TreeLod/PackageWriter.h"
+
+#ifdef TREELOD_WITH_OGRE
+#include "TreeLod/ErrorCurveMeasurer.h"
+#include "TreeLod/OffscreenRenderer.h"
+#endif
 
 #include <nlohmann/json.hpp>
 
@@ -31,6 +37,7 @@ namespace TreeLod
             std::vector<std::string> techniques;
             std::vector<std::string> leafMaterials;
             std::vector<std::string> options; ///< TECHNIQUE.NAME=VALUE
+            bool errorCurves = false;
             bool quiet = false;
         };
 
@@ -112,8 +119,28 @@ namespace TreeLod
             if (!added)
                 return printError(added.error());
 
+            std::vector<std::uint8_t> bytes = writer.toBytes();
+            if (args.errorCurves)
+            {
+#ifdef TREELOD_WITH_OGRE
+                try
+                {
+                    OffscreenRenderer renderer;
+                    Result<std::vector<std::uint8_t>> measured = addErrorCurves(renderer, bytes, args.output, {}, progress);
+                    if (!measured)
+                        return printError(measured.error());
+                    bytes = std::move(measured.value());
+                    meta.techniques.push_back(ERROR_CURVES_CHUNK);
+                }
+                catch (const Ogre::Exception& e)
+                {
+                    return printError(fail(args.output, "error curves", e.getDescription()));
+                }
+#else
+                return printError(fail("", "--error-curves", "this build has no Ogre plugin to draw the levels with"));
+#endif
+            }
             report(progress, "write", 0.0f);
-            const std::vector<std::uint8_t> bytes = writer.toBytes();
             Result<void> written = writeFileAtomic(args.output, bytes);
             if (!written)
                 return printError(written.error());
@@ -123,7 +150,7 @@ namespace TreeLod
             for (const std::string& t : meta.techniques)
                 list += (list.empty() ? "" : ", ") + t;
             std::printf("wrote %s: %zu chunks (%s + meta), %zu bytes; %zu leaves, %zu bark triangles\n",
-                        args.output.c_str(), writer.chunkCount(), list.c_str(), bytes.size(), model->leaves.size(),
+                        args.output.c_str(), writer.chunkCount() + (args.errorCurves ? 1 : 0), list.c_str(), bytes.size(), model->leaves.size(),
                         model->barkTriangleCount());
             return EXIT_OK;
         }
@@ -149,6 +176,9 @@ namespace TreeLod
                         "materials with this name are leaves (repeatable; default: alphaMode MASK/BLEND)")
             ->allow_extra_args(false);
         cmd->add_option("--option", args->options, optionHelp)->allow_extra_args(false);
+        cmd->add_flag("--error-curves", args->errorCurves,
+                      "also measure the error curves of every level (image error against screen height, drawn "
+                      "through Ogre against the CPU reference): what budgeted auto chooses levels by");
         cmd->add_flag("-q,--quiet", args->quiet, "no progress display");
         cmd->callback([args]() { setExitCode(runBake(*args)); });
     }

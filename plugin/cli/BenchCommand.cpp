@@ -16,8 +16,9 @@
 // §5, Fig. 13), for the reference too. A reference frame whose triangle count would exceed
 // --reference-budget is skipped and said so, never estimated. Writes DIR/frames.csv,
 // DIR/summary.json and the data of the plots as CSV (frame time along the path, the ellipsoids-and-lines paper Fig. 11;
-// the speed/accuracy trade over the LoD biases with the reference and the floors marked) with
-// DIR/plots.json; bench/plot.py draws them as PNG when python3 has matplotlib.
+// the speed/accuracy trade over the LoD biases with the reference and the floors marked, and its
+// Pareto front, also in summary.json and printed) with DIR/plots.json; bench/plot.py draws them as
+// PNG when python3 has matplotlib.
 #include "CliSupport.h"
 #include "Commands.h"
 
@@ -40,6 +41,7 @@
 #ifdef TREELOD_WITH_OGRE
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/CacheTreeBaker.h"
+#include "TreeLod/ErrorCurveMeasurer.h"
 #include "TreeLod/ForestScene.h"
 #include "TreeLod/Image.h"
 #include "TreeLod/OffscreenRenderer.h"
@@ -280,6 +282,63 @@ namespace TreeLod
             return {};
         }
 
+        /// A run's point in the trade plot: median frame ms over the frames every run of its tree
+        /// count timed (commonTimedFrames), mean FLIP on its sampled frames; NaN where not measured.
+        struct TradePoint
+        {
+            double medianFrameMs = NAN, meanFlip = NAN;
+            bool measured() const { return std::isfinite(medianFrameMs) && std::isfinite(meanFlip); }
+        };
+
+        /// The trade point of each run, in the order of `runs`.
+        std::vector<TradePoint> tradePoints(const std::vector<Run>& runs)
+        {
+            std::map<std::uint32_t, std::vector<bool>> common; // trees -> frames every run timed
+            std::vector<TradePoint> points;
+            for (const Run& run : runs)
+            {
+                auto it = common.find(run.count);
+                if (it == common.end())
+                    it = common.emplace(run.count, commonTimedFrames(runs, run.count)).first;
+                std::vector<double> ms, flips;
+                for (std::size_t f = 0; f < run.frames.size(); ++f)
+                {
+                    if (run.frames[f].timed && f < it->second.size() && it->second[f])
+                        ms.push_back(run.frames[f].timing.frameMilliseconds);
+                    flips.push_back(run.frames[f].flip);
+                }
+                points.push_back({statsOf(ms).median, statsOf(flips).mean});
+            }
+            return points;
+        }
+
+        /// The runs (indices) of the same tree count whose trade point dominates that of `runs[i]`:
+        /// at least as fast and as accurate, strictly better in one. None: on the Pareto front, if measured.
+        std::vector<std::size_t> dominatorsOf(std::size_t i, const std::vector<Run>& runs,
+                                              const std::vector<TradePoint>& points)
+        {
+            std::vector<std::size_t> out;
+            const TradePoint& p = points[i];
+            for (std::size_t j = 0; j < runs.size(); ++j)
+            {
+                const TradePoint& q = points[j];
+                if (runs[j].count == runs[i].count && p.measured() && q.measured() &&
+                    q.medianFrameMs <= p.medianFrameMs && q.meanFlip <= p.meanFlip &&
+                    (q.medianFrameMs < p.medianFrameMs || q.meanFlip < p.meanFlip))
+                    out.push_back(j);
+            }
+            return out;
+        }
+
+        /// "auto" and auto with an error budget ("auto@0.02").
+        bool isAutoRun(const std::string& technique) { return technique.rfind("auto", 0) == 0; }
+
+        /// A run as the Pareto line names it: "lodf", or "lodf@0.5" at a bias other than 1.
+        std::string runName(const Run& run)
+        {
+            return run.technique + (run.lodBias == 1.0f ? "" : "@" + number(run.lodBias, 3));
+        }
+
         bool writeOutputs(const BenchArgs& args, const SceneScript& script, std::uint32_t frames, int width, int height,
                           const std::vector<Run>& runs,
                           const std::map<std::uint32_t, std::map<std::uint32_t, ReferenceSample>>& references,
@@ -326,12 +385,88 @@ namespace TreeLod
                 framesPeakMiB = std::fmax(framesPeakMiB, run.peakRssMiB); // NaN: not measured
             const double benchPeakMiB = residentMemory().peakMiB;
             summary["peakRssMiB"] = {{"frameTimer", num(framesPeakMiB)}, {"bench", num(benchPeakMiB)}};
+            // The Pareto front of each tree count over the trade plot's points: the runs no other
+            // run dominates; for auto runs off it, the runs that dominate them.
+            const std::vector<TradePoint> points = tradePoints(runs);
+            std::vector<std::vector<std::size_t>> dominators;
+            for (std::size_t i = 0; i < runs.size(); ++i)
+                dominators.push_back(dominatorsOf(i, runs, points));
+            auto onFront = [&](std::size_t i) { return points[i].measured() && dominators[i].empty(); };
+            auto pointJson = [&](std::size_t i) {
+                return json{{"technique", runs[i].technique},
+                            {"lodBias", runs[i].lodBias},
+                            {"medianFrameMs", num(points[i].medianFrameMs)},
+                            {"meanFlip", num(points[i].meanFlip)}};
+            };
+            std::vector<std::uint32_t> counts;
+            for (const Run& run : runs)
+                if (std::find(counts.begin(), counts.end(), run.count) == counts.end())
+                    counts.push_back(run.count);
+            json pareto = json::array();
+            for (std::uint32_t count : counts)
+            {
+                std::vector<std::size_t> front, autoOff; // autoOff: measured auto runs off the front
+                bool anyAuto = false;
+                for (std::size_t i = 0; i < runs.size(); ++i)
+                {
+                    if (runs[i].count != count || !points[i].measured())
+                        continue;
+                    if (onFront(i))
+                        front.push_back(i);
+                    if (isAutoRun(runs[i].technique))
+                    {
+                        anyAuto = true;
+                        if (!onFront(i))
+                            autoOff.push_back(i);
+                    }
+                }
+                const bool autoFront = std::any_of(front.begin(), front.end(),
+                                                   [&](std::size_t i) { return isAutoRun(runs[i].technique); });
+                std::stable_sort(front.begin(), front.end(), [&](std::size_t a, std::size_t b) {
+                    return points[a].medianFrameMs < points[b].medianFrameMs;
+                });
+                json frontJson = json::array(), dominatedBy = json::array();
+                std::string line;
+                for (std::size_t i : front)
+                {
+                    frontJson.push_back(pointJson(i));
+                    char text[96];
+                    std::snprintf(text, sizeof text, " %.3g ms %.3g", points[i].medianFrameMs, points[i].meanFlip);
+                    line += (line.empty() ? "" : ", ") + runName(runs[i]) + text;
+                }
+                if (front.empty())
+                    line = "no run has both a frame time and a FLIP";
+                if (autoFront)
+                    line += "; auto on the front";
+                for (std::size_t i : autoOff)
+                {
+                    json entry = pointJson(i);
+                    entry["by"] = json::array();
+                    std::string by;
+                    for (std::size_t j : dominators[i])
+                    {
+                        entry["by"].push_back(pointJson(j));
+                        by += (by.empty() ? "" : ", ") + runName(runs[j]);
+                    }
+                    dominatedBy.push_back(entry);
+                    if (!autoFront)
+                        line += "; " + runName(runs[i]) + " is dominated by " + by;
+                }
+                pareto.push_back({{"trees", count},
+                                  {"front", frontJson},
+                                  {"autoOnFront", anyAuto ? json(autoFront) : json(nullptr)},
+                                  {"dominatedBy", dominatedBy}});
+                if (!args.quiet)
+                    std::printf("Pareto front (%s): %s\n", treesText(count).c_str(), line.c_str());
+            }
+            summary["pareto"] = pareto;
             if (!args.quiet)
                 std::printf("peak resident memory: frame timer %.0f MiB, bench %.0f MiB\n", framesPeakMiB,
                             benchPeakMiB);
             json results = json::array();
-            for (const Run& run : runs)
+            for (std::size_t i = 0; i < runs.size(); ++i)
             {
+                const Run& run = runs[i];
                 const Run* reference = nullptr;
                 for (const Run& other : runs)
                     if (other.count == run.count && other.technique == REFERENCE_TECHNIQUE)
@@ -395,6 +530,9 @@ namespace TreeLod
                                    {"referenceTemporalNoise", num(statsOf(refNoise).mean)},
                                    {"assetBytes", run.assetBytes},
                                    {"bakeSeconds", run.bakeSeconds},
+                                   {"trade", {{"medianFrameMs", num(points[i].medianFrameMs)},
+                                              {"meanFlip", num(points[i].meanFlip)}}},
+                                   {"onParetoFront", points[i].measured() ? json(onFront(i)) : json(nullptr)},
                                    {"skipped", skipped}});
             }
             summary["results"] = results;
@@ -412,49 +550,36 @@ namespace TreeLod
                 plots.push_back(std::move(spec));
                 return writeText(args.output + "/" + name + ".csv", csvText);
             };
-            std::vector<std::uint32_t> counts;
-            for (const Run& run : runs)
-                if (std::find(counts.begin(), counts.end(), run.count) == counts.end())
-                    counts.push_back(run.count);
             for (std::uint32_t count : counts)
             {
                 const std::string suffix = counts.size() > 1 ? "-" + std::to_string(count) : "";
-                const std::vector<bool> common = commonTimedFrames(runs, count);
                 // frame-time: per run at bias 1 (and the comparisons), frame ms along the path; empty
                 // where the frame was not timed (a gap in the line).
                 std::string timeCsv = "series,label,time_s,frame_ms\n";
                 // trade: one curve per technique over the biases; the comparisons are single points
-                // drawn with their `marker` (ComparisonRun::marker).
-                std::string tradeCsv = "series,label,lod_bias,median_frame_ms,mean_flip,marker\n";
+                // drawn with their `marker` (ComparisonRun::marker). on_front: 1 for the runs on the
+                // Pareto front.
+                std::string tradeCsv = "series,label,lod_bias,median_frame_ms,mean_flip,marker,on_front\n";
                 std::vector<std::string> curveRows;
-                for (const Run& run : runs)
+                for (std::size_t i = 0; i < runs.size(); ++i)
                 {
+                    const Run& run = runs[i];
                     if (run.count != count)
                         continue;
-                    const double median = statsOf([&] {
-                        std::vector<double> v;
-                        for (std::size_t f = 0; f < run.frames.size(); ++f)
-                            if (run.frames[f].timed && f < common.size() && common[f])
-                                v.push_back(run.frames[f].timing.frameMilliseconds);
-                        return v;
-                    }()).median;
-                    std::vector<double> flips;
-                    for (const FrameRecord& r : run.frames)
-                        flips.push_back(r.flip);
-                    const double meanFlip = statsOf(flips).mean;
+                    const std::string point = number(run.lodBias, 3) + "," + number(points[i].medianFrameMs, 6) + "," +
+                                              number(points[i].meanFlip, 6) + ",";
+                    const std::string front = onFront(i) ? ",1\n" : ",0\n";
                     if (isComparisonRun(run.technique))
                     {
                         for (const ComparisonRun& c : comparisonRuns())
                             if (c.technique == run.technique)
-                                tradeCsv += csvField(run.technique) + "," + csvField(c.label) + "," +
-                                            number(run.lodBias, 3) + "," + number(median, 6) + "," +
-                                            number(meanFlip, 6) + "," + std::string(1, c.marker) + "\n";
+                                tradeCsv += csvField(run.technique) + "," + csvField(c.label) + "," + point +
+                                            std::string(1, c.marker) + front;
                     }
                     else
                         curveRows.push_back(csvField(run.technique) + "," +
                                             csvField(run.technique + " (LoD bias " + args.lodBiases + ")") + "," +
-                                            number(run.lodBias, 3) + "," + number(median, 6) + "," +
-                                            number(meanFlip, 6) + ",\n");
+                                            point + front);
                     if (run.lodBias == 1.0f || isComparisonRun(run.technique))
                     {
                         std::string label = run.technique;
@@ -670,6 +795,33 @@ namespace TreeLod
             return runs;
         }
 
+        /// The error curves of every package that the budgeted auto choices draw, measured here (an
+        /// OffscreenRenderer of this process) where a package lacks them: treelod_frames links no baker.
+        Result<void> bakeErrorCurves(const SceneScript& script, const std::vector<std::string>& autoChoices,
+                                     const CacheTreeBaker& baker, const ProgressCallback& progress)
+        {
+            if (autoChoices.empty())
+                return {};
+            std::unique_ptr<OffscreenRenderer> renderer;
+            for (const auto& [source, techniques] : scenePackages(script, autoChoices))
+                for (const BakeCacheEntry& entry : baker.getEntries())
+                    if (entry.source == source)
+                    {
+                        if (!renderer)
+                            renderer = std::make_unique<OffscreenRenderer>();
+                        const auto start = std::chrono::steady_clock::now();
+                        Result<bool> measured = ensureErrorCurves(*renderer, entry.path, {}, progress);
+                        if (!measured)
+                            return measured.error();
+                        if (*measured)
+                            report(progress, "error curves of " + entry.name + ": " +
+                                                 number(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1) + " s",
+                                   1.0f);
+                        break;
+                    }
+            return {};
+        }
+
         int runBench(const BenchArgs& args)
         {
             Result<SceneScript> loaded = loadSceneScript(args.scene, readGreyImage);
@@ -688,12 +840,17 @@ namespace TreeLod
                 return printError(biases.error());
             // Every run draws from these: the reference, the floors, then the techniques.
             std::vector<std::string> drawn = {REFERENCE_TECHNIQUE, FLOOR_TECHNIQUE};
+            std::vector<std::string> autoChoices; // budgeted auto needs the error curves of what it draws
             for (const std::string& t : splitList(args.techniques))
             {
-                if (t != "auto" && bakeTechniqueOf(t).empty())
-                    return printError(fail("", "--techniques",
-                                           "unknown technique '" + t + "' (known: auto, " + knownSceneTechniques() + ")"));
+                float budget = 0.0f;
+                const bool isAuto = parseAutoTechnique(t, budget);
+                if (!isAuto && bakeTechniqueOf(t).empty())
+                    return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: auto, auto@E, " +
+                                                                   knownSceneTechniques() + ")"));
                 drawn.push_back(t == "auto" ? "" : t);
+                if (isAuto)
+                    autoChoices.push_back(drawn.back());
             }
             if (args.samples == 0 || frames == 0)
                 return printError(fail("", "--frames/--samples", "must be >= 1"));
@@ -722,6 +879,8 @@ namespace TreeLod
             {
                 return printError(fail(args.scene, "species", e.getDescription()));
             }
+            if (Result<void> curves = bakeErrorCurves(script, autoChoices, baker, progress); !curves)
+                return printError(curves.error());
             const std::string packageList = args.output + "/packages.json";
             if (Result<void> w = baker.writePackageList(packageList); !w)
                 return printError(w.error());

@@ -12,4 +12,5 @@ namespace TreeLod
     void addBakeCommand(CLI::App& app);
     void addRenderCommand(CLI::App& app);
     void addBenchCommand(CLI::App& app);
+    void addCalibrateCommand(CLI::App& app);
 }

@@ -21,7 +21,9 @@
 #include "CliSupport.h"
 
 #include "TreeLod/AtomicFile.h"
+#include "TreeLod/ErrorCurves.h"
 #include "TreeLod/ForestScene.h"
+#include "TreeLod/LevelCalibration.h"
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/PackageListBaker.h"
 #include "TreeLod/ProcessMemory.h"
@@ -63,6 +65,7 @@ namespace TreeLod
             double shadowLodBias = 0.0;   // 0: the script's
             bool preload = false;         // every Forest level built before the frames (no uploads timed)
             bool skipComparisons = false; // only the techniques: no reference, no floors (memory of one scene)
+            std::string calibration;      // "" = userCacheDirectory(): where cost calibrations are kept
             bool quiet = false;
         };
 
@@ -136,8 +139,9 @@ namespace TreeLod
             std::vector<std::string> techniques;
             for (const std::string& t : splitList(args.techniques))
             {
-                if (t != "auto" && bakeTechniqueOf(t).empty())
-                    return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: " +
+                float budget = 0.0f;
+                if (!parseAutoTechnique(t, budget) && bakeTechniqueOf(t).empty())
+                    return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: auto, auto@E, " +
                                                                    knownSceneTechniques() + ")"));
                 if (args.skipComparisons || (t != REFERENCE_TECHNIQUE && t != FLOOR_TECHNIQUE && !isQuadFloor(t)))
                     techniques.push_back(t); // otherwise run once below, with the comparisons
@@ -189,6 +193,34 @@ namespace TreeLod
                 OffscreenRenderer::savePng(image, args.output + "/images/" + stem + ".png");
             };
 
+            // Budgeted auto needs this machine's cost of every level: calibrated once per package and
+            // renderer (cached), before any scene exists, since calibrating draws alone.
+            std::map<std::string, std::vector<LevelCost>> levelCosts; // by assetCostKey
+            std::vector<std::string> autoChoices; // as ForestSceneOptions::technique
+            for (const std::string& t : techniques)
+            {
+                float budget = 0.0f;
+                if (parseAutoTechnique(t, budget))
+                    autoChoices.push_back(t == "auto" ? "" : t);
+            }
+            if (!autoChoices.empty())
+                for (const auto& [source, bake] : scenePackages(script, autoChoices))
+                {
+                    TreeAssetPtr asset = TreeAssetManager::getSingleton().require(source, bake, "TreeLod");
+                    if (!asset->hasChunk(ERROR_CURVES_CHUNK))
+                        continue; // auto draws the fixed bands (ForestScene logs why)
+                    bool calibrated = false;
+                    Result<std::vector<LevelCost>> costs = requireLevelCosts(
+                        renderer, *asset, args.calibration.empty() ? userCacheDirectory() : args.calibration, {},
+                        progress, &calibrated);
+                    if (!costs)
+                        return printError(costs.error());
+                    if (calibrated && !args.quiet)
+                        std::fprintf(stderr, "calibrated %zu levels of %s on %s\n", costs->size(), source.c_str(),
+                                     rendererString(renderer.getRoot()).c_str());
+                    levelCosts[assetCostKey(asset->getPackage())] = std::move(costs.value());
+                }
+
             using nlohmann::json;
             json runsJson = json::array();
             // Rewritten whole after every run ("complete": false until the last): a run cut short
@@ -212,6 +244,13 @@ namespace TreeLod
             for (std::uint32_t count : counts)
             {
                 ForestSceneOptions options;
+                options.levelCosts = [&](TreeAsset& asset) {
+                    const auto found = levelCosts.find(assetCostKey(asset.getPackage()));
+                    if (found == levelCosts.end())
+                        OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND, "no calibrated costs for " + asset.getName(),
+                                    "treelod_frames");
+                    return found->second;
+                };
                 options.placement.totalCount = count;
                 options.placement.scale = args.scale;
                 options.uploadBudget = args.uploadBudget;
@@ -326,6 +365,7 @@ namespace TreeLod
                         progress(label, 1.0f);
                         const auto [rss, peak] = residentMemory();
                         run["frames"] = std::move(frameRows);
+                        run["levelNotes"] = scene->getLevelNotes();
                         run["gpuBytes"] = scene->getGpuBytes();
                         run["instanceBytes"] = scene->getForest().getInstances().getMemoryBytes();
                         run["rssMiB"] = rss;
@@ -380,6 +420,8 @@ int main(int argc, char** argv)
                  "build every Forest level before the frames (Forest::makeAllResident: nothing uploaded while timing)");
     app.add_flag("--skip-comparisons", args.skipComparisons,
                  "run only --techniques: no reference, no floors (e.g. to read one scene's resident memory)");
+    app.add_option("--calibration", args.calibration,
+                   "folder of the cost calibrations budgeted auto reads and writes (default: the user's cache)");
     app.add_flag("-q,--quiet", args.quiet, "no progress");
     try
     {

@@ -12,6 +12,7 @@ int main(int argc, char** argv)
     TreeLod::addBakeCommand(app);
     TreeLod::addRenderCommand(app);
     TreeLod::addBenchCommand(app);
+    TreeLod::addCalibrateCommand(app);
     TreeLod::addCompareCommand(app);
     try
     {

@@ -2,6 +2,8 @@
 // (ForestInstances::cull) and drawn with hardware instancing. See Forest.h.
 #include "TreeLod/Forest.h"
 
+#include "TreeLod/ErrorCurves.h"
+#include "TreeLod/LevelSelection.h"
 #include "TreeLod/ObjectParams.h"
 
 #include "TreeLod/TechniqueRegistry.h"
@@ -82,6 +84,20 @@ namespace TreeLod
         }
 
         using Span = ForestLevelSpan;
+
+        /// The LoD value (reference-sphere units) of `asset` drawn `heightPixels` tall: a tree h
+        /// metres tall drawn h_px pixels tall has r_px = h_px * R / h, value = 4 pi r_px^2.
+        Ogre::Real pixelCountForHeight(TreeAsset& asset, Ogre::Real heightPixels, const Ogre::String& label,
+                                       const char* source)
+        {
+            const Ogre::AxisAlignedBox bounds = asset.getBounds();
+            const Ogre::Real height = bounds.getMaximum().y - bounds.getMinimum().y;
+            const Ogre::Real radius = referenceRadius(asset);
+            if (!(height > 0.0f) || !(radius > 0.0f))
+                invalid(label + "the tree has no height: no screen size to choose levels by", source);
+            const double rPx = double(heightPixels) * double(radius) / double(height);
+            return Ogre::Real(std::min(4.0 * Ogre::Math::PI * rPx * rPx, double(FLT_MAX)));
+        }
 
         /// Every level of `technique` over all LoD values, near to far (reference-sphere units).
         std::vector<Span> techniqueSpans(TreeAsset& asset, ForestLevelProvider& technique, const Ogre::String& name)
@@ -313,22 +329,90 @@ namespace TreeLod
         return {ForestBand{"lodf", 160.0f}, ForestBand{"billboard-cloud", 24.0f}, ForestBand{FLOOR_TECHNIQUE, 0.0f}};
     }
 
+    std::vector<ForestLevel> Forest::getCandidateLevels(TreeAsset& asset, const std::vector<Ogre::String>& techniques)
+    {
+        std::vector<ForestLevel> levels;
+        for (const TechniqueInfo& info : TechniqueRegistry::getSingleton().getTechniques())
+        {
+            if (!info.forestLevels || !asset.hasChunk(info.chunkTechnique) ||
+                (!techniques.empty() && std::find(techniques.begin(), techniques.end(), info.name) == techniques.end()))
+                continue;
+            for (const Span& span : info.forestLevels->getSpans(asset, info.name))
+            {
+                ForestLevel level = span.level;
+                level.minPixelCount = 0.0f;
+                const bool seen = std::any_of(levels.begin(), levels.end(), [&](const ForestLevel& l) {
+                    return l.technique == level.technique && l.techniqueLevel == level.techniqueLevel &&
+                           l.lowRes == level.lowRes;
+                });
+                if (!seen)
+                    levels.push_back(level);
+            }
+        }
+        return levels;
+    }
+
+    Ogre::String Forest::describeLevel(const ForestLevel& level)
+    {
+        const TechniqueInfo* info = TechniqueRegistry::getSingleton().find(level.technique);
+        return info && info->forestLevels ? info->forestLevels->describeLevel(level) : level.technique;
+    }
+
+    Ogre::Real Forest::heightForPixelCount(TreeAsset& asset, Ogre::Real pixelCount)
+    {
+        const Ogre::Real perPixel = pixelCountForHeight(asset, 1.0f, "asset '" + asset.getName() + "': ",
+                                                        "Forest::heightForPixelCount");
+        return std::sqrt(std::max(pixelCount, 0.0f) / perPixel);
+    }
+
+    std::vector<Ogre::String> Forest::getAutoTechniques()
+    {
+        return {REFERENCE_TECHNIQUE, "lodf", "billboard-cloud", "classic-billboard-cloud", FLOOR_TECHNIQUE};
+    }
+
+    std::vector<ForestLevel> Forest::levelsForErrorBudget(TreeAsset& asset, const std::vector<LevelCost>& costs,
+                                                          float errorBudget)
+    {
+        const char* source = "Forest::levelsForErrorBudget";
+        const Ogre::String label = "asset '" + asset.getName() + "': ";
+        if (!asset.hasChunk(ERROR_CURVES_CHUNK))
+            invalid(label + "no error curves (bake them: treelod bake, or the bench's cache)", source);
+        Result<ErrorCurves> curves = decodeErrorCurves(asset.readChunk(ERROR_CURVES_CHUNK), asset.getName());
+        if (!curves)
+            invalid(curves.error().message(), source);
+        // Only the auto techniques' levels that this asset has: the others' curves are dropped.
+        const std::vector<Ogre::String> autoTechniques = getAutoTechniques();
+        std::vector<ErrorCurveLevel> kept;
+        for (ErrorCurveLevel& level : curves->levels)
+            if (std::find(autoTechniques.begin(), autoTechniques.end(), level.technique) != autoTechniques.end())
+                kept.push_back(std::move(level));
+        curves->levels = std::move(kept);
+        Result<std::vector<LevelChoice>> choices = chooseLevels(*curves, costs, errorBudget, MAX_LEVELS);
+        if (!choices)
+            invalid(label + choices.error().message(), source);
+        std::vector<ForestLevel> levels;
+        for (const LevelChoice& choice : *choices)
+        {
+            const ErrorCurveLevel& c = curves->levels[choice.curveLevel];
+            ForestLevel level;
+            level.technique = c.technique;
+            level.techniqueLevel = c.techniqueLevel;
+            level.lowRes = c.lowRes;
+            level.minPixelCount = choice.minHeightPx > 0.0f ? pixelCountForHeight(asset, choice.minHeightPx, label, source)
+                                                            : 0.0f;
+            levels.push_back(level);
+        }
+        return levels;
+    }
+
     std::vector<ForestLevel> Forest::levelsForBands(TreeAsset& asset, const std::vector<ForestBand>& bands)
     {
         const char* source = "Forest::levelsForBands";
         const Ogre::String label = "asset '" + asset.getName() + "': ";
         if (bands.empty())
             invalid(label + "no technique bands", source);
-        const Ogre::AxisAlignedBox bounds = asset.getBounds();
-        const Ogre::Real height = bounds.getMaximum().y - bounds.getMinimum().y;
-        const Ogre::Real radius = referenceRadius(asset);
-        if (!(height > 0.0f) || !(radius > 0.0f))
-            invalid(label + "the tree has no height: no screen size to choose levels by", source);
-        // A tree h metres tall drawn h_px pixels tall: r_px = h_px * R / h, value = 4 pi r_px^2.
-        auto pixelCount = [&](Ogre::Real heightPixels) {
-            const double rPx = double(heightPixels) * double(radius) / double(height);
-            return Ogre::Real(std::min(4.0 * Ogre::Math::PI * rPx * rPx, double(FLT_MAX)));
-        };
+        pixelCountForHeight(asset, 1.0f, label, source); // a tree without height has no screen size: refused here
+        auto pixelCount = [&](Ogre::Real heightPixels) { return pixelCountForHeight(asset, heightPixels, label, source); };
 
         std::vector<ForestLevel> levels;
         Ogre::Real upper = NO_UPPER;

@@ -1,13 +1,16 @@
 #include "TreeLod/ForestScene.h"
 
+#include "TreeLod/ErrorCurves.h"
 #include "TreeLod/ImpostorData.h"
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 
+#include <OgreLogManager.h>
 #include <OgreManualObject.h>
 #include <OgreMaterialManager.h>
 #include <OgreSceneNode.h>
+#include <OgreStringConverter.h>
 #include <OgreTechnique.h>
 
 #include <glm/gtc/constants.hpp>
@@ -15,6 +18,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -35,10 +40,17 @@ namespace TreeLod
                                              const std::string& technique, std::set<std::string>& bake)
         {
             std::vector<ForestBand> bands;
+            float budget = 0.0f;
+            if (parseAutoTechnique(technique, budget) || (technique.empty() && species.autoTechnique))
+            {
+                // Budgeted auto chooses among these; the fixed bands draw from a subset of them.
+                bake.insert(REFERENCE_CHUNK);
+                for (const Ogre::String& name : Forest::getAutoTechniques())
+                    bake.insert(bakeTechniqueOf(name));
+                return Forest::getAutoBands();
+            }
             if (!technique.empty())
                 bands = {ForestBand{technique, 0.0f}};
-            else if (species.autoTechnique)
-                bands = Forest::getAutoBands();
             else
                 for (const TechniqueBand& band : species.bands)
                     bands.push_back(ForestBand{band.technique, band.minPixels});
@@ -79,6 +91,24 @@ namespace TreeLod
             return IMPOSTOR_CHUNK;
         const TechniqueInfo* info = TechniqueRegistry::getSingleton().find(technique);
         return info && info->forestLevels ? info->chunkTechnique : "";
+    }
+
+    bool parseAutoTechnique(const std::string& technique, float& budget)
+    {
+        if (technique == "auto")
+        {
+            budget = std::numeric_limits<float>::quiet_NaN();
+            return true;
+        }
+        if (technique.rfind("auto@", 0) != 0)
+            return false;
+        const std::string number = technique.substr(5);
+        char* end = nullptr;
+        const double value = std::strtod(number.c_str(), &end);
+        if (number.empty() || *end != '\0' || !(value >= 0.0 && value <= 1.0))
+            return false;
+        budget = float(value);
+        return true;
     }
 
     bool isQuadFloor(const std::string& technique)
@@ -242,6 +272,7 @@ namespace TreeLod
         }
 
         mAssets.clear();
+        mLevelNotes.clear();
         for (std::size_t s = 0; s < mScript.species.size(); ++s)
         {
             const SceneSpecies& species = mScript.species[s];
@@ -263,7 +294,33 @@ namespace TreeLod
                 continue; // drawn by the floor below, not the Forest
             try
             {
-                mForest->addSpecies(asset, Forest::levelsForBands(*asset, bands[s]));
+                float budget = 0.0f;
+                const bool budgeted = parseAutoTechnique(mTechnique, budget) || (mTechnique.empty() && species.autoTechnique);
+                if (std::isnan(budget))
+                    budget = mScript.lod.maxError;
+                std::vector<ForestLevel> levels;
+                std::string note;
+                if (budgeted && mOptions.levelCosts && asset->hasChunk(ERROR_CURVES_CHUNK))
+                {
+                    levels = Forest::levelsForErrorBudget(*asset, mOptions.levelCosts(*asset), budget);
+                    note = "budget " + Ogre::StringConverter::toString(budget) + ":";
+                    for (std::size_t l = 0; l < levels.size(); ++l)
+                        note += (l ? ", " : " ") + Forest::describeLevel(levels[l]) + " >= " +
+                                Ogre::StringConverter::toString(int(std::round(Forest::heightForPixelCount(*asset, levels[l].minPixelCount)))) + " px";
+                }
+                else
+                {
+                    levels = Forest::levelsForBands(*asset, bands[s]);
+                    if (budgeted)
+                        note = std::string("fixed auto bands: ") +
+                               (asset->hasChunk(ERROR_CURVES_CHUNK) ? "no level costs given" : "the package has no error curves");
+                }
+                if (!note.empty())
+                {
+                    Ogre::LogManager::getSingleton().logMessage("TreeLod: species '" + species.name + "': " + note);
+                    mLevelNotes.push_back(species.name + ": " + note);
+                }
+                mForest->addSpecies(asset, levels);
             }
             catch (const Ogre::Exception& e)
             {

@@ -297,18 +297,7 @@ namespace TreeLod
         return import(path);
     }
 
-    std::string defaultBakeCacheDirectory()
-    {
-        const char* xdg = std::getenv("XDG_CACHE_HOME");
-        if (xdg && std::filesystem::path(xdg).is_absolute())
-            return (std::filesystem::path(xdg) / "treelod").string();
-        const char* home = std::getenv("HOME");
-        if (home && *home)
-            return (std::filesystem::path(home) / ".cache" / "treelod").string();
-        std::error_code ec;
-        const std::filesystem::path temp = std::filesystem::temp_directory_path(ec);
-        return ((ec ? std::filesystem::path("/tmp") : temp) / "treelod-cache").string();
-    }
+    std::string defaultBakeCacheDirectory() { return userCacheDirectory(); }
 
     BakeCache::BakeCache(std::string directory) : mDirectory(std::move(directory)) {}
 

@@ -296,17 +296,6 @@ namespace TreeLod
 
     // ---- meta and bake --------------------------------------------------------------------
 
-    std::uint64_t fnv1a64(const void* data, std::size_t size)
-    {
-        const auto* p = static_cast<const std::uint8_t*>(data);
-        std::uint64_t h = 0xcbf29ce484222325ull;
-        for (std::size_t i = 0; i < size; ++i)
-        {
-            h ^= p[i];
-            h *= 0x100000001b3ull;
-        }
-        return h;
-    }
 
     std::string PackageMeta::toJson() const
     {

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -138,5 +139,18 @@ namespace TreeLod
         if (in.bad())
             return fail(path, "", "read error");
         return bytes;
+    }
+
+    std::string userCacheDirectory()
+    {
+        const char* xdg = std::getenv("XDG_CACHE_HOME");
+        if (xdg && std::filesystem::path(xdg).is_absolute())
+            return (std::filesystem::path(xdg) / "treelod").string();
+        const char* home = std::getenv("HOME");
+        if (home && *home)
+            return (std::filesystem::path(home) / ".cache" / "treelod").string();
+        std::error_code ec;
+        const std::filesystem::path temp = std::filesystem::temp_directory_path(ec);
+        return ((ec ? std::filesystem::path("/tmp") : temp) / "treelod-cache").string();
     }
 }

@@ -1,5 +1,6 @@
 #include "TreeLod/TechniqueDescriptor.h"
 
+#include "TreeLod/ErrorCurves.h"
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
 
@@ -50,7 +51,10 @@ namespace TreeLod
         {
             static std::vector<TechniqueDescriptor> descriptors = {
                 {REFERENCE_CHUNK, "the polygonal tree with GPU-ready mip-mapped textures",
-                 REFERENCE_CHUNK_FORMAT_VERSION, &inspectReference, &fuzzReference}};
+                 REFERENCE_CHUNK_FORMAT_VERSION, &inspectReference, &fuzzReference},
+                // Here, not by a TechniqueRegistration: nothing else may pull ErrorCurves.o out
+                // of the static library, and the Ogre side writes the chunk, no baker.
+                errorCurvesDescriptor()};
             return descriptors;
         }
     }

@@ -738,7 +738,7 @@ namespace TreeLod
 
         SceneScript readScript(const Json& root, const std::string& baseDir, const GreyImageReader& readImage)
         {
-            allowKeys(root, "", {"name", "description", "ground", "species", "placements", "sun", "shadows",
+            allowKeys(root, "", {"name", "description", "ground", "species", "placements", "sun", "shadows", "lod",
                                  "camera", "resolution", "frames", "counts"});
             SceneScript s;
             s.name = text(need(root, "", "name"), "/name");
@@ -786,6 +786,12 @@ namespace TreeLod
                 s.sun = readSun(*v, "/sun");
             if (const Json* v = find(root, "shadows"))
                 s.shadows = readShadows(*v, "/shadows");
+            if (const Json* v = find(root, "lod"))
+            {
+                allowKeys(*v, "/lod", {"maxError"});
+                if (const Json* e = find(*v, "maxError"))
+                    s.lod.maxError = float(number(*e, "/lod/maxError", 0.0, 1.0));
+            }
             s.camera = readCamera(need(root, "", "camera"), "/camera");
 
             const Json& resolution = need(root, "", "resolution");

@@ -65,6 +65,7 @@
 
 #include "TreeLod/ForestInstances.h"
 #include "TreeLod/ForestLevelProvider.h"
+#include "TreeLod/LevelCosts.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreCamera.h>
@@ -116,6 +117,31 @@ namespace TreeLod
         /// Ogre::InvalidParametersException naming the band and technique when a technique is
         /// unknown or the asset lacks its chunk.
         static std::vector<ForestLevel> levelsForBands(TreeAsset& asset, const std::vector<ForestBand>& bands);
+
+        /// Every level `asset` can be drawn at, for measuring (error curves, calibration): each
+        /// registered technique that can be a Forest level and whose chunk the asset holds (of
+        /// `techniques` only, when not empty), with all its levels (ForestLevelProvider::getSpans) in
+        /// its own order, each once, minPixelCount 0.
+        static std::vector<ForestLevel> getCandidateLevels(TreeAsset& asset,
+                                                           const std::vector<Ogre::String>& techniques = {});
+
+        /// A few words naming `level` (its technique's ForestLevelProvider::describeLevel).
+        static Ogre::String describeLevel(const ForestLevel& level);
+        /// The height on screen (pixels) of `asset` at LoD value `pixelCount` (reference-sphere
+        /// units, as ForestLevel::minPixelCount): the inverse of the bands' conversion.
+        static Ogre::Real heightForPixelCount(TreeAsset& asset, Ogre::Real pixelCount);
+
+        /// The techniques budgeted auto chooses among: the reference, lodf, both billboard clouds
+        /// and the impostor.
+        static std::vector<Ogre::String> getAutoTechniques();
+
+        /// Budgeted auto (docs/forest.md, "Budgeted levels"): the levels chooseLevels
+        /// (LevelSelection.h) gives for `asset` from its error-curves chunk and `costs` (this
+        /// machine's, LevelCalibration.h) within `errorBudget`, among getAutoTechniques' levels.
+        /// Throws Ogre::InvalidParametersException naming the asset when it has no error curves,
+        /// the budget is not in [0, 1] or no level has a cost.
+        static std::vector<ForestLevel> levelsForErrorBudget(TreeAsset& asset, const std::vector<LevelCost>& costs,
+                                                             float errorBudget);
 
         /// Add a species; returns its index (= ForestInstances kind). Levels near to far (at most
         /// ForestInstances::MAX_THRESHOLDS + 1), strictly decreasing minPixelCount, the last 0;

@@ -8,9 +8,12 @@
 // (CacheTreeBaker.h, TreeLodSceneBake) bakes them, PackageListBaker (PackageListBaker.h) looks
 // them up in the list a bake wrote.
 //
-// Technique choice: the script's ("auto" = Forest::getAutoBands(); distance bands become
-// screen-height bands for the script's camera: h_px = height * resolutionY / (2 d tan(fovY/2))),
-// or one technique for every species and distance (`treelod bench --techniques`, the browser).
+// Technique choice: the script's, or one technique for every species and distance (`treelod
+// bench --techniques`, the browser). "auto" is budgeted (Forest::levelsForErrorBudget: the
+// script's "lod" maxError, or E for the choice "auto@E") where the package has error curves and
+// ForestSceneOptions::levelCosts gives this machine's costs; otherwise, and logged, the fixed bands
+// of Forest::getAutoBands(). Distance bands become screen-height bands for the script's camera:
+// h_px = height * resolutionY / (2 d tan(fovY/2)).
 #pragma once
 
 #include "TreeLod/Forest.h"
@@ -23,6 +26,7 @@
 #include <OgreManualObject.h>
 #include <OgreSceneManager.h>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -41,6 +45,10 @@ namespace TreeLod
     /// tree), "merged-quads" (every tree's quad in a few static batches) and "billboard-set" (a
     /// plain Ogre BillboardSet per species, unlit).
     bool isQuadFloor(const std::string& technique);
+
+    /// Whether `technique` is budgeted auto: "auto" (`budget` = NaN: the script's) or "auto@E" with E
+    /// in [0, 1] (`budget` = E). False for anything else, "auto@" with a bad number included.
+    bool parseAutoTechnique(const std::string& technique, float& budget);
 
     /// The techniques bakeTechniqueOf knows, for messages: "mesh, lodf, billboard-cloud, ...".
     std::string knownSceneTechniques();
@@ -64,6 +72,9 @@ namespace TreeLod
         /// first frame needs is built in it).
         std::uint64_t uploadBudget = 0;
         Ogre::String group = "TreeLod"; ///< resource group for assets, meshes and materials
+        /// This machine's costs of an asset's levels (LevelCalibration.h), for budgeted auto; may
+        /// throw Ogre::Exception. Null: auto draws the fixed bands.
+        std::function<std::vector<LevelCost>(TreeAsset& asset)> levelCosts;
     };
 
     class ForestScene
@@ -106,6 +117,10 @@ namespace TreeLod
         /// The camera at frame `frame` of `frameCount` (0 = the script's frame count).
         CameraSpec cameraAtFrame(std::uint32_t frame, std::uint32_t frameCount = 0) const;
 
+        /// Per species, how its levels were chosen: "budget 0.02: lodf 0 >= 301 px, ..." or why the
+        /// fixed auto bands were used.
+        const std::vector<std::string>& getLevelNotes() const { return mLevelNotes; }
+
         /// GPU bytes of the drawables in use (Forest::getGpuBytes).
         std::uint64_t getGpuBytes() const;
 
@@ -125,6 +140,7 @@ namespace TreeLod
         std::vector<std::shared_ptr<TreeAssetRequest>> mPendingBakes;
         std::vector<PlacedTree> mPlacements;
         std::vector<TreeAssetPtr> mAssets;
+        std::vector<std::string> mLevelNotes;
         Forest* mForest = nullptr;
         std::unique_ptr<EntityFloor> mEntityFloor;
         std::unique_ptr<MergedQuadFloor> mMergedQuadFloor;

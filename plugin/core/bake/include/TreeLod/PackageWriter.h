@@ -2,6 +2,7 @@
 // block compression, and the reference bake: TreeModel -> "reference" + "meta" chunks -> file.
 #pragma once
 
+#include "TreeLod/Crc32.h" // fnv1a64
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/Progress.h"
 #include "TreeLod/Result.h"
@@ -85,8 +86,6 @@ namespace TreeLod
     /// that a leaf material uses, plain box filtered for the others.
     ReferenceChunk makeReferenceChunk(const TreeModel& model);
 
-    /// 64-bit FNV-1a of bytes (the content hash recorded in the meta chunk).
-    std::uint64_t fnv1a64(const void* data, std::size_t size);
 
     /// What the "meta" chunk records, as one JSON object with sorted keys, e.g.
     /// {"generator":"treelod 0.1.0","options":{"leafMaterials":["Leaves"]},

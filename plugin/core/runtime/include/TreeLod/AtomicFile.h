@@ -28,4 +28,8 @@ namespace TreeLod
 
     /// Read a whole file. Error names the file and the reason (missing, unreadable).
     Result<std::vector<std::uint8_t>> readFile(const std::string& path);
+
+    /// TreeLod's folder of the user's cache: $XDG_CACHE_HOME/treelod when that is absolute, else
+    /// $HOME/.cache/treelod, else <temp>/treelod-cache (the bake cache, cost calibrations).
+    std::string userCacheDirectory();
 }

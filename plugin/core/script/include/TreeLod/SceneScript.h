@@ -140,6 +140,15 @@ namespace TreeLod
         float lodBias = 1.0f;           ///< Forest::setShadowLodBias: < 1 = coarser casters than the view
     };
 
+    /// "lod": how `auto` species choose levels (docs/scene-format.md).
+    struct SceneLod
+    {
+        static constexpr float DEFAULT_MAX_ERROR = 0.02f;
+        /// Error budget of budgeted auto (Forest::setErrorBudget): FLIP over the tree's box above
+        /// the polygonal reference's own, in [0, 1].
+        float maxError = DEFAULT_MAX_ERROR;
+    };
+
     struct SceneKeyframe
     {
         double time = 0.0; ///< seconds, strictly increasing
@@ -166,6 +175,7 @@ namespace TreeLod
         std::vector<ScenePlacement> placements;
         SceneSun sun;
         SceneShadows shadows;
+        SceneLod lod;
         SceneCamera camera;
         int width = 1280, height = 720; ///< "resolution": [w, h]
         std::uint32_t frames = 1;       ///< frames spread over the camera path

@@ -1,0 +1,99 @@
+// TreeViews: how a single tree is framed and compared in image space, shared by the bake-time
+// error curves (ErrorCurveMeasurer.h) and the studies in bench/: the tree's extent in an image,
+// a square crop around it (image error is taken over the tree's own box, not over a frame of
+// sky), the distance at which it is a given number of pixels tall, and the CPU reference
+// quantised as the GPU's frames are.
+#pragma once
+
+#include "TreeLod/Camera.h"
+#include "TreeLod/Image.h"
+#include "TreeLod/ReferenceRenderer.h"
+
+#include <glm/glm.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace TreeLod
+{
+    /// Pixels that differ from the background (as tests/ogre treeCoverage counts them).
+    struct Extent
+    {
+        int minX = std::numeric_limits<int>::max(), minY = std::numeric_limits<int>::max();
+        int maxX = -1, maxY = -1;
+        bool any() const { return maxX >= 0; }
+        int heightPx() const { return any() ? maxY - minY + 1 : 0; }
+    };
+
+    inline Extent treeExtent(const Image& image, const glm::vec3& background = LightingSpec().background)
+    {
+        Extent e;
+        for (int y = 0; y < image.height; ++y)
+            for (int x = 0; x < image.width; ++x)
+                if (glm::length(glm::vec3(image.at(x, y)) - background) > 0.02f)
+                {
+                    e.minX = std::min(e.minX, x);
+                    e.maxX = std::max(e.maxX, x);
+                    e.minY = std::min(e.minY, y);
+                    e.maxY = std::max(e.maxY, y);
+                }
+        return e;
+    }
+
+    inline Extent unite(Extent a, const Extent& b)
+    {
+        a.minX = std::min(a.minX, b.minX);
+        a.minY = std::min(a.minY, b.minY);
+        a.maxX = std::max(a.maxX, b.maxX);
+        a.maxY = std::max(a.maxY, b.maxY);
+        return a;
+    }
+
+    struct Crop
+    {
+        int x = 0, y = 0, side = 0;
+    };
+
+    /// A square around the tree with a margin, inside the image (the whole image if none).
+    inline Crop cropAround(const Extent& e, int width, int height)
+    {
+        const int full = std::min(width, height);
+        if (!e.any())
+            return {0, 0, full};
+        const int side = std::clamp(int(std::ceil(1.15 * std::max(e.maxX - e.minX + 1, e.maxY - e.minY + 1))) + 4,
+                                    8, full);
+        const int cx = (e.minX + e.maxX + 1) / 2, cy = (e.minY + e.maxY + 1) / 2;
+        return {std::clamp(cx - side / 2, 0, width - side), std::clamp(cy - side / 2, 0, height - side), side};
+    }
+
+    /// The `crop` of `image`, pixel for pixel.
+    inline Image cropImage(const Image& image, const Crop& crop)
+    {
+        Image out(crop.side, crop.side);
+        for (int y = 0; y < crop.side; ++y)
+            for (int x = 0; x < crop.side; ++x)
+                out.at(x, y) = image.at(crop.x + x, crop.y + y);
+        return out;
+    }
+
+    /// Distance at which a tree `treeHeight` metres tall is about `px` pixels tall in a
+    /// `size`-pixel-high view with a vertical field of view of `fovYDegrees` (small-angle).
+    inline double distanceForHeight(double treeHeight, double px, int size, double fovYDegrees = 45.0)
+    {
+        return treeHeight * size / (2.0 * px * std::tan(0.5 * fovYDegrees * 3.14159265358979323846 / 180.0));
+    }
+
+    /// The CPU ray-traced reference at size x size, quantised to 8 bits like the GPU frames
+    /// (FLIP's power law turns float-vs-8-bit rounding of a flat sky into ~0.03 mean error).
+    inline Image traceReference(const ReferenceRenderer& cpu, const CameraSpec& camera, int size, int supersample)
+    {
+        RenderOptions options;
+        options.width = options.height = size;
+        options.samplesPerPixel = supersample * supersample;
+        Image traced = cpu.render(camera, options).colour;
+        for (glm::vec4& p : traced.pixels)
+            p = glm::round(glm::clamp(p, 0.0f, 1.0f) * 255.0f) / 255.0f;
+        return traced;
+    }
+}

@@ -1,0 +1,85 @@
+// ErrorCurves: package chunk "error-curves", the image error of every Forest level of one tree
+// against the tree's height on screen, measured at bake time by the Ogre side (which renders the
+// levels). Here: the data, its layout and its checks. TechniqueDescriptor.cpp registers the
+// chunk's descriptor together with "reference", so every program linking TreeLodRuntime knows it.
+//
+// ---- Meaning ----------------------------------------------------------------------------
+// For each height in heightsPx (the tree's height on screen, pixels), each level is
+// rendered from `views` directions and compared with the reference (the polygonal tree,
+// supersampled referenceSamples times per pixel): flip is the mean FLIP over the views,
+// flipMax the worst view's, rmse the mean multi-scale RMSE (ImageMetrics.h).
+// A level is named as ForestLevel names it: (technique, techniqueLevel, lowRes).
+//
+// ---- Chunk layout, level 0, formatVersion 1 (ERROR_CURVES_FORMAT_VERSION) -----------------
+// Little-endian; H = heightCount:
+//   u32 heightCount H (1..64), u32 levelCount (1..256), u32 views (>= 1), u32 referenceSamples (>= 1)
+//   f32 heightsPx[H]
+//   levelCount levels:
+//       u32 nameLength (1..32), char technique[nameLength] (printable ASCII, no terminator)
+//       u32 techniqueLevel, u32 flags (bit 0: lowRes; others are an error)
+//       f32 flip[H], f32 flipMax[H], f32 rmse[H]
+//   (end of chunk: trailing bytes are an error)
+#pragma once
+
+#include "TreeLod/Result.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace TreeLod
+{
+    struct TechniqueDescriptor;
+
+    constexpr const char* ERROR_CURVES_CHUNK = "error-curves";
+    constexpr std::uint32_t ERROR_CURVES_FORMAT_VERSION = 1;
+    constexpr std::size_t ERROR_CURVES_MAX_HEIGHTS = 64;
+    constexpr std::size_t ERROR_CURVES_MAX_LEVELS = 256;
+    constexpr float ERROR_CURVES_MIN_HEIGHT_PX = 1.0f;
+    constexpr float ERROR_CURVES_MAX_HEIGHT_PX = 16384.0f;
+
+    /// One Forest level's curve: image error against the tree's height on screen.
+    struct ErrorCurveLevel
+    {
+        std::string technique;            ///< registered technique name ("mesh", "lodf", ...), 1..32 printable ASCII
+        std::uint32_t techniqueLevel = 0; ///< the technique's own level (as ForestLevel::techniqueLevel)
+        bool lowRes = false;              ///< as ForestLevel::lowRes
+        std::vector<float> flip;          ///< mean FLIP over the views, one per height, in [0, 1]
+        std::vector<float> flipMax;       ///< worst view's FLIP, one per height, in [0, 1], >= flip
+        std::vector<float> rmse;          ///< mean multi-scale RMSE over the views, one per height, in [0, 1]
+    };
+
+    struct ErrorCurves
+    {
+        std::vector<float> heightsPx;        ///< strictly increasing, finite, in [1, 16384]; 1..64 entries
+        std::uint32_t views = 0;             ///< views averaged per height (>= 1)
+        std::uint32_t referenceSamples = 0;  ///< reference supersampling per pixel (>= 1)
+        std::vector<ErrorCurveLevel> levels; ///< 1..256 levels; (technique, techniqueLevel, lowRes) unique
+
+        /// The index of the level (technique, techniqueLevel, lowRes), or -1.
+        int find(const std::string& technique, std::uint32_t techniqueLevel, bool lowRes) const;
+
+        /// FLIP of `level` at `heightPx`: linear interpolation in log2(height) between the two nearest
+        /// heights, clamped to the first/last value outside the measured range. Non-finite or <= 0
+        /// heights give the first value. 0 when `level` is out of range or has no values; on
+        /// validated curves the result is in [0, 1].
+        float flipAt(std::size_t level, float heightPx) const;
+    };
+
+    /// Serialise in the layout above. Deterministic; does not validate (decode does, and the
+    /// measurer should call validateErrorCurves before writing).
+    std::vector<std::uint8_t> encodeErrorCurves(const ErrorCurves& curves);
+
+    /// Strict: every count, size and value checked; errors name `label`, the element
+    /// ("error-curves level 3 'lodf' 1200", "error-curves heights[2]") and the reason.
+    Result<ErrorCurves> decodeErrorCurves(const std::vector<std::uint8_t>& bytes, const std::string& label);
+
+    /// The same checks on a value (decode calls it; the measurer calls it before writing): counts
+    /// within the limits, every curve one value per height, values finite and in range, heights
+    /// strictly increasing, flipMax >= flip - 1e-6, names valid, levels unique.
+    Result<void> validateErrorCurves(const ErrorCurves& curves, const std::string& label);
+
+    /// The chunk's descriptor (inspect, fuzz); TechniqueDescriptor.cpp registers it.
+    TechniqueDescriptor errorCurvesDescriptor();
+}

@@ -1,0 +1,64 @@
+// LevelCalibration: what each level of a tree costs on the running machine (LevelCosts.h).
+//
+// For every level the asset can be drawn at (Forest::getCandidateLevels), a grid of trees at
+// that one level, spaced so they do not overlap, is drawn through a Forest (instanced, as in a
+// scene) at each calibration height; each frame is timed until a one-pixel read-back returns
+// (OGRE 1.12's GL3Plus has no timer queries), the median of a few frames taken, the median of an
+// empty frame subtracted and the rest divided by the tree count. The grid shrinks for levels
+// whose frame would take long, so a calibration stays short. Results are cached per renderer
+// string (costCalibrationPath): a calibration from another renderer is never reused.
+#pragma once
+
+#include "TreeLod/ForestLevelProvider.h"
+#include "TreeLod/LevelCosts.h"
+#include "TreeLod/Progress.h"
+#include "TreeLod/Result.h"
+
+#include <string>
+#include <vector>
+
+namespace Ogre
+{
+    class Root;
+    class SceneManager;
+    class SceneNode;
+}
+
+namespace TreeLod
+{
+    class Forest;
+    class OffscreenRenderer;
+    class TreeAsset;
+    struct ForestInstance;
+
+    struct CalibrationOptions
+    {
+        std::vector<float> heightsPx{16.0f, 64.0f, 256.0f};
+        int viewport = 512;         ///< square, pixels
+        int frames = 3;             ///< timed per measurement (after one warm-up)
+        std::uint32_t maxTrees = 1024;
+        double longFrameMs = 400.0; ///< a grid whose frame takes longer is shrunk once to about this
+    };
+
+    /// The render system's name, device and driver: the key of a calibration file.
+    std::string rendererString(Ogre::Root& root);
+
+    /// A Forest drawing `asset` at `level` alone (every value), with `instances`, attached to `node`.
+    /// Throws Ogre::Exception as Forest::addSpecies / addInstances do.
+    Forest* createLevelForest(Ogre::SceneManager& sceneManager, Ogre::SceneNode& node, TreeAsset& asset,
+                              const ForestLevel& level, const std::vector<ForestInstance>& instances,
+                              const std::string& name);
+
+    /// Calibrate every candidate level of `asset` (loaded). Errors name the asset and the level.
+    Result<std::vector<LevelCost>> calibrateLevels(OffscreenRenderer& renderer, TreeAsset& asset,
+                                                   const CalibrationOptions& options = {},
+                                                   const ProgressCallback& progress = {});
+
+    /// The costs of `asset`'s levels on this renderer: from the calibration file in `directory`
+    /// when it holds them all, else calibrated and added to it (atomically). `calibrated` tells
+    /// which. Errors name the file or the asset.
+    Result<std::vector<LevelCost>> requireLevelCosts(OffscreenRenderer& renderer, TreeAsset& asset,
+                                                     const std::string& directory,
+                                                     const CalibrationOptions& options = {},
+                                                     const ProgressCallback& progress = {}, bool* calibrated = nullptr);
+}

@@ -1,0 +1,293 @@
+#include "TreeLod/ErrorCurveMeasurer.h"
+
+#include "TreeLod/AtomicFile.h"
+#include "TreeLod/Forest.h"
+#include "TreeLod/ImageMetrics.h"
+#include "TreeLod/LevelCalibration.h"
+#include "TreeLod/ModelChunk.h"
+#include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/Package.h"
+#include "TreeLod/PackageWriter.h"
+#include "TreeLod/RgbaImageConversion.h"
+#include "TreeLod/TreeAssetManager.h"
+#include "TreeLod/TreeViews.h"
+
+#include <OgreException.h>
+#include <OgreSceneManager.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace TreeLod
+{
+    namespace
+    {
+        constexpr float FOV_Y_DEGREES = 45.0f;
+
+        std::string describe(const ForestLevel& level)
+        {
+            return level.technique + " " + std::to_string(level.techniqueLevel) + (level.lowRes ? " low" : "");
+        }
+
+        /// One view of the tree at one screen height: the camera and the square image size.
+        struct View
+        {
+            CameraSpec camera;
+            int size = 0;
+        };
+
+        /// The tree's box height spans `heightPx` pixels at the view's distance (ForestBand's
+        /// units); the image holds the box's bounding sphere.
+        View makeView(const glm::vec3& lo, const glm::vec3& hi, float heightPx, const glm::vec2& view)
+        {
+            const glm::vec3 centre = 0.5f * (lo + hi);
+            const float boxHeight = std::max(hi.y - lo.y, 1e-6f);
+            const float radius = 0.5f * glm::length(hi - lo);
+            View v;
+            v.size = std::max(8, int(std::ceil(2.1f * heightPx * radius / boxHeight)) + 2);
+            const float distance = float(distanceForHeight(boxHeight, heightPx, v.size, FOV_Y_DEGREES));
+            const float az = glm::radians(view.x), el = glm::radians(view.y);
+            const glm::vec3 dir(std::sin(az) * std::cos(el), std::sin(el), std::cos(az) * std::cos(el));
+            v.camera.position = centre + distance * dir;
+            v.camera.target = centre;
+            v.camera.up = std::abs(dir.y) > 0.99f ? glm::vec3(0.0f, 0.0f, -1.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
+            v.camera.fovYDegrees = FOV_Y_DEGREES;
+            v.camera.nearClip = std::max(distance - 1.5f * radius, 0.01f * distance);
+            v.camera.farClip = distance + 1.5f * radius;
+            return v;
+        }
+
+        struct Scores
+        {
+            double flip = 0.0, rmse = 0.0;
+        };
+
+        Result<Scores> score(const Image& reference, const Image& test, const std::string& element)
+        {
+            const Crop crop = cropAround(unite(treeExtent(reference), treeExtent(test)), reference.width,
+                                         reference.height);
+            const Image a = cropImage(reference, crop), b = cropImage(test, crop);
+            Result<FlipResult> f = flip(a, b);
+            if (!f)
+                return fail("", element, "FLIP: " + f.error().message());
+            Result<MultiScaleRmseResult> m = multiScaleRmse(a, b);
+            if (!m)
+                return fail("", element, "multi-scale RMSE: " + m.error().message());
+            return Scores{f->mean, m->combined};
+        }
+    }
+
+    Result<ErrorCurves> measureErrorCurves(OffscreenRenderer& renderer, TreeAsset& asset,
+                                           const ErrorCurveOptions& options, const ProgressCallback& progress)
+    {
+        const std::string label = "asset '" + asset.getName() + "'";
+        if (options.heightsPx.empty() || options.views.empty() || options.referenceSupersample < 1)
+            return fail(label, "error curves", "no heights, no views or a supersampling below 1");
+        std::vector<ForestLevel> levels;
+        try
+        {
+            levels = Forest::getCandidateLevels(asset);
+        }
+        catch (const Ogre::Exception& e)
+        {
+            return fail(label, "error curves", e.getDescription());
+        }
+        if (levels.empty())
+            return fail(label, "error curves", "no technique can draw this asset as a Forest level");
+
+        const TreeModel& model = asset.getReference().model;
+        const ReferenceRenderer cpu(model);
+        const glm::vec3 lo = model.boundsMin, hi = model.boundsMax;
+
+        ErrorCurves curves;
+        curves.heightsPx = options.heightsPx;
+        curves.views = std::uint32_t(options.views.size());
+        curves.referenceSamples = std::uint32_t(options.referenceSupersample * options.referenceSupersample);
+        curves.levels.resize(levels.size());
+        for (std::size_t l = 0; l < levels.size(); ++l)
+        {
+            ErrorCurveLevel& c = curves.levels[l];
+            c.technique = levels[l].technique;
+            c.techniqueLevel = levels[l].techniqueLevel;
+            c.lowRes = levels[l].lowRes;
+            c.flip.assign(options.heightsPx.size(), 0.0f);
+            c.flipMax.assign(options.heightsPx.size(), 0.0f);
+            c.rmse.assign(options.heightsPx.size(), 0.0f);
+        }
+
+        renderer.setLighting(LightingSpec()); // the CPU reference's (RenderOptions' default)
+        renderer.setShadows(false);
+        renderer.setLodBias(1.0f);
+        renderer.clearContent();
+        Ogre::SceneManager& sceneManager = renderer.getSceneManager();
+        // One Forest per level, each drawn at every height and view.
+        std::vector<Forest*> forests;
+        try
+        {
+            for (std::size_t l = 0; l < levels.size(); ++l)
+            {
+                Forest* forest = createLevelForest(sceneManager, renderer.getContentNode(), asset, levels[l],
+                                                   {ForestInstance{}}, "TreeLod/ErrorCurves/" + std::to_string(l));
+                forest->setVisible(false);
+                forests.push_back(forest);
+            }
+        }
+        catch (const Ogre::Exception& e)
+        {
+            renderer.clearContent();
+            return fail(label, "level " + describe(levels[forests.size()]), e.getDescription());
+        }
+
+        const std::size_t total = options.heightsPx.size() * options.views.size();
+        std::size_t done = 0;
+        for (std::size_t h = 0; h < options.heightsPx.size(); ++h)
+            for (const glm::vec2& viewAngles : options.views)
+            {
+                report(progress, "error curves", float(done++) / float(total));
+                const View view = makeView(lo, hi, options.heightsPx[h], viewAngles);
+                const Image reference = traceReference(cpu, view.camera, view.size, options.referenceSupersample);
+                for (std::size_t l = 0; l < levels.size(); ++l)
+                {
+                    forests[l]->setVisible(true);
+                    Image test;
+                    try
+                    {
+                        test = toImage(renderer.render(view.camera, view.size, view.size, 1));
+                    }
+                    catch (const Ogre::Exception& e)
+                    {
+                        renderer.clearContent();
+                        return fail(label, "level " + describe(levels[l]), e.getDescription());
+                    }
+                    forests[l]->setVisible(false);
+                    Result<Scores> s = score(reference, test, "level " + describe(levels[l]));
+                    if (!s)
+                    {
+                        renderer.clearContent();
+                        return s.error();
+                    }
+                    ErrorCurveLevel& c = curves.levels[l];
+                    const float n = float(options.views.size());
+                    c.flip[h] += float(s->flip) / n;
+                    c.rmse[h] += float(s->rmse) / n;
+                    c.flipMax[h] = std::max(c.flipMax[h], float(s->flip));
+                }
+            }
+        renderer.clearContent();
+        report(progress, "error curves", 1.0f);
+        for (ErrorCurveLevel& c : curves.levels)
+            for (std::size_t h = 0; h < c.flip.size(); ++h)
+            {
+                c.flip[h] = std::clamp(c.flip[h], 0.0f, 1.0f);
+                c.rmse[h] = std::clamp(c.rmse[h], 0.0f, 1.0f);
+                c.flipMax[h] = std::max(c.flipMax[h], c.flip[h]);
+            }
+        if (Result<void> valid = validateErrorCurves(curves, label); !valid)
+            return valid.error();
+        return curves;
+    }
+
+    bool coversCandidateLevels(const ErrorCurves& curves, TreeAsset& asset, const ErrorCurveOptions& options)
+    {
+        if (curves.heightsPx != options.heightsPx || curves.views != options.views.size())
+            return false;
+        for (const ForestLevel& level : Forest::getCandidateLevels(asset))
+            if (curves.find(level.technique, level.techniqueLevel, level.lowRes) < 0)
+                return false;
+        return true;
+    }
+
+    namespace
+    {
+        /// `bytes` loaded as a TreeAsset of TreeAssetManager's for as long as it lives.
+        class TemporaryAsset
+        {
+        public:
+            TemporaryAsset(std::vector<std::uint8_t> bytes, const std::string& label)
+            {
+                static int counter = 0;
+                mAsset = TreeAssetManager::getSingleton().loadFromBytes(
+                    "TreeLod/ErrorCurves/" + std::to_string(counter++) + "/" + label, Ogre::RGN_DEFAULT,
+                    std::move(bytes));
+            }
+            ~TemporaryAsset() { TreeAssetManager::getSingleton().remove(mAsset); }
+            TreeAsset& get() { return *mAsset; }
+
+        private:
+            TreeAssetPtr mAsset;
+        };
+
+        Result<std::vector<std::uint8_t>> withCurves(TreeAsset& asset, const ErrorCurves& curves, const std::string& label)
+        {
+            const PackageReader& reader = asset.getPackage();
+            PackageWriter writer;
+            for (std::size_t i = 0; i < reader.chunks().size(); ++i)
+            {
+                const ChunkInfo& info = reader.chunks()[i];
+                if (info.technique == ERROR_CURVES_CHUNK)
+                    continue;
+                Result<std::vector<std::uint8_t>> chunk = reader.readChunk(i);
+                if (!chunk)
+                    return chunk.error();
+                if (Result<void> added = writer.addChunk(info.technique, info.level, info.formatVersion,
+                                                         std::move(chunk.value()));
+                    !added)
+                    return fail(label, info.element(), added.error().message());
+            }
+            if (Result<void> added = writer.addChunk(ERROR_CURVES_CHUNK, 0, ERROR_CURVES_FORMAT_VERSION,
+                                                     encodeErrorCurves(curves));
+                !added)
+                return fail(label, ERROR_CURVES_CHUNK, added.error().message());
+            return writer.toBytes();
+        }
+    }
+
+    Result<std::vector<std::uint8_t>> addErrorCurves(OffscreenRenderer& renderer, const std::vector<std::uint8_t>& bytes,
+                                                     const std::string& label, const ErrorCurveOptions& options,
+                                                     const ProgressCallback& progress)
+    {
+        try
+        {
+            TemporaryAsset asset(bytes, label);
+            Result<ErrorCurves> curves = measureErrorCurves(renderer, asset.get(), options, progress);
+            if (!curves)
+                return fail(label, "error curves", curves.error().message());
+            return withCurves(asset.get(), *curves, label);
+        }
+        catch (const Ogre::Exception& e)
+        {
+            return fail(label, "", e.getDescription());
+        }
+    }
+
+    Result<bool> ensureErrorCurves(OffscreenRenderer& renderer, const std::string& path,
+                                   const ErrorCurveOptions& options, const ProgressCallback& progress)
+    {
+        Result<std::vector<std::uint8_t>> bytes = readFile(path);
+        if (!bytes)
+            return bytes.error();
+        try
+        {
+            TemporaryAsset asset(std::move(bytes.value()), path);
+            if (asset.get().hasChunk(ERROR_CURVES_CHUNK))
+            {
+                Result<ErrorCurves> held = decodeErrorCurves(asset.get().readChunk(ERROR_CURVES_CHUNK), path);
+                if (held && coversCandidateLevels(*held, asset.get(), options))
+                    return false;
+            }
+            Result<ErrorCurves> curves = measureErrorCurves(renderer, asset.get(), options, progress);
+            if (!curves)
+                return fail(path, "error curves", curves.error().message());
+            Result<std::vector<std::uint8_t>> updated = withCurves(asset.get(), *curves, path);
+            if (!updated)
+                return updated.error();
+            if (Result<void> written = writeFileAtomic(path, *updated); !written)
+                return written.error();
+            return true;
+        }
+        catch (const Ogre::Exception& e)
+        {
+            return fail(path, "", e.getDescription());
+        }
+    }
+}

@@ -1,0 +1,227 @@
+#include "TreeLod/LevelCalibration.h"
+
+#include "TreeLod/Forest.h"
+#include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/Package.h"
+#include "TreeLod/TreeAssetManager.h"
+
+#include <OgreRenderSystem.h>
+#include <OgreRenderSystemCapabilities.h>
+#include <OgreRoot.h>
+#include <OgreSceneManager.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+namespace TreeLod
+{
+    namespace
+    {
+        double median(std::vector<double> v)
+        {
+            std::sort(v.begin(), v.end());
+            return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+        }
+
+        std::string describe(const ForestLevel& level)
+        {
+            return level.technique + " " + std::to_string(level.techniqueLevel) + (level.lowRes ? " low" : "");
+        }
+
+        /// A grid of `count` trees facing the camera (looking along -Z from the origin), each
+        /// `heightPx` tall in a `viewport`-pixel view, `spacingPx` apart.
+        std::vector<ForestInstance> grid(const Ogre::AxisAlignedBox& box, float heightPx, float spacingPx, int viewport,
+                                         std::uint32_t count, float& distance)
+        {
+            const float boxHeight = std::max(box.getMaximum().y - box.getMinimum().y, 1e-6f);
+            distance = float(boxHeight * viewport / (2.0 * heightPx * std::tan(Ogre::Math::PI / 8.0)));
+            const float metresPerPx = boxHeight / heightPx;
+            const int columns = std::max(1, int(std::ceil(std::sqrt(double(count)))));
+            std::vector<ForestInstance> instances;
+            for (std::uint32_t i = 0; i < count; ++i)
+            {
+                const int cx = int(i) % columns, cy = int(i) / columns;
+                ForestInstance instance;
+                instance.position = glm::vec3((float(cx) - 0.5f * float(columns - 1)) * spacingPx * metresPerPx,
+                                              (float(cy) - 0.5f * float(columns - 1)) * spacingPx * metresPerPx -
+                                                  0.5f * (box.getMinimum().y + box.getMaximum().y),
+                                              -distance);
+                instances.push_back(instance);
+            }
+            return instances;
+        }
+    }
+
+    std::string rendererString(Ogre::Root& root)
+    {
+        Ogre::RenderSystem* system = root.getRenderSystem();
+        if (!system)
+            return "no render system";
+        const Ogre::RenderSystemCapabilities* caps = system->getCapabilities();
+        return system->getName() + " | " + (caps ? caps->getDeviceName() : Ogre::String("?")) + " | " +
+               (caps ? caps->getDriverVersion().toString() : Ogre::String("?"));
+    }
+
+    Forest* createLevelForest(Ogre::SceneManager& sceneManager, Ogre::SceneNode& node, TreeAsset& asset,
+                              const ForestLevel& level, const std::vector<ForestInstance>& instances,
+                              const std::string& name)
+    {
+        const TreeAssetPtr pointer = TreeAssetManager::getSingleton().getByName(asset.getName(), asset.getGroup());
+        if (!pointer)
+            OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND, "asset '" + asset.getName() + "' is not TreeAssetManager's",
+                        "createLevelForest");
+        auto* forest = static_cast<Forest*>(sceneManager.createMovableObject(name, ForestFactory::FACTORY_TYPE_NAME));
+        try
+        {
+            ForestLevel only = level;
+            only.minPixelCount = 0.0f;
+            forest->addSpecies(pointer, {only});
+            forest->addInstances(instances);
+        }
+        catch (...)
+        {
+            sceneManager.destroyMovableObject(forest);
+            throw;
+        }
+        node.attachObject(forest);
+        return forest;
+    }
+
+    Result<std::vector<LevelCost>> calibrateLevels(OffscreenRenderer& renderer, TreeAsset& asset,
+                                                   const CalibrationOptions& options, const ProgressCallback& progress)
+    {
+        const std::string label = "asset '" + asset.getName() + "'";
+        if (options.heightsPx.empty() || options.viewport < 16 || options.frames < 1 || options.maxTrees == 0)
+            return fail(label, "calibration", "needs heights, a viewport of 16 px or more, frames and trees");
+        std::vector<ForestLevel> levels;
+        try
+        {
+            levels = Forest::getCandidateLevels(asset);
+        }
+        catch (const Ogre::Exception& e)
+        {
+            return fail(label, "calibration", e.getDescription());
+        }
+        const Ogre::AxisAlignedBox box = asset.getBounds();
+        const Ogre::Vector3 size = box.getSize();
+        const float aspect = std::max(1.0f, std::max(size.x, size.z) / std::max(size.y, 1e-6f));
+        renderer.setShadows(false);
+        renderer.setLodBias(1.0f);
+        renderer.clearContent();
+
+        // The camera of each height (trees `heightPx` tall in the viewport) and its empty frame's time.
+        struct Setup
+        {
+            float heightPx = 0.0f, spacingPx = 0.0f, distance = 0.0f;
+            std::uint32_t count = 0;
+            CameraSpec camera;
+            double emptyMs = 0.0;
+        };
+        std::vector<Setup> setups;
+        for (const float heightPx : options.heightsPx)
+        {
+            Setup setup;
+            setup.heightPx = heightPx;
+            setup.spacingPx = 1.2f * heightPx * aspect;
+            const int columns = std::max(1, int(float(options.viewport) / setup.spacingPx));
+            setup.count = std::min(options.maxTrees, std::uint32_t(columns * columns));
+            grid(box, heightPx, setup.spacingPx, options.viewport, 1, setup.distance);
+            setup.camera.position = glm::vec3(0.0f);
+            setup.camera.target = glm::vec3(0.0f, 0.0f, -1.0f);
+            setup.camera.fovYDegrees = 45.0f;
+            setup.camera.nearClip = std::max(0.01f, 0.25f * setup.distance);
+            setup.camera.farClip = 4.0f * setup.distance;
+            setup.emptyMs = median(renderer.timeFrames(setup.camera, options.viewport, options.viewport, options.frames));
+            setups.push_back(setup);
+        }
+
+        std::vector<LevelCost> costs;
+        const std::size_t total = levels.size() * setups.size();
+        std::size_t done = 0;
+        for (const ForestLevel& level : levels)
+        {
+            LevelCost cost;
+            cost.technique = level.technique;
+            cost.techniqueLevel = level.techniqueLevel;
+            cost.lowRes = level.lowRes;
+            for (const Setup& setup : setups)
+            {
+                report(progress, "calibrate " + describe(level) + " at " + std::to_string(int(setup.heightPx)) + " px",
+                       float(done++) / float(total));
+                std::uint32_t count = setup.count;
+                double perTree = 0.0;
+                try
+                {
+                    for (int attempt = 0; attempt < 2; ++attempt)
+                    {
+                        float distance = 0.0f;
+                        createLevelForest(renderer.getSceneManager(), renderer.getContentNode(), asset, level,
+                                          grid(box, setup.heightPx, setup.spacingPx, options.viewport, count, distance),
+                                          "TreeLod/Calibration");
+                        const double full = median(renderer.timeFrames(setup.camera, options.viewport,
+                                                                       options.viewport, options.frames));
+                        renderer.clearContent();
+                        perTree = std::max(0.0, full - setup.emptyMs) / double(count);
+                        // A long frame: once more with about longFrameMs worth of trees.
+                        if (attempt == 0 && full > 2.0 * options.longFrameMs && count > 1)
+                            count = std::clamp<std::uint32_t>(
+                                std::uint32_t(options.longFrameMs / std::max(perTree, 1e-6)), 1, count - 1);
+                        else
+                            break;
+                    }
+                }
+                catch (const Ogre::Exception& e)
+                {
+                    renderer.clearContent();
+                    return fail(label, "level " + describe(level), e.getDescription());
+                }
+                cost.heightsPx.push_back(setup.heightPx);
+                cost.msPerTree.push_back(float(perTree));
+            }
+            costs.push_back(std::move(cost));
+        }
+        report(progress, "calibrate", 1.0f);
+        return costs;
+    }
+
+    Result<std::vector<LevelCost>> requireLevelCosts(OffscreenRenderer& renderer, TreeAsset& asset,
+                                                     const std::string& directory, const CalibrationOptions& options,
+                                                     const ProgressCallback& progress, bool* calibrated)
+    {
+        if (calibrated)
+            *calibrated = false;
+        const std::string renderString = rendererString(renderer.getRoot());
+        const std::string path = costCalibrationPath(directory, renderString);
+        const std::string key = assetCostKey(asset.getPackage());
+        CostCalibration calibration;
+        calibration.renderer = renderString;
+        std::error_code ec;
+        if (std::filesystem::exists(path, ec))
+        {
+            Result<CostCalibration> read = readCostCalibration(path, renderString);
+            if (read)
+                calibration = std::move(read.value());
+            else
+                report(progress, "warning: " + read.error().message() + "; calibrating again", 0.0f);
+        }
+        if (const std::vector<LevelCost>* held = calibration.find(key))
+        {
+            bool all = true;
+            for (const ForestLevel& level : Forest::getCandidateLevels(asset))
+                all = all && findLevelCost(*held, level.technique, level.techniqueLevel, level.lowRes) >= 0;
+            if (all)
+                return *held;
+        }
+        Result<std::vector<LevelCost>> costs = calibrateLevels(renderer, asset, options, progress);
+        if (!costs)
+            return costs.error();
+        calibration.assets[key] = costs.value();
+        std::filesystem::create_directories(directory, ec);
+        if (Result<void> written = writeCostCalibration(path, calibration); !written)
+            return written.error();
+        if (calibrated)
+            *calibrated = true;
+        return costs;
+    }
+}

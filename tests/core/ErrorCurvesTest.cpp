@@ -1,0 +1,307 @@
+// The "error-curves" chunk: what is encoded decodes to the same values, flipAt interpolates in
+// log2(height) and clamps, and every broken value or byte is refused naming the element. The
+// descriptor is registered by TreeLodRuntime itself, whatever the program references.
+#include "TreeLod/ErrorCurves.h"
+#include "TreeLod/TechniqueDescriptor.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace TreeLod
+{
+    namespace
+    {
+        ErrorCurveLevel level(const std::string& technique, std::uint32_t techniqueLevel, bool lowRes,
+                              std::vector<float> flip)
+        {
+            ErrorCurveLevel l;
+            l.technique = technique;
+            l.techniqueLevel = techniqueLevel;
+            l.lowRes = lowRes;
+            l.flipMax = flip;
+            for (float& v : l.flipMax)
+                v = std::min(1.0f, v + 0.125f);
+            l.rmse = flip;
+            for (float& v : l.rmse)
+                v *= 0.5f;
+            l.flip = std::move(flip);
+            return l;
+        }
+
+        /// Three heights an octave pair apart, values exact in binary so interpolation is exact.
+        ErrorCurves sample()
+        {
+            ErrorCurves c;
+            c.heightsPx = {8.0f, 32.0f, 128.0f};
+            c.views = 6;
+            c.referenceSamples = 4;
+            c.levels = {level("mesh", 0, false, {0.0625f, 0.03125f, 0.015625f}),
+                        level("lodf", 0, false, {0.5f, 0.25f, 0.125f}),
+                        level("lodf", 1200, false, {0.75f, 0.5f, 0.25f}),
+                        level("billboard-cloud", 1, true, {1.0f, 0.875f, 0.5f}),
+                        level("impostor", 0, false, {0.875f, 0.75f, 0.625f})};
+            return c;
+        }
+
+        std::string decodeError(const std::vector<std::uint8_t>& bytes)
+        {
+            Result<ErrorCurves> decoded = decodeErrorCurves(bytes, "tree.treelod");
+            return decoded ? std::string() : decoded.error().message();
+        }
+
+        std::string validateError(const ErrorCurves& curves)
+        {
+            Result<void> valid = validateErrorCurves(curves, "tree.treelod");
+            return valid ? std::string() : valid.error().message();
+        }
+
+        void putU32(std::vector<std::uint8_t>& b, std::size_t at, std::uint32_t v)
+        {
+            for (int i = 0; i < 4; ++i)
+                b[at + i] = std::uint8_t(v >> (8 * i));
+        }
+
+        void putF32(std::vector<std::uint8_t>& b, std::size_t at, float v)
+        {
+            std::uint32_t bits;
+            std::memcpy(&bits, &v, 4);
+            putU32(b, at, bits);
+        }
+
+        bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+    }
+
+    TEST(ErrorCurves, roundTripKeepsEveryValue)
+    {
+        const ErrorCurves c = sample();
+        ASSERT_TRUE(validateErrorCurves(c, "tree").ok()) << validateError(c);
+        const std::vector<std::uint8_t> bytes = encodeErrorCurves(c);
+        // 16 header + 12 heights + per level: 4 + name + 8 + 36.
+        EXPECT_EQ(bytes.size(), 16u + 12u + 5u * 48u + 4u + 4u + 4u + 15u + 8u);
+        Result<ErrorCurves> decoded = decodeErrorCurves(bytes, "tree");
+        ASSERT_TRUE(decoded.ok()) << decoded.error().message();
+        EXPECT_EQ(decoded->heightsPx, c.heightsPx);
+        EXPECT_EQ(decoded->views, 6u);
+        EXPECT_EQ(decoded->referenceSamples, 4u);
+        ASSERT_EQ(decoded->levels.size(), c.levels.size());
+        for (std::size_t i = 0; i < c.levels.size(); ++i)
+        {
+            EXPECT_EQ(decoded->levels[i].technique, c.levels[i].technique);
+            EXPECT_EQ(decoded->levels[i].techniqueLevel, c.levels[i].techniqueLevel);
+            EXPECT_EQ(decoded->levels[i].lowRes, c.levels[i].lowRes);
+            EXPECT_EQ(decoded->levels[i].flip, c.levels[i].flip);
+            EXPECT_EQ(decoded->levels[i].flipMax, c.levels[i].flipMax);
+            EXPECT_EQ(decoded->levels[i].rmse, c.levels[i].rmse);
+        }
+        EXPECT_EQ(encodeErrorCurves(decoded.value()), bytes); // deterministic
+    }
+
+    TEST(ErrorCurves, flipAtInterpolatesInLog2HeightAndClamps)
+    {
+        const ErrorCurves c = sample();
+        const std::size_t lodf = 1; // 0.5, 0.25, 0.125 at 8, 32, 128 px
+        // At the measured heights: the measured values.
+        EXPECT_EQ(c.flipAt(lodf, 8.0f), 0.5f);
+        EXPECT_EQ(c.flipAt(lodf, 32.0f), 0.25f);
+        EXPECT_EQ(c.flipAt(lodf, 128.0f), 0.125f);
+        // 16 px is halfway from 8 to 32 in log2 (3, 4, 5): halfway between the values; 64 likewise.
+        EXPECT_EQ(c.flipAt(lodf, 16.0f), 0.375f);
+        EXPECT_EQ(c.flipAt(lodf, 64.0f), 0.1875f);
+        // A quarter of the way in log2 (2^3.5 is halfway from 8 to 16).
+        EXPECT_NEAR(c.flipAt(lodf, float(8.0 * std::sqrt(2.0))), 0.4375f, 1e-6f);
+        // Linear in height would give 0.5 - 0.25 * 12 / 24 = 0.375 at 20 px; log2 gives more weight below.
+        EXPECT_NEAR(c.flipAt(lodf, 20.0f), 0.5f - 0.25f * float(std::log2(20.0 / 8.0) / 2.0), 1e-6f);
+        // Outside the measured range: the end values.
+        EXPECT_EQ(c.flipAt(lodf, 1.0f), 0.5f);
+        EXPECT_EQ(c.flipAt(lodf, 4096.0f), 0.125f);
+        EXPECT_EQ(c.flipAt(lodf, FLT_MAX), 0.125f);
+        // Not a height: the first value.
+        EXPECT_EQ(c.flipAt(lodf, 0.0f), 0.5f);
+        EXPECT_EQ(c.flipAt(lodf, -3.0f), 0.5f);
+        EXPECT_EQ(c.flipAt(lodf, std::numeric_limits<float>::quiet_NaN()), 0.5f);
+        EXPECT_EQ(c.flipAt(lodf, std::numeric_limits<float>::infinity()), 0.5f);
+        // No such level.
+        EXPECT_EQ(c.flipAt(99, 16.0f), 0.0f);
+    }
+
+    TEST(ErrorCurves, findNamesTheLevelByAllThreeKeys)
+    {
+        const ErrorCurves c = sample();
+        EXPECT_EQ(c.find("mesh", 0, false), 0);
+        EXPECT_EQ(c.find("lodf", 0, false), 1);
+        EXPECT_EQ(c.find("lodf", 1200, false), 2);
+        EXPECT_EQ(c.find("billboard-cloud", 1, true), 3);
+        EXPECT_EQ(c.find("billboard-cloud", 1, false), -1);
+        EXPECT_EQ(c.find("lodf", 600, false), -1);
+        EXPECT_EQ(c.find("reference", 0, false), -1);
+    }
+
+    TEST(ErrorCurves, validationNamesTheElement)
+    {
+        ErrorCurves c = sample();
+        c.levels[2].flip[1] = std::numeric_limits<float>::quiet_NaN();
+        std::string e = validateError(c);
+        EXPECT_TRUE(contains(e, "tree.treelod: error-curves level 2 'lodf' 1200 flip[1]: nan")) << e;
+
+        c = sample();
+        c.heightsPx[2] = 32.0f;
+        e = validateError(c);
+        EXPECT_TRUE(contains(e, "heights[2]: 32 px after 32 px")) << e;
+
+        c = sample();
+        c.heightsPx[0] = 0.5f;
+        EXPECT_TRUE(contains(validateError(c), "heights[0]: 0.5 px outside [1, 16384]")) << validateError(c);
+
+        c = sample();
+        c.levels.push_back(c.levels[2]);
+        e = validateError(c);
+        EXPECT_TRUE(contains(e, "level 5 'lodf' 1200: the same level as level 2")) << e;
+        c.levels.back().lowRes = true; // another level: fine
+        EXPECT_EQ(validateError(c), "");
+
+        c = sample();
+        c.levels[3].flipMax[0] = 0.5f;
+        e = validateError(c);
+        EXPECT_TRUE(contains(e, "level 3 'billboard-cloud' 1 low-res flipMax[0]: 0.5 below the mean FLIP 1")) << e;
+        c.levels[3].flipMax[0] = 1.0f - 5e-7f; // within the tolerance
+        EXPECT_EQ(validateError(c), "");
+
+        c = sample();
+        c.levels[1].rmse.pop_back();
+        EXPECT_TRUE(contains(validateError(c), "level 1 'lodf' 0 rmse: 2 values for 3 heights")) << validateError(c);
+
+        c = sample();
+        c.levels[0].technique = "";
+        EXPECT_TRUE(contains(validateError(c), "level 0: technique name of 0 bytes")) << validateError(c);
+        c.levels[0].technique = std::string(33, 'x');
+        EXPECT_TRUE(contains(validateError(c), "level 0: technique name of 33 bytes")) << validateError(c);
+        c.levels[0].technique = "me\nsh";
+        EXPECT_TRUE(contains(validateError(c), "level 0: technique name")) << validateError(c);
+
+        c = sample();
+        c.views = 0;
+        EXPECT_TRUE(contains(validateError(c), "views: 0 views")) << validateError(c);
+        c = sample();
+        c.levels.clear();
+        EXPECT_TRUE(contains(validateError(c), "levels: 0 levels (1..256 allowed)")) << validateError(c);
+        c = sample();
+        c.heightsPx.assign(65, 1.0f);
+        EXPECT_TRUE(contains(validateError(c), "heights: 65 heights (1..64 allowed)")) << validateError(c);
+    }
+
+    TEST(ErrorCurves, decodeRefusesBrokenBytes)
+    {
+        const std::vector<std::uint8_t> good = encodeErrorCurves(sample());
+        ASSERT_EQ(decodeError(good), "");
+
+        // Cut anywhere: refused, never a crash.
+        for (std::size_t size = 0; size < good.size(); ++size)
+            EXPECT_NE(decodeError({good.begin(), good.begin() + std::ptrdiff_t(size)}), "") << size;
+        std::string e = decodeError({good.begin(), good.end() - 1});
+        EXPECT_TRUE(contains(e, "tree.treelod: error-curves level 4 'impostor' 0: truncated")) << e;
+
+        std::vector<std::uint8_t> bytes = good;
+        bytes.push_back(0);
+        EXPECT_TRUE(contains(decodeError(bytes), "error-curves: 1 trailing bytes")) << decodeError(bytes);
+
+        // Counts over the limits, or more than the bytes hold, refused before allocating.
+        bytes = good;
+        putU32(bytes, 0, 0xFFFFFFFFu);
+        EXPECT_TRUE(contains(decodeError(bytes), "heights: 4294967295 heights (1..64 allowed)")) << decodeError(bytes);
+        bytes = good;
+        putU32(bytes, 4, 257);
+        EXPECT_TRUE(contains(decodeError(bytes), "levels: 257 levels (1..256 allowed)")) << decodeError(bytes);
+        bytes = good;
+        putU32(bytes, 4, 256);
+        e = decodeError(bytes);
+        EXPECT_TRUE(contains(e, "levels: truncated: 256 levels of 3 heights need at least")) << e;
+
+        // A NaN height (bytes 16..27 are the heights).
+        bytes = good;
+        putF32(bytes, 20, std::numeric_limits<float>::quiet_NaN());
+        EXPECT_TRUE(contains(decodeError(bytes), "error-curves heights[1]: nan px")) << decodeError(bytes);
+
+        // A technique name longer than 32 bytes (level 0's name length at 28).
+        bytes = good;
+        putU32(bytes, 28, 40);
+        e = decodeError(bytes);
+        EXPECT_TRUE(contains(e, "error-curves level 0: string of 40 bytes, at most 32")) << e;
+
+        // Unknown flags (level 0: length 4, "mesh", techniqueLevel, flags at 40).
+        bytes = good;
+        putU32(bytes, 40, 2);
+        e = decodeError(bytes);
+        EXPECT_TRUE(contains(e, "error-curves level 0 'mesh' 0: unknown flags 2")) << e;
+
+        // A value outside [0, 1] (level 0's flip[0] at 44).
+        bytes = good;
+        putF32(bytes, 44, 1.5f);
+        EXPECT_TRUE(contains(decodeError(bytes), "level 0 'mesh' 0 flip[0]: 1.5 outside [0, 1]")) << decodeError(bytes);
+    }
+
+    TEST(ErrorCurves, descriptorIsRegisteredAndInspects)
+    {
+        // Registered with "reference" in TechniqueDescriptor.cpp, so that no static registration
+        // can be dropped by the linker.
+        const TechniqueDescriptor* d = findTechniqueDescriptor(ERROR_CURVES_CHUNK);
+        ASSERT_NE(d, nullptr);
+        EXPECT_EQ(d->formatVersion, ERROR_CURVES_FORMAT_VERSION);
+        ASSERT_NE(d->inspect, nullptr);
+        ASSERT_NE(d->fuzz, nullptr);
+        EXPECT_FALSE(d->description.empty());
+        EXPECT_EQ(techniqueDescriptors().front().name, "reference");
+
+        const std::vector<std::uint8_t> bytes = encodeErrorCurves(sample());
+        Result<ChunkSummary> summary = d->inspect(bytes, "tree.treelod");
+        ASSERT_TRUE(summary.ok()) << summary.error().message();
+        EXPECT_EQ(summary->text, "5 levels x 3 heights (8-128 px), 6 views; FLIP at 8/128 px: mesh 0.062/0.016, "
+                                 "lodf 0 0.500/0.125, lodf 1200 0.750/0.250, billboard-cloud low-res 1.000/0.500, "
+                                 "impostor 0.875/0.625");
+        const nlohmann::json json = nlohmann::json::parse(summary->json, nullptr, false);
+        ASSERT_TRUE(json.is_object()) << summary->json;
+        EXPECT_EQ(json["levels"], 5);
+        EXPECT_EQ(json["heightsPx"], nlohmann::json({8, 32, 128}));
+        EXPECT_EQ(json["views"], 6);
+        EXPECT_EQ(json["referenceSamples"], 4);
+        ASSERT_EQ(json["curves"].size(), 5u);
+        EXPECT_EQ(json["curves"][2]["technique"], "lodf");
+        EXPECT_EQ(json["curves"][2]["level"], 1200);
+        EXPECT_EQ(json["curves"][3]["lowRes"], true);
+        EXPECT_EQ(json["curves"][1]["flip"], nlohmann::json({0.5, 0.25, 0.125}));
+        EXPECT_EQ(json["curves"][1]["flipMax"], nlohmann::json({0.625, 0.375, 0.25}));
+        EXPECT_EQ(json["curves"][1]["rmse"], nlohmann::json({0.25, 0.125, 0.0625}));
+
+        // Broken: refused naming the package; the fuzz hook never traps on valid or broken bytes.
+        Result<ChunkSummary> refused = d->inspect({bytes.begin(), bytes.begin() + 10}, "broken.treelod");
+        ASSERT_FALSE(refused.ok());
+        EXPECT_TRUE(contains(refused.error().message(), "broken.treelod")) << refused.error().message();
+        d->fuzz(bytes);
+        d->fuzz({bytes.begin(), bytes.begin() + 10});
+    }
+
+    TEST(ErrorCurves, inspectListsAtMostEightLevelsAndShowsThreeHeights)
+    {
+        ErrorCurves c;
+        c.heightsPx = {8, 16, 32, 64, 128, 256, 512};
+        c.views = 1;
+        c.referenceSamples = 1;
+        for (std::uint32_t l = 0; l < 10; ++l)
+            c.levels.push_back(level("lodf", l, false, std::vector<float>(7, 0.25f)));
+        Result<ChunkSummary> summary = findTechniqueDescriptor(ERROR_CURVES_CHUNK)->inspect(encodeErrorCurves(c), "t");
+        ASSERT_TRUE(summary.ok()) << summary.error().message();
+        EXPECT_EQ(summary->text.rfind("10 levels x 7 heights (8-512 px), 1 view; FLIP at 32/128/512 px: lodf 0 "
+                                      "0.250/0.250/0.250, lodf 1 ",
+                                      0),
+                  0u)
+            << summary->text;
+        EXPECT_TRUE(contains(summary->text, "lodf 7 0.250/0.250/0.250, ...")) << summary->text;
+        EXPECT_FALSE(contains(summary->text, "lodf 8")) << summary->text;
+        EXPECT_EQ(summary->text.find('\n'), std::string::npos);
+    }
+}
