@@ -14,8 +14,9 @@ Each CSV has a header line, a `series` column (rows of one series form one line,
 and a `label` column (its legend text). An empty or non-finite value is a gap in the line, and on
 a log axis so is a value <= 0. A row whose `marker` column (optional) is not empty is a single
 labelled point drawn with that matplotlib marker (o, s, ^, x, D) in black, not part of a line:
-the trade plot's polygonal reference and floors. A plot without data still gets its axes and
-title, and reads "no data".
+the trade plot's polygonal reference and floors. Rows whose `on_front` column (optional) is 1 are
+the Pareto front: a thin grey step line through them, in order of x, and a circle round each. A
+plot without data still gets its axes and title, and reads "no data".
 
 Needs matplotlib (Debian: apt install python3-matplotlib); exits 3 without it.
 """
@@ -40,15 +41,18 @@ def drawable(value, log):
 
 
 def read_series(path, x_column, y_column, log_x, log_y):
-    """(lines, markers): lines as [(label, xs, ys)] in order of first appearance, gaps as NaN;
-    markers as [(label, x, y, shape)]."""
+    """(lines, markers, front): lines as [(label, xs, ys)] in order of first appearance, gaps as
+    NaN; markers as [(label, x, y, shape)]; front as [(x, y)] sorted by x."""
     lines = {}
     markers = []
+    front = []
     with open(path, newline="") as f:
         for row in csv.DictReader(f):
             x, y = number(row.get(x_column)), number(row.get(y_column))
             if not (drawable(x, log_x) and drawable(y, log_y)):
                 x = y = math.nan
+            if (row.get("on_front") or "").strip() == "1" and math.isfinite(x):
+                front.append((x, y))
             shape = (row.get("marker") or "").strip()
             if shape:
                 if math.isfinite(x):
@@ -59,12 +63,12 @@ def read_series(path, x_column, y_column, log_x, log_y):
                 lines[key] = (row.get("label") or key, [], [])
             lines[key][1].append(x)
             lines[key][2].append(y)
-    return list(lines.values()), markers
+    return list(lines.values()), markers, sorted(front)
 
 
 def draw(plt, ticker, directory, out_directory, spec):
     log_x, log_y = bool(spec.get("logX")), bool(spec.get("logY"))
-    lines, markers = read_series(os.path.join(directory, spec["csv"]), spec["x"], spec["y"], log_x, log_y)
+    lines, markers, front = read_series(os.path.join(directory, spec["csv"]), spec["x"], spec["y"], log_x, log_y)
     figure, axes = plt.subplots(figsize=(9.6, 6.0), dpi=100)
     has_data = False
     for label, xs, ys in lines:
@@ -75,6 +79,11 @@ def draw(plt, ticker, directory, out_directory, spec):
         has_data = True
         axes.plot([x], [y], linestyle="none", marker=shape, markersize=9, color="black",
                   markerfacecolor="none" if shape != "x" else "black", markeredgewidth=1.5, label=label or None)
+    if front:
+        # Behind the data; each step keeps a point's error up to the next point's frame time.
+        axes.plot([x for x, _ in front], [y for _, y in front], drawstyle="steps-post", color="grey",
+                  linewidth=0.8, marker="o", markersize=15, markerfacecolor="none", markeredgecolor="grey",
+                  markeredgewidth=1.0, label="Pareto front", zorder=1)
     for log, axis, scale in ((log_x, axes.xaxis, axes.set_xscale), (log_y, axes.yaxis, axes.set_yscale)):
         if log and has_data:
             scale("log")

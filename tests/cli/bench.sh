@@ -21,6 +21,108 @@ plot() {
   grep -q "\"$name.csv\"" "$dir/plots.json" || fail "plots.json does not list $name.csv"
   if [ $plotted = 1 ]; then png "$dir/$name.png"; fi
 }
+# The number of results in a summary.json.
+results() { python3 -c 'import json, sys; print(len(json.load(open(sys.argv[1]))["results"]))' "$1"; }
+# The Pareto front of DIR/summary.json recomputed from its results' trade points, per tree count:
+# onParetoFront on every result with both numbers, the front sorted by time and dominated by no
+# result, autoOnFront and dominatedBy as the results say, the trade CSVs' on_front the same. The
+# checker is checked too: a copy where one result dominates the fastest front member must fail.
+# With REPORT (the bench's stdout), its "Pareto front" lines name the same fronts.
+pareto() {
+  python3 - "$@" <<'EOF'
+import copy, csv, json, os, sys
+
+def point(r):
+    t = r.get("trade") or {}
+    return t.get("medianFrameMs"), t.get("meanFlip")
+
+def dominates(a, b):
+    return a[0] <= b[0] and a[1] <= b[1] and (a[0] < b[0] or a[1] < b[1])
+
+def key(r):
+    return r["technique"], r["lodBias"]
+
+def problems(summary):
+    out = []
+    pareto = {p["trees"]: p for p in summary.get("pareto", [])}
+    for trees in sorted({r["trees"] for r in summary["results"]}):
+        rs = [r for r in summary["results"] if r["trees"] == trees]
+        measured = [r for r in rs if None not in point(r)]
+        if trees not in pareto:
+            out.append(f"{trees} trees: no pareto object")
+            continue
+        p = pareto[trees]
+        for r in rs:
+            want = not any(dominates(point(o), point(r)) for o in measured) if r in measured else None
+            if r.get("onParetoFront", "missing") != want:
+                out.append(f"{trees} trees: {key(r)} onParetoFront {r.get('onParetoFront', 'missing')}, recomputed {want}")
+        front = p["front"]
+        times = [f["medianFrameMs"] for f in front]
+        if not front:
+            out.append(f"{trees} trees: empty front")
+        if times != sorted(times):
+            out.append(f"{trees} trees: front not sorted by time: {times}")
+        byKey = {key(r): r for r in rs}
+        for f in front:
+            r = byKey.get(key(f))
+            if r is None or point(r) != (f["medianFrameMs"], f["meanFlip"]):
+                out.append(f"{trees} trees: front member {key(f)} is not a result's trade point")
+                continue
+            for o in measured:
+                if dominates(point(o), point(r)):
+                    out.append(f"{trees} trees: front member {key(f)} dominated by {key(o)}")
+        if sorted(key(f) for f in front) != sorted(key(r) for r in rs if r.get("onParetoFront")):
+            out.append(f"{trees} trees: front and onParetoFront disagree")
+        autos = [r for r in measured if r["technique"].startswith("auto")]
+        want = any(r.get("onParetoFront") for r in autos) if autos else None
+        if p.get("autoOnFront", "missing") != want:
+            out.append(f"{trees} trees: autoOnFront {p.get('autoOnFront', 'missing')}, results say {want}")
+        if sorted(key(d) for d in p["dominatedBy"]) != sorted(key(r) for r in autos if r.get("onParetoFront") is False):
+            out.append(f"{trees} trees: dominatedBy does not list the auto runs off the front")
+        for d in p["dominatedBy"]:
+            mine = point(byKey[key(d)]) if key(d) in byKey else (None, None)
+            by = [point(byKey[key(b)]) for b in d["by"] if key(b) in byKey]
+            if not by or len(by) != len(d["by"]) or not all(None not in mine and dominates(b, mine) for b in by):
+                out.append(f"{trees} trees: {key(d)} dominatedBy lists a run that does not dominate it")
+    return out
+
+directory = sys.argv[1]
+summary = json.load(open(os.path.join(directory, "summary.json")))
+fail = problems(summary)
+counts = sorted({r["trees"] for r in summary["results"]})
+for p in summary.get("pareto", []):
+    trees = p["trees"]
+    name = f"trade-{trees}.csv" if len(counts) > 1 else "trade.csv"
+    front = {key(f) for f in p["front"]}
+    for row in csv.DictReader(open(os.path.join(directory, name), newline="")):
+        want = "1" if (row["series"], float(row["lod_bias"])) in front else "0"
+        if row.get("on_front") != want:
+            fail.append(f"{name}: {row['series']} at {row['lod_bias']}: on_front {row.get('on_front')}, expected {want}")
+    if p["front"]:
+        broken = copy.deepcopy(summary)
+        first = p["front"][0]
+        other = next((r for r in broken["results"] if r["trees"] == trees and key(r) != key(first)), None)
+        if other is not None:
+            other["trade"] = {"medianFrameMs": first["medianFrameMs"], "meanFlip": first["meanFlip"] - 1.0}
+            if not problems(broken):
+                fail.append(f"{trees} trees: the check passes a front member dominated by {key(other)}")
+if len(sys.argv) > 2:
+    lines = [l.strip() for l in open(sys.argv[2]) if l.startswith("Pareto front (")]
+    if len(lines) != len(summary.get("pareto", [])):
+        fail.append(f"{len(lines)} Pareto lines printed, expected {len(summary.get('pareto', []))}")
+    for line, p in zip(lines, summary.get("pareto", [])):
+        names = [e.split(" ")[0] for e in line.split(": ", 1)[1].split(";")[0].split(", ")]
+        want = [f["technique"] + ("" if f["lodBias"] == 1 else "@%g" % f["lodBias"]) for f in p["front"]]
+        if names != want:
+            fail.append(f"printed front {names}, summary's {want}: {line}")
+        if (p["autoOnFront"] is True) != line.endswith("; auto on the front") or \
+           (p["autoOnFront"] is False) != ("is dominated by" in line):
+            fail.append(f"printed line disagrees with autoOnFront {p['autoOnFront']}: {line}")
+for f in fail:
+    print(f"{directory}: {f}")
+sys.exit(1 if fail else 0)
+EOF
+}
 
 # 1. One tree: reference, the four floors and auto at two biases over 6 frames.
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/single" --frames 6 --size 160x90 \
@@ -28,8 +130,9 @@ plot() {
 for f in frames.csv summary.json plots.json; do [ -s "$out/single/$f" ] || fail "single/$f missing"; done
 # frame time: the reference, 4 floors and auto at bias 1, 6 frames each; trade: 5 points + auto at 2 biases.
 plot "$out/single" frame-time 36; plot "$out/single" trade 7
-# Every comparison run is a marked point in the trade plot; only auto's two biases form a curve.
-n=$(awk -F, 'NR > 1 && $NF == ""' "$out/single/trade.csv" | wc -l)
+# Every comparison run is a marked point in the trade plot (the column before on_front); only
+# auto's two biases form a curve.
+n=$(awk -F, 'NR > 1 && $(NF - 1) == ""' "$out/single/trade.csv" | wc -l)
 [ "$n" = 2 ] || fail "trade.csv has $n unmarked rows, expected auto's 2"
 rows=$(($(wc -l < "$out/single/frames.csv") - 1))
 [ "$rows" = 42 ] || fail "frames.csv has $rows rows, expected (mesh + 4 floors + auto x 2 biases) x 6 = 42"
@@ -47,7 +150,11 @@ n=$(awk -F, 'NR > 1 && $13 != ""' "$out/single/frames.csv" | wc -l)
 grep -q '"technique": "auto"' "$out/single/summary.json" || fail "summary lacks auto"
 grep -q '"speedupVsReference": [0-9]' "$out/single/summary.json" || fail "summary has no measured speedup"
 grep -q '"ratioToFloor": [0-9]' "$out/single/summary.json" || fail "summary has no ratio to the floor"
-[ "$(grep -c '"lodBias"' "$out/single/summary.json")" = 7 ] || fail "summary should have 7 results"
+[ "$(results "$out/single/summary.json")" = 7 ] || fail "summary should have 7 results"
+# Every run of one tree has a frame time and a FLIP, so each says whether it is on the Pareto front.
+[ "$(grep -Ec '"onParetoFront": (true|false)' "$out/single/summary.json")" = 7 ] \
+  || fail "summary should say for all 7 results whether they are on the Pareto front"
+pareto "$out/single" || fail "single: Pareto front above"
 # The frames came from treelod_frames (which links no baker) through the package list.
 for f in packages.json timings.json; do [ -s "$out/single/$f" ] || fail "single/$f missing"; done
 grep -q '"format": "treelod-package-list"' "$out/single/packages.json" || fail "packages.json is not a package list"
@@ -78,7 +185,15 @@ EOF
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/cut-report" --frames 6 --size 160x90 \
   --techniques auto --lod-bias 1,0.5 --samples 2 --cache "$cache" --frames-from "$out/cut" -q 2> "$out/cut.txt"
 grep -q "incomplete (the frame timer stopped after 2 runs)" "$out/cut.txt" || { cat "$out/cut.txt"; fail "no warning"; }
-[ "$(grep -c '"lodBias"' "$out/cut-report/summary.json")" = 2 ] || fail "a cut-short timer's 2 runs not reported"
+[ "$(results "$out/cut-report/summary.json")" = 2 ] || fail "a cut-short timer's 2 runs not reported"
+# Without -q the bench prints the Pareto front; on the same frames (--frames-from) it is the same front.
+"$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/single-report" --frames 6 --size 160x90 \
+  --techniques auto --lod-bias 1,0.5 --samples 2 --cache "$cache" --frames-from "$out/single" \
+  > "$out/report.txt" 2> "$out/report-progress.txt"
+grep -q '^Pareto front (1 tree): ' "$out/report.txt" || { cat "$out/report.txt"; fail "no Pareto front printed"; }
+pareto "$out/single-report" "$out/report.txt" || fail "single-report: Pareto front above"
+python3 -c 'import json, sys; a, b = (json.load(open(f))["pareto"] for f in sys.argv[1:]); sys.exit(a != b)' \
+  "$out/single/summary.json" "$out/single-report/summary.json" || fail "the same frames gave another Pareto front"
 # The bake cache reported what it built; a second run reuses everything.
 grep -q 'baked' "$out/single/summary.json" || fail "first run baked nothing?"
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/single2" --frames 2 --size 64x36 \
@@ -99,6 +214,9 @@ for c in $counts; do
   plot "$out/table2" trade-$c 6; plot "$out/table2" frame-time-$c 18
   grep -Eq "\"trees\": $c,?\$" "$out/table2/summary.json" || fail "summary lacks $c trees"
 done
+# A Pareto front per tree count; without auto runs, autoOnFront is null.
+pareto "$out/table2" || fail "table2: Pareto front above"
+[ "$(grep -c '"autoOnFront": null' "$out/table2/summary.json")" = 2 ] || fail "table2: autoOnFront should be null twice"
 
 # 3. A bad script: exit 2, file:line:column named, nothing written.
 printf '{\n  "name": "bad",\n  "frames": -3\n}\n' > "$out/bad.json"

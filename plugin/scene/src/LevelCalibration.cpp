@@ -149,27 +149,25 @@ namespace TreeLod
             {
                 report(progress, "calibrate " + describe(level) + " at " + std::to_string(int(setup.heightPx)) + " px",
                        float(done++) / float(total));
-                std::uint32_t count = setup.count;
                 double perTree = 0.0;
                 try
                 {
-                    for (int attempt = 0; attempt < 2; ++attempt)
-                    {
+                    auto timeGrid = [&](std::uint32_t count, int frames) {
                         float distance = 0.0f;
                         createLevelForest(renderer.getSceneManager(), renderer.getContentNode(), asset, level,
                                           grid(box, setup.heightPx, setup.spacingPx, options.viewport, count, distance),
                                           "TreeLod/Calibration");
-                        const double full = median(renderer.timeFrames(setup.camera, options.viewport,
-                                                                       options.viewport, options.frames));
+                        // timeFrames draws one untimed frame first (programs linked, levels built)
+                        const double ms = median(renderer.timeFrames(setup.camera, options.viewport, options.viewport,
+                                                                     frames));
                         renderer.clearContent();
-                        perTree = std::max(0.0, full - setup.emptyMs) / double(count);
-                        // A long frame: once more with about longFrameMs worth of trees.
-                        if (attempt == 0 && full > 2.0 * options.longFrameMs && count > 1)
-                            count = std::clamp<std::uint32_t>(
-                                std::uint32_t(options.longFrameMs / std::max(perTree, 1e-6)), 1, count - 1);
-                        else
-                            break;
-                    }
+                        return std::max(0.0, ms - setup.emptyMs);
+                    };
+                    const std::uint32_t probe = std::min(options.probeTrees, setup.count);
+                    const double probeMs = timeGrid(probe, 1) / double(probe);
+                    const std::uint32_t count = std::clamp<std::uint32_t>(
+                        std::uint32_t(options.targetFrameMs / std::max(probeMs, 1e-4)), 1, setup.count);
+                    perTree = timeGrid(count, options.frames) / double(count);
                 }
                 catch (const Ogre::Exception& e)
                 {

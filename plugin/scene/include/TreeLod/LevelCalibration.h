@@ -4,8 +4,9 @@
 // that one level, spaced so they do not overlap, is drawn through a Forest (instanced, as in a
 // scene) at each calibration height; each frame is timed until a one-pixel read-back returns
 // (OGRE 1.12's GL3Plus has no timer queries), the median of a few frames taken, the median of an
-// empty frame subtracted and the rest divided by the tree count. The grid shrinks for levels
-// whose frame would take long, so a calibration stays short. Results are cached per renderer
+// empty frame subtracted and the rest divided by the tree count. An untimed probe frame of a few
+// trees sizes the timed grid to about targetFrameMs, so a calibration stays short whatever a
+// level costs (a few seconds per level on llvmpipe). Results are cached per renderer
 // string (costCalibrationPath): a calibration from another renderer is never reused.
 #pragma once
 
@@ -37,7 +38,8 @@ namespace TreeLod
         int viewport = 512;         ///< square, pixels
         int frames = 3;             ///< timed per measurement (after one warm-up)
         std::uint32_t maxTrees = 1024;
-        double longFrameMs = 400.0; ///< a grid whose frame takes longer is shrunk once to about this
+        std::uint32_t probeTrees = 16; ///< the warm-up frame's grid, which sizes the timed one
+        double targetFrameMs = 60.0;   ///< the timed grid holds about this many milliseconds of trees
     };
 
     /// The render system's name, device and driver: the key of a calibration file.
