@@ -294,7 +294,7 @@ namespace TreeLod
                 continue; // drawn by the floor below, not the Forest
             try
             {
-                float budget = 0.0f;
+                float budget = std::numeric_limits<float>::quiet_NaN(); // NaN: the script's
                 const bool budgeted = parseAutoTechnique(mTechnique, budget) || (mTechnique.empty() && species.autoTechnique);
                 if (std::isnan(budget))
                     budget = mScript.lod.maxError;
