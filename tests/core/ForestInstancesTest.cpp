@@ -919,3 +919,74 @@ namespace TreeLod
             }
     }
 }
+
+namespace TreeLod
+{
+    namespace
+    {
+        /// The level `forest`'s only instance gets in each cull from cameras at `distances`.
+        std::vector<std::uint32_t> levelsAlong(const ForestInstances& forest, const std::vector<float>& distances,
+                                               float hysteresis)
+        {
+            ForestVisibility vis;
+            std::vector<std::uint32_t> levels;
+            for (const float d : distances)
+            {
+                CameraSpec spec;
+                spec.position = glm::vec3(0.0f, 0.0f, -10.0f + d);
+                spec.target = glm::vec3(0.0f, 0.0f, -10.0f);
+                spec.fovYDegrees = 90.0f;
+                EXPECT_TRUE(forest.cull(CullCamera::fromSpec(spec, 100.0f, 100.0f), 1.0f, vis, hysteresis));
+                for (const ForestBucket& bucket : vis.getBuckets())
+                    if (bucket.count)
+                        levels.push_back(bucket.level);
+            }
+            return levels;
+        }
+    }
+
+    TEST(ForestInstances, hysteresisHoldsATreeStillUnderCameraJitter)
+    {
+        // Value 100 pi at 10 m (pixelCountIsFourPiProjectedRadiusSquared), the switch at exactly
+        // that: a camera jittering 1 % about 10 m crosses it every frame.
+        ForestInstances forest;
+        ForestKind kind = pixelKind("tree", {100.0f * glm::pi<float>()});
+        kind.boundsCentre = glm::vec3(0.0f);
+        kind.boundsRadius = 1.0f;
+        ASSERT_TRUE(forest.addKind(kind));
+        ASSERT_TRUE(forest.add(ForestInstance{glm::vec3(0.0f, 0.0f, -10.0f), 0.0f, 1.0f, 0}));
+        std::vector<float> jitter;
+        for (int f = 0; f < 20; ++f)
+            jitter.push_back(f % 2 ? 10.1f : 9.9f);
+        const std::vector<std::uint32_t> without = levelsAlong(forest, jitter, 0.0f);
+        ASSERT_EQ(without.size(), jitter.size());
+        EXPECT_EQ(std::count(without.begin(), without.end(), 0u), 10) << "no hysteresis: it flickers";
+        const std::vector<std::uint32_t> with = levelsAlong(forest, jitter, 0.15f);
+        ASSERT_EQ(with.size(), jitter.size());
+        EXPECT_EQ(std::count(with.begin(), with.end(), with.front()), 20) << "hysteresis 0.15: it holds";
+
+        // Beyond the band it switches: 10 m -> 12 m is a factor 1.44 in value (> 1.15).
+        const std::vector<std::uint32_t> away = levelsAlong(forest, {9.9f, 12.0f, 9.9f, 8.0f}, 0.15f);
+        EXPECT_EQ(away, (std::vector<std::uint32_t>{0u, 1u, 1u, 0u}));
+
+        // A distance kind: the same hold, from the other side of the key's sign.
+        ForestInstances byDistance;
+        ForestKind dk = distanceKind("tree", {100.0f});
+        dk.boundsCentre = glm::vec3(0.0f);
+        dk.boundsRadius = 1.0f;
+        ASSERT_TRUE(byDistance.addKind(dk));
+        ASSERT_TRUE(byDistance.add(ForestInstance{glm::vec3(0.0f, 0.0f, -10.0f), 0.0f, 1.0f, 0}));
+        const std::vector<std::uint32_t> d0 = levelsAlong(byDistance, jitter, 0.0f);
+        EXPECT_EQ(std::count(d0.begin(), d0.end(), 0u), 10);
+        const std::vector<std::uint32_t> d1 = levelsAlong(byDistance, jitter, 0.15f);
+        EXPECT_EQ(std::count(d1.begin(), d1.end(), d1.front()), 20);
+        EXPECT_EQ(levelsAlong(byDistance, {9.9f, 12.0f, 10.1f, 8.0f}, 0.15f),
+                  (std::vector<std::uint32_t>{0u, 1u, 1u, 0u}));
+
+        ForestVisibility vis;
+        CameraSpec spec;
+        EXPECT_FALSE(forest.cull(CullCamera::fromSpec(spec, 100.0f, 100.0f), 1.0f, vis, -0.1f));
+        EXPECT_FALSE(forest.cull(CullCamera::fromSpec(spec, 100.0f, 100.0f), 1.0f, vis, std::nanf("")));
+        EXPECT_FALSE(forest.cull(CullCamera::fromSpec(spec, 100.0f, 100.0f), 1.0f, vis, 1.5f));
+    }
+}

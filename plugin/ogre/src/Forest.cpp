@@ -701,6 +701,14 @@ namespace TreeLod
         mLodBias = bias;
     }
 
+    void Forest::setLodHysteresis(Ogre::Real hysteresis)
+    {
+        if (!(hysteresis >= 0.0f && hysteresis <= 1.0f))
+            invalid("Forest '" + mName + "': LoD hysteresis " + std::to_string(hysteresis) + " is not in [0, 1]",
+                    "Forest::setLodHysteresis");
+        mLodHysteresis = hysteresis;
+    }
+
     void Forest::setShadowLodBias(Ogre::Real bias)
     {
         if (!std::isfinite(bias) || !(bias > 0.0f))
@@ -948,7 +956,7 @@ namespace TreeLod
         }
 
         const auto start = std::chrono::steady_clock::now();
-        const Result<void> culled = mInstances.cull(state.camera, state.lodBias, state.visibility);
+        const Result<void> culled = mInstances.cull(state.camera, state.lodBias, state.visibility, mLodHysteresis);
         const double cullMs =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         if (!culled)

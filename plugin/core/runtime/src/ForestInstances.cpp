@@ -113,7 +113,7 @@ namespace TreeLod
                (mIndices.capacity() + mVisible.capacity() + mVisibleBucket.capacity() + mCursor.capacity() +
                 mNearFirst.capacity()) *
                    sizeof(std::uint32_t) +
-               mVisibleClass.capacity() +
+               mVisibleClass.capacity() + mLastLevel.capacity() +
                mTransforms.capacity() * sizeof(float);
     }
 
@@ -425,10 +425,13 @@ namespace TreeLod
 
     // ---- the per-frame loop ----------------------------------------------------------------------
 
-    Result<void> ForestInstances::cull(const CullCamera& camera, float lodBias, ForestVisibility& out) const
+    Result<void> ForestInstances::cull(const CullCamera& camera, float lodBias, ForestVisibility& out,
+                                       float hysteresis) const
     {
         if (!std::isfinite(lodBias) || !(lodBias > 0.0f))
             return fail("", "LoD bias", text(lodBias) + " is not finite and > 0");
+        if (!(hysteresis >= 0.0f && hysteresis <= 1.0f))
+            return fail("", "LoD hysteresis", text(hysteresis) + " is not in [0, 1]");
         for (std::size_t p = 0; p < 6; ++p)
             if (!finite(glm::vec3(camera.planes[p])) || !std::isfinite(camera.planes[p].w))
                 return fail("", "camera", "frustum plane " + std::to_string(p) + " is not finite");
@@ -446,6 +449,14 @@ namespace TreeLod
         }
         out.mBuckets.resize(mBucketCount);
         out.mCursor.assign(mBucketCount, 0u);
+        constexpr std::uint8_t LEVEL_NONE = 0xFF;
+        if (out.mLastLevelInstances != n || out.mLastLevel.size() < n)
+        {
+            out.mLastLevel.assign(std::max(n, out.mLastLevel.size()), LEVEL_NONE);
+            out.mLastLevelInstances = n;
+        }
+        std::uint8_t* lastLevel = out.mLastLevel.data();
+        const float nearFactor = 1.0f + hysteresis, farFactor = 1.0f / (1.0f + hysteresis);
 
         // Pass 1: cull, pick the level, count per bucket. Planes copied out for the compiler.
         float pl[6][4];
@@ -511,7 +522,20 @@ namespace TreeLod
             const float dx = px[i] - eye.x, dy = py[i] - eye.y, dz = pz[i] - eye.z;
             const float d2 = dx * dx + dy * dy + dz * dz;
             const float key = lodKey(d2, r, kindDistance[kind] != 0, c);
-            const std::uint32_t bucket = kindFirst[kind] + levelForKey(tables + kind * MAX_THRESHOLDS, key);
+            const float* table = tables + kind * MAX_THRESHOLDS;
+            std::uint32_t level = levelForKey(table, key);
+            if (hysteresis > 0.0f && lastLevel[i] != LEVEL_NONE && lastLevel[i] != level)
+            {
+                // Keys grow toward finer levels (distance keys are negated, so scaling a negative
+                // key by more than 1 makes it coarser): the band [finest, coarsest] of key * (1 +- h).
+                const float a = key * nearFactor, b = key * farFactor;
+                const std::uint32_t finest = levelForKey(table, std::max(a, b));
+                const std::uint32_t coarsest = levelForKey(table, std::min(a, b));
+                if (lastLevel[i] >= finest && lastLevel[i] <= coarsest)
+                    level = lastLevel[i];
+            }
+            lastLevel[i] = std::uint8_t(level);
+            const std::uint32_t bucket = kindFirst[kind] + level;
             // Distance class: the exponent and top two mantissa bits of d^2 (monotonic for d^2 >= 0).
             std::uint32_t bits;
             std::memcpy(&bits, &d2, sizeof bits);

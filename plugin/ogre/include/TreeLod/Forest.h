@@ -171,6 +171,11 @@ namespace TreeLod
         /// bounds the worst frames when a shadow camera magnifies the trees near the viewer (LiSPSM).
         void setShadowLodBias(Ogre::Real bias);
         Ogre::Real getShadowLodBias() const { return mShadowLodBias; }
+        /// LoD hysteresis h in [0, 1] (default 0.15): a tree keeps its level while its LoD value
+        /// is within a factor 1 + h of what would switch it (ForestInstances::cull), per camera, so
+        /// that trees at a switch do not flicker under camera jitter.
+        void setLodHysteresis(Ogre::Real hysteresis);
+        Ogre::Real getLodHysteresis() const { return mLodHysteresis; }
         /// Keep the LoD camera of the last frame (levels stop changing; culling goes on).
         void setLodFrozen(bool frozen);
         bool isLodFrozen() const { return mLodFrozen; }
@@ -242,6 +247,7 @@ namespace TreeLod
         Ogre::Real mRadius = 0.0f;
         Ogre::Real mLodBias = 1.0f;
         Ogre::Real mShadowLodBias = 1.0f;
+        Ogre::Real mLodHysteresis = 0.15f;
         bool mLodFrozen = false;
         ForestStats mStats;
         std::uint64_t mInstanceBufferBytes = 0;

@@ -158,6 +158,8 @@ namespace TreeLod
         std::vector<std::uint8_t> mVisibleClass;   // scratch: their distance classes
         std::vector<std::uint32_t> mNearFirst;     // scratch: positions in mVisible, near first
         std::vector<std::uint32_t> mCursor;      // scratch: fill position per bucket
+        std::vector<std::uint8_t> mLastLevel;    // per dense instance: its level last time it was seen (LEVEL_NONE)
+        std::size_t mLastLevelInstances = 0;     // the instance count mLastLevel was made for
         std::uint32_t mVisibleCount = 0;
         std::uint32_t mCulledCount = 0;
     };
@@ -230,8 +232,13 @@ namespace TreeLod
         std::uint32_t levelForValue(std::uint32_t kind, float value) const;
 
         /// Cull and select levels for every instance (see the file comment). Error if the bias is
-        /// not finite and > 0 or the camera has a non-finite value; `out` is untouched then.
-        Result<void> cull(const CullCamera& camera, float lodBias, ForestVisibility& out) const;
+        /// not finite and > 0, the hysteresis not in [0, 1] or the camera has a non-finite value;
+        /// `out` is untouched then.
+        /// Hysteresis h: an instance keeps the level it had in `out`'s last cull while that level is
+        /// one its LoD value times or divided by (1 + h) would give, so trees near a switch do not
+        /// flicker between two levels under camera jitter (0: none). `out` remembers the levels
+        /// per instance; after instances are added or removed it starts afresh.
+        Result<void> cull(const CullCamera& camera, float lodBias, ForestVisibility& out, float hysteresis = 0.0f) const;
 
     private:
         std::string check(const ForestInstance& instance) const; ///< "" or the reason it is refused

@@ -1,0 +1,205 @@
+// Budgeted level selection (LevelSelection.h) and the cost calibration file (LevelCosts.h):
+// budget 0 draws the reference, budget 1 the cheapest level, bad budgets are refused, runs are
+// merged to the Forest's level limit; costs interpolate in log-log and a calibration made on
+// another renderer is not reused.
+#include "TreeLod/AtomicFile.h"
+#include "TreeLod/LevelSelection.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+
+namespace TreeLod
+{
+    namespace
+    {
+        ErrorCurveLevel curve(const std::string& technique, std::uint32_t level, std::vector<float> flip)
+        {
+            ErrorCurveLevel c;
+            c.technique = technique;
+            c.techniqueLevel = level;
+            c.flip = flip;
+            c.flipMax = flip;
+            c.rmse = flip;
+            return c;
+        }
+
+        LevelCost cost(const std::string& technique, std::uint32_t level, std::vector<float> ms)
+        {
+            LevelCost c;
+            c.technique = technique;
+            c.techniqueLevel = level;
+            c.heightsPx = {16.0f, 64.0f, 256.0f};
+            c.msPerTree = ms;
+            return c;
+        }
+
+        /// Heights 16, 64, 256 px. The mesh: 0.05 everywhere, the dearest. "lodf" 1: 0.06 at every
+        /// height, half the mesh's cost. "impostor": 0.06 at 16 px, 0.30 at 256, nearly free.
+        struct Fixture
+        {
+            ErrorCurves curves;
+            std::vector<LevelCost> costs;
+            Fixture()
+            {
+                curves.heightsPx = {16.0f, 64.0f, 256.0f};
+                curves.views = 1;
+                curves.referenceSamples = 4;
+                curves.levels = {curve("mesh", 0, {0.05f, 0.05f, 0.05f}), curve("lodf", 1, {0.06f, 0.06f, 0.06f}),
+                                 curve("impostor", 0, {0.06f, 0.18f, 0.30f})};
+                costs = {cost("mesh", 0, {1.0f, 2.0f, 8.0f}), cost("lodf", 1, {0.5f, 1.0f, 4.0f}),
+                         cost("impostor", 0, {0.001f, 0.004f, 0.016f})};
+            }
+        };
+    }
+
+    TEST(LevelSelection, budgetZeroDrawsTheReferenceAndOneTheCheapest)
+    {
+        Fixture f;
+        Result<std::vector<LevelChoice>> zero = chooseLevels(f.curves, f.costs, 0.0f);
+        ASSERT_TRUE(zero) << zero.error().message();
+        ASSERT_EQ(zero->size(), 1u);
+        EXPECT_EQ(zero->front().curveLevel, 0u);
+        EXPECT_EQ(zero->front().minHeightPx, 0.0f);
+
+        Result<std::vector<LevelChoice>> one = chooseLevels(f.curves, f.costs, 1.0f);
+        ASSERT_TRUE(one);
+        ASSERT_EQ(one->size(), 1u);
+        EXPECT_EQ(one->front().curveLevel, 2u);
+    }
+
+    TEST(LevelSelection, theCheapestLevelWithinTheBudgetAtEachHeight)
+    {
+        Fixture f;
+        // 0.02 over the mesh: lodf (0.06) everywhere it is cheaper; the impostor only where its
+        // error is at most 0.07: below 16 * 2^(1/12) px (0.06 at 16, +0.12 per octave... to 64).
+        Result<std::vector<LevelChoice>> runs = chooseLevels(f.curves, f.costs, 0.02f);
+        ASSERT_TRUE(runs) << runs.error().message();
+        ASSERT_EQ(runs->size(), 2u);
+        EXPECT_EQ((*runs)[0].curveLevel, 1u);
+        EXPECT_EQ((*runs)[1].curveLevel, 2u);
+        EXPECT_GT((*runs)[0].minHeightPx, 14.0f);
+        EXPECT_LT((*runs)[0].minHeightPx, 19.0f);
+        EXPECT_FLOAT_EQ((*runs)[0].flip, 0.06f);
+        EXPECT_EQ((*runs)[1].minHeightPx, 0.0f);
+        EXPECT_LE((*runs)[1].flip, 0.07f + 1e-6f);
+
+        // Below 0.01 lodf is not allowed: the mesh near, the impostor nowhere above 16 px.
+        Result<std::vector<LevelChoice>> tight = chooseLevels(f.curves, f.costs, 0.005f);
+        ASSERT_TRUE(tight);
+        EXPECT_EQ(tight->front().curveLevel, 0u);
+
+        // A level without a cost is never chosen.
+        std::vector<LevelCost> noLodf = {f.costs[0], f.costs[2]};
+        Result<std::vector<LevelChoice>> without = chooseLevels(f.curves, noLodf, 0.02f);
+        ASSERT_TRUE(without);
+        for (const LevelChoice& c : *without)
+            EXPECT_NE(c.curveLevel, 1u);
+    }
+
+    TEST(LevelSelection, runsAreMergedToTheLimit)
+    {
+        Fixture f;
+        // Costs that alternate between lodf and the mesh every few samples.
+        f.curves.heightsPx = {1.0f, 2.0f, 4.0f, 8.0f, 16.0f, 32.0f, 64.0f, 128.0f, 256.0f, 512.0f, 1024.0f};
+        const std::size_t n = f.curves.heightsPx.size();
+        f.curves.levels = {curve("mesh", 0, std::vector<float>(n, 0.05f)), curve("lodf", 1, std::vector<float>(n, 0.05f))};
+        f.costs[0].heightsPx = f.curves.heightsPx;
+        f.costs[1].heightsPx = f.curves.heightsPx;
+        f.costs[0].msPerTree.assign(n, 1.0f);
+        f.costs[1].msPerTree.clear();
+        for (std::size_t i = 0; i < n; ++i)
+            f.costs[1].msPerTree.push_back(i % 2 ? 0.5f : 2.0f);
+        Result<std::vector<LevelChoice>> many = chooseLevels(f.curves, f.costs, 0.01f);
+        ASSERT_TRUE(many);
+        EXPECT_GT(many->size(), 4u);
+        Result<std::vector<LevelChoice>> few = chooseLevels(f.curves, f.costs, 0.01f, 3);
+        ASSERT_TRUE(few);
+        EXPECT_LE(few->size(), 3u);
+        for (std::size_t r = 1; r < few->size(); ++r)
+        {
+            EXPECT_NE((*few)[r].curveLevel, (*few)[r - 1].curveLevel) << "neighbours of one level are one run";
+            EXPECT_LT((*few)[r].minHeightPx, (*few)[r - 1].minHeightPx);
+        }
+        EXPECT_EQ(few->back().minHeightPx, 0.0f);
+    }
+
+    TEST(LevelSelection, badBudgetsAndCurvesAreRefused)
+    {
+        Fixture f;
+        for (const float budget : {-0.01f, std::nanf(""), 1.5f, INFINITY})
+        {
+            Result<std::vector<LevelChoice>> r = chooseLevels(f.curves, f.costs, budget);
+            ASSERT_FALSE(r) << budget;
+            EXPECT_NE(r.error().message().find("error budget"), std::string::npos) << r.error().message();
+        }
+        ErrorCurves noMesh = f.curves;
+        noMesh.levels.erase(noMesh.levels.begin());
+        Result<std::vector<LevelChoice>> r = chooseLevels(noMesh, f.costs, 0.02f);
+        ASSERT_FALSE(r);
+        EXPECT_NE(r.error().message().find("mesh"), std::string::npos) << r.error().message();
+        r = chooseLevels(f.curves, {}, 0.02f);
+        ASSERT_FALSE(r);
+        EXPECT_NE(r.error().message().find("cost"), std::string::npos) << r.error().message();
+    }
+
+    TEST(LevelCosts, costsInterpolateInLogLog)
+    {
+        const LevelCost c = cost("lodf", 1, {1.0f, 4.0f, 64.0f});
+        EXPECT_FLOAT_EQ(c.msAt(16.0f), 1.0f);
+        EXPECT_FLOAT_EQ(c.msAt(4.0f), 1.0f) << "below the first height: the first value";
+        EXPECT_NEAR(c.msAt(32.0f), 2.0f, 1e-4f) << "halfway in log between 1 and 4";
+        EXPECT_NEAR(c.msAt(128.0f), 16.0f, 1e-3f);
+        EXPECT_NEAR(c.msAt(512.0f), 256.0f, 1e-2f) << "the last slope (area) extrapolated";
+        const LevelCost falling = cost("x", 0, {1.0f, 2.0f, 1.0f});
+        EXPECT_FLOAT_EQ(falling.msAt(1024.0f), 1.0f) << "never a falling extrapolation";
+        EXPECT_TRUE(std::isfinite(c.msAt(std::nanf(""))));
+        EXPECT_TRUE(std::isfinite(c.msAt(INFINITY)));
+    }
+
+    TEST(LevelCosts, aCalibrationFromAnotherRendererIsNotReused)
+    {
+        const std::string dir = testing::TempDir() + "/treelod-costs-" + std::to_string(::getpid());
+        std::filesystem::create_directories(dir);
+        const std::string renderer = "OpenGL 3+ Rendering Subsystem | llvmpipe (LLVM 15.0.6, 256 bits) | 4.5.0.0";
+        const std::string other = "OpenGL 3+ Rendering Subsystem | NVIDIA H200/PCIe/SSE2 | 4.6.0.0";
+        EXPECT_NE(costCalibrationPath(dir, renderer), costCalibrationPath(dir, other));
+
+        CostCalibration calibration;
+        calibration.renderer = renderer;
+        calibration.assets["0123456789abcdef"] = {cost("lodf", 1200, {0.5f, 1.0f, 4.0f}), cost("impostor", 0, {0.0f, 0.01f, 0.1f})};
+        const std::string path = costCalibrationPath(dir, renderer);
+        ASSERT_TRUE(writeCostCalibration(path, calibration));
+        Result<CostCalibration> read = readCostCalibration(path, renderer);
+        ASSERT_TRUE(read) << read.error().message();
+        const std::vector<LevelCost>* levels = read->find("0123456789abcdef");
+        ASSERT_NE(levels, nullptr);
+        ASSERT_EQ(levels->size(), 2u);
+        EXPECT_EQ(findLevelCost(*levels, "lodf", 1200, false), 0);
+        EXPECT_EQ((*levels)[0].msPerTree, (std::vector<float>{0.5f, 1.0f, 4.0f}));
+        EXPECT_EQ(read->find("fedcba9876543210"), nullptr);
+
+        // The same file read for another renderer (copied, renamed by hand): refused, naming both.
+        Result<CostCalibration> foreign = readCostCalibration(path, other);
+        ASSERT_FALSE(foreign);
+        EXPECT_NE(foreign.error().message().find(path), std::string::npos);
+        EXPECT_NE(foreign.error().message().find("NVIDIA"), std::string::npos) << foreign.error().message();
+
+        // Damaged files: errors naming the file and the element.
+        const std::string bad = dir + "/bad.json";
+        for (const std::string& text :
+             {std::string("not json"), std::string(R"({"renderer": "r", "version": 1, "assets": {"k": [{"technique": "lodf", "level": 1, "heightsPx": [16, 8], "msPerTree": [1, 2]}]}})"),
+              std::string(R"({"renderer": "r", "version": 1, "assets": {"k": [{"technique": "lodf", "level": 1, "heightsPx": [16], "msPerTree": [-1]}]}})"),
+              std::string(R"({"renderer": "r", "version": 9, "assets": {}})")})
+        {
+            ASSERT_TRUE(writeFileAtomic(bad, std::vector<std::uint8_t>(text.begin(), text.end())));
+            Result<CostCalibration> r = readCostCalibration(bad, "r");
+            ASSERT_FALSE(r) << text;
+            EXPECT_NE(r.error().message().find(bad), std::string::npos) << r.error().message();
+        }
+        std::filesystem::remove_all(dir);
+    }
+}
