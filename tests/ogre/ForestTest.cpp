@@ -11,17 +11,20 @@
 // the core bakers (few AO rays) and cached in $TREELOD_TEST_OUT/forest, keyed by this binary's
 // modification time.
 #include "OgreTestSupport.h"
+#include "TreeLod/AtomicFile.h"
 
 #include "TreeLod/BillboardCloudResources.h"
 #include "TreeLod/FoliageLodResources.h"
 #include "TreeLod/BillboardCloudBaker.h"
 #include "TreeLod/BillboardCloudTree.h"
+#include "TreeLod/ErrorCurveMeasurer.h"
 #include "TreeLod/FoliageLodBaker.h"
 #include "TreeLod/FoliageLodTree.h"
 #include "TreeLod/Forest.h"
 #include "TreeLod/GltfImporter.h"
 #include "TreeLod/ImpostorBaker.h"
 #include "TreeLod/ImpostorData.h"
+#include "TreeLod/LevelCalibration.h"
 #include "TreeLod/PackageWriter.h"
 #include "TreeLod/QuadFloors.h"
 #include "TreeLod/TreeAssetManager.h"
@@ -39,6 +42,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -1347,5 +1351,229 @@ namespace TreeLod
         holder->detachObject(survivor);
         manager.destroyCamera(survivor);
         manager.destroySceneNode(holder);
+    }
+}
+
+namespace TreeLod
+{
+    namespace
+    {
+        /// Few heights and views: the curves of the oak's levels in seconds.
+        ErrorCurveOptions smallCurveOptions()
+        {
+            ErrorCurveOptions o;
+            o.heightsPx = {16.0f, 64.0f, 192.0f};
+            o.views = {{0.0f, 10.0f}, {100.0f, 45.0f}};
+            o.referenceSupersample = 2;
+            return o;
+        }
+
+        /// The oak's package with its error curves (smallCurveOptions), loaded as "oak.budget-test".
+        TreeAssetPtr oakWithCurves()
+        {
+            return OgreEnvironment::keep<TreeAssetPtr>("forest.oak-curves", [] {
+                const ForestTree& tree = oak();
+                const std::vector<std::uint8_t> bytes = cachedPackage("forest", "oak-curves", [&] {
+                    Result<std::vector<std::uint8_t>> with = addErrorCurves(
+                        OgreEnvironment::renderer(), cachedPackage("forest", "oak", [&] { return bakePackage(tree.model, "oak"); }),
+                        "oak", smallCurveOptions());
+                    EXPECT_TRUE(with.ok()) << (with.ok() ? "" : with.error().message());
+                    return with.ok() ? with.value() : std::vector<std::uint8_t>{};
+                });
+                return TreeAssetManager::getSingleton().loadFromBytes("oak.budget-test", Ogre::RGN_DEFAULT, bytes);
+            });
+        }
+
+        /// Costs fixed here, not calibrated, so that the levels (and the golden) do not follow the
+        /// machine's noise: the mesh dearest, lodf by its leaves, clouds cheap, the impostor nearly free.
+        std::vector<LevelCost> fixedCosts(TreeAsset& asset)
+        {
+            std::vector<LevelCost> costs;
+            for (const ForestLevel& level : Forest::getCandidateLevels(asset))
+            {
+                LevelCost c;
+                c.technique = level.technique;
+                c.techniqueLevel = level.techniqueLevel;
+                c.lowRes = level.lowRes;
+                c.heightsPx = {16.0f, 256.0f};
+                const float base = level.technique == "mesh"              ? 2.0f
+                                   : level.technique == "lodf"            ? 0.2f + 1.5e-4f * float(level.techniqueLevel)
+                                   : level.technique == "billboard-cloud" ? 0.3f - 0.1f * float(level.techniqueLevel)
+                                                                          : 0.005f;
+                c.msPerTree = {base, 16.0f * base};
+                costs.push_back(c);
+            }
+            return costs;
+        }
+    }
+
+    TEST(Forest, errorCurvesRankTheLevelsAgainstTheCpuReference)
+    {
+        const TreeAssetPtr asset = oakWithCurves();
+        ASSERT_TRUE(asset->hasChunk(ERROR_CURVES_CHUNK));
+        Result<ErrorCurves> curves = decodeErrorCurves(asset->readChunk(ERROR_CURVES_CHUNK), "oak");
+        ASSERT_TRUE(curves) << curves.error().message();
+        EXPECT_TRUE(coversCandidateLevels(*curves, *asset, smallCurveOptions()));
+        EXPECT_EQ(curves->levels.size(), Forest::getCandidateLevels(*asset).size());
+        const int mesh = curves->find("mesh", 0, false), quad = curves->find("impostor", 0, false);
+        ASSERT_GE(mesh, 0);
+        ASSERT_GE(quad, 0);
+        int fullLodf = -1;
+        for (std::size_t l = 0; l < curves->levels.size(); ++l)
+            if (curves->levels[l].technique == "lodf" &&
+                (fullLodf < 0 || curves->levels[l].techniqueLevel > curves->levels[std::size_t(fullLodf)].techniqueLevel))
+                fullLodf = int(l);
+        ASSERT_GE(fullLodf, 0);
+        for (std::size_t h = 0; h < curves->heightsPx.size(); ++h)
+        {
+            const float m = curves->levels[std::size_t(mesh)].flip[h];
+            std::printf("%5.0f px: mesh %.4f, lodf (all leaves) %.4f, impostor %.4f\n", double(curves->heightsPx[h]),
+                        double(m), double(curves->levels[std::size_t(fullLodf)].flip[h]),
+                        double(curves->levels[std::size_t(quad)].flip[h]));
+            // The GPU's mesh against the CPU's: the same tree, one sample a pixel against four.
+            EXPECT_GT(m, 0.0f);
+            EXPECT_LT(m, 0.12f);
+            // LoDF with every leaf draws what the mesh draws.
+            EXPECT_NEAR(curves->levels[std::size_t(fullLodf)].flip[h], m, 0.01f);
+        }
+        // Close up, one quad is far from the tree; every curve's worst view is at least its mean.
+        EXPECT_GT(curves->levels[std::size_t(quad)].flip.back(), curves->levels[std::size_t(mesh)].flip.back() + 0.05f);
+        for (const ErrorCurveLevel& level : curves->levels)
+            for (std::size_t h = 0; h < level.flip.size(); ++h)
+                EXPECT_GE(level.flipMax[h], level.flip[h]);
+
+        // The chunk is added once: a package that holds curves covering its levels is not measured again.
+        const std::string path = OgreEnvironment::outDir() + "/oak-curves.treelod";
+        const std::vector<std::uint8_t> bytes = cachedPackage("forest", "oak-curves", [] {
+            ADD_FAILURE() << "oakWithCurves() cached the package";
+            return std::vector<std::uint8_t>{};
+        });
+        ASSERT_TRUE(writeFileAtomic(path, bytes));
+        Result<bool> again = ensureErrorCurves(OgreEnvironment::renderer(), path, smallCurveOptions());
+        ASSERT_TRUE(again) << again.error().message();
+        EXPECT_FALSE(*again);
+        EXPECT_EQ(readFile(path).value(), bytes);
+        // Other heights: measured again, the other chunks' bytes unchanged.
+        ErrorCurveOptions other = smallCurveOptions();
+        other.heightsPx = {32.0f};
+        again = ensureErrorCurves(OgreEnvironment::renderer(), path, other);
+        ASSERT_TRUE(again) << again.error().message();
+        EXPECT_TRUE(*again);
+        Result<PackageReader> rewritten = PackageReader::open(path);
+        ASSERT_TRUE(rewritten);
+        for (const ChunkInfo& info : asset->getPackage().chunks())
+        {
+            if (info.technique == ERROR_CURVES_CHUNK)
+                continue;
+            EXPECT_EQ(rewritten->readChunk(info.technique, info.level).value(),
+                      asset->getPackage().readChunk(info.technique, info.level).value())
+                << info.element();
+        }
+        Result<ErrorCurves> remeasured = decodeErrorCurves(rewritten->readChunk(ERROR_CURVES_CHUNK, 0).value(), path);
+        ASSERT_TRUE(remeasured);
+        EXPECT_EQ(remeasured->heightsPx, other.heightsPx);
+    }
+
+    TEST(Forest, calibrationTimesEveryLevelAndIsCachedPerRenderer)
+    {
+        const TreeAssetPtr asset = oakWithCurves();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        CalibrationOptions options;
+        options.heightsPx = {16.0f, 64.0f};
+        options.viewport = 128;
+        options.frames = 1;
+        options.targetFrameMs = 10.0;
+        const std::string dir = OgreEnvironment::outDir() + "/calibration";
+        std::filesystem::remove_all(dir);
+        bool calibrated = false;
+        Result<std::vector<LevelCost>> costs = requireLevelCosts(r, *asset, dir, options, {}, &calibrated);
+        ASSERT_TRUE(costs) << costs.error().message();
+        EXPECT_TRUE(calibrated);
+        ASSERT_EQ(costs->size(), Forest::getCandidateLevels(*asset).size());
+        for (const LevelCost& c : *costs)
+        {
+            ASSERT_EQ(c.msPerTree.size(), 2u) << c.technique;
+            for (const float ms : c.msPerTree)
+                EXPECT_TRUE(std::isfinite(ms) && ms >= 0.0f) << c.technique;
+        }
+        // The cache answers the second time, for this renderer only.
+        Result<std::vector<LevelCost>> cached = requireLevelCosts(r, *asset, dir, options, {}, &calibrated);
+        ASSERT_TRUE(cached);
+        EXPECT_FALSE(calibrated);
+        EXPECT_EQ(cached->front().msPerTree, costs->front().msPerTree);
+        const std::string renderer = rendererString(r.getRoot());
+        EXPECT_NE(renderer.find("OpenGL"), std::string::npos) << renderer;
+        Result<CostCalibration> file = readCostCalibration(costCalibrationPath(dir, renderer), renderer);
+        ASSERT_TRUE(file) << file.error().message();
+        // The same costs under another renderer's name: not this renderer's, so calibrated again.
+        CostCalibration foreign = *file;
+        foreign.renderer = "OpenGL 3+ Rendering Subsystem | some GPU | 4.6";
+        ASSERT_TRUE(writeCostCalibration(costCalibrationPath(dir, renderer), foreign));
+        cached = requireLevelCosts(r, *asset, dir, options, {}, &calibrated);
+        ASSERT_TRUE(cached);
+        EXPECT_TRUE(calibrated);
+    }
+
+    TEST(Forest, anErrorBudgetChoosesTheCheapestLevelWithinIt)
+    {
+        const TreeAssetPtr asset = oakWithCurves();
+        const ForestTree& tree = oak();
+        const std::vector<LevelCost> costs = fixedCosts(*asset);
+
+        const std::vector<ForestLevel> reference = Forest::levelsForErrorBudget(*asset, costs, 0.0f);
+        ASSERT_EQ(reference.size(), 1u);
+        EXPECT_EQ(reference[0].technique, "mesh");
+        const std::vector<ForestLevel> cheapest = Forest::levelsForErrorBudget(*asset, costs, 1.0f);
+        ASSERT_EQ(cheapest.size(), 1u);
+        EXPECT_EQ(cheapest[0].technique, "impostor");
+        const std::vector<ForestLevel> budgeted = Forest::levelsForErrorBudget(*asset, costs, 0.03f);
+        ASSERT_GE(budgeted.size(), 2u);
+        std::string described;
+        for (const ForestLevel& level : budgeted)
+            described += Forest::describeLevel(level) + " >= " +
+                         std::to_string(int(Forest::heightForPixelCount(*asset, level.minPixelCount))) + " px; ";
+        std::printf("budget 0.03: %s\n", described.c_str());
+        EXPECT_NE(budgeted.front().technique, "impostor") << described;
+        EXPECT_EQ(budgeted.back().minPixelCount, 0.0f);
+
+        for (const float bad : {-0.1f, 1.5f, std::nanf("")})
+            EXPECT_THROW(Forest::levelsForErrorBudget(*asset, costs, bad), Ogre::InvalidParametersException) << bad;
+        try
+        {
+            Forest::levelsForErrorBudget(*tree.asset, costs, 0.03f);
+            ADD_FAILURE() << "an asset without curves was accepted";
+        }
+        catch (const Ogre::InvalidParametersException& e)
+        {
+            EXPECT_NE(e.getDescription().find("oak.forest-test"), std::string::npos) << e.getDescription();
+            EXPECT_NE(e.getDescription().find("no error curves"), std::string::npos) << e.getDescription();
+        }
+
+        // Drawn: a grid from near to far, one sample a pixel as the curves measured, against the
+        // mesh supersampled 4x4: within the budget of the mesh's own error (and a margin for a
+        // whole frame where the curves saw one tree), better than the cheapest, not a black picture.
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+        const CameraSpec view = look(glm::vec3(0.3f * h, 1.4f * h, 7.0f * h), glm::vec3(0.0f, 0.0f, -4.0f * h));
+        std::vector<Image> pictures;
+        Image supersampled;
+        for (const std::vector<ForestLevel>* levels : {&reference, &budgeted, &cheapest})
+        {
+            Forest* forest = placeForest();
+            forest->addSpecies(asset, *levels);
+            forest->addInstances(grid(6, 1.6f * h));
+            if (levels == &reference)
+                supersampled = toImage(r.render(view, 320, 180, 4));
+            pictures.push_back(toImage(r.render(view, 320, 180, 1)));
+        }
+        const double flipMesh = flipMean(supersampled, pictures[0]), flipBudgeted = flipMean(supersampled, pictures[1]),
+                     flipCheapest = flipMean(supersampled, pictures[2]);
+        std::printf("FLIP against the mesh 4x4: mesh %.4f, budget 0.03 %.4f, budget 1 %.4f\n", flipMesh, flipBudgeted,
+                    flipCheapest);
+        EXPECT_GT(treeCoverage(pictures[1], BACKGROUND), 0.15);
+        EXPECT_LT(flipBudgeted, flipMesh + 0.03 + 0.01);
+        EXPECT_LT(flipBudgeted + 0.02, flipCheapest);
+        writePng(OgreEnvironment::outDir() + "/forest-budgets.png", sideBySide(pictures));
+        compareWithGolden(pictures[1], "forest-budget", 0.03);
     }
 }
