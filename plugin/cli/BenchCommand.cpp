@@ -29,6 +29,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -42,6 +43,8 @@
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/CacheTreeBaker.h"
 #include "TreeLod/ErrorCurveMeasurer.h"
+#include "TreeLod/ErrorCurves.h"
+#include "TreeLod/Package.h"
 #include "TreeLod/ForestScene.h"
 #include "TreeLod/Image.h"
 #include "TreeLod/OffscreenRenderer.h"
@@ -647,6 +650,44 @@ namespace TreeLod
                                               {"yLabel", "median frame ms"},
                                               {"logX", true},
                                               {"logY", true},
+                                              {"markers", true}});
+                    !w)
+                    return printError(w.error()), false;
+            }
+            // The error curves budgeted auto chose by: FLIP against screen height per level and package.
+            for (const BakeCacheEntry& entry : baker.getEntries())
+            {
+                Result<PackageReader> package = PackageReader::open(entry.path);
+                if (!package || package->findChunk(ERROR_CURVES_CHUNK, 0) < 0)
+                    continue;
+                Result<std::vector<std::uint8_t>> bytes = package->readChunk(ERROR_CURVES_CHUNK, 0);
+                Result<ErrorCurves> curves = bytes ? decodeErrorCurves(*bytes, entry.path) : Result<ErrorCurves>(bytes.error());
+                if (!curves)
+                    return printError(curves.error()), false;
+                std::string csv = "series,label,height_px,flip,flip_max,ms_rmse\n";
+                for (const ErrorCurveLevel& level : curves->levels)
+                {
+                    const std::string label = level.technique + " " + std::to_string(level.techniqueLevel) +
+                                              (level.lowRes ? " low-res" : "");
+                    for (std::size_t h = 0; h < curves->heightsPx.size(); ++h)
+                        csv += csvField(label) + "," + csvField(label) + "," + number(curves->heightsPx[h], 6) + "," +
+                               number(level.flip[h], 6) + "," + number(level.flipMax[h], 6) + "," +
+                               number(level.rmse[h], 6) + "\n";
+                }
+                std::string fileName = entry.name;
+                for (char& c : fileName)
+                    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-' && c != '_')
+                        c = '_';
+                if (Result<void> w = addPlot("curves-" + fileName, csv,
+                                             {{"title", entry.name + ": error curves (FLIP over the tree's box against the "
+                                                                     "CPU reference, mean of " +
+                                                            std::to_string(curves->views) + " views)"},
+                                              {"x", "height_px"},
+                                              {"y", "flip"},
+                                              {"xLabel", "tree height on screen (px)"},
+                                              {"yLabel", "mean FLIP"},
+                                              {"logX", true},
+                                              {"logY", false},
                                               {"markers", true}});
                     !w)
                     return printError(w.error()), false;
