@@ -309,6 +309,24 @@ namespace TreeLod
         EXPECT_EQ(coarse->shadows.lodBias, 0.25f);
     }
 
+    TEST(SceneScript, lodTakesAnErrorBudget)
+    {
+        EXPECT_EQ(parsed(MINIMAL).lod.maxError, SceneLod::DEFAULT_MAX_ERROR);
+        EXPECT_EQ(parsed(replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"lod\": {\"maxError\": 0.05}")).lod.maxError,
+                  0.05f);
+        EXPECT_EQ(parsed(replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"lod\": {}")).lod.maxError,
+                  SceneLod::DEFAULT_MAX_ERROR);
+        for (const char* bad : {"{\"maxError\": 1.5}", "{\"maxError\": -0.1}", "{\"maxError\": \"low\"}"})
+        {
+            const std::string message =
+                errorOf(replaced(MINIMAL, "\"frames\": 2", std::string("\"frames\": 2, \"lod\": ") + bad));
+            EXPECT_NE(message.find("/lod/maxError"), std::string::npos) << message;
+        }
+        const std::string unknown =
+            errorOf(replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"lod\": {\"maxErr\": 0.1}"));
+        EXPECT_NE(unknown.find("maxErr"), std::string::npos) << unknown;
+    }
+
     TEST(SceneScript, techniqueBandsParseAndMustBeOrdered)
     {
         SceneScript s = parsed(replaced(MINIMAL, "\"techniques\": \"auto\"",

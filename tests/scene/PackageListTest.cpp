@@ -2,6 +2,7 @@
 // runtime side's TreeBaker, no baking) answers from it; readGreyImageOgre reads heightfields
 // through Ogre. Headless: one Root with Codec_STBI, no render system.
 #include "TreeLod/CacheTreeBaker.h"
+#include "TreeLod/ForestScene.h"
 #include "TreeLod/Image.h"
 #include "TreeLod/OgreGreyImage.h"
 #include "TreeLod/PackageListBaker.h"
@@ -12,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -137,6 +139,35 @@ namespace TreeLod
         }
         const std::string message = thrown([&] { PackageListBaker list(dir + "/absent.json"); });
         EXPECT_NE(message.find(dir + "/absent.json"), std::string::npos) << message;
+    }
+
+    TEST(ForestScene, budgetedAutoNamesItsBudgetAndBakesEveryTechniqueItChoosesAmong)
+    {
+        float budget = -1.0f;
+        EXPECT_TRUE(parseAutoTechnique("auto", budget));
+        EXPECT_TRUE(std::isnan(budget)) << "plain auto takes the script's budget";
+        EXPECT_TRUE(parseAutoTechnique("auto@0.05", budget));
+        EXPECT_FLOAT_EQ(budget, 0.05f);
+        EXPECT_TRUE(parseAutoTechnique("auto@0", budget));
+        EXPECT_EQ(budget, 0.0f);
+        for (const char* bad : {"auto@", "auto@x", "auto@1.5", "auto@-0.1", "auto@nan", "auto@0.1x", "lodf", "autox"})
+            EXPECT_FALSE(parseAutoTechnique(bad, budget)) << bad;
+
+        Result<SceneScript> script = parseSceneScript(R"({"name": "t", "ground": {"kind": "plane", "size": 100},
+            "species": [{"name": "s", "source": "preset:shrub", "leaves": 100, "techniques": "auto"}],
+            "placements": [{"species": "s", "positions": [[0, 0]]}],
+            "camera": {"keyframes": [{"time": 0, "position": [0, 1, 10], "target": [0, 1, 0]}]},
+            "resolution": [64, 64], "frames": 1})",
+                                                      "t.json", "");
+        ASSERT_TRUE(script.ok()) << script.error().message();
+        for (const std::string& choice : {std::string(""), std::string("auto@0.05")})
+        {
+            const auto packages = scenePackages(*script, {choice});
+            ASSERT_EQ(packages.size(), 1u);
+            EXPECT_EQ(packages.begin()->second,
+                      (std::vector<std::string>{"billboard-cloud", "classic-billboard-cloud", "impostor", "lodf", "reference"}))
+                << "choice '" << choice << "'";
+        }
     }
 
     TEST(OgreGreyImage, readsWhatTheBakeSideReads)
