@@ -63,7 +63,7 @@ namespace TreeLod
                         // Drop this tree's entry so that it is measured again.
                         const std::string path = costCalibrationPath(directory, rendererName);
                         Result<CostCalibration> held = readCostCalibration(path, rendererName);
-                        if (held && held->assets.erase(assetCostKey(asset->getPackage())))
+                        if (held && held->assets.erase(levelCostKey(*asset)))
                             if (Result<void> w = writeCostCalibration(path, *held); !w)
                                 return printError(w.error());
                     }

@@ -218,7 +218,7 @@ namespace TreeLod
                     if (calibrated && !args.quiet)
                         std::fprintf(stderr, "calibrated %zu levels of %s on %s\n", costs->size(), source.c_str(),
                                      rendererString(renderer.getRoot()).c_str());
-                    levelCosts[assetCostKey(asset->getPackage())] = std::move(costs.value());
+                    levelCosts[levelCostKey(*asset)] = std::move(costs.value());
                 }
 
             using nlohmann::json;
@@ -245,7 +245,7 @@ namespace TreeLod
             {
                 ForestSceneOptions options;
                 options.levelCosts = [&](TreeAsset& asset) {
-                    const auto found = levelCosts.find(assetCostKey(asset.getPackage()));
+                    const auto found = levelCosts.find(levelCostKey(asset));
                     if (found == levelCosts.end())
                         OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND, "no calibrated costs for " + asset.getName(),
                                     "treelod_frames");

@@ -67,6 +67,10 @@ namespace TreeLod
         /// Nothing is still arriving (a technique's bakes, Forest levels within the upload
         /// budget): what the next frame shows is complete. Screenshots wait for it.
         virtual bool isSettled() const { return true; }
+        /// Budgeted auto's error budget (Forest::levelsForErrorBudget), where the sample has one.
+        virtual bool hasErrorBudget() const { return false; }
+        virtual float getErrorBudget() const { return 0.0f; }
+        virtual void setErrorBudget(float) {}
         virtual bool hasCameraPath() const { return false; }
         virtual bool isPlaying() const { return false; }
         virtual void setPlaying(bool) {}

@@ -1,5 +1,7 @@
 #include "ForestSample.h"
 
+#include "TreeLod/AtomicFile.h"
+#include "TreeLod/LevelCalibration.h"
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/TechniqueRegistry.h"
 
@@ -55,6 +57,20 @@ namespace TreeLod
         mSceneManager = mRoot.createSceneManager();
         ForestSceneOptions options;
         options.uploadBudget = UPLOAD_BUDGET;
+        // Budgeted auto with this renderer's costs from the user's cache; none: the fixed bands.
+        options.levelCosts = [this](TreeAsset& asset) {
+            const std::string renderer = rendererString(mRoot);
+            const std::string path = costCalibrationPath(userCacheDirectory(), renderer);
+            Result<CostCalibration> calibration = readCostCalibration(path, renderer);
+            const std::vector<LevelCost>* costs = calibration ? calibration->find(levelCostKey(asset)) : nullptr;
+            if (!costs)
+                OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
+                            "no calibration of " + asset.getName() + " on this renderer in " + path +
+                                " (treelod calibrate makes one)",
+                            "ForestSample");
+            return *costs;
+        };
+        mErrorBudget = mScript.lod.maxError;
         mScene = std::make_unique<ForestScene>(*mSceneManager, *mSceneManager->getRootSceneNode(), mScript, options);
         mCamera = mSceneManager->createCamera("TreeLod/Browser/ForestCamera");
         mCameraNode = mSceneManager->getRootSceneNode()->createChildSceneNode();
@@ -147,6 +163,14 @@ namespace TreeLod
         mScene->requestTechnique(technique == SCRIPT_TECHNIQUE ? "" : technique);
     }
 
+    void ForestSample::setErrorBudget(float budget)
+    {
+        mErrorBudget = budget;
+        char technique[32];
+        std::snprintf(technique, sizeof technique, "auto@%g", double(budget));
+        setTechnique(technique);
+    }
+
     void ForestSample::setLodBias(float bias)
     {
         mLodBias = bias;
@@ -196,6 +220,13 @@ namespace TreeLod
                                              " meanwhile)");
         if (!mBakeError.empty())
             stats.emplace_back("Bake failed", mBakeError);
+        // "oak: budget 0.02: lodf 3000 >= 117 px, ...": how, here; which levels, in the level box.
+        for (const std::string& note : mScene->getLevelNotes())
+        {
+            const std::size_t colon = note.find(": ");
+            const std::string how = note.substr(colon + 2);
+            stats.emplace_back("Auto " + note.substr(0, colon), how.substr(0, how.find(':')));
+        }
         return stats;
     }
 
@@ -208,7 +239,7 @@ namespace TreeLod
         for (const std::vector<std::uint32_t>& counts : s.levelCounts)
             for (std::uint32_t count : counts)
                 most = std::max(most, count);
-        std::vector<std::string> lines;
+        std::vector<std::string> lines = mScene->getLevelNotes();
         for (std::size_t species = 0; species < s.levelCounts.size(); ++species)
         {
             const std::vector<ForestLevel>& levels = forest.getLevels(std::uint32_t(species));
@@ -226,7 +257,7 @@ namespace TreeLod
                                 std::to_string(count));
             }
         }
-        if (lines.empty())
+        if (lines.size() == mScene->getLevelNotes().size())
             lines.push_back("(no tree in view)");
         return lines;
     }

@@ -47,6 +47,12 @@ namespace TreeLod
         void setLodFrozen(bool frozen) override;
         bool hasCameraPath() const override { return true; }
         bool isSettled() const override;
+        /// Auto at another budget: the technique "auto@E" (ForestScene.h). Levels come from the
+        /// packages' error curves and this renderer's calibration in the user's cache (`treelod
+        /// bench` or `treelod calibrate` made them); without them auto keeps its fixed bands.
+        bool hasErrorBudget() const override { return true; }
+        float getErrorBudget() const override { return mErrorBudget; }
+        void setErrorBudget(float budget) override;
         bool isPlaying() const override { return mPlaying; }
         void setPlaying(bool playing) override { mPlaying = playing; }
         void setScreenshotView(unsigned index, unsigned count) override;
@@ -72,6 +78,7 @@ namespace TreeLod
         bool mPlaying = true;
         std::string mBakeError; ///< the last technique switch's failed bake, shown in the stats
         float mLodBias = 1.0f;
+        float mErrorBudget = 0.0f; ///< set from the script's lod.maxError when built
         bool mShadows = false;
         bool mWireframe = false;
     };

@@ -21,6 +21,7 @@
 #include <malloc.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -43,6 +44,18 @@ namespace TreeLod
         double secondsSince(std::chrono::steady_clock::time_point start)
         {
             return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        }
+
+        /// The error budget slider's steps (FLIP over the reference's own; 0: the reference itself).
+        const std::array<float, 10> ERROR_BUDGETS{0.0f, 0.005f, 0.01f, 0.02f, 0.03f, 0.05f, 0.08f, 0.12f, 0.2f, 1.0f};
+
+        std::size_t nearestErrorBudget(float budget)
+        {
+            std::size_t best = 0;
+            for (std::size_t i = 1; i < ERROR_BUDGETS.size(); ++i)
+                if (std::abs(ERROR_BUDGETS[i] - budget) < std::abs(ERROR_BUDGETS[best] - budget))
+                    best = i;
+            return best;
         }
 
         std::string biasCaption(int exponent)
@@ -405,6 +418,7 @@ namespace TreeLod
         mTrays->destroyAllWidgets();
         mTechniqueMenu = nullptr;
         mLodBiasSlider = nullptr;
+        mErrorBudgetSlider = nullptr;
         mShadowsBox = mWireframeBox = mFreezeBox = nullptr;
         mPlayButton = nullptr;
         mStatsPanel = nullptr;
@@ -482,6 +496,11 @@ namespace TreeLod
                                                       10, sample.getTechniques());
         mLodBiasSlider = mTrays->createLongSlider(TL_TOPLEFT, "LodBias", "LoD bias ([ ])", WIDGET_WIDTH, 60.0f, 54.0f,
                                                   -4.0f, 4.0f, 9);
+        mErrorBudgetSlider = nullptr;
+        if (sample.hasErrorBudget())
+            mErrorBudgetSlider = mTrays->createLongSlider(TL_TOPLEFT, "ErrorBudget", "Error budget (auto)", WIDGET_WIDTH,
+                                                          60.0f, 54.0f, 0.0f, float(ERROR_BUDGETS.size() - 1),
+                                                          unsigned(ERROR_BUDGETS.size()));
         mShadowsBox = mTrays->createCheckBox(TL_TOPLEFT, "Shadows", "Shadows (H)", WIDGET_WIDTH);
         mWireframeBox = mTrays->createCheckBox(TL_TOPLEFT, "Wireframe", "Wireframe (R)", WIDGET_WIDTH);
         mFreezeBox = mTrays->createCheckBox(TL_TOPLEFT, "FreezeLod", "Freeze LoD (L)", WIDGET_WIDTH);
@@ -505,6 +524,12 @@ namespace TreeLod
         const int exponent = int(std::lround(std::log2(std::max(1e-3f, sample.getLodBias()))));
         mLodBiasSlider->setValue(Ogre::Real(exponent), false);
         mLodBiasSlider->setValueCaption(biasCaption(exponent));
+        if (mErrorBudgetSlider)
+        {
+            const std::size_t step = nearestErrorBudget(sample.getErrorBudget());
+            mErrorBudgetSlider->setValue(Ogre::Real(step), false);
+            mErrorBudgetSlider->setValueCaption(Ogre::StringConverter::toString(ERROR_BUDGETS[step]));
+        }
         mShadowsBox->setChecked(sample.getShadows(), false);
         mWireframeBox->setChecked(sample.getWireframe(), false);
         mFreezeBox->setChecked(sample.isLodFrozen(), false);
@@ -886,6 +911,12 @@ namespace TreeLod
     {
         if (slider == mLodBiasSlider && mCurrent >= 0)
             setLodBiasExponent(int(std::lround(slider->getValue())));
+        if (slider == mErrorBudgetSlider && mCurrent >= 0)
+        {
+            const std::size_t step = std::min(ERROR_BUDGETS.size() - 1, std::size_t(std::lround(slider->getValue())));
+            mSamples[std::size_t(mCurrent)]->setErrorBudget(ERROR_BUDGETS[step]);
+            slider->setValueCaption(Ogre::StringConverter::toString(ERROR_BUDGETS[step]));
+        }
     }
 
     void TreeLodBrowser::checkBoxToggled(OgreBites::CheckBox* box)

@@ -150,6 +150,7 @@ namespace TreeLod
         OgreBites::TextBox* mDescription = nullptr;
         OgreBites::SelectMenu* mTechniqueMenu = nullptr;
         OgreBites::Slider* mLodBiasSlider = nullptr;
+        OgreBites::Slider* mErrorBudgetSlider = nullptr; ///< samples with budgeted auto only
         OgreBites::CheckBox* mShadowsBox = nullptr;
         OgreBites::CheckBox* mWireframeBox = nullptr;
         OgreBites::CheckBox* mFreezeBox = nullptr;

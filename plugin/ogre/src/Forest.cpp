@@ -87,7 +87,7 @@ namespace TreeLod
 
         /// The LoD value (reference-sphere units) of `asset` drawn `heightPixels` tall: a tree h
         /// metres tall drawn h_px pixels tall has r_px = h_px * R / h, value = 4 pi r_px^2.
-        Ogre::Real pixelCountForHeight(TreeAsset& asset, Ogre::Real heightPixels, const Ogre::String& label,
+        Ogre::Real valueForHeight(TreeAsset& asset, Ogre::Real heightPixels, const Ogre::String& label,
                                        const char* source)
         {
             const Ogre::AxisAlignedBox bounds = asset.getBounds();
@@ -358,9 +358,15 @@ namespace TreeLod
         return info && info->forestLevels ? info->forestLevels->describeLevel(level) : level.technique;
     }
 
+    Ogre::Real Forest::pixelCountForHeight(TreeAsset& asset, Ogre::Real heightPixels)
+    {
+        return valueForHeight(asset, heightPixels, "asset '" + asset.getName() + "': ",
+                                            "Forest::pixelCountForHeight");
+    }
+
     Ogre::Real Forest::heightForPixelCount(TreeAsset& asset, Ogre::Real pixelCount)
     {
-        const Ogre::Real perPixel = pixelCountForHeight(asset, 1.0f, "asset '" + asset.getName() + "': ",
+        const Ogre::Real perPixel = valueForHeight(asset, 1.0f, "asset '" + asset.getName() + "': ",
                                                         "Forest::heightForPixelCount");
         return std::sqrt(std::max(pixelCount, 0.0f) / perPixel);
     }
@@ -398,7 +404,7 @@ namespace TreeLod
             level.technique = c.technique;
             level.techniqueLevel = c.techniqueLevel;
             level.lowRes = c.lowRes;
-            level.minPixelCount = choice.minHeightPx > 0.0f ? pixelCountForHeight(asset, choice.minHeightPx, label, source)
+            level.minPixelCount = choice.minHeightPx > 0.0f ? valueForHeight(asset, choice.minHeightPx, label, source)
                                                             : 0.0f;
             levels.push_back(level);
         }
@@ -411,8 +417,8 @@ namespace TreeLod
         const Ogre::String label = "asset '" + asset.getName() + "': ";
         if (bands.empty())
             invalid(label + "no technique bands", source);
-        pixelCountForHeight(asset, 1.0f, label, source); // a tree without height has no screen size: refused here
-        auto pixelCount = [&](Ogre::Real heightPixels) { return pixelCountForHeight(asset, heightPixels, label, source); };
+        valueForHeight(asset, 1.0f, label, source); // a tree without height has no screen size: refused here
+        auto pixelCount = [&](Ogre::Real heightPixels) { return valueForHeight(asset, heightPixels, label, source); };
 
         std::vector<ForestLevel> levels;
         Ogre::Real upper = NO_UPPER;

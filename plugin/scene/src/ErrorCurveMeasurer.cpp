@@ -120,27 +120,29 @@ namespace TreeLod
         renderer.setLodBias(1.0f);
         renderer.clearContent();
         Ogre::SceneManager& sceneManager = renderer.getSceneManager();
-        // One Forest per level, each drawn at every height and view.
-        std::vector<Forest*> forests;
-        try
-        {
-            for (std::size_t l = 0; l < levels.size(); ++l)
-            {
-                Forest* forest = createLevelForest(sceneManager, renderer.getContentNode(), asset, levels[l],
-                                                   {ForestInstance{}}, "TreeLod/ErrorCurves/" + std::to_string(l));
-                forest->setVisible(false);
-                forests.push_back(forest);
-            }
-        }
-        catch (const Ogre::Exception& e)
-        {
-            renderer.clearContent();
-            return fail(label, "level " + describe(levels[forests.size()]), e.getDescription());
-        }
-
         const std::size_t total = options.heightsPx.size() * options.views.size();
         std::size_t done = 0;
         for (std::size_t h = 0; h < options.heightsPx.size(); ++h)
+        {
+            // One Forest per level, its bark at the mesh LoD level a Forest draws at this height.
+            std::vector<Forest*> forests;
+            try
+            {
+                renderer.clearContent();
+                for (std::size_t l = 0; l < levels.size(); ++l)
+                {
+                    Forest* forest =
+                        createLevelForest(sceneManager, renderer.getContentNode(), asset, levels[l], {ForestInstance{}},
+                                          "TreeLod/ErrorCurves/" + std::to_string(l), options.heightsPx[h]);
+                    forest->setVisible(false);
+                    forests.push_back(forest);
+                }
+            }
+            catch (const Ogre::Exception& e)
+            {
+                renderer.clearContent();
+                return fail(label, "level " + describe(levels[forests.size()]), e.getDescription());
+            }
             for (const glm::vec2& viewAngles : options.views)
             {
                 report(progress, "error curves", float(done++) / float(total));
@@ -173,6 +175,7 @@ namespace TreeLod
                     c.flipMax[h] = std::max(c.flipMax[h], float(s->flip));
                 }
             }
+        }
         renderer.clearContent();
         report(progress, "error curves", 1.0f);
         for (ErrorCurveLevel& c : curves.levels)

@@ -300,9 +300,20 @@ namespace TreeLod
                     budget = mScript.lod.maxError;
                 std::vector<ForestLevel> levels;
                 std::string note;
+                std::vector<LevelCost> costs;
+                std::string noCosts = "no level costs given";
                 if (budgeted && mOptions.levelCosts && asset->hasChunk(ERROR_CURVES_CHUNK))
+                    try
+                    {
+                        costs = mOptions.levelCosts(*asset);
+                    }
+                    catch (const Ogre::Exception& e)
+                    {
+                        noCosts = e.getDescription();
+                    }
+                if (!costs.empty())
                 {
-                    levels = Forest::levelsForErrorBudget(*asset, mOptions.levelCosts(*asset), budget);
+                    levels = Forest::levelsForErrorBudget(*asset, costs, budget);
                     note = "budget " + Ogre::StringConverter::toString(budget) + ":";
                     for (std::size_t l = 0; l < levels.size(); ++l)
                         note += (l ? ", " : " ") + Forest::describeLevel(levels[l]) + " >= " +
@@ -313,7 +324,7 @@ namespace TreeLod
                     levels = Forest::levelsForBands(*asset, bands[s]);
                     if (budgeted)
                         note = std::string("fixed auto bands: ") +
-                               (asset->hasChunk(ERROR_CURVES_CHUNK) ? "no level costs given" : "the package has no error curves");
+                               (asset->hasChunk(ERROR_CURVES_CHUNK) ? noCosts : "the package has no error curves");
                 }
                 if (!note.empty())
                 {

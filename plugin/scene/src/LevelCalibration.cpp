@@ -3,6 +3,7 @@
 #include "TreeLod/Forest.h"
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/Package.h"
+#include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 
 #include <OgreRenderSystem.h>
@@ -63,9 +64,23 @@ namespace TreeLod
                (caps ? caps->getDriverVersion().toString() : Ogre::String("?"));
     }
 
+    std::string levelCostKey(TreeAsset& asset)
+    {
+        std::vector<std::string> chunks;
+        for (const ForestLevel& level : Forest::getCandidateLevels(asset))
+        {
+            const TechniqueInfo& info = TechniqueRegistry::getSingleton().get(level.technique);
+            if (std::find(chunks.begin(), chunks.end(), info.chunkTechnique) == chunks.end())
+                chunks.push_back(info.chunkTechnique);
+        }
+        if (std::find(chunks.begin(), chunks.end(), REFERENCE_CHUNK) == chunks.end())
+            chunks.push_back(REFERENCE_CHUNK); // the bark every level draws
+        return assetCostKey(asset.getPackage(), chunks);
+    }
+
     Forest* createLevelForest(Ogre::SceneManager& sceneManager, Ogre::SceneNode& node, TreeAsset& asset,
                               const ForestLevel& level, const std::vector<ForestInstance>& instances,
-                              const std::string& name)
+                              const std::string& name, float heightPx)
     {
         const TreeAssetPtr pointer = TreeAssetManager::getSingleton().getByName(asset.getName(), asset.getGroup());
         if (!pointer)
@@ -76,7 +91,14 @@ namespace TreeLod
         {
             ForestLevel only = level;
             only.minPixelCount = 0.0f;
-            forest->addSpecies(pointer, {only});
+            std::vector<ForestLevel> levels = {only};
+            if (heightPx > 0.0f)
+            {
+                ForestLevel above = level; // built only if a tree is taller than 1.05 heightPx: never here
+                above.minPixelCount = Forest::pixelCountForHeight(asset, 1.05f * heightPx);
+                levels.insert(levels.begin(), above);
+            }
+            forest->addSpecies(pointer, levels);
             forest->addInstances(instances);
         }
         catch (...)
@@ -156,7 +178,7 @@ namespace TreeLod
                         float distance = 0.0f;
                         createLevelForest(renderer.getSceneManager(), renderer.getContentNode(), asset, level,
                                           grid(box, setup.heightPx, setup.spacingPx, options.viewport, count, distance),
-                                          "TreeLod/Calibration");
+                                          "TreeLod/Calibration", setup.heightPx);
                         // timeFrames draws one untimed frame first (programs linked, levels built)
                         const double ms = median(renderer.timeFrames(setup.camera, options.viewport, options.viewport,
                                                                      frames));
@@ -191,7 +213,7 @@ namespace TreeLod
             *calibrated = false;
         const std::string renderString = rendererString(renderer.getRoot());
         const std::string path = costCalibrationPath(directory, renderString);
-        const std::string key = assetCostKey(asset.getPackage());
+        const std::string key = levelCostKey(asset);
         CostCalibration calibration;
         calibration.renderer = renderString;
         std::error_code ec;

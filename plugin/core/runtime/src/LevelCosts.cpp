@@ -2,7 +2,6 @@
 
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/Crc32.h"
-#include "TreeLod/ErrorCurves.h"
 #include "TreeLod/Package.h"
 
 #include <nlohmann/json.hpp>
@@ -142,11 +141,11 @@ namespace TreeLod
         return writeFileAtomic(path, std::vector<std::uint8_t>(text.begin(), text.end()));
     }
 
-    std::string assetCostKey(const PackageReader& package)
+    std::string assetCostKey(const PackageReader& package, const std::vector<std::string>& chunks)
     {
         std::string entries;
         for (const ChunkInfo& info : package.chunks())
-            if (info.technique != META_CHUNK && info.technique != ERROR_CURVES_CHUNK)
+            if (std::find(chunks.begin(), chunks.end(), info.technique) != chunks.end())
                 entries += info.technique + "/" + std::to_string(info.level) + "/" +
                            std::to_string(info.formatVersion) + "/" + std::to_string(info.crc32) + ";";
         return hex16(fnv1a64(entries.data(), entries.size()));

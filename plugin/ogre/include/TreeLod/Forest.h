@@ -130,6 +130,9 @@ namespace TreeLod
         /// The height on screen (pixels) of `asset` at LoD value `pixelCount` (reference-sphere
         /// units, as ForestLevel::minPixelCount): the inverse of the bands' conversion.
         static Ogre::Real heightForPixelCount(TreeAsset& asset, Ogre::Real pixelCount);
+        /// The LoD value (reference-sphere units) of `asset` drawn `heightPixels` tall: the bands'
+        /// conversion. Throws Ogre::InvalidParametersException for a tree without height.
+        static Ogre::Real pixelCountForHeight(TreeAsset& asset, Ogre::Real heightPixels);
 
         /// The techniques budgeted auto chooses among: the reference, lodf, both billboard clouds
         /// and the impostor.

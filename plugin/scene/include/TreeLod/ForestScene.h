@@ -72,8 +72,8 @@ namespace TreeLod
         /// first frame needs is built in it).
         std::uint64_t uploadBudget = 0;
         Ogre::String group = "TreeLod"; ///< resource group for assets, meshes and materials
-        /// This machine's costs of an asset's levels (LevelCalibration.h), for budgeted auto; may
-        /// throw Ogre::Exception. Null: auto draws the fixed bands.
+        /// This machine's costs of an asset's levels (LevelCalibration.h), for budgeted auto. Null,
+        /// or an Ogre::Exception from it (its text logged as the reason): auto draws the fixed bands.
         std::function<std::vector<LevelCost>(TreeAsset& asset)> levelCosts;
     };
 

@@ -45,11 +45,16 @@ namespace TreeLod
     /// The render system's name, device and driver: the key of a calibration file.
     std::string rendererString(Ogre::Root& root);
 
+    /// The calibration key of `asset` (assetCostKey over the chunks its candidate levels draw from).
+    std::string levelCostKey(TreeAsset& asset);
+
     /// A Forest drawing `asset` at `level` alone (every value), with `instances`, attached to `node`.
-    /// Throws Ogre::Exception as Forest::addSpecies / addInstances do.
+    /// Its bark is the bark mesh's LoD level for trees `heightPx` tall, as a Forest whose level
+    /// ends there draws it (Forest.h, "Bark"): a copy of the level above it, never drawn, bounds
+    /// it; 0 = full detail. Throws Ogre::Exception as Forest::addSpecies / addInstances do.
     Forest* createLevelForest(Ogre::SceneManager& sceneManager, Ogre::SceneNode& node, TreeAsset& asset,
                               const ForestLevel& level, const std::vector<ForestInstance>& instances,
-                              const std::string& name);
+                              const std::string& name, float heightPx = 0.0f);
 
     /// Calibrate every candidate level of `asset` (loaded). Errors name the asset and the level.
     Result<std::vector<LevelCost>> calibrateLevels(OffscreenRenderer& renderer, TreeAsset& asset,

@@ -5,8 +5,8 @@
 //
 // File (JSON, written atomically): {"renderer": "...", "version": 1, "assets": {"<asset key>":
 // [{"technique": "lodf", "level": 1200, "lowRes": false, "heightsPx": [16, 64, 256],
-// "msPerTree": [0.012, 0.020, 0.151]}, ...]}}. The asset key (assetCostKey) hashes the package's
-// drawable chunks, so a rebaked tree is calibrated again.
+// "msPerTree": [0.012, 0.020, 0.151]}, ...]}}. The asset key (assetCostKey) hashes the chunks the
+// levels draw from, so a rebaked tree is calibrated again.
 #pragma once
 
 #include "TreeLod/Result.h"
@@ -58,6 +58,7 @@ namespace TreeLod
     Result<void> writeCostCalibration(const std::string& path, const CostCalibration& calibration);
 
     /// The calibration key of a package: FNV-1a 64 (16 hex) of the table entries (technique,
-    /// level, format version, CRC-32) of every chunk but "meta" and "error-curves".
-    std::string assetCostKey(const PackageReader& package);
+    /// level, format version, CRC-32) of its chunks named in `chunks` (those the calibrated levels
+    /// draw from), so that adding another technique's chunk to the package keeps its costs.
+    std::string assetCostKey(const PackageReader& package, const std::vector<std::string>& chunks);
 }
