@@ -24,11 +24,6 @@ namespace TreeLod
     {
         constexpr float FOV_Y_DEGREES = 45.0f;
 
-        std::string describe(const ForestLevel& level)
-        {
-            return level.technique + " " + std::to_string(level.techniqueLevel) + (level.lowRes ? " low" : "");
-        }
-
         /// One view of the tree at one screen height: the camera and the square image size.
         struct View
         {
@@ -141,7 +136,7 @@ namespace TreeLod
             catch (const Ogre::Exception& e)
             {
                 renderer.clearContent();
-                return fail(label, "level " + describe(levels[forests.size()]), e.getDescription());
+                return fail(label, "level " + Forest::describeLevel(levels[forests.size()]), e.getDescription());
             }
             for (const glm::vec2& viewAngles : options.views)
             {
@@ -159,10 +154,10 @@ namespace TreeLod
                     catch (const Ogre::Exception& e)
                     {
                         renderer.clearContent();
-                        return fail(label, "level " + describe(levels[l]), e.getDescription());
+                        return fail(label, "level " + Forest::describeLevel(levels[l]), e.getDescription());
                     }
                     forests[l]->setVisible(false);
-                    Result<Scores> s = score(reference, test, "level " + describe(levels[l]));
+                    Result<Scores> s = score(reference, test, "level " + Forest::describeLevel(levels[l]));
                     if (!s)
                     {
                         renderer.clearContent();

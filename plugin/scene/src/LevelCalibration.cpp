@@ -25,11 +25,6 @@ namespace TreeLod
             return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
         }
 
-        std::string describe(const ForestLevel& level)
-        {
-            return level.technique + " " + std::to_string(level.techniqueLevel) + (level.lowRes ? " low" : "");
-        }
-
         /// A grid of `count` trees facing the camera (looking along -Z from the origin), each
         /// `heightPx` tall in a `viewport`-pixel view, `spacingPx` apart.
         std::vector<ForestInstance> grid(const Ogre::AxisAlignedBox& box, float heightPx, float spacingPx, int viewport,
@@ -169,7 +164,7 @@ namespace TreeLod
             cost.lowRes = level.lowRes;
             for (const Setup& setup : setups)
             {
-                report(progress, "calibrate " + describe(level) + " at " + std::to_string(int(setup.heightPx)) + " px",
+                report(progress, "calibrate " + Forest::describeLevel(level) + " at " + std::to_string(int(setup.heightPx)) + " px",
                        float(done++) / float(total));
                 double perTree = 0.0;
                 try
@@ -194,7 +189,7 @@ namespace TreeLod
                 catch (const Ogre::Exception& e)
                 {
                     renderer.clearContent();
-                    return fail(label, "level " + describe(level), e.getDescription());
+                    return fail(label, "level " + Forest::describeLevel(level), e.getDescription());
                 }
                 cost.heightsPx.push_back(setup.heightPx);
                 cost.msPerTree.push_back(float(perTree));
