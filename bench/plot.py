@@ -71,10 +71,11 @@ def draw(plt, ticker, directory, out_directory, spec):
     lines, markers, front = read_series(os.path.join(directory, spec["csv"]), spec["x"], spec["y"], log_x, log_y)
     figure, axes = plt.subplots(figsize=(9.6, 6.0), dpi=100)
     has_data = False
-    for label, xs, ys in lines:
+    for i, (label, xs, ys) in enumerate(lines):
         has_data = has_data or any(math.isfinite(v) for v in xs)
+        # Past the colour cycle's ten colours, dashed then dotted: no two lines look alike.
         axes.plot(xs, ys, label=label or None, linewidth=2.0, marker="o" if spec.get("markers", True) else None,
-                  markersize=5)
+                  markersize=5, linestyle=("-", "--", ":")[(i // 10) % 3])
     for label, x, y, shape in markers:
         has_data = True
         axes.plot([x], [y], linestyle="none", marker=shape, markersize=9, color="black",
