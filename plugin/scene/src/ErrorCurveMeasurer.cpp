@@ -115,6 +115,14 @@ namespace TreeLod
         renderer.setLodBias(1.0f);
         renderer.clearContent();
         Ogre::SceneManager& sceneManager = renderer.getSceneManager();
+        // The mean is over the views a camera near the ground sees; the worst view includes them all.
+        auto meanView = [&](const glm::vec2& view) {
+            const bool anySide = std::any_of(options.views.begin(), options.views.end(), [&](const glm::vec2& v) {
+                return v.y <= options.meanMaxElevation;
+            });
+            return !anySide || view.y <= options.meanMaxElevation;
+        };
+        const std::size_t meanViews = std::size_t(std::count_if(options.views.begin(), options.views.end(), meanView));
         const std::size_t total = options.heightsPx.size() * options.views.size();
         std::size_t done = 0;
         for (std::size_t h = 0; h < options.heightsPx.size(); ++h)
@@ -164,9 +172,11 @@ namespace TreeLod
                         return s.error();
                     }
                     ErrorCurveLevel& c = curves.levels[l];
-                    const float n = float(options.views.size());
-                    c.flip[h] += float(s->flip) / n;
-                    c.rmse[h] += float(s->rmse) / n;
+                    if (meanView(viewAngles))
+                    {
+                        c.flip[h] += float(s->flip) / float(meanViews);
+                        c.rmse[h] += float(s->rmse) / float(meanViews);
+                    }
                     c.flipMax[h] = std::max(c.flipMax[h], float(s->flip));
                 }
             }

@@ -6,7 +6,9 @@
 // each view (azimuths around the tree and one from above), and compared with the CPU ray-traced
 // reference (ReferenceRenderer, supersampled) over a square crop around the tree (the union of
 // both images' tree pixels): FLIP (Andersson et al. 2020) and multi-scale RMSE (the
-// ellipsoids-and-lines paper, §4). The view is sized so the tree's box height spans `heightPx`
+// ellipsoids-and-lines paper, §4). The curves the selection reads (flip, rmse) average the views
+// up to 60 degrees of elevation; the view from above counts in the worst view (flipMax) only: a
+// crown thinned from above is not what a camera near the ground sees of it. The view is sized so the tree's box height spans `heightPx`
 // pixels at the distance the Forest's LoD would see it at (the units of ForestBand).
 // The "mesh" curve is the rasteriser's own error at that size: the floor no level can beat.
 //
@@ -35,6 +37,10 @@ namespace TreeLod
         std::vector<float> heightsPx{8.0f, 16.0f, 32.0f, 64.0f, 128.0f, 256.0f, 512.0f};
         /// (azimuth, elevation) in degrees: three around at 10 degrees, one at 45, one from above.
         std::vector<glm::vec2> views{{0.0f, 10.0f}, {120.0f, 10.0f}, {240.0f, 10.0f}, {60.0f, 45.0f}, {30.0f, 85.0f}};
+        /// ErrorCurveLevel::flip and rmse average the views at this elevation or below (those a camera
+        /// near the ground sees); flipMax is the worst of all of them, from above included. All
+        /// views count when none is this low.
+        float meanMaxElevation = 60.0f;
         int referenceSupersample = 2; ///< per axis
     };
 

@@ -6,8 +6,9 @@
 // ---- Meaning ----------------------------------------------------------------------------
 // For each height in heightsPx (the tree's height on screen, pixels), each level is
 // rendered from `views` directions and compared with the reference (the polygonal tree,
-// supersampled referenceSamples times per pixel): flip is the mean FLIP over the views,
-// flipMax the worst view's, rmse the mean multi-scale RMSE (ImageMetrics.h).
+// supersampled referenceSamples times per pixel): flip is the mean FLIP over the views (the
+// measurer averages those a camera near the ground sees), flipMax the worst view's (all views),
+// rmse the mean multi-scale RMSE (ImageMetrics.h) over the same views as flip.
 // A level is named as ForestLevel names it: (technique, techniqueLevel, lowRes).
 //
 // ---- Chunk layout, level 0, formatVersion 1 (ERROR_CURVES_FORMAT_VERSION) -----------------
@@ -45,7 +46,7 @@ namespace TreeLod
         std::string technique;            ///< registered technique name ("mesh", "lodf", ...), 1..32 printable ASCII
         std::uint32_t techniqueLevel = 0; ///< the technique's own level (as ForestLevel::techniqueLevel)
         bool lowRes = false;              ///< as ForestLevel::lowRes
-        std::vector<float> flip;          ///< mean FLIP over the views, one per height, in [0, 1]
+        std::vector<float> flip;          ///< mean FLIP over the (side) views, one per height, in [0, 1]
         std::vector<float> flipMax;       ///< worst view's FLIP, one per height, in [0, 1], >= flip
         std::vector<float> rmse;          ///< mean multi-scale RMSE over the views, one per height, in [0, 1]
     };

@@ -143,7 +143,7 @@ namespace TreeLod
     /// "lod": how `auto` species choose levels (docs/scene-format.md).
     struct SceneLod
     {
-        static constexpr float DEFAULT_MAX_ERROR = 0.02f;
+        static constexpr float DEFAULT_MAX_ERROR = 0.03f;
         /// Error budget of budgeted auto (Forest::setErrorBudget): FLIP over the tree's box above
         /// the polygonal reference's own, in [0, 1].
         float maxError = DEFAULT_MAX_ERROR;
