@@ -1138,8 +1138,9 @@ namespace TreeLod
             ForestVisibility vis;
             ASSERT_TRUE(forest.cull(camera, 1.0f, vis));
             EXPECT_EQ(vis.getVisibleCount(), MILLION);
+            // per visible tree: transform, indices, distance class; per tree (all visible here): its last level
             const std::size_t perVisible = ForestVisibility::TRANSFORM_FLOATS * sizeof(float) +
-                                           4 * sizeof(std::uint32_t) + sizeof(std::uint8_t);
+                                           4 * sizeof(std::uint32_t) + 2 * sizeof(std::uint8_t);
             const std::size_t visibilityBound = MILLION * perVisible +
                                                 forest.getBucketCount() * (sizeof(ForestBucket) + sizeof(std::uint32_t));
             EXPECT_LE(vis.getCapacityBytes(), visibilityBound);
