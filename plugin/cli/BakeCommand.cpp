@@ -126,7 +126,8 @@ namespace TreeLod
                 try
                 {
                     OffscreenRenderer renderer;
-                    Result<std::vector<std::uint8_t>> measured = addErrorCurves(renderer, bytes, args.output, {}, progress);
+                    Result<std::vector<std::uint8_t>> measured =
+                        addErrorCurves(renderer, bytes, args.output, {}, progress);
                     if (!measured)
                         return printError(measured.error());
                     bytes = std::move(measured.value());
@@ -150,8 +151,8 @@ namespace TreeLod
             for (const std::string& t : meta.techniques)
                 list += (list.empty() ? "" : ", ") + t;
             std::printf("wrote %s: %zu chunks (%s + meta), %zu bytes; %zu leaves, %zu bark triangles\n",
-                        args.output.c_str(), writer.chunkCount() + (args.errorCurves ? 1 : 0), list.c_str(), bytes.size(), model->leaves.size(),
-                        model->barkTriangleCount());
+                        args.output.c_str(), writer.chunkCount() + (args.errorCurves ? 1 : 0), list.c_str(),
+                        bytes.size(), model->leaves.size(), model->barkTriangleCount());
             return EXIT_OK;
         }
     }

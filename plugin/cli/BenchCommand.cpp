@@ -854,9 +854,10 @@ namespace TreeLod
                         Result<bool> measured = ensureErrorCurves(*renderer, entry.path, {}, progress);
                         if (!measured)
                             return measured.error();
+                        const double seconds =
+                            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
                         if (*measured)
-                            report(progress, "error curves of " + entry.name + ": " +
-                                                 number(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1) + " s",
+                            report(progress, "error curves of " + entry.name + " measured in " + number(seconds, 1) + " s",
                                    1.0f);
                         break;
                     }

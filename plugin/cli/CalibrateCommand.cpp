@@ -86,7 +86,8 @@ namespace TreeLod
                         for (std::size_t h = 0; h < c.heightsPx.size(); ++h)
                         {
                             char cell[64];
-                            std::snprintf(cell, sizeof cell, "  %g px %.4f ms", double(c.heightsPx[h]), double(c.msPerTree[h]));
+                            std::snprintf(cell, sizeof cell, "  %g px %.4f ms", double(c.heightsPx[h]),
+                                          double(c.msPerTree[h]));
                             row += cell;
                         }
                         if (!args.json)

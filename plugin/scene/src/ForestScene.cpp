@@ -295,7 +295,8 @@ namespace TreeLod
             try
             {
                 float budget = std::numeric_limits<float>::quiet_NaN(); // NaN: the script's
-                const bool budgeted = parseAutoTechnique(mTechnique, budget) || (mTechnique.empty() && species.autoTechnique);
+                const bool budgeted =
+                    parseAutoTechnique(mTechnique, budget) || (mTechnique.empty() && species.autoTechnique);
                 if (std::isnan(budget))
                     budget = mScript.lod.maxError;
                 std::vector<ForestLevel> levels;
@@ -316,8 +317,11 @@ namespace TreeLod
                     levels = Forest::levelsForErrorBudget(*asset, costs, budget);
                     note = "budget " + Ogre::StringConverter::toString(budget) + ":";
                     for (std::size_t l = 0; l < levels.size(); ++l)
+                    {
+                        const float px = Forest::heightForPixelCount(*asset, levels[l].minPixelCount);
                         note += (l ? ", " : " ") + Forest::describeLevel(levels[l]) + " >= " +
-                                Ogre::StringConverter::toString(int(std::round(Forest::heightForPixelCount(*asset, levels[l].minPixelCount)))) + " px";
+                                Ogre::StringConverter::toString(int(std::round(px))) + " px";
+                    }
                 }
                 else
                 {
