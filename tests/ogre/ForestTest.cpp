@@ -1489,7 +1489,7 @@ namespace TreeLod
         Result<std::vector<LevelCost>> costs = requireLevelCosts(r, *asset, dir, options, {}, &calibrated);
         ASSERT_TRUE(costs) << costs.error().message();
         EXPECT_TRUE(calibrated);
-        ASSERT_EQ(costs->size(), Forest::getCandidateLevels(*asset).size());
+        ASSERT_EQ(costs->size(), Forest::getCandidateLevels(*asset, Forest::getAutoTechniques()).size());
         for (const LevelCost& c : *costs)
         {
             ASSERT_EQ(c.msPerTree.size(), 2u) << c.technique;

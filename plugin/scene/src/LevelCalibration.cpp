@@ -62,7 +62,7 @@ namespace TreeLod
     std::string levelCostKey(TreeAsset& asset)
     {
         std::vector<std::string> chunks;
-        for (const ForestLevel& level : Forest::getCandidateLevels(asset))
+        for (const ForestLevel& level : Forest::getCandidateLevels(asset, Forest::getAutoTechniques()))
         {
             const TechniqueInfo& info = TechniqueRegistry::getSingleton().get(level.technique);
             if (std::find(chunks.begin(), chunks.end(), info.chunkTechnique) == chunks.end())
@@ -114,7 +114,7 @@ namespace TreeLod
         std::vector<ForestLevel> levels;
         try
         {
-            levels = Forest::getCandidateLevels(asset);
+            levels = Forest::getCandidateLevels(asset, Forest::getAutoTechniques());
         }
         catch (const Ogre::Exception& e)
         {
@@ -223,7 +223,7 @@ namespace TreeLod
         if (const std::vector<LevelCost>* held = calibration.find(key))
         {
             bool all = true;
-            for (const ForestLevel& level : Forest::getCandidateLevels(asset))
+            for (const ForestLevel& level : Forest::getCandidateLevels(asset, Forest::getAutoTechniques()))
                 all = all && findLevelCost(*held, level.technique, level.techniqueLevel, level.lowRes) >= 0;
             if (all)
                 return *held;

@@ -1,6 +1,7 @@
 // LevelCalibration: what each level of a tree costs on the running machine (LevelCosts.h).
 //
-// For every level the asset can be drawn at (Forest::getCandidateLevels), a grid of trees at
+// For every level budgeted auto chooses among (Forest::getCandidateLevels of
+// Forest::getAutoTechniques()), a grid of trees at
 // that one level, spaced so they do not overlap, is drawn through a Forest (instanced, as in a
 // scene) at each calibration height; each frame is timed until a one-pixel read-back returns
 // (OGRE 1.12's GL3Plus has no timer queries), the median of a few frames taken, the median of an
@@ -45,7 +46,8 @@ namespace TreeLod
     /// The render system's name, device and driver: the key of a calibration file.
     std::string rendererString(Ogre::Root& root);
 
-    /// The calibration key of `asset` (assetCostKey over the chunks its candidate levels draw from).
+    /// The calibration key of `asset` (assetCostKey over the chunks its auto levels draw from, so
+    /// that other techniques' chunks added to the package later keep its costs).
     std::string levelCostKey(TreeAsset& asset);
 
     /// A Forest drawing `asset` at `level` alone (every value), with `instances`, attached to `node`.
@@ -56,7 +58,7 @@ namespace TreeLod
                               const ForestLevel& level, const std::vector<ForestInstance>& instances,
                               const std::string& name, float heightPx = 0.0f);
 
-    /// Calibrate every candidate level of `asset` (loaded). Errors name the asset and the level.
+    /// Calibrate every auto level of `asset` (loaded). Errors name the asset and the level.
     Result<std::vector<LevelCost>> calibrateLevels(OffscreenRenderer& renderer, TreeAsset& asset,
                                                    const CalibrationOptions& options = {},
                                                    const ProgressCallback& progress = {});
