@@ -116,12 +116,9 @@ namespace TreeLod
         renderer.clearContent();
         Ogre::SceneManager& sceneManager = renderer.getSceneManager();
         // The mean is over the views a camera near the ground sees; the worst view includes them all.
-        auto meanView = [&](const glm::vec2& view) {
-            const bool anySide = std::any_of(options.views.begin(), options.views.end(), [&](const glm::vec2& v) {
-                return v.y <= options.meanMaxElevation;
-            });
-            return !anySide || view.y <= options.meanMaxElevation;
-        };
+        const bool anySide = std::any_of(options.views.begin(), options.views.end(),
+                                         [&](const glm::vec2& v) { return v.y <= options.meanMaxElevation; });
+        auto meanView = [&](const glm::vec2& view) { return !anySide || view.y <= options.meanMaxElevation; };
         const std::size_t meanViews = std::size_t(std::count_if(options.views.begin(), options.views.end(), meanView));
         const std::size_t total = options.heightsPx.size() * options.views.size();
         std::size_t done = 0;
@@ -225,8 +222,14 @@ namespace TreeLod
             TreeAssetPtr mAsset;
         };
 
-        Result<std::vector<std::uint8_t>> withCurves(TreeAsset& asset, const ErrorCurves& curves, const std::string& label)
+        /// The package of `asset` with its error curves measured and added, the other chunks copied.
+        Result<std::vector<std::uint8_t>> withCurves(OffscreenRenderer& renderer, TreeAsset& asset,
+                                                     const ErrorCurveOptions& options, const ProgressCallback& progress,
+                                                     const std::string& label)
         {
+            Result<ErrorCurves> curves = measureErrorCurves(renderer, asset, options, progress);
+            if (!curves)
+                return fail(label, "error curves", curves.error().message());
             const PackageReader& reader = asset.getPackage();
             PackageWriter writer;
             for (std::size_t i = 0; i < reader.chunks().size(); ++i)
@@ -243,7 +246,7 @@ namespace TreeLod
                     return fail(label, info.element(), added.error().message());
             }
             if (Result<void> added = writer.addChunk(ERROR_CURVES_CHUNK, 0, ERROR_CURVES_FORMAT_VERSION,
-                                                     encodeErrorCurves(curves));
+                                                     encodeErrorCurves(*curves));
                 !added)
                 return fail(label, ERROR_CURVES_CHUNK, added.error().message());
             return writer.toBytes();
@@ -257,10 +260,7 @@ namespace TreeLod
         try
         {
             TemporaryAsset asset(bytes, label);
-            Result<ErrorCurves> curves = measureErrorCurves(renderer, asset.get(), options, progress);
-            if (!curves)
-                return fail(label, "error curves", curves.error().message());
-            return withCurves(asset.get(), *curves, label);
+            return withCurves(renderer, asset.get(), options, progress, label);
         }
         catch (const Ogre::Exception& e)
         {
@@ -283,10 +283,7 @@ namespace TreeLod
                 if (held && coversCandidateLevels(*held, asset.get(), options))
                     return false;
             }
-            Result<ErrorCurves> curves = measureErrorCurves(renderer, asset.get(), options, progress);
-            if (!curves)
-                return fail(path, "error curves", curves.error().message());
-            Result<std::vector<std::uint8_t>> updated = withCurves(asset.get(), *curves, path);
+            Result<std::vector<std::uint8_t>> updated = withCurves(renderer, asset.get(), options, progress, path);
             if (!updated)
                 return updated.error();
             if (Result<void> written = writeFileAtomic(path, *updated); !written)

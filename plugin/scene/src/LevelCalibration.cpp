@@ -19,20 +19,22 @@ namespace TreeLod
 {
     namespace
     {
+        constexpr float FOV_Y_DEGREES = 45.0f;
+
         double median(std::vector<double> v)
         {
             std::sort(v.begin(), v.end());
             return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
         }
 
-        /// A grid of `count` trees facing the camera (looking along -Z from the origin), each
-        /// `heightPx` tall in a `viewport`-pixel view, `spacingPx` apart.
-        std::vector<ForestInstance> grid(const Ogre::AxisAlignedBox& box, float heightPx, float spacingPx, int viewport,
-                                         std::uint32_t count, float& distance)
+        float boxHeight(const Ogre::AxisAlignedBox& box) { return std::max(box.getMaximum().y - box.getMinimum().y, 1e-6f); }
+
+        /// A grid of `count` trees `distance` metres in front of the camera (looking along -Z from
+        /// the origin), each `heightPx` tall, `spacingPx` apart.
+        std::vector<ForestInstance> grid(const Ogre::AxisAlignedBox& box, float heightPx, float spacingPx,
+                                         float distance, std::uint32_t count)
         {
-            const float boxHeight = std::max(box.getMaximum().y - box.getMinimum().y, 1e-6f);
-            distance = float(boxHeight * viewport / (2.0 * heightPx * std::tan(Ogre::Math::PI / 8.0)));
-            const float metresPerPx = boxHeight / heightPx;
+            const float metresPerPx = boxHeight(box) / heightPx;
             const int columns = std::max(1, int(std::ceil(std::sqrt(double(count)))));
             std::vector<ForestInstance> instances;
             for (std::uint32_t i = 0; i < count; ++i)
@@ -130,7 +132,7 @@ namespace TreeLod
         // The camera of each height (trees `heightPx` tall in the viewport) and its empty frame's time.
         struct Setup
         {
-            float heightPx = 0.0f, spacingPx = 0.0f, distance = 0.0f;
+            float heightPx = 0.0f, spacingPx = 0.0f, distance = 0.0f; ///< distance: of the grid
             std::uint32_t count = 0;
             CameraSpec camera;
             double emptyMs = 0.0;
@@ -143,10 +145,10 @@ namespace TreeLod
             setup.spacingPx = 1.2f * heightPx * aspect;
             const int columns = std::max(1, int(float(options.viewport) / setup.spacingPx));
             setup.count = std::min(options.maxTrees, std::uint32_t(columns * columns));
-            grid(box, heightPx, setup.spacingPx, options.viewport, 1, setup.distance);
+            setup.distance = float(distanceForHeight(boxHeight(box), heightPx, options.viewport, FOV_Y_DEGREES));
             setup.camera.position = glm::vec3(0.0f);
             setup.camera.target = glm::vec3(0.0f, 0.0f, -1.0f);
-            setup.camera.fovYDegrees = 45.0f;
+            setup.camera.fovYDegrees = FOV_Y_DEGREES;
             setup.camera.nearClip = std::max(0.01f, 0.25f * setup.distance);
             setup.camera.farClip = 4.0f * setup.distance;
             setup.emptyMs = median(renderer.timeFrames(setup.camera, options.viewport, options.viewport, options.frames));
@@ -164,15 +166,15 @@ namespace TreeLod
             cost.lowRes = level.lowRes;
             for (const Setup& setup : setups)
             {
-                report(progress, "calibrate " + Forest::describeLevel(level) + " at " + std::to_string(int(setup.heightPx)) + " px",
+                report(progress,
+                       "calibrate " + Forest::describeLevel(level) + " at " + std::to_string(int(setup.heightPx)) + " px",
                        float(done++) / float(total));
                 double perTree = 0.0;
                 try
                 {
                     auto timeGrid = [&](std::uint32_t count, int frames) {
-                        float distance = 0.0f;
                         createLevelForest(renderer.getSceneManager(), renderer.getContentNode(), asset, level,
-                                          grid(box, setup.heightPx, setup.spacingPx, options.viewport, count, distance),
+                                          grid(box, setup.heightPx, setup.spacingPx, setup.distance, count),
                                           "TreeLod/Calibration", setup.heightPx);
                         // timeFrames draws one untimed frame first (programs linked, levels built)
                         const double ms = median(renderer.timeFrames(setup.camera, options.viewport, options.viewport,

@@ -1,8 +1,8 @@
 // TreeViews: how a single tree is framed and compared in image space, shared by the bake-time
 // error curves (ErrorCurveMeasurer.h) and the studies in bench/: the tree's extent in an image,
 // a square crop around it (image error is taken over the tree's own box, not over a frame of
-// sky), the distance at which it is a given number of pixels tall, and the CPU reference
-// quantised as the GPU's frames are.
+// sky), and the CPU reference quantised as the GPU's frames are. (The distance at which a tree
+// is a given number of pixels tall is Camera.h's distanceForHeight.)
 #pragma once
 
 #include "TreeLod/Camera.h"
@@ -75,13 +75,6 @@ namespace TreeLod
             for (int x = 0; x < crop.side; ++x)
                 out.at(x, y) = image.at(crop.x + x, crop.y + y);
         return out;
-    }
-
-    /// Distance at which a tree `treeHeight` metres tall is about `px` pixels tall in a
-    /// `size`-pixel-high view with a vertical field of view of `fovYDegrees` (small-angle).
-    inline double distanceForHeight(double treeHeight, double px, int size, double fovYDegrees = 45.0)
-    {
-        return treeHeight * size / (2.0 * px * std::tan(0.5 * fovYDegrees * 3.14159265358979323846 / 180.0));
     }
 
     /// The CPU ray-traced reference at size x size, quantised to 8 bits like the GPU frames

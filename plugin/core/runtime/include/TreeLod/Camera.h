@@ -5,10 +5,18 @@
 
 #include <glm/glm.hpp>
 
+#include <cmath>
 #include <string>
 
 namespace TreeLod
 {
+    /// Distance at which a tree `treeHeight` metres tall is about `px` pixels tall in a
+    /// `size`-pixel-high view with a vertical field of view of `fovYDegrees` (small-angle).
+    inline double distanceForHeight(double treeHeight, double px, int size, double fovYDegrees = 45.0)
+    {
+        return treeHeight * size / (2.0 * px * std::tan(0.5 * fovYDegrees * 3.14159265358979323846 / 180.0));
+    }
+
     struct CameraSpec
     {
         glm::vec3 position{0.0f, 1.0f, 10.0f};
