@@ -53,21 +53,20 @@ namespace TreeLod
         const std::size_t n = std::min(heightsPx.size(), msPerTree.size());
         if (n == 0)
             return 0.0f;
-        if (n == 1 || !(heightsPx.front() < heightPx) || !std::isfinite(heightPx))
-            return std::isinf(heightPx) && n > 1 ? msAt(heightsPx.back() * 1024.0f) : msPerTree.front();
-        // log(ms) against log(h); a zero cost is floored so that its log exists
+        if (n == 1 || std::isnan(heightPx) || heightPx <= heightsPx.front())
+            return msPerTree.front();
+        heightPx = std::min(heightPx, 1024.0f * heightsPx[n - 1]); // +inf: far past the last height
+        // log(ms) against log(h) on the segment holding heightPx (the last one past the end); a
+        // zero cost is floored so that its log exists.
         auto logMs = [&](std::size_t i) { return std::log(std::max(msPerTree[i], 1e-9f)); };
         std::size_t i = 1;
         while (i + 1 < n && heightsPx[i] < heightPx)
             ++i;
         const float t = std::log(heightPx / heightsPx[i - 1]) / std::log(heightsPx[i] / heightsPx[i - 1]);
-        if (heightPx > heightsPx[n - 1])
-        {
-            const float slope = std::max(0.0f, logMs(n - 1) - logMs(n - 2));
-            return std::exp(logMs(n - 1) + slope * std::log(heightPx / heightsPx[n - 1]) /
-                                               std::log(heightsPx[n - 1] / heightsPx[n - 2]));
-        }
-        return std::exp(logMs(i - 1) + t * (logMs(i) - logMs(i - 1)));
+        const float rise = logMs(i) - logMs(i - 1);
+        if (t > 1.0f) // past the last height: from there, never falling
+            return std::exp(logMs(i) + (t - 1.0f) * std::max(0.0f, rise));
+        return std::exp(logMs(i - 1) + t * rise);
     }
 
     const std::vector<LevelCost>* CostCalibration::find(const std::string& assetKey) const
