@@ -162,12 +162,14 @@ for floor in impostor entities merged-quads billboard-set; do
   grep -q "\"$floor\": [0-9]" "$out/single/summary.json" || fail "summary has no ratio to the $floor floor"
 done
 grep -q '"worstFrame": {' "$out/single/summary.json" || fail "summary does not record the worst frame"
-# Levels are built when first seen, one per frame under a 1-byte budget: some timed frame of auto
-# uploads, and every timed frame says how much.
+# Levels are built when first seen, one per frame under a 1-byte budget: some timed frame of the
+# mesh (its levels split where the bark mesh's LoD switches; frame 2 needs one the warm-up frames
+# 0, 1, 3 and 5 did not) uploads, and every timed frame says how much. Not auto's: its levels
+# follow this machine's calibrated costs, so which frames need a new one is not fixed.
 awk -F, 'NR > 1 && $6 == 1 && $NF !~ /^[0-9]+$/ { bad = 1; print } END { exit bad }' "$out/single/frames.csv" \
   || fail "timed frames without uploaded bytes above"
-awk -F, 'NR > 1 && $2 == "auto" && $NF > 0 { n++ } END { exit !(n > 0) }' "$out/single/frames.csv" \
-  || fail "auto built no level during the timed frames"
+awk -F, 'NR > 1 && $2 == "mesh" && $NF > 0 { n++ } END { exit !(n > 0) }' "$out/single/frames.csv" \
+  || fail "the mesh built no level during the timed frames"
 # treelod_frames --preload builds every level first: no timed frame uploads.
 "$(dirname "$treelod")/treelod_frames" "$src/samples/scenes/single-tree.json" --packages "$out/single/packages.json" \
   -o "$out/preload" --skip-comparisons --techniques auto --lod-bias 1 --frames 6 --size 160x90 --samples 1 --preload -q
