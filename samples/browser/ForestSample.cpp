@@ -166,6 +166,9 @@ namespace TreeLod
     void ForestSample::setErrorBudget(float budget)
     {
         mErrorBudget = budget;
+        // Budgeted species re-plan in place; otherwise the scene is rebuilt as "auto@budget".
+        if (!mScene->isTechniquePending() && mScene->setErrorBudget(budget))
+            return;
         char technique[32];
         std::snprintf(technique, sizeof technique, "auto@%g", double(budget));
         setTechnique(technique);

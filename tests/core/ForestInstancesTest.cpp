@@ -990,3 +990,54 @@ namespace TreeLod
         EXPECT_FALSE(forest.cull(CullCamera::fromSpec(spec, 100.0f, 100.0f), 1.0f, vis, 1.5f));
     }
 }
+
+namespace TreeLod
+{
+    TEST(ForestInstances, replacedTablesMoveTheBucketsAfterThemAndForgetLevelsTheyLack)
+    {
+        ForestInstances forest;
+        addKinds(forest);
+        std::mt19937 rng(7);
+        ASSERT_TRUE(forest.add(randomInstances(rng, 2000, 400.0f, forest.getKindCount())));
+        CameraSpec spec;
+        spec.position = glm::vec3(0.0f, 30.0f, 0.0f);
+        spec.target = glm::vec3(100.0f, 0.0f, 100.0f);
+        const CullCamera camera = CullCamera::fromSpec(spec, 640.0f, 360.0f);
+        ForestVisibility vis;
+        ASSERT_TRUE(forest.cull(camera, 1.0f, vis, 0.15f));
+        const std::uint32_t before = vis.getVisibleCount();
+
+        // Kind 0: four levels down to two; every bucket after it moves by two.
+        ASSERT_EQ(forest.getBucketIndex(1, 0), 4u);
+        ASSERT_TRUE(forest.setKindThresholds(0, {2e4f}));
+        EXPECT_EQ(forest.getLevelCount(0), 2u);
+        EXPECT_EQ(forest.getBucketIndex(1, 0), 2u);
+        EXPECT_EQ(forest.getBucketIndex(3, 3), 2u + 3u + 1u + 3u);
+        EXPECT_EQ(forest.getBucketCount(), 2u + 3u + 1u + 4u);
+        // The same visibility culled again: the new layout, and the levels it remembered for
+        // hysteresis forgotten (index 1 of kind 0 is another level now): as a fresh one's.
+        ASSERT_TRUE(forest.cull(camera, 1.0f, vis, 0.15f));
+        ForestVisibility fresh;
+        ASSERT_TRUE(forest.cull(camera, 1.0f, fresh, 0.15f));
+        EXPECT_EQ(vis.getVisibleCount(), before);
+        ASSERT_EQ(vis.getBucketCount(), forest.getBucketCount());
+        for (std::size_t b = 0; b < vis.getBucketCount(); ++b)
+        {
+            EXPECT_EQ(vis.getBucket(b).kind, fresh.getBucket(b).kind) << b;
+            EXPECT_EQ(vis.getBucket(b).level, fresh.getBucket(b).level) << b;
+            EXPECT_EQ(vis.getBucket(b).count, fresh.getBucket(b).count) << b;
+        }
+
+        // Refused as addKind refuses, the table unchanged; an unknown kind is named.
+        Result<void> bad = forest.setKindThresholds(1, {5e2f, 5e4f});
+        ASSERT_FALSE(bad);
+        EXPECT_NE(bad.error().message().find("pine/billboard-cloud"), std::string::npos) << bad.error().message();
+        EXPECT_EQ(forest.getKind(1).thresholds, (std::vector<float>{5e4f, 5e2f}));
+        EXPECT_FALSE(forest.setKindThresholds(0, {std::nanf("")}));
+        EXPECT_FALSE(forest.setKindThresholds(0, std::vector<float>(ForestInstances::MAX_THRESHOLDS + 1, 1.0f)));
+        Result<void> unknown = forest.setKindThresholds(9, {});
+        ASSERT_FALSE(unknown);
+        EXPECT_NE(unknown.error().message().find("kind 9"), std::string::npos) << unknown.error().message();
+        EXPECT_EQ(forest.getBucketCount(), 2u + 3u + 1u + 4u);
+    }
+}

@@ -146,6 +146,72 @@ namespace TreeLod
         EXPECT_NE(r.error().message().find("cost"), std::string::npos) << r.error().message();
     }
 
+    TEST(LevelSelection, shadowCastersTakeTheCheapestCoarserLevelWithinTheirBudget)
+    {
+        Fixture f;
+        // The view: the mesh from 64 px, lodf from 16 px, the impostor below.
+        const std::vector<LevelChoice> view{{0, 64.0f, 0.05f}, {1, 16.0f, 0.06f}, {2, 0.0f, 0.06f}};
+
+        // 0.005: nothing coarser is within it; each run keeps its level.
+        Result<std::vector<std::size_t>> same = chooseShadowLevels(f.curves, f.costs, view, 0.005f);
+        ASSERT_TRUE(same) << same.error().message();
+        EXPECT_EQ(*same, (std::vector<std::size_t>{0u, 1u, 2u}));
+        // 0.02: the mesh's casters draw lodf (0.06 <= 0.05 + 0.02, half the cost), never a finer level.
+        Result<std::vector<std::size_t>> coarser = chooseShadowLevels(f.curves, f.costs, view, 0.02f);
+        ASSERT_TRUE(coarser);
+        EXPECT_EQ(*coarser, (std::vector<std::size_t>{1u, 1u, 2u}));
+        // 1: the impostor everywhere.
+        Result<std::vector<std::size_t>> cheapest = chooseShadowLevels(f.curves, f.costs, view, 1.0f);
+        ASSERT_TRUE(cheapest);
+        EXPECT_EQ(*cheapest, (std::vector<std::size_t>{2u, 2u, 2u}));
+        for (const float bad : {-0.1f, std::nanf(""), 2.0f})
+        {
+            Result<std::vector<std::size_t>> r = chooseShadowLevels(f.curves, f.costs, view, bad);
+            ASSERT_FALSE(r) << bad;
+            EXPECT_NE(r.error().message().find("shadow error budget"), std::string::npos) << r.error().message();
+        }
+    }
+
+    TEST(LevelSelection, aFrameBudgetTakesTheFinestStepPredictedWithinIt)
+    {
+        Fixture f;
+        EXPECT_EQ(selectionSample(8192.0f), 0u);
+        EXPECT_EQ(selectionSample(1.0f), SELECTION_SAMPLES - 1);
+        EXPECT_EQ(selectionSample(0.0f), SELECTION_SAMPLES - 1);
+        EXPECT_EQ(selectionSample(std::nanf("")), SELECTION_SAMPLES - 1);
+        EXPECT_EQ(selectionSample(1e9f), 0u);
+        EXPECT_FLOAT_EQ(selectionHeight(selectionSample(64.0f)), 64.0f);
+
+        // 10 trees at 64 px, 100 at 16 px: the mesh plan costs 10 x 2 + 100 x 1 ms.
+        HeightHistogram trees;
+        for (int i = 0; i < 10; ++i)
+            trees.add(64.0f);
+        for (int i = 0; i < 100; ++i)
+            trees.add(16.0f);
+        std::vector<double> predicted;
+        for (const float budget : frameBudgetLadder())
+        {
+            Result<std::vector<LevelChoice>> plan = chooseLevels(f.curves, f.costs, budget);
+            ASSERT_TRUE(plan);
+            predicted.push_back(trees.milliseconds(planCostPerTree(f.curves, f.costs, *plan)));
+        }
+        EXPECT_NEAR(predicted.front(), 120.0, 1e-3);
+        EXPECT_LT(predicted.back(), 0.2);
+        for (std::size_t s = 1; s < predicted.size(); ++s)
+            EXPECT_LE(predicted[s], predicted[s - 1] + 1e-9) << "a larger budget never costs more here";
+
+        EXPECT_EQ(chooseFrameBudgetStep(predicted, 1000.0, 5), 0u) << "everything fits: the reference";
+        EXPECT_EQ(chooseFrameBudgetStep(predicted, 1e-6, 0), predicted.size() - 1) << "nothing fits: the coarsest";
+        const std::size_t fits = chooseFrameBudgetStep(predicted, 70.0, predicted.size() - 1, 1.0);
+        EXPECT_LE(predicted[fits], 70.0);
+        EXPECT_TRUE(fits == 0 || predicted[fits - 1] > 70.0);
+        // Hysteresis: from a coarser step, a finer one is taken only well within the budget.
+        EXPECT_EQ(chooseFrameBudgetStep({100.0, 10.0}, 105.0, 1, 0.85), 1u);
+        EXPECT_EQ(chooseFrameBudgetStep({100.0, 10.0}, 105.0, 0, 0.85), 0u) << "already there: it stays";
+        EXPECT_EQ(chooseFrameBudgetStep({100.0, 10.0}, 120.0, 1, 0.85), 0u);
+        EXPECT_EQ(chooseFrameBudgetStep({}, 10.0, 0), 0u);
+    }
+
     TEST(LevelCosts, costsInterpolateInLogLog)
     {
         const LevelCost c = cost("lodf", 1, {1.0f, 4.0f, 64.0f});

@@ -325,6 +325,23 @@ namespace TreeLod
         const std::string unknown =
             errorOf(replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"lod\": {\"maxErr\": 0.1}"));
         EXPECT_NE(unknown.find("maxErr"), std::string::npos) << unknown;
+
+        // The shadow casters' budget and the frame budget.
+        const SceneScript both = parsed(replaced(MINIMAL, "\"frames\": 2",
+                                                 "\"frames\": 2, \"lod\": {\"shadowMaxError\": 0.2, \"frameBudgetMs\": 16}"));
+        EXPECT_EQ(both.lod.shadowMaxError, 0.2f);
+        EXPECT_EQ(both.lod.frameBudgetMs, 16.0f);
+        EXPECT_EQ(both.lod.maxError, SceneLod::DEFAULT_MAX_ERROR);
+        EXPECT_EQ(parsed(MINIMAL).lod.shadowMaxError, SceneLod::DEFAULT_SHADOW_MAX_ERROR);
+        EXPECT_EQ(parsed(MINIMAL).lod.frameBudgetMs, 0.0f);
+        for (const auto& [bad, key] : {std::pair<const char*, const char*>{"{\"shadowMaxError\": 2}", "/lod/shadowMaxError"},
+                                      {"{\"frameBudgetMs\": -1}", "/lod/frameBudgetMs"},
+                                      {"{\"frameBudgetMs\": \"fast\"}", "/lod/frameBudgetMs"}})
+        {
+            const std::string message =
+                errorOf(replaced(MINIMAL, "\"frames\": 2", std::string("\"frames\": 2, \"lod\": ") + bad));
+            EXPECT_NE(message.find(key), std::string::npos) << message;
+        }
     }
 
     TEST(SceneScript, techniqueBandsParseAndMustBeOrdered)

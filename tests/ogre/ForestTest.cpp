@@ -1577,3 +1577,132 @@ namespace TreeLod
         compareWithGolden(pictures[1], "forest-budget", 0.03);
     }
 }
+
+namespace TreeLod
+{
+    TEST(Forest, budgetedSpeciesReplanInPlaceForAnErrorAFrameAndAShadowBudget)
+    {
+        const TreeAssetPtr asset = oakWithCurves();
+        const ForestTree& tree = oak();
+        const std::vector<LevelCost> costs = fixedCosts(*asset);
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+        const CameraSpec view = look(glm::vec3(0.3f * h, 1.4f * h, 7.0f * h), glm::vec3(0.0f, 0.0f, -4.0f * h));
+        const std::vector<ForestInstance> trees = grid(6, 1.6f * h);
+        auto sameLevels = [](const std::vector<ForestLevel>& a, const std::vector<ForestLevel>& b) {
+            return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](const auto& x, const auto& y) {
+                       return x.technique == y.technique && x.techniqueLevel == y.techniqueLevel &&
+                              x.lowRes == y.lowRes && x.minPixelCount == y.minPixelCount;
+                   });
+        };
+        const std::vector<ForestLevel> planned = Forest::levelsForErrorBudget(*asset, costs, 0.03f);
+        ASSERT_GE(planned.size(), 2u);
+
+        // The same levels added as fixed: the picture a budgeted species must give.
+        Forest* fixed = placeForest();
+        fixed->addSpecies(asset, planned);
+        fixed->addInstances(trees);
+        const Image expected = toImage(r.render(view, 320, 180, 1));
+
+        Forest* forest = placeForest();
+        EXPECT_EQ(forest->getErrorBudget(), DEFAULT_ERROR_BUDGET);
+        EXPECT_EQ(forest->getShadowErrorBudget(), DEFAULT_SHADOW_ERROR_BUDGET);
+        try
+        {
+            forest->addBudgetedSpecies(tree.asset, costs);
+            ADD_FAILURE() << "an asset without curves was accepted";
+        }
+        catch (const Ogre::InvalidParametersException& e)
+        {
+            EXPECT_NE(e.getDescription().find("no error curves"), std::string::npos) << e.getDescription();
+        }
+        EXPECT_EQ(forest->getSpeciesCount(), 0u) << "nothing added";
+        const std::uint32_t s = forest->addBudgetedSpecies(asset, costs);
+        EXPECT_TRUE(forest->isBudgeted(s));
+        EXPECT_TRUE(sameLevels(forest->getLevels(s), planned));
+        forest->addInstances(trees);
+        const Image first = toImage(r.render(view, 320, 180, 1));
+        const std::vector<std::uint32_t> firstCounts = forest->getStats().levelCounts.at(s);
+        // Not bit-identical in general: passes of one hash are ordered by address in Ogre's queue, and
+        // the order decides ties of equal depth; a level drawn wrong differs by 100 times more.
+        EXPECT_LT(flipMean(expected, first), 2e-4);
+        EXPECT_GT(treeCoverage(first, BACKGROUND), 0.15);
+
+        // 0: the reference everywhere; 1: the cheapest everywhere; back: the first picture again.
+        forest->setErrorBudget(0.0f);
+        ASSERT_EQ(forest->getLevels(s).size(), 1u);
+        EXPECT_EQ(forest->getLevels(s)[0].technique, "mesh");
+        const Image reference = toImage(r.render(view, 320, 180, 1));
+        EXPECT_EQ(forest->getStats().levelCounts.at(s), (std::vector<std::uint32_t>{forest->getStats().visibleInstances}));
+        forest->setErrorBudget(1.0f);
+        ASSERT_EQ(forest->getLevels(s).size(), 1u);
+        EXPECT_EQ(forest->getLevels(s)[0].technique, "impostor");
+        const Image cheapest = toImage(r.render(view, 320, 180, 1));
+        EXPECT_EQ(forest->getStats().levelCounts.at(s), (std::vector<std::uint32_t>{forest->getStats().visibleInstances}));
+        forest->setErrorBudget(0.03f);
+        EXPECT_TRUE(sameLevels(forest->getLevels(s), planned));
+        const Image again = toImage(r.render(view, 320, 180, 1));
+        EXPECT_EQ(forest->getStats().levelCounts.at(s), firstCounts);
+        EXPECT_LT(flipMean(expected, again), 2e-4) << "levels, buckets and hysteresis as a new Forest's";
+        EXPECT_GT(flipMean(reference, cheapest), 0.02);
+        writePng(OgreEnvironment::outDir() + "/forest-replanned.png", sideBySide({reference, again, cheapest}));
+
+        for (const float bad : {std::nanf(""), -0.1f, 1.5f})
+        {
+            EXPECT_THROW(forest->setErrorBudget(bad), Ogre::InvalidParametersException) << bad;
+            EXPECT_THROW(forest->setShadowErrorBudget(bad), Ogre::InvalidParametersException) << bad;
+        }
+        for (const float bad : {std::nanf(""), -1.0f, INFINITY})
+            EXPECT_THROW(forest->setFrameBudgetMs(bad), Ogre::InvalidParametersException) << bad;
+        EXPECT_EQ(forest->getErrorBudget(), 0.03f) << "refused budgets change nothing";
+
+        // A frame budget nothing fits: the cheapest step, taken the viewer frame after a measurement.
+        forest->setFrameBudgetMs(1e-6f);
+        r.render(view, 160, 90, 1);
+        EXPECT_GT(forest->getStats().predictedMilliseconds, 0.0);
+        r.render(view, 160, 90, 1);
+        EXPECT_EQ(forest->getErrorBudget(), frameBudgetLadder().back());
+        EXPECT_EQ(forest->getLevels(s).back().technique, "impostor");
+        // One everything fits: the reference; its prediction, the mesh's fixed cost (2 ms at 16 px,
+        // growing with the height) summed over the 36 trees.
+        forest->setFrameBudgetMs(1e6f);
+        for (unsigned f = 0; f < Forest::FRAME_BUDGET_INTERVAL + 2; ++f)
+            r.render(view, 160, 90, 1);
+        EXPECT_EQ(forest->getErrorBudget(), 0.0f);
+        EXPECT_EQ(forest->getLevels(s).size(), 1u);
+        const double meshMs = forest->getStats().predictedMilliseconds;
+        EXPECT_GT(meshMs, 36.0 * 2.0);
+        EXPECT_LT(meshMs, 36.0 * 64.0);
+        // Half of that: a step predicted within it, coarser than the reference.
+        forest->setFrameBudgetMs(float(0.5 * meshMs));
+        for (unsigned f = 0; f < 2 * Forest::FRAME_BUDGET_INTERVAL + 1; ++f)
+            r.render(view, 160, 90, 1);
+        EXPECT_GT(forest->getErrorBudget(), 0.0f);
+        EXPECT_LE(forest->getStats().predictedMilliseconds, 0.5 * meshMs);
+        // Off: the error budget set last.
+        forest->setFrameBudgetMs(0.0f);
+        EXPECT_EQ(forest->getErrorBudget(), 0.03f);
+        EXPECT_TRUE(sameLevels(forest->getLevels(s), planned));
+
+        // Shadow casters: their own budget picks coarser levels for them; the view keeps its own.
+        forest->setShadowErrorBudget(1.0f);
+        const std::uint32_t last = std::uint32_t(planned.size() - 1);
+        EXPECT_EQ(forest->getShadowLevels(s), std::vector<std::uint32_t>(planned.size(), last));
+        r.setShadows(true, 1024);
+        const Image coarseCasters = toImage(r.render(view, 320, 180, 1));
+        const std::vector<std::uint32_t> viewCounts = forest->getStats().levelCounts.at(s);
+        forest->setShadowErrorBudget(0.0f);
+        for (std::uint32_t l = 0; l < planned.size(); ++l)
+            EXPECT_GE(forest->getShadowLevels(s)[l], l) << "never finer than the view";
+        const Image viewCasters = toImage(r.render(view, 320, 180, 1));
+        const Image viewCastersAgain = toImage(r.render(view, 320, 180, 1));
+        r.setShadows(false);
+        EXPECT_EQ(forest->getStats().levelCounts.at(s), viewCounts);
+        const double noise = flipMean(viewCasters, viewCastersAgain), casters = flipMean(viewCasters, coarseCasters);
+        std::printf("shadow error budget 1 vs 0: FLIP %.5f (the same frame twice: %.5f)\n", casters, noise);
+        EXPECT_GT(casters, 0.002);
+        EXPECT_GT(casters, 5.0 * noise);
+        EXPECT_GT(treeCoverage(coarseCasters, BACKGROUND), 0.15);
+        writePng(OgreEnvironment::outDir() + "/forest-shadow-budget.png", sideBySide({viewCasters, coarseCasters}));
+    }
+}

@@ -133,6 +133,85 @@ namespace TreeLod
             return split;
         }
 
+        /// The asset's error curves, only the levels of Forest::getAutoTechniques (budgeted auto's).
+        ErrorCurves autoCurves(TreeAsset& asset, const Ogre::String& label, const char* source)
+        {
+            if (!asset.hasChunk(ERROR_CURVES_CHUNK))
+                invalid(label + "no error curves (bake them: treelod bake, or the bench's cache)", source);
+            Result<ErrorCurves> curves = decodeErrorCurves(asset.readChunk(ERROR_CURVES_CHUNK), asset.getName());
+            if (!curves)
+                invalid(curves.error().message(), source);
+            const std::vector<Ogre::String> autoTechniques = Forest::getAutoTechniques();
+            std::vector<ErrorCurveLevel> kept;
+            for (ErrorCurveLevel& level : curves->levels)
+                if (std::find(autoTechniques.begin(), autoTechniques.end(), level.technique) != autoTechniques.end())
+                    kept.push_back(std::move(level));
+            curves->levels = std::move(kept);
+            return std::move(*curves);
+        }
+
+        /// The Forest levels of a selection (LevelSelection.h): its runs' heights as LoD values.
+        std::vector<ForestLevel> levelsForChoices(TreeAsset& asset, const ErrorCurves& curves,
+                                                  const std::vector<LevelChoice>& choices, const Ogre::String& label,
+                                                  const char* source)
+        {
+            std::vector<ForestLevel> levels;
+            for (const LevelChoice& choice : choices)
+            {
+                const ErrorCurveLevel& c = curves.levels[choice.curveLevel];
+                ForestLevel level;
+                level.technique = c.technique;
+                level.techniqueLevel = c.techniqueLevel;
+                level.lowRes = c.lowRes;
+                level.minPixelCount =
+                    choice.minHeightPx > 0.0f ? valueForHeight(asset, choice.minHeightPx, label, source) : 0.0f;
+                levels.push_back(level);
+            }
+            return levels;
+        }
+
+        bool sameDrawable(const ForestLevel& a, const ForestLevel& b)
+        {
+            return a.technique == b.technique && a.techniqueLevel == b.techniqueLevel && a.lowRes == b.lowRes;
+        }
+
+        /// Check `levels` as addSpecies takes them (throws naming `label`, the level and the reason);
+        /// `drawn` grows by what they draw outside the asset's box.
+        void checkLevels(TreeAsset& asset, const std::vector<ForestLevel>& levels, const Ogre::String& label,
+                         const char* source, Ogre::AxisAlignedBox& drawn)
+        {
+            if (levels.empty() || levels.size() > MAX_LEVELS)
+                invalid(label + std::to_string(levels.size()) + " levels (1 to " + std::to_string(MAX_LEVELS) + ")",
+                        source);
+            for (std::size_t l = 0; l < levels.size(); ++l)
+            {
+                const ForestLevel& level = levels[l];
+                const Ogre::String element = label + "level " + std::to_string(l) + " '" + level.technique + "': ";
+                ForestLevelProvider& technique = levelProvider(level.technique, element, source);
+                const bool last = l + 1 == levels.size();
+                if (!std::isfinite(level.minPixelCount) || level.minPixelCount < 0.0f ||
+                    (l > 0 && !(level.minPixelCount < levels[l - 1].minPixelCount)) ||
+                    (last && level.minPixelCount != 0.0f))
+                    invalid(element + "minPixelCount " + std::to_string(level.minPixelCount) +
+                                " (finite, >= 0, below the previous level's, 0 for the last level)",
+                            source);
+                try
+                {
+                    technique.checkLevel(asset, level, drawn);
+                }
+                catch (const Ogre::Exception& e)
+                {
+                    invalid(element + e.getDescription(), source);
+                }
+            }
+        }
+
+        /// The largest LoD value level `l` of `levels` is drawn at (reference-sphere units).
+        Ogre::Real upperValue(const std::vector<ForestLevel>& levels, std::size_t l)
+        {
+            return l == 0 ? NO_UPPER : levels[l - 1].minPixelCount;
+        }
+
         std::uint64_t textureBytes(const Ogre::Texture& texture)
         {
             std::uint64_t bytes = 0;
@@ -187,12 +266,35 @@ namespace TreeLod
         Failed    ///< building threw (logged); its trees keep drawing the fallback
     };
 
+    /// What a budgeted species is planned from (Forest.h, "Budgeted species").
+    struct Forest::BudgetPlan
+    {
+        ErrorCurves curves;                  ///< the auto techniques' levels
+        std::vector<LevelCost> costs;        ///< this machine's
+        std::vector<LevelChoice> choices;    ///< the plan in use
+        /// Per frameBudgetLadder() step: its plan's cost per tree at each selection sample height.
+        std::vector<std::vector<float>> ladderMsPerTree;
+        HeightHistogram visible; ///< the viewer's trees at the frame budget's last measurement
+    };
+
     struct Forest::Species
     {
         TreeAssetPtr asset;
         std::vector<ForestLevel> levels;
         std::vector<std::vector<std::unique_ptr<Part>>> parts; ///< per level; empty until resident
         std::vector<Residency> residency;                     ///< per level
+        std::vector<std::uint32_t> shadowLevels;              ///< per level: what its shadow casters draw
+        std::unique_ptr<BudgetPlan> budget;                   ///< budgeted species only
+        /// (kind radius / reference radius)^2: the kind's LoD values per reference-sphere value.
+        double kindUnit = 1.0;
+        /// Tree height on screen (px) per square root of the kind's LoD value.
+        double heightPerRootValue = 0.0;
+
+        /// A level's switch value in the kind's units (Forest.h, "Units").
+        float kindValue(Ogre::Real minPixelCount) const
+        {
+            return float(std::min(double(minPixelCount) * kindUnit, double(FLT_MAX)));
+        }
     };
 
     /// One instanced draw of one camera: a Part with that camera's instance buffer of its bucket.
@@ -381,34 +483,11 @@ namespace TreeLod
     {
         const char* source = "Forest::levelsForErrorBudget";
         const Ogre::String label = "asset '" + asset.getName() + "': ";
-        if (!asset.hasChunk(ERROR_CURVES_CHUNK))
-            invalid(label + "no error curves (bake them: treelod bake, or the bench's cache)", source);
-        Result<ErrorCurves> curves = decodeErrorCurves(asset.readChunk(ERROR_CURVES_CHUNK), asset.getName());
-        if (!curves)
-            invalid(curves.error().message(), source);
-        // Only the auto techniques' levels that this asset has: the others' curves are dropped.
-        const std::vector<Ogre::String> autoTechniques = getAutoTechniques();
-        std::vector<ErrorCurveLevel> kept;
-        for (ErrorCurveLevel& level : curves->levels)
-            if (std::find(autoTechniques.begin(), autoTechniques.end(), level.technique) != autoTechniques.end())
-                kept.push_back(std::move(level));
-        curves->levels = std::move(kept);
-        Result<std::vector<LevelChoice>> choices = chooseLevels(*curves, costs, errorBudget, MAX_LEVELS);
+        const ErrorCurves curves = autoCurves(asset, label, source);
+        Result<std::vector<LevelChoice>> choices = chooseLevels(curves, costs, errorBudget, MAX_LEVELS);
         if (!choices)
             invalid(label + choices.error().message(), source);
-        std::vector<ForestLevel> levels;
-        for (const LevelChoice& choice : *choices)
-        {
-            const ErrorCurveLevel& c = curves->levels[choice.curveLevel];
-            ForestLevel level;
-            level.technique = c.technique;
-            level.techniqueLevel = c.techniqueLevel;
-            level.lowRes = c.lowRes;
-            level.minPixelCount = choice.minHeightPx > 0.0f ? valueForHeight(asset, choice.minHeightPx, label, source)
-                                                            : 0.0f;
-            levels.push_back(level);
-        }
-        return levels;
+        return levelsForChoices(asset, curves, *choices, label, source);
     }
 
     std::vector<ForestLevel> Forest::levelsForBands(TreeAsset& asset, const std::vector<ForestBand>& bands)
@@ -588,48 +667,80 @@ namespace TreeLod
 
     std::uint32_t Forest::addSpecies(const TreeAssetPtr& asset, const std::vector<ForestLevel>& levels)
     {
+        return addSpeciesImpl(asset, levels, nullptr);
+    }
+
+    std::uint32_t Forest::addBudgetedSpecies(const TreeAssetPtr& asset, const std::vector<LevelCost>& costs)
+    {
+        const char* source = "Forest::addBudgetedSpecies";
+        const Ogre::String label = "Forest '" + mName + "' species " + std::to_string(mSpecies.size()) + " ('" +
+                                   (asset ? asset->getName() : Ogre::String("null")) + "'): ";
+        if (!asset)
+            invalid(label + "no asset", source);
+        auto plan = std::make_unique<BudgetPlan>();
+        plan->curves = autoCurves(*asset, label, source);
+        plan->costs = costs;
+        for (const float step : frameBudgetLadder())
+        {
+            Result<std::vector<LevelChoice>> choices = chooseLevels(plan->curves, costs, step, MAX_LEVELS);
+            if (!choices)
+                invalid(label + choices.error().message(), source);
+            plan->ladderMsPerTree.push_back(planCostPerTree(plan->curves, costs, *choices));
+        }
+        Result<std::vector<LevelChoice>> choices = chooseLevels(plan->curves, costs, mErrorBudget, MAX_LEVELS);
+        if (!choices)
+            invalid(label + choices.error().message(), source);
+        plan->choices = *choices;
+        const std::vector<ForestLevel> levels = levelsForChoices(*asset, plan->curves, plan->choices, label, source);
+        return addSpeciesImpl(asset, levels, std::move(plan));
+    }
+
+    std::uint32_t Forest::addSpeciesImpl(const TreeAssetPtr& asset, const std::vector<ForestLevel>& levels,
+                                         std::unique_ptr<BudgetPlan> budget)
+    {
         const char* source = "Forest::addSpecies";
         const Ogre::String label = "Forest '" + mName + "' species " + std::to_string(mSpecies.size()) + " ('" +
                                    (asset ? asset->getName() : Ogre::String("null")) + "'): ";
         if (!asset)
             invalid(label + "no asset", source);
-        if (levels.empty() || levels.size() > MAX_LEVELS)
-            invalid(label + std::to_string(levels.size()) + " levels (1 to " + std::to_string(MAX_LEVELS) + ")",
-                    source);
+        // Planned from decoded chunks only (nothing uploaded but the bark mesh levelsForBands
+        // plans with); each level's drawables are built when its trees first need them.
+        Ogre::AxisAlignedBox drawn = asset->getBounds();
+        checkLevels(*asset, levels, label, source, drawn);
+        if (budget)
+        {
+            // The kind's sphere holds every level a budget may choose: re-plans keep it.
+            std::vector<ForestLevel> candidates;
+            for (const ErrorCurveLevel& c : budget->curves.levels)
+                if (findLevelCost(budget->costs, c.technique, c.techniqueLevel, c.lowRes) >= 0)
+                {
+                    ForestLevel level;
+                    level.technique = c.technique;
+                    level.techniqueLevel = c.techniqueLevel;
+                    level.lowRes = c.lowRes;
+                    level.minPixelCount = 0.0f;
+                    Ogre::AxisAlignedBox box = asset->getBounds();
+                    checkLevels(*asset, {level}, label + "candidate ", source, box);
+                    drawn.merge(box);
+                }
+        }
         auto species = std::make_unique<Species>();
         species->asset = asset;
         species->levels = levels;
         species->parts.resize(levels.size());
         species->residency.assign(levels.size(), Residency::Absent);
-        // Planned from decoded chunks only (nothing uploaded but the bark mesh levelsForBands
-        // plans with); each level's drawables are built when its trees first need them.
-        Ogre::AxisAlignedBox drawn = asset->getBounds();
-        for (std::size_t l = 0; l < levels.size(); ++l)
+        species->budget = std::move(budget);
+        try
         {
-            const ForestLevel& level = levels[l];
-            const Ogre::String element = label + "level " + std::to_string(l) + " '" + level.technique + "': ";
-            ForestLevelProvider& technique = levelProvider(level.technique, element, source);
-            const bool last = l + 1 == levels.size();
-            if (!std::isfinite(level.minPixelCount) || level.minPixelCount < 0.0f ||
-                (l > 0 && !(level.minPixelCount < levels[l - 1].minPixelCount)) ||
-                (last && level.minPixelCount != 0.0f))
-                invalid(element + "minPixelCount " + std::to_string(level.minPixelCount) +
-                            " (finite, >= 0, below the previous level's, 0 for the last level)",
-                        source);
-            try
-            {
-                technique.checkLevel(*asset, level, drawn);
-                // The last level is the fallback of every other: resident from the start.
-                if (last)
-                {
-                    species->parts[l] = buildParts(*asset, level, l == 0 ? NO_UPPER : levels[l - 1].minPixelCount);
-                    species->residency[l] = Residency::Resident;
-                }
-            }
-            catch (const Ogre::Exception& e)
-            {
-                invalid(element + e.getDescription(), source);
-            }
+            // The last level is the fallback of every other: resident from the start.
+            species->parts.back() = buildParts(*asset, levels.back(), upperValue(levels, levels.size() - 1));
+            species->residency.back() = Residency::Resident;
+        }
+        catch (const Ogre::Exception& e)
+        {
+            invalid(label + "level " + std::to_string(levels.size() - 1) + " '" + levels.back().technique +
+                        "': " + e.getDescription(),
+                    source);
         }
 
         // The kind: a tight sphere about what is drawn; thresholds in its units (Forest.h).
@@ -639,19 +750,254 @@ namespace TreeLod
         if (!(referenceR > 0.0f))
             invalid(label + "the tree has no extent", source);
         const double unit = double(radius) * double(radius) / (double(referenceR) * double(referenceR));
+        const Ogre::AxisAlignedBox bounds = asset->getBounds();
+        const double height = double(bounds.getMaximum().y - bounds.getMinimum().y);
+        // valueForHeight inverted: value = 4 pi (h_px R / height)^2 in reference units, x unit here.
+        species->kindUnit = unit;
+        species->heightPerRootValue = height / (double(referenceR) * std::sqrt(4.0 * Ogre::Math::PI * unit));
         ForestKind kind;
         kind.name = asset->getName() + " species " + std::to_string(mSpecies.size());
         kind.boundsCentre = glm::vec3(centre.x, centre.y, centre.z);
         kind.boundsRadius = radius;
         for (std::size_t l = 0; l + 1 < levels.size(); ++l)
-            kind.thresholds.push_back(float(std::min(double(levels[l].minPixelCount) * unit, double(FLT_MAX))));
+            kind.thresholds.push_back(species->kindValue(levels[l].minPixelCount));
         Result<std::uint32_t> added = mInstances.addKind(kind);
         if (!added)
             invalid(label + added.error().message(), source);
         OgreAssert(added.value() == mSpecies.size(), "kinds and species share indices");
         mSpecies.push_back(std::move(species));
         mStats.levelCounts.emplace_back(levels.size(), 0u);
+        updateShadowLevels(added.value());
         return added.value();
+    }
+
+    bool Forest::isBudgeted(std::uint32_t species) const { return mSpecies.at(species)->budget != nullptr; }
+
+    const std::vector<std::uint32_t>& Forest::getShadowLevels(std::uint32_t species) const
+    {
+        return mSpecies.at(species)->shadowLevels;
+    }
+
+    void Forest::updateShadowLevels(std::uint32_t s)
+    {
+        Species& species = *mSpecies[s];
+        species.shadowLevels.resize(species.levels.size());
+        for (std::uint32_t l = 0; l < species.shadowLevels.size(); ++l)
+            species.shadowLevels[l] = l;
+        if (!species.budget)
+            return;
+        const BudgetPlan& plan = *species.budget;
+        Result<std::vector<std::size_t>> shadow =
+            chooseShadowLevels(plan.curves, plan.costs, plan.choices, mShadowErrorBudget);
+        if (shadow && shadow->size() == species.levels.size())
+            for (std::size_t l = 0; l < shadow->size(); ++l)
+                species.shadowLevels[l] = std::uint32_t((*shadow)[l]);
+    }
+
+    void Forest::replan(std::uint32_t s, const std::vector<LevelChoice>& choices)
+    {
+        const char* source = "Forest::replan";
+        Species& species = *mSpecies[s];
+        BudgetPlan& plan = *species.budget;
+        TreeAsset& asset = *species.asset;
+        const Ogre::String label =
+            "Forest '" + mName + "' species " + std::to_string(s) + " ('" + asset.getName() + "'): ";
+        const std::vector<ForestLevel> levels = levelsForChoices(asset, plan.curves, choices, label, source);
+        plan.choices = choices;
+        const bool same = levels.size() == species.levels.size() &&
+                          std::equal(levels.begin(), levels.end(), species.levels.begin(),
+                                     [](const ForestLevel& a, const ForestLevel& b) {
+                                         return sameDrawable(a, b) && a.minPixelCount == b.minPixelCount;
+                                     });
+        if (same)
+        {
+            updateShadowLevels(s);
+            return;
+        }
+        Ogre::AxisAlignedBox drawn = asset.getBounds();
+        checkLevels(asset, levels, label, source, drawn);
+
+        // Parts: the last level first (its failure changes nothing); then kept, rebuilt or absent.
+        const std::size_t count = levels.size();
+        std::vector<std::vector<std::unique_ptr<Part>>> parts(count);
+        std::vector<Residency> residency(count, Residency::Absent);
+        std::vector<bool> moved(species.levels.size(), false);
+        auto findOld = [&](std::size_t l, bool sameUpper) -> int {
+            for (std::size_t k = 0; k < species.levels.size(); ++k)
+                if (!moved[k] && species.residency[k] == Residency::Resident &&
+                    sameDrawable(species.levels[k], levels[l]) &&
+                    (!sameUpper || upperValue(species.levels, k) == upperValue(levels, l)))
+                    return int(k);
+            return -1;
+        };
+        const int keptLast = findOld(count - 1, true);
+        if (keptLast < 0)
+        {
+            try
+            {
+                parts[count - 1] = buildParts(asset, levels[count - 1], upperValue(levels, count - 1));
+            }
+            catch (const Ogre::Exception& e)
+            {
+                invalid(label + "level " + std::to_string(count - 1) + " '" + levels[count - 1].technique +
+                            "': " + e.getDescription() + " (the levels stay as they were)",
+                        source);
+            }
+            residency[count - 1] = Residency::Resident;
+        }
+        for (std::size_t l = 0; l < count; ++l)
+        {
+            if (residency[l] == Residency::Resident)
+                continue;
+            if (const int k = findOld(l, true); k >= 0)
+            {
+                parts[l] = std::move(species.parts[std::size_t(k)]);
+                moved[std::size_t(k)] = true;
+                residency[l] = Residency::Resident;
+            }
+            else if (findOld(l, false) >= 0)
+            {
+                // Its drawables are uploaded: the parts at the new switch value cost no upload.
+                try
+                {
+                    parts[l] = buildParts(asset, levels[l], upperValue(levels, l));
+                    residency[l] = Residency::Resident;
+                }
+                catch (const Ogre::Exception&)
+                {
+                    residency[l] = Residency::Absent; // built on demand, where a failure is logged
+                }
+            }
+        }
+
+        // The kind's table; each camera's buckets of this species reset (their batches draw the
+        // old parts), the buckets of later species moved with their indices.
+        const std::uint32_t first = mInstances.getBucketIndex(s, 0);
+        const std::size_t oldCount = species.levels.size();
+        std::vector<float> thresholds;
+        for (std::size_t l = 0; l + 1 < count; ++l)
+            thresholds.push_back(species.kindValue(levels[l].minPixelCount));
+        if (Result<void> set = mInstances.setKindThresholds(s, thresholds); !set)
+            invalid(label + set.error().message(), source);
+        for (auto& [camera, state] : mCameras)
+        {
+            std::vector<std::unique_ptr<BucketState>>& buckets = state->buckets;
+            if (buckets.size() <= first)
+                continue; // has not seen this species yet
+            const std::size_t end = std::min(buckets.size(), first + oldCount);
+            std::vector<std::unique_ptr<BucketState>> slots;
+            for (std::size_t b = first; b < end; ++b)
+                slots.push_back(std::move(buckets[b]));
+            for (std::unique_ptr<BucketState>& slot : slots)
+            {
+                slot->batches.clear();
+                slot->drawnLevel = NO_LEVEL;
+            }
+            while (slots.size() > count)
+            {
+                mInstanceBufferBytes -= slots.back()->capacity * INSTANCE_BYTES;
+                slots.pop_back();
+            }
+            while (slots.size() < count)
+                slots.push_back(std::make_unique<BucketState>());
+            buckets.erase(buckets.begin() + std::ptrdiff_t(first), buckets.begin() + std::ptrdiff_t(end));
+            buckets.insert(buckets.begin() + std::ptrdiff_t(first), std::make_move_iterator(slots.begin()),
+                           std::make_move_iterator(slots.end()));
+        }
+        mUploadQueue.erase(std::remove_if(mUploadQueue.begin(), mUploadQueue.end(),
+                                          [s](const auto& entry) { return entry.first == s; }),
+                           mUploadQueue.end());
+        species.levels = levels;
+        species.parts = std::move(parts);
+        species.residency = std::move(residency);
+        mStats.levelCounts[s].assign(count, 0u);
+        mStats.instanceBufferBytes = mInstanceBufferBytes;
+        updateShadowLevels(s);
+    }
+
+    void Forest::applyErrorBudget(float budget)
+    {
+        for (std::uint32_t s = 0; s < mSpecies.size(); ++s)
+        {
+            Species& species = *mSpecies[s];
+            if (!species.budget)
+                continue;
+            Result<std::vector<LevelChoice>> choices =
+                chooseLevels(species.budget->curves, species.budget->costs, budget, MAX_LEVELS);
+            if (!choices)
+                invalid("Forest '" + mName + "' species " + std::to_string(s) + ": " + choices.error().message(),
+                        "Forest::setErrorBudget");
+            replan(s, *choices);
+        }
+        mErrorBudget = budget;
+    }
+
+    void Forest::setErrorBudget(float budget)
+    {
+        if (!(std::isfinite(budget) && budget >= 0.0f && budget <= 1.0f))
+            invalid("Forest '" + mName + "': error budget " + std::to_string(budget) + " is not a number in [0, 1]",
+                    "Forest::setErrorBudget");
+        applyErrorBudget(budget);
+        mUserErrorBudget = budget;
+        const std::vector<float>& ladder = frameBudgetLadder();
+        mFrameBudgetStep = std::size_t(std::lower_bound(ladder.begin(), ladder.end(), budget) - ladder.begin());
+        mFrameBudgetStep = std::min(mFrameBudgetStep, ladder.size() - 1);
+        mWantedBudgetStep = mFrameBudgetStep;
+    }
+
+    void Forest::setShadowErrorBudget(float budget)
+    {
+        if (!(std::isfinite(budget) && budget >= 0.0f && budget <= 1.0f))
+            invalid("Forest '" + mName + "': shadow error budget " + std::to_string(budget) +
+                        " is not a number in [0, 1]",
+                    "Forest::setShadowErrorBudget");
+        mShadowErrorBudget = budget;
+        for (std::uint32_t s = 0; s < mSpecies.size(); ++s)
+            updateShadowLevels(s);
+    }
+
+    void Forest::setFrameBudgetMs(float milliseconds)
+    {
+        if (!(std::isfinite(milliseconds) && milliseconds >= 0.0f))
+            invalid("Forest '" + mName + "': frame budget " + std::to_string(milliseconds) +
+                        " ms is not finite and >= 0 (0: none)",
+                    "Forest::setFrameBudgetMs");
+        const bool off = milliseconds == 0.0f && mFrameBudgetMs > 0.0f;
+        mFrameBudgetMs = milliseconds;
+        mFrameBudgetFrames = 0;
+        mStats.predictedMilliseconds = 0.0;
+        if (off)
+            setErrorBudget(mUserErrorBudget);
+    }
+
+    void Forest::measureFrameBudget(const CameraState& state)
+    {
+        // Every visible tree of a budgeted species, counted at its height on screen.
+        for (const std::unique_ptr<Species>& species : mSpecies)
+            if (species->budget)
+                species->budget->visible.clear();
+        const ForestVisibility& visibility = state.visibility;
+        for (std::uint32_t b = 0; b < visibility.getBucketCount(); ++b)
+        {
+            const ForestBucket& bucket = visibility.getBucket(b);
+            Species& species = *mSpecies[bucket.kind];
+            if (!species.budget || bucket.count == 0)
+                continue;
+            const std::uint32_t* indices = visibility.getBucketIndices(b);
+            for (std::uint32_t i = 0; i < bucket.count; ++i)
+            {
+                const float value = mInstances.lodValue(indices[i], state.camera, state.lodBias);
+                species.budget->visible.add(float(species.heightPerRootValue * std::sqrt(double(value))));
+            }
+        }
+        const std::size_t steps = frameBudgetLadder().size();
+        std::vector<double> predicted(steps, 0.0);
+        for (const std::unique_ptr<Species>& species : mSpecies)
+            if (species->budget)
+                for (std::size_t step = 0; step < steps; ++step)
+                    predicted[step] += species->budget->visible.milliseconds(species->budget->ladderMsPerTree[step]);
+        mStats.predictedMilliseconds = predicted[std::min(mFrameBudgetStep, steps - 1)];
+        mWantedBudgetStep = chooseFrameBudgetStep(predicted, double(mFrameBudgetMs), mFrameBudgetStep);
     }
 
     std::uint32_t Forest::getSpeciesCount() const { return std::uint32_t(mSpecies.size()); }
@@ -875,11 +1221,11 @@ namespace TreeLod
         mCurrentCamera = camera;
     }
 
-    void Forest::fillBucket(CameraState& state, std::uint32_t b)
+    void Forest::fillBucket(CameraState& state, std::uint32_t b, std::uint32_t level)
     {
         const ForestBucket& bucket = state.visibility.getBucket(b);
         BucketState& slot = *state.buckets[b];
-        const std::uint32_t drawn = getDrawnLevel(bucket.kind, bucket.level);
+        const std::uint32_t drawn = getDrawnLevel(bucket.kind, level);
         if (slot.drawnLevel != drawn)
         {
             // First use, or the bucket's own level (or a nearer fallback) became resident.
@@ -932,6 +1278,20 @@ namespace TreeLod
         const bool shadowTexture =
             mManager && mManager->_getCurrentRenderStage() == Ogre::SceneManager::IRS_RENDER_TO_TEXTURE;
         const bool viewer = camera->getLodCamera() == camera && !shadowTexture;
+        if (viewer && mFrameBudgetMs > 0.0f && mWantedBudgetStep != mFrameBudgetStep)
+        {
+            // The frame budget's choice of the last measurement, before this camera culls.
+            try
+            {
+                applyErrorBudget(frameBudgetLadder()[mWantedBudgetStep]);
+                mFrameBudgetStep = mWantedBudgetStep;
+            }
+            catch (const Ogre::Exception& e)
+            {
+                Ogre::LogManager::getSingleton().logError(e.getDescription());
+                mWantedBudgetStep = mFrameBudgetStep;
+            }
+        }
         std::unique_ptr<CameraState>& entry = mCameras[camera];
         if (!entry)
         {
@@ -970,17 +1330,25 @@ namespace TreeLod
             Ogre::LogManager::getSingleton().logError("Forest '" + mName + "': " + culled.error().message());
             return;
         }
+        if (viewer && mFrameBudgetMs > 0.0f && !mLodFrozen && mFrameBudgetFrames++ % FRAME_BUDGET_INTERVAL == 0)
+            measureFrameBudget(state);
+
+        // The level each bucket draws: shadow casters their species' shadow level.
+        auto wantedLevel = [&](const ForestBucket& bucket) {
+            return shadowTexture ? mSpecies[bucket.kind]->shadowLevels[bucket.level] : bucket.level;
+        };
 
         // Residency: ask for the levels this camera needs, then build within this frame's budget;
         // until built, a level's trees draw the nearest resident level (getDrawnLevel).
         for (std::uint32_t b = 0; b < state.visibility.getBucketCount(); ++b)
         {
             const ForestBucket& bucket = state.visibility.getBucket(b);
-            Residency& residency = mSpecies[bucket.kind]->residency[bucket.level];
+            const std::uint32_t level = wantedLevel(bucket);
+            Residency& residency = mSpecies[bucket.kind]->residency[level];
             if (bucket.count > 0 && residency == Residency::Absent)
             {
                 residency = Residency::Queued;
-                mUploadQueue.emplace_back(bucket.kind, bucket.level);
+                mUploadQueue.emplace_back(bucket.kind, level);
             }
         }
         serviceUploads();
@@ -996,8 +1364,8 @@ namespace TreeLod
                 mStats.levelCounts[bucket.kind][bucket.level] = bucket.count;
             if (bucket.count == 0)
                 continue;
-            fillBucket(state, b);
-            if (state.buckets[b]->drawnLevel != bucket.level)
+            fillBucket(state, b, wantedLevel(bucket));
+            if (state.buckets[b]->drawnLevel != wantedLevel(bucket))
                 fallbacks += bucket.count;
             for (const std::unique_ptr<Batch>& batch : state.buckets[b]->batches)
             {

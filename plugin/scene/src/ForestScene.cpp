@@ -240,6 +240,41 @@ namespace TreeLod
         mGroundNode->attachObject(mGround);
     }
 
+    std::string ForestScene::levelNote(const LevelNote& note) const
+    {
+        if (note.species < 0)
+            return note.fixed;
+        const std::uint32_t species = std::uint32_t(note.species);
+        const std::vector<ForestLevel>& levels = mForest->getLevels(species);
+        std::string text = "budget " + Ogre::StringConverter::toString(mForest->getErrorBudget()) + ":";
+        for (std::size_t l = 0; l < levels.size(); ++l)
+        {
+            const float px = Forest::heightForPixelCount(*mForest->getAsset(species), levels[l].minPixelCount);
+            text += (l ? ", " : " ") + Forest::describeLevel(levels[l]) + " >= " +
+                    Ogre::StringConverter::toString(int(std::round(px))) + " px";
+        }
+        return text;
+    }
+
+    std::vector<std::string> ForestScene::getLevelNotes() const
+    {
+        std::vector<std::string> notes;
+        for (const LevelNote& note : mLevelNotes)
+            notes.push_back(note.name + ": " + levelNote(note));
+        return notes;
+    }
+
+    bool ForestScene::setErrorBudget(float budget)
+    {
+        for (std::uint32_t s = 0; mForest && s < mForest->getSpeciesCount(); ++s)
+            if (mForest->isBudgeted(s))
+            {
+                mForest->setErrorBudget(budget);
+                return true;
+            }
+        return false;
+    }
+
     void ForestScene::buildSpecies()
     {
         static int counter = 0;
@@ -249,6 +284,7 @@ namespace TreeLod
         mForestNode->attachObject(mForest);
         mForest->setUploadBudget(mOptions.uploadBudget);
         mForest->setShadowLodBias(mScript.shadows.lodBias);
+        mForest->setFrameBudgetMs(mScript.lod.frameBudgetMs);
 
         // Bands per species; then one bake request per distinct source with every technique its
         // species draw (two species sharing a file share one package and one asset).
@@ -299,8 +335,7 @@ namespace TreeLod
                     parseAutoTechnique(mTechnique, budget) || (mTechnique.empty() && species.autoTechnique);
                 if (std::isnan(budget))
                     budget = mScript.lod.maxError;
-                std::vector<ForestLevel> levels;
-                std::string note;
+                const std::size_t notesBefore = mLevelNotes.size();
                 std::vector<LevelCost> costs;
                 std::string noCosts = "no level costs given";
                 if (budgeted && mOptions.levelCosts && asset->hasChunk(ERROR_CURVES_CHUNK))
@@ -314,28 +349,26 @@ namespace TreeLod
                     }
                 if (!costs.empty())
                 {
-                    levels = Forest::levelsForErrorBudget(*asset, costs, budget);
-                    note = "budget " + Ogre::StringConverter::toString(budget) + ":";
-                    for (std::size_t l = 0; l < levels.size(); ++l)
-                    {
-                        const float px = Forest::heightForPixelCount(*asset, levels[l].minPixelCount);
-                        note += (l ? ", " : " ") + Forest::describeLevel(levels[l]) + " >= " +
-                                Ogre::StringConverter::toString(int(std::round(px))) + " px";
-                    }
+                    // The Forest's budgets are the scene's: species of one scene share them.
+                    mForest->setErrorBudget(budget);
+                    mForest->setShadowErrorBudget(mScript.lod.shadowMaxError);
+                    const std::uint32_t added = mForest->addBudgetedSpecies(asset, costs);
+                    mLevelNotes.push_back(LevelNote{species.name, int(added), ""});
                 }
                 else
                 {
-                    levels = Forest::levelsForBands(*asset, bands[s]);
+                    const std::vector<ForestLevel> levels = Forest::levelsForBands(*asset, bands[s]);
                     if (budgeted)
-                        note = std::string("fixed auto bands: ") +
-                               (asset->hasChunk(ERROR_CURVES_CHUNK) ? noCosts : "the package has no error curves");
+                        mLevelNotes.push_back(
+                            LevelNote{species.name, -1,
+                                      std::string("fixed auto bands: ") +
+                                          (asset->hasChunk(ERROR_CURVES_CHUNK) ? noCosts
+                                                                               : "the package has no error curves")});
+                    mForest->addSpecies(asset, levels);
                 }
-                if (!note.empty())
-                {
-                    Ogre::LogManager::getSingleton().logMessage("TreeLod: species '" + species.name + "': " + note);
-                    mLevelNotes.push_back(species.name + ": " + note);
-                }
-                mForest->addSpecies(asset, levels);
+                if (mLevelNotes.size() > notesBefore)
+                    Ogre::LogManager::getSingleton().logMessage("TreeLod: species '" + species.name +
+                                                                "': " + levelNote(mLevelNotes.back()));
             }
             catch (const Ogre::Exception& e)
             {

@@ -128,15 +128,8 @@ namespace TreeLod
 
     // ---- kinds -----------------------------------------------------------------------------------
 
-    Result<std::uint32_t> ForestInstances::addKind(const ForestKind& kind)
+    Result<void> ForestInstances::checkThresholds(const ForestKind& kind, const std::string& element) const
     {
-        const std::string element = "kind " + std::to_string(mKinds.size()) + " '" + kind.name + "'";
-        if (!finite(kind.boundsCentre))
-            return fail("", element, "bounding sphere centre " + text(kind.boundsCentre) + " is not finite");
-        if (!std::isfinite(kind.boundsRadius) || !(kind.boundsRadius > 0.0f))
-            return fail("", element, "bounding radius " + text(kind.boundsRadius) + " is not finite and > 0");
-        if (mKinds.size() >= MAX_KINDS)
-            return fail("", element, "more than " + std::to_string(MAX_KINDS) + " kinds");
         if (kind.thresholds.size() > MAX_THRESHOLDS)
             return fail("", element, std::to_string(kind.thresholds.size()) + " LoD thresholds (at most " +
                                          std::to_string(MAX_THRESHOLDS) + ")");
@@ -154,21 +147,62 @@ namespace TreeLod
                                              (distance ? "distance thresholds increase" :
                                                          "pixel-count thresholds decrease"));
         }
+        return {};
+    }
+
+    void ForestInstances::writeKindTable(std::uint32_t index)
+    {
+        const ForestKind& kind = mKinds[index];
+        const bool distance = kind.lodMode == ForestLodMode::Distance;
+        mKindDistance[index] = distance ? 1 : 0;
+        float* table = mKindTable.data() + std::size_t(index) * MAX_THRESHOLDS;
+        for (std::size_t i = 0; i < MAX_THRESHOLDS; ++i)
+            table[i] = i >= kind.thresholds.size() ? -std::numeric_limits<float>::infinity() // never above the key
+                                                   : distance ? -kind.thresholds[i] : kind.thresholds[i];
+        ++mTableGeneration; // levels remembered for hysteresis may mean others now
+        // Buckets are kind-major: a kind's level count moves the buckets of the kinds after it.
+        mBucketCount = 0;
+        for (std::uint32_t k = 0; k < mKinds.size(); ++k)
+        {
+            mKindFirstBucket[k] = mBucketCount;
+            mBucketCount += getLevelCount(k);
+        }
+    }
+
+    Result<std::uint32_t> ForestInstances::addKind(const ForestKind& kind)
+    {
+        const std::string element = "kind " + std::to_string(mKinds.size()) + " '" + kind.name + "'";
+        if (!finite(kind.boundsCentre))
+            return fail("", element, "bounding sphere centre " + text(kind.boundsCentre) + " is not finite");
+        if (!std::isfinite(kind.boundsRadius) || !(kind.boundsRadius > 0.0f))
+            return fail("", element, "bounding radius " + text(kind.boundsRadius) + " is not finite and > 0");
+        if (mKinds.size() >= MAX_KINDS)
+            return fail("", element, "more than " + std::to_string(MAX_KINDS) + " kinds");
+        if (Result<void> valid = checkThresholds(kind, element); !valid)
+            return valid.error();
 
         const std::uint32_t index = std::uint32_t(mKinds.size());
         mKinds.push_back(kind);
-        mKindFirstBucket.push_back(mBucketCount);
-        mKindDistance.push_back(distance ? 1 : 0);
-        for (std::size_t i = 0; i < MAX_THRESHOLDS; ++i)
-        {
-            if (i >= kind.thresholds.size())
-                mKindTable.push_back(-std::numeric_limits<float>::infinity()); // never above the key
-            else
-                mKindTable.push_back(distance ? -kind.thresholds[i] : kind.thresholds[i]);
-        }
-        mBucketCount += getLevelCount(index);
+        mKindFirstBucket.push_back(0);
+        mKindDistance.push_back(0);
+        mKindTable.resize(mKindTable.size() + MAX_THRESHOLDS);
+        writeKindTable(index);
         // Instances already placed keep their kinds; their spheres do not depend on new kinds.
         return index;
+    }
+
+    Result<void> ForestInstances::setKindThresholds(std::uint32_t kind, const std::vector<float>& thresholds)
+    {
+        if (kind >= mKinds.size())
+            return fail("", "kind " + std::to_string(kind), "no such kind (" + std::to_string(mKinds.size()) + " kinds)");
+        ForestKind changed = mKinds[kind];
+        changed.thresholds = thresholds;
+        if (Result<void> valid = checkThresholds(changed, "kind " + std::to_string(kind) + " '" + changed.name + "'");
+            !valid)
+            return valid;
+        mKinds[kind] = std::move(changed);
+        writeKindTable(kind);
+        return {};
     }
 
     // ---- instances -------------------------------------------------------------------------------
@@ -450,10 +484,11 @@ namespace TreeLod
         out.mBuckets.resize(mBucketCount);
         out.mCursor.assign(mBucketCount, 0u);
         constexpr std::uint8_t LEVEL_NONE = 0xFF;
-        if (out.mLastLevelInstances != n || out.mLastLevel.size() < n)
+        if (out.mLastLevelInstances != n || out.mLastLevel.size() < n || out.mLastLevelTables != mTableGeneration)
         {
             out.mLastLevel.assign(std::max(n, out.mLastLevel.size()), LEVEL_NONE);
             out.mLastLevelInstances = n;
+            out.mLastLevelTables = mTableGeneration;
         }
         std::uint8_t* lastLevel = out.mLastLevel.data();
         const float nearFactor = 1.0f + hysteresis, farFactor = 1.0f / (1.0f + hysteresis);

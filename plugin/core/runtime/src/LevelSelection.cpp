@@ -5,31 +5,59 @@
 
 namespace TreeLod
 {
+    float selectionHeight(std::size_t k)
+    {
+        return std::exp2(float(SELECTION_OCTAVES) - float(k) / SELECTION_SAMPLES_PER_OCTAVE);
+    }
+
+    std::size_t selectionSample(float heightPx)
+    {
+        if (!(heightPx > 0.0f) || !std::isfinite(heightPx))
+            return heightPx == std::numeric_limits<float>::infinity() ? 0 : SELECTION_SAMPLES - 1;
+        const float k = std::round((float(SELECTION_OCTAVES) - std::log2(heightPx)) * SELECTION_SAMPLES_PER_OCTAVE);
+        return std::size_t(std::clamp(k, 0.0f, float(SELECTION_SAMPLES - 1)));
+    }
+
+    namespace
+    {
+        /// Each curve level's cost, or null.
+        std::vector<const LevelCost*> costsOf(const ErrorCurves& curves, const std::vector<LevelCost>& costs)
+        {
+            std::vector<const LevelCost*> costOf(curves.levels.size(), nullptr);
+            for (std::size_t l = 0; l < curves.levels.size(); ++l)
+            {
+                const ErrorCurveLevel& level = curves.levels[l];
+                const int c = findLevelCost(costs, level.technique, level.techniqueLevel, level.lowRes);
+                if (c >= 0)
+                    costOf[l] = &costs[std::size_t(c)];
+            }
+            return costOf;
+        }
+
+        Result<int> checkBudget(const ErrorCurves& curves, float budget, const char* what)
+        {
+            if (!(std::isfinite(budget) && budget >= 0.0f && budget <= 1.0f))
+                return fail("", what, std::to_string(budget) + " is not a number in [0, 1]");
+            const int reference = curves.find(LEVEL_SELECTION_REFERENCE, 0, false);
+            if (reference < 0)
+                return fail("", "error curves",
+                            std::string("no curve of the reference '") + LEVEL_SELECTION_REFERENCE + "'");
+            return reference;
+        }
+    }
+
     Result<std::vector<LevelChoice>> chooseLevels(const ErrorCurves& curves, const std::vector<LevelCost>& costs,
                                                   float errorBudget, std::size_t maxRuns)
     {
-        if (!(std::isfinite(errorBudget) && errorBudget >= 0.0f && errorBudget <= 1.0f))
-            return fail("", "error budget", std::to_string(errorBudget) + " is not a number in [0, 1]");
+        Result<int> reference = checkBudget(curves, errorBudget, "error budget");
+        if (!reference)
+            return reference.error();
         if (maxRuns == 0)
             return fail("", "error budget", "no level may be used (maxRuns 0)");
-        const int reference = curves.find(LEVEL_SELECTION_REFERENCE, 0, false);
-        if (reference < 0)
-            return fail("", "error curves", std::string("no curve of the reference '") + LEVEL_SELECTION_REFERENCE + "'");
 
         // Each curve level's cost, or null (not a candidate; the reference stays allowed).
-        std::vector<const LevelCost*> costOf(curves.levels.size(), nullptr);
-        bool anyCost = false;
-        for (std::size_t l = 0; l < curves.levels.size(); ++l)
-        {
-            const ErrorCurveLevel& level = curves.levels[l];
-            const int c = findLevelCost(costs, level.technique, level.techniqueLevel, level.lowRes);
-            if (c >= 0)
-            {
-                costOf[l] = &costs[std::size_t(c)];
-                anyCost = true;
-            }
-        }
-        if (!anyCost)
+        const std::vector<const LevelCost*> costOf = costsOf(curves, costs);
+        if (std::find_if(costOf.begin(), costOf.end(), [](const LevelCost* c) { return c != nullptr; }) == costOf.end())
             return fail("", "level costs", "no level of the error curves has a calibrated cost");
 
         struct Run
@@ -40,18 +68,18 @@ namespace TreeLod
             float flip = 0.0f;
         };
         std::vector<Run> runs;
-        constexpr int SAMPLES_PER_OCTAVE = 4, OCTAVES = 13; // 8192 px down to 1 px
-        for (int k = 0; k <= OCTAVES * SAMPLES_PER_OCTAVE; ++k)
+        constexpr int SAMPLES_PER_OCTAVE = SELECTION_SAMPLES_PER_OCTAVE;
+        for (std::size_t k = 0; k < SELECTION_SAMPLES; ++k)
         {
-            const float h = std::exp2(float(OCTAVES) - float(k) / SAMPLES_PER_OCTAVE);
-            const float allowed = curves.flipAt(std::size_t(reference), h) + errorBudget;
-            std::size_t best = std::size_t(reference);
+            const float h = selectionHeight(k);
+            const float allowed = curves.flipAt(std::size_t(*reference), h) + errorBudget;
+            std::size_t best = std::size_t(*reference);
             float bestCost = costOf[best] ? costOf[best]->msAt(h) : std::numeric_limits<float>::infinity();
             float bestFlip = curves.flipAt(best, h);
             if (errorBudget > 0.0f)
                 for (std::size_t l = 0; l < curves.levels.size(); ++l)
                 {
-                    if (!costOf[l] || l == std::size_t(reference))
+                    if (!costOf[l] || l == std::size_t(*reference))
                         continue;
                     const float flip = curves.flipAt(l, h);
                     const float cost = costOf[l]->msAt(h);
@@ -82,9 +110,9 @@ namespace TreeLod
             const Run& gone = runs[shortest];
             keep.samples += gone.samples;
             keep.lowestHeight = std::min(keep.lowestHeight, gone.lowestHeight);
-            for (int k = 0; k <= OCTAVES * SAMPLES_PER_OCTAVE; ++k) // its error over the heights it gains
+            for (std::size_t k = 0; k < SELECTION_SAMPLES; ++k) // its error over the heights it gains
             {
-                const float h = std::exp2(float(OCTAVES) - float(k) / SAMPLES_PER_OCTAVE);
+                const float h = selectionHeight(k);
                 if (h >= gone.lowestHeight && h < gone.lowestHeight * std::exp2(float(gone.samples) / SAMPLES_PER_OCTAVE))
                     keep.flip = std::max(keep.flip, curves.flipAt(keep.level, h));
             }
@@ -109,5 +137,103 @@ namespace TreeLod
             choices.push_back(LevelChoice{runs[r].level, boundary, runs[r].flip});
         }
         return choices;
+    }
+
+    std::size_t choiceAt(const std::vector<LevelChoice>& choices, float heightPx)
+    {
+        for (std::size_t r = 0; r < choices.size(); ++r)
+            if (heightPx >= choices[r].minHeightPx)
+                return r;
+        return choices.empty() ? 0 : choices.size() - 1;
+    }
+
+    Result<std::vector<std::size_t>> chooseShadowLevels(const ErrorCurves& curves, const std::vector<LevelCost>& costs,
+                                                        const std::vector<LevelChoice>& choices, float shadowBudget)
+    {
+        Result<int> reference = checkBudget(curves, shadowBudget, "shadow error budget");
+        if (!reference)
+            return reference.error();
+        const std::vector<const LevelCost*> costOf = costsOf(curves, costs);
+        for (const LevelChoice& choice : choices)
+            if (choice.curveLevel >= curves.levels.size())
+                return fail("", "level choices", "curve level " + std::to_string(choice.curveLevel) + " of " +
+                                                     std::to_string(curves.levels.size()));
+        std::vector<std::size_t> shadow(choices.size());
+        for (std::size_t r = 0; r < choices.size(); ++r)
+        {
+            // Run r's sampled heights: those that choiceAt gives r for.
+            std::vector<float> heights;
+            for (std::size_t k = 0; k < SELECTION_SAMPLES; ++k)
+                if (choiceAt(choices, selectionHeight(k)) == r)
+                    heights.push_back(selectionHeight(k));
+            shadow[r] = r;
+            double bestCost = std::numeric_limits<double>::infinity();
+            for (std::size_t c = r; c < choices.size(); ++c)
+            {
+                const std::size_t level = choices[c].curveLevel;
+                const LevelCost* cost = costOf[level];
+                if (!cost && c != r)
+                    continue;
+                double total = 0.0;
+                bool within = true;
+                for (const float h : heights)
+                {
+                    total += cost ? cost->msAt(h) : 0.0;
+                    within &= curves.flipAt(level, h) <= curves.flipAt(std::size_t(*reference), h) + shadowBudget;
+                }
+                if ((c == r || within) && total < bestCost)
+                {
+                    shadow[r] = c;
+                    bestCost = total;
+                }
+            }
+        }
+        return shadow;
+    }
+
+    std::vector<float> planCostPerTree(const ErrorCurves& curves, const std::vector<LevelCost>& costs,
+                                       const std::vector<LevelChoice>& choices)
+    {
+        const std::vector<const LevelCost*> costOf = costsOf(curves, costs);
+        std::vector<float> ms(SELECTION_SAMPLES, 0.0f);
+        if (choices.empty())
+            return ms;
+        for (std::size_t k = 0; k < SELECTION_SAMPLES; ++k)
+        {
+            const float h = selectionHeight(k);
+            const std::size_t level = choices[choiceAt(choices, h)].curveLevel;
+            ms[k] = level < costOf.size() && costOf[level] ? costOf[level]->msAt(h) : 0.0f;
+        }
+        return ms;
+    }
+
+    double HeightHistogram::milliseconds(const std::vector<float>& msPerTree) const
+    {
+        double ms = 0.0;
+        for (std::size_t k = 0; k < counts.size() && k < msPerTree.size(); ++k)
+            ms += double(counts[k]) * double(msPerTree[k]);
+        return ms;
+    }
+
+    const std::vector<float>& frameBudgetLadder()
+    {
+        static const std::vector<float> ladder{0.0f, 0.005f, 0.01f, 0.02f, 0.03f, 0.05f,
+                                               0.08f, 0.12f, 0.2f, 0.35f, 1.0f};
+        return ladder;
+    }
+
+    std::size_t chooseFrameBudgetStep(const std::vector<double>& predictedMs, double frameBudgetMs,
+                                      std::size_t current, double finerMargin)
+    {
+        if (predictedMs.empty())
+            return 0;
+        current = std::min(current, predictedMs.size() - 1);
+        for (std::size_t step = 0; step < predictedMs.size(); ++step)
+        {
+            const double limit = step < current ? finerMargin * frameBudgetMs : frameBudgetMs;
+            if (predictedMs[step] <= limit)
+                return step;
+        }
+        return predictedMs.size() - 1;
     }
 }

@@ -788,9 +788,13 @@ namespace TreeLod
                 s.shadows = readShadows(*v, "/shadows");
             if (const Json* v = find(root, "lod"))
             {
-                allowKeys(*v, "/lod", {"maxError"});
+                allowKeys(*v, "/lod", {"maxError", "shadowMaxError", "frameBudgetMs"});
                 if (const Json* e = find(*v, "maxError"))
                     s.lod.maxError = float(number(*e, "/lod/maxError", 0.0, 1.0));
+                if (const Json* e = find(*v, "shadowMaxError"))
+                    s.lod.shadowMaxError = float(number(*e, "/lod/shadowMaxError", 0.0, 1.0));
+                if (const Json* e = find(*v, "frameBudgetMs"))
+                    s.lod.frameBudgetMs = float(number(*e, "/lod/frameBudgetMs", 0.0, 1e6));
             }
             s.camera = readCamera(need(root, "", "camera"), "/camera");
 

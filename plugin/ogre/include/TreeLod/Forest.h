@@ -56,6 +56,23 @@
 //   getDrawnLevel, the nearest resident level, coarser first. A level that fails to build is
 //   logged and keeps its fallback. Uploads run on the render thread (GL): the budget bounds
 //   them per frame. Levels are never evicted while the Forest lives.
+// - Budgeted species (addBudgetedSpecies; docs/forest.md, "Budgeted levels"): levels chosen from
+//   the asset's error curves and this machine's costs (LevelSelection.h) for the Forest's error
+//   budget, and chosen again when it changes (setErrorBudget, or the frame budget's controller):
+//   the kind's table is replaced (ForestInstances::setKindThresholds; its sphere holds every
+//   candidate level, so it does not change), levels drawn before at the same switch value keep
+//   their parts, levels whose drawables were uploaded are rebuilt at once, the last level is
+//   built before anything changes (a failure leaves the old plan), the others are built when
+//   needed, as under "Residency". Each camera's buckets of the species are reset.
+//   Shadow casters of a budgeted species draw, per level, chooseShadowLevels' level for the
+//   shadow error budget: the cheapest of that level and the coarser ones within it.
+//   A frame budget (setFrameBudgetMs) re-plans every FRAME_BUDGET_INTERVAL viewer frames: the
+//   viewer's visible trees of budgeted species are counted by height on screen (their LoD value,
+//   bias included), each step of frameBudgetLadder() is predicted as the sum of the levels'
+//   calibrated costs (LevelCost::msAt), and the finest step within the budget is taken
+//   (chooseFrameBudgetStep, with hysteresis) from the next viewer frame. The prediction counts
+//   the viewer's trees only, not shadow passes nor what else the frame draws: it is a model of
+//   the calibration, not a timer (GL3Plus in OGRE 1.12 has no timer queries to close the loop).
 // - ForestStats describe the last viewer camera (one whose LoD camera is itself, outside shadow
 //   texture rendering); they are cleared before each viewer's visibility pass, so a viewer that
 //   does not see the Forest's bounds reports nothing visible. Cameras without a viewport (area
@@ -66,6 +83,7 @@
 #include "TreeLod/ForestInstances.h"
 #include "TreeLod/ForestLevelProvider.h"
 #include "TreeLod/LevelCosts.h"
+#include "TreeLod/LevelSelection.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreCamera.h>
@@ -98,6 +116,9 @@ namespace TreeLod
         std::uint32_t pendingLevels = 0;      ///< levels asked for and waiting for a later frame
         /// Visible instances of the viewer drawn at a fallback level (theirs not resident yet).
         std::uint32_t fallbackInstances = 0;
+        /// The frame budget's prediction at its last re-plan (ms, the viewer's trees of budgeted
+        /// species at the levels in use); 0 without a frame budget.
+        double predictedMilliseconds = 0.0;
     };
 
     class Forest : public Ogre::MovableObject
@@ -145,6 +166,34 @@ namespace TreeLod
         /// the budget is not in [0, 1] or no level has a cost.
         static std::vector<ForestLevel> levelsForErrorBudget(TreeAsset& asset, const std::vector<LevelCost>& costs,
                                                              float errorBudget);
+
+        /// Add a budgeted species: its levels are levelsForErrorBudget's for getErrorBudget(), chosen
+        /// again whenever the budget changes (see "Budgeted species"). `costs`: this machine's
+        /// (LevelCalibration.h). Throws as levelsForErrorBudget and addSpecies; nothing is added then.
+        std::uint32_t addBudgetedSpecies(const TreeAssetPtr& asset, const std::vector<LevelCost>& costs);
+        bool isBudgeted(std::uint32_t species) const;
+
+        /// Error budget of the budgeted species (default DEFAULT_ERROR_BUDGET: FLIP over the
+        /// tree's box above the polygonal reference's own), in [0, 1]; re-plans them now. Throws
+        /// Ogre::InvalidParametersException for NaN or a budget outside [0, 1]. Under a frame
+        /// budget, the start of its controller, which then sets the budget itself.
+        void setErrorBudget(float budget);
+        /// The error budget the budgeted species are planned for now.
+        float getErrorBudget() const { return mErrorBudget; }
+        /// Shadow casters' own error budget, in [0, 1] (default DEFAULT_SHADOW_ERROR_BUDGET); see
+        /// "Budgeted species". Throws as setErrorBudget.
+        void setShadowErrorBudget(float budget);
+        float getShadowErrorBudget() const { return mShadowErrorBudget; }
+        /// The level the shadow casters of `species` draw for each of its levels (itself for a
+        /// species with fixed levels).
+        const std::vector<std::uint32_t>& getShadowLevels(std::uint32_t species) const;
+        /// Frame budget in milliseconds for the viewer's trees of budgeted species (0, the default:
+        /// none, the error budget holds); finite and >= 0, else Ogre::InvalidParametersException.
+        /// Turning it off plans for the last setErrorBudget again.
+        void setFrameBudgetMs(float milliseconds);
+        float getFrameBudgetMs() const { return mFrameBudgetMs; }
+        /// Viewer frames between two re-plans of the frame budget.
+        static constexpr unsigned FRAME_BUDGET_INTERVAL = 8;
 
         /// Add a species; returns its index (= ForestInstances kind). Levels near to far (at most
         /// ForestInstances::MAX_THRESHOLDS + 1), strictly decreasing minPixelCount, the last 0;
@@ -219,6 +268,19 @@ namespace TreeLod
         class ViewerListener;
         class CameraListener;
 
+        struct BudgetPlan;
+        /// addSpecies and addBudgetedSpecies: `budget` is null for fixed levels.
+        std::uint32_t addSpeciesImpl(const TreeAssetPtr& asset, const std::vector<ForestLevel>& levels,
+                                     std::unique_ptr<BudgetPlan> budget);
+        /// Replace the levels of budgeted species `species` by those of `choices` (see "Budgeted
+        /// species"); throws naming the species when its last level cannot be built (nothing changed).
+        void replan(std::uint32_t species, const std::vector<LevelChoice>& choices);
+        /// Plan every budgeted species for `budget` (replan where its levels change).
+        void applyErrorBudget(float budget);
+        void updateShadowLevels(std::uint32_t species);
+        /// The frame budget's measurement on the viewer's cull: prediction and the step it wants.
+        void measureFrameBudget(const CameraState& state);
+
         /// The parts `level` of `asset` draws (instanced materials made on the way).
         std::vector<std::unique_ptr<Part>> buildParts(TreeAsset& asset, const ForestLevel& level,
                                                       Ogre::Real upperPixelCount);
@@ -232,8 +294,9 @@ namespace TreeLod
         /// This Forest's instanced clone of material `name` (and of its shadow casters).
         Ogre::MaterialPtr instancedMaterial(const Ogre::String& name, const Ogre::String& group);
         bool useShadowedMaterials() const;
-        /// Write the instances of `state`'s bucket `bucket` into its instance buffer (grown if needed).
-        void fillBucket(CameraState& state, std::uint32_t bucket);
+        /// Write the instances of `state`'s bucket `bucket` into its instance buffer (grown if needed),
+        /// drawn with the parts of level `level` of its species (or its fallback).
+        void fillBucket(CameraState& state, std::uint32_t bucket, std::uint32_t level);
         /// Zero the per-frame counts of mStats (a viewer's visibility pass begins).
         void clearFrameStats();
         /// Free the state of `camera` (being destroyed): its instance buffers and Renderables.
@@ -251,6 +314,13 @@ namespace TreeLod
         Ogre::Real mLodBias = 1.0f;
         Ogre::Real mShadowLodBias = 1.0f;
         Ogre::Real mLodHysteresis = 0.15f;
+        float mErrorBudget = DEFAULT_ERROR_BUDGET;      ///< in use
+        float mUserErrorBudget = DEFAULT_ERROR_BUDGET;  ///< the last setErrorBudget
+        float mShadowErrorBudget = DEFAULT_SHADOW_ERROR_BUDGET;
+        float mFrameBudgetMs = 0.0f;
+        std::size_t mFrameBudgetStep = 0;   ///< frameBudgetLadder() step in use
+        std::size_t mWantedBudgetStep = 0;  ///< the controller's choice, applied at the next viewer frame
+        unsigned mFrameBudgetFrames = 0;    ///< viewer frames since the last measurement
         bool mLodFrozen = false;
         ForestStats mStats;
         std::uint64_t mInstanceBufferBytes = 0;

@@ -117,9 +117,12 @@ namespace TreeLod
         /// The camera at frame `frame` of `frameCount` (0 = the script's frame count).
         CameraSpec cameraAtFrame(std::uint32_t frame, std::uint32_t frameCount = 0) const;
 
-        /// Per species, how its levels were chosen: "budget 0.02: lodf 0 >= 301 px, ..." or why the
-        /// fixed auto bands were used.
-        const std::vector<std::string>& getLevelNotes() const { return mLevelNotes; }
+        /// Per auto species, how its levels are chosen now: "oak: budget 0.02: lodf 0 >= 301 px, ..."
+        /// or why the fixed auto bands were used.
+        std::vector<std::string> getLevelNotes() const;
+        /// Re-plan the budgeted species for `budget` now (Forest::setErrorBudget; throws as it does);
+        /// false, and nothing changed, when no species is budgeted.
+        bool setErrorBudget(float budget);
 
         /// GPU bytes of the drawables in use (Forest::getGpuBytes).
         std::uint64_t getGpuBytes() const;
@@ -140,7 +143,14 @@ namespace TreeLod
         std::vector<std::shared_ptr<TreeAssetRequest>> mPendingBakes;
         std::vector<PlacedTree> mPlacements;
         std::vector<TreeAssetPtr> mAssets;
-        std::vector<std::string> mLevelNotes;
+        struct LevelNote
+        {
+            std::string name; ///< the script's species
+            int species = -1; ///< the Forest's budgeted species, or -1: `fixed` says why not
+            std::string fixed;
+        };
+        std::string levelNote(const LevelNote& note) const;
+        std::vector<LevelNote> mLevelNotes;
         Forest* mForest = nullptr;
         std::unique_ptr<EntityFloor> mEntityFloor;
         std::unique_ptr<MergedQuadFloor> mMergedQuadFloor;

@@ -160,6 +160,7 @@ namespace TreeLod
         std::vector<std::uint32_t> mCursor;      // scratch: fill position per bucket
         std::vector<std::uint8_t> mLastLevel;    // per dense instance: its level last time it was seen (LEVEL_NONE)
         std::size_t mLastLevelInstances = 0;     // the instance count mLastLevel was made for
+        std::uint32_t mLastLevelTables = 0;      // the ForestInstances table generation it was made for
         std::uint32_t mVisibleCount = 0;
         std::uint32_t mCulledCount = 0;
     };
@@ -183,6 +184,11 @@ namespace TreeLod
 
         /// Add a kind; returns its index. Kinds are never removed.
         Result<std::uint32_t> addKind(const ForestKind& kind);
+        /// Replace a kind's LoD table (same checks as addKind; the kind is unchanged on error). When
+        /// its level count changes, the bucket indices of the kinds after it move (getBucketIndex);
+        /// a ForestVisibility culled before holds the old buckets until its next cull, which forgets
+        /// the levels it remembered for hysteresis (a level index may mean another level now).
+        Result<void> setKindThresholds(std::uint32_t kind, const std::vector<float>& thresholds);
         std::uint32_t getKindCount() const { return std::uint32_t(mKinds.size()); }
         const ForestKind& getKind(std::uint32_t kind) const { return mKinds[kind]; }
         std::uint32_t getLevelCount(std::uint32_t kind) const
@@ -237,11 +243,14 @@ namespace TreeLod
         /// Hysteresis h: an instance keeps the level it had in `out`'s last cull while that level is
         /// one its LoD value times or divided by (1 + h) would give, so trees near a switch do not
         /// flicker between two levels under camera jitter (0: none). `out` remembers the levels
-        /// per instance; after instances are added or removed it starts afresh.
+        /// per instance; after instances are added or removed, or a kind's table changes, it
+        /// starts afresh.
         Result<void> cull(const CullCamera& camera, float lodBias, ForestVisibility& out, float hysteresis = 0.0f) const;
 
     private:
         std::string check(const ForestInstance& instance) const; ///< "" or the reason it is refused
+        Result<void> checkThresholds(const ForestKind& kind, const std::string& element) const;
+        void writeKindTable(std::uint32_t kind); ///< its table row and every kind's first bucket
         ForestHandle takeHandle();
         std::array<std::vector<float>*, 5> floatArrays(); ///< every per-instance float array
         void write(std::size_t slot, const ForestInstance& instance);
@@ -256,6 +265,7 @@ namespace TreeLod
         /// are, distance thresholds negated (value = -d^2 / bias), padding never reached.
         std::vector<float> mKindTable;
         std::uint32_t mBucketCount = 0;
+        std::uint32_t mTableGeneration = 0; ///< counts table changes (addKind, setKindThresholds)
 
         // instances (structure of arrays, dense): 32 bytes each with the handle maps;
         // scale, rotation and the world sphere are derived from these where needed

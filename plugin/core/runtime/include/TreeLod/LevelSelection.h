@@ -7,19 +7,41 @@
 // level: near to far, each with the smallest height it is drawn at. A budget of 0 draws the
 // reference itself; a budget of 1 the cheapest level everywhere. A level without a cost is not a
 // candidate.
+// Shadow casters (chooseShadowLevels) get their own, coarser budget: each run's casters draw the
+// cheapest of its level and the coarser runs' levels within that budget over the run's heights.
+// A frame budget (chooseFrameBudgetStep) picks the finest error budget of a ladder whose plans'
+// predicted cost, the visible trees counted by height (HeightHistogram) times each level's
+// LevelCost::msAt, fits: a model of this machine's calibrated costs, not a timer.
 #pragma once
 
 #include "TreeLod/ErrorCurves.h"
 #include "TreeLod/LevelCosts.h"
 #include "TreeLod/Result.h"
 
+#include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace TreeLod
 {
     /// The technique whose curve is the floor of every budget (TechniqueRegistry's REFERENCE_TECHNIQUE).
     constexpr const char* LEVEL_SELECTION_REFERENCE = "mesh";
+
+    /// The error budget the Forest starts with (Forest::setErrorBudget, scene scripts' "lod" maxError).
+    constexpr float DEFAULT_ERROR_BUDGET = 0.03f;
+    /// The shadow casters' error budget the Forest starts with (Forest::setShadowErrorBudget): coarser
+    /// than the view's, as a shadow shows a tree's outline blurred and from one side.
+    constexpr float DEFAULT_SHADOW_ERROR_BUDGET = 0.08f;
+
+    /// The heights the selection samples: 4 per octave from 8192 px (sample 0) down to 1 px.
+    constexpr int SELECTION_SAMPLES_PER_OCTAVE = 4;
+    constexpr int SELECTION_OCTAVES = 13;
+    constexpr std::size_t SELECTION_SAMPLES = SELECTION_OCTAVES * SELECTION_SAMPLES_PER_OCTAVE + 1;
+    /// Height of sample k (< SELECTION_SAMPLES), pixels.
+    float selectionHeight(std::size_t k);
+    /// The sample nearest `heightPx` in log2 (clamped to the range; non-finite or <= 0: the last).
+    std::size_t selectionSample(float heightPx);
 
     /// One run of the selection: curves.levels[curveLevel] while the tree is >= minHeightPx tall.
     struct LevelChoice
@@ -34,4 +56,39 @@ namespace TreeLod
     /// curves without the reference level or with no level that has a cost.
     Result<std::vector<LevelChoice>> chooseLevels(const ErrorCurves& curves, const std::vector<LevelCost>& costs,
                                                   float errorBudget, std::size_t maxRuns = 16);
+
+    /// The run of `choices` drawn at `heightPx` (the first whose minHeightPx it reaches).
+    std::size_t choiceAt(const std::vector<LevelChoice>& choices, float heightPx);
+
+    /// Shadow casters' levels: for each run r of `choices`, the index (>= r) of the run whose level
+    /// its casters draw: the cheapest over run r's sampled heights among run r's own level and the
+    /// coarser runs' levels whose FLIP stays within `shadowBudget` of the reference's at every one
+    /// of those heights (run r's own when none is cheaper). Errors as chooseLevels.
+    Result<std::vector<std::size_t>> chooseShadowLevels(const ErrorCurves& curves, const std::vector<LevelCost>& costs,
+                                                        const std::vector<LevelChoice>& choices, float shadowBudget);
+
+    /// Milliseconds per tree a plan costs at each selection sample height: the cost of the level
+    /// `choices` draws there (LevelCost::msAt; 0 for a level without a cost).
+    std::vector<float> planCostPerTree(const ErrorCurves& curves, const std::vector<LevelCost>& costs,
+                                       const std::vector<LevelChoice>& choices);
+
+    /// Visible trees of one species counted by height on screen, at the nearest selection sample.
+    struct HeightHistogram
+    {
+        std::vector<std::uint32_t> counts = std::vector<std::uint32_t>(SELECTION_SAMPLES, 0u);
+        void add(float heightPx) { ++counts[selectionSample(heightPx)]; }
+        void clear() { std::fill(counts.begin(), counts.end(), 0u); }
+        /// Sum of count x msPerTree (planCostPerTree's).
+        double milliseconds(const std::vector<float>& msPerTree) const;
+    };
+
+    /// The error budgets a frame budget chooses among, finest first (0: the reference).
+    const std::vector<float>& frameBudgetLadder();
+
+    /// The step of the ladder a frame budget takes, from `predictedMs` (one per step, finest first)
+    /// and the step in use: the finest step predicted within `frameBudgetMs`; but a step finer than
+    /// `current` only where it is predicted within `finerMargin` x the budget (hysteresis: a frame
+    /// near the budget does not flip between two steps). The coarsest step when none fits.
+    std::size_t chooseFrameBudgetStep(const std::vector<double>& predictedMs, double frameBudgetMs,
+                                      std::size_t current, double finerMargin = 0.85);
 }

@@ -36,6 +36,7 @@
 
 #include "TreeLod/Camera.h"
 #include "TreeLod/GreyImage.h"
+#include "TreeLod/LevelSelection.h"
 #include "TreeLod/Result.h"
 
 #include <glm/glm.hpp>
@@ -143,10 +144,15 @@ namespace TreeLod
     /// "lod": how `auto` species choose levels (docs/scene-format.md).
     struct SceneLod
     {
-        static constexpr float DEFAULT_MAX_ERROR = 0.03f;
+        static constexpr float DEFAULT_MAX_ERROR = DEFAULT_ERROR_BUDGET;
+        static constexpr float DEFAULT_SHADOW_MAX_ERROR = DEFAULT_SHADOW_ERROR_BUDGET;
         /// Error budget of budgeted auto (Forest::setErrorBudget): FLIP over the tree's box above
         /// the polygonal reference's own, in [0, 1].
         float maxError = DEFAULT_MAX_ERROR;
+        /// The shadow casters' own error budget (Forest::setShadowErrorBudget), in [0, 1].
+        float shadowMaxError = DEFAULT_SHADOW_MAX_ERROR;
+        /// Frame budget of budgeted auto (Forest::setFrameBudgetMs), ms; 0: none.
+        float frameBudgetMs = 0.0f;
     };
 
     struct SceneKeyframe
