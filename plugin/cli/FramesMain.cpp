@@ -332,6 +332,12 @@ namespace TreeLod
                                     row["uploadedBytes"] = stats.uploadedBytes;
                                     row["pendingLevels"] = stats.pendingLevels;
                                     row["fallbackTrees"] = stats.fallbackInstances;
+                                    if (scene->getForest().getFrameBudgetMs() > 0.0f)
+                                    {
+                                        // The frame budget's model at its last re-plan, and its choice.
+                                        row["predictedMs"] = stats.predictedMilliseconds;
+                                        row["errorBudget"] = scene->getForest().getErrorBudget();
+                                    }
                                 }
                             }
                             if (isSampled(f))
