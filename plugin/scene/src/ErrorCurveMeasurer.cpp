@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 
 namespace TreeLod
 {
@@ -148,6 +149,10 @@ namespace TreeLod
                 report(progress, "error curves", float(done++) / float(total));
                 const View view = makeView(lo, hi, options.heightsPx[h], viewAngles);
                 const Image reference = traceReference(cpu, view.camera, view.size, options.referenceSupersample);
+                // Each level's image is scored on another thread while Ogre (this thread, which owns
+                // the GL context) draws the next: FLIP on the CPU overlaps the renderer's work. The
+                // scores do not depend on the thread count (ImageMetrics.h).
+                std::vector<std::future<Result<Scores>>> scores;
                 for (std::size_t l = 0; l < levels.size(); ++l)
                 {
                     forests[l]->setVisible(true);
@@ -158,13 +163,23 @@ namespace TreeLod
                     }
                     catch (const Ogre::Exception& e)
                     {
+                        scores.clear(); // waits for the scores under way: they read `reference`
                         renderer.clearContent();
                         return fail(label, "level " + Forest::describeLevel(levels[l]), e.getDescription());
                     }
                     forests[l]->setVisible(false);
-                    Result<Scores> s = score(reference, test, "level " + Forest::describeLevel(levels[l]));
+                    scores.push_back(std::async(std::launch::async,
+                                                [&reference, test = std::move(test),
+                                                 element = "level " + Forest::describeLevel(levels[l])] {
+                                                    return score(reference, test, element);
+                                                }));
+                }
+                for (std::size_t l = 0; l < levels.size(); ++l)
+                {
+                    Result<Scores> s = scores[l].get();
                     if (!s)
                     {
+                        scores.clear();
                         renderer.clearContent();
                         return s.error();
                     }
