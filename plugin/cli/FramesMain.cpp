@@ -335,8 +335,10 @@ namespace TreeLod
                                     if (scene->getForest().getFrameBudgetMs() > 0.0f)
                                     {
                                         // The frame budget's model at its last re-plan, and its choice.
+                                        scene->getForest().notifyFrameTime(float(timing.frameMilliseconds));
                                         row["predictedMs"] = stats.predictedMilliseconds;
                                         row["errorBudget"] = scene->getForest().getErrorBudget();
+                                        row["frameTimeRatio"] = scene->getForest().getFrameTimeRatio();
                                     }
                                 }
                             }

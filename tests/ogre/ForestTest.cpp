@@ -1598,11 +1598,19 @@ namespace TreeLod
         const std::vector<ForestLevel> planned = Forest::levelsForErrorBudget(*asset, costs, 0.03f);
         ASSERT_GE(planned.size(), 2u);
 
-        // The same levels added as fixed: the picture a budgeted species must give.
+        // The same levels added as fixed: the picture a budgeted species must give. A frame budget
+        // has nothing to plan there: the error budget stays.
         Forest* fixed = placeForest();
         fixed->addSpecies(asset, planned);
         fixed->addInstances(trees);
+        EXPECT_FALSE(fixed->isBudgeted(0));
+        EXPECT_EQ(fixed->getShadowLevels(0).size(), planned.size());
         const Image expected = toImage(r.render(view, 320, 180, 1));
+        fixed->setFrameBudgetMs(1e-6f);
+        r.render(view, 320, 180, 1);
+        r.render(view, 320, 180, 1);
+        EXPECT_EQ(fixed->getErrorBudget(), DEFAULT_ERROR_BUDGET);
+        EXPECT_TRUE(sameLevels(fixed->getLevels(0), planned));
 
         Forest* forest = placeForest();
         EXPECT_EQ(forest->getErrorBudget(), DEFAULT_ERROR_BUDGET);
@@ -1673,6 +1681,21 @@ namespace TreeLod
         const double meshMs = forest->getStats().predictedMilliseconds;
         EXPECT_GT(meshMs, 36.0 * 2.0);
         EXPECT_LT(meshMs, 36.0 * 64.0);
+        // Measured frames reported at 4x the model: the controller scales its predictions by the
+        // running ratio and leaves the reference, which the model alone keeps.
+        forest->setFrameBudgetMs(float(2.0 * meshMs));
+        for (unsigned f = 0; f < Forest::FRAME_BUDGET_INTERVAL + 2; ++f)
+            r.render(view, 160, 90, 1);
+        EXPECT_EQ(forest->getErrorBudget(), 0.0f) << "the model alone: the reference fits";
+        EXPECT_EQ(forest->getFrameTimeRatio(), 1.0);
+        for (unsigned f = 0; f < 3 * Forest::FRAME_BUDGET_INTERVAL + 1; ++f)
+        {
+            r.render(view, 160, 90, 1);
+            forest->notifyFrameTime(float(4.0 * meshMs));
+            forest->notifyFrameTime(std::nanf("")); // ignored
+        }
+        EXPECT_GT(forest->getFrameTimeRatio(), 1.5);
+        EXPECT_GT(forest->getErrorBudget(), 0.0f) << "measured frames 4x the model: a coarser step";
         // Half of that: a step predicted within it, coarser than the reference.
         forest->setFrameBudgetMs(float(0.5 * meshMs));
         for (unsigned f = 0; f < 2 * Forest::FRAME_BUDGET_INTERVAL + 1; ++f)

@@ -966,6 +966,10 @@ namespace TreeLod
         mFrameBudgetMs = milliseconds;
         mFrameBudgetFrames = 0;
         mStats.predictedMilliseconds = 0.0;
+        mFrameTimeRatio = 1.0;
+        mReportedMs = 0.0;
+        mReportedFrames = 0;
+        mPlanPredictedMs = 0.0;
         if (off)
             setErrorBudget(mUserErrorBudget);
     }
@@ -973,9 +977,15 @@ namespace TreeLod
     void Forest::measureFrameBudget(const CameraState& state)
     {
         // Every visible tree of a budgeted species, counted at its height on screen.
+        bool anyBudgeted = false;
         for (const std::unique_ptr<Species>& species : mSpecies)
             if (species->budget)
+            {
                 species->budget->visible.clear();
+                anyBudgeted = true;
+            }
+        if (!anyBudgeted)
+            return; // nothing to plan: the error budget stays
         const ForestVisibility& visibility = state.visibility;
         for (std::uint32_t b = 0; b < visibility.getBucketCount(); ++b)
         {
@@ -996,8 +1006,29 @@ namespace TreeLod
             if (species->budget)
                 for (std::size_t step = 0; step < steps; ++step)
                     predicted[step] += species->budget->visible.milliseconds(species->budget->ladderMsPerTree[step]);
+        // Reported frame times since the last measurement against what was predicted for their plan:
+        // the running ratio (a quarter of the way to each new one, within [0.1, 10]).
+        if (mReportedFrames > 0 && mPlanPredictedMs > 0.0)
+        {
+            const double ratio = std::clamp(mReportedMs / mReportedFrames / mPlanPredictedMs, 0.1, 10.0);
+            mFrameTimeRatio = std::clamp(mFrameTimeRatio + 0.25 * (ratio - mFrameTimeRatio), 0.1, 10.0);
+        }
+        mReportedMs = 0.0;
+        mReportedFrames = 0;
+        for (double& ms : predicted)
+            ms *= mFrameTimeRatio;
         mStats.predictedMilliseconds = predicted[std::min(mFrameBudgetStep, steps - 1)];
         mWantedBudgetStep = chooseFrameBudgetStep(predicted, double(mFrameBudgetMs), mFrameBudgetStep);
+        mPlanPredictedMs = predicted[mWantedBudgetStep] / mFrameTimeRatio;
+    }
+
+    void Forest::notifyFrameTime(float milliseconds)
+    {
+        if (mFrameBudgetMs > 0.0f && std::isfinite(milliseconds) && milliseconds > 0.0f)
+        {
+            mReportedMs += double(milliseconds);
+            ++mReportedFrames;
+        }
     }
 
     std::uint32_t Forest::getSpeciesCount() const { return std::uint32_t(mSpecies.size()); }

@@ -71,8 +71,10 @@
 //   bias included), each step of frameBudgetLadder() is predicted as the sum of the levels'
 //   calibrated costs (LevelCost::msAt), and the finest step within the budget is taken
 //   (chooseFrameBudgetStep, with hysteresis) from the next viewer frame. The prediction counts
-//   the viewer's trees only, not shadow passes nor what else the frame draws: it is a model of
-//   the calibration, not a timer (GL3Plus in OGRE 1.12 has no timer queries to close the loop).
+//   the viewer's trees only, not shadow passes nor what else the frame draws, and not how much
+//   nearer trees hide: it is a model of the calibration. GL3Plus in OGRE 1.12 has no timer
+//   queries to close the loop inside the Forest; an application that times its frames reports
+//   them (notifyFrameTime) and the predictions are scaled by measured / predicted.
 // - ForestStats describe the last viewer camera (one whose LoD camera is itself, outside shadow
 //   texture rendering); they are cleared before each viewer's visibility pass, so a viewer that
 //   does not see the Forest's bounds reports nothing visible. Cameras without a viewport (area
@@ -117,7 +119,7 @@ namespace TreeLod
         /// Visible instances of the viewer drawn at a fallback level (theirs not resident yet).
         std::uint32_t fallbackInstances = 0;
         /// The frame budget's prediction at its last re-plan (ms, the viewer's trees of budgeted
-        /// species at the levels in use); 0 without a frame budget.
+        /// species at the levels in use, times Forest::getFrameTimeRatio); 0 without a frame budget.
         double predictedMilliseconds = 0.0;
     };
 
@@ -192,6 +194,14 @@ namespace TreeLod
         /// Turning it off plans for the last setErrorBudget again.
         void setFrameBudgetMs(float milliseconds);
         float getFrameBudgetMs() const { return mFrameBudgetMs; }
+        /// The application's measured time of the frame just drawn (ms, finite and > 0; others are
+        /// ignored): under a frame budget the controller scales its predictions by the running ratio
+        /// of measured to predicted time, closing the loop on what the calibration cannot see
+        /// (occlusion between trees, the rest of the frame). Optional: without reports the
+        /// prediction stands alone.
+        void notifyFrameTime(float milliseconds);
+        /// Measured over predicted time, as the controller applies it (1 until frames are reported).
+        double getFrameTimeRatio() const { return mFrameTimeRatio; }
         /// Viewer frames between two re-plans of the frame budget.
         static constexpr unsigned FRAME_BUDGET_INTERVAL = 8;
 
@@ -321,6 +331,10 @@ namespace TreeLod
         std::size_t mFrameBudgetStep = 0;   ///< frameBudgetLadder() step in use
         std::size_t mWantedBudgetStep = 0;  ///< the controller's choice, applied at the next viewer frame
         unsigned mFrameBudgetFrames = 0;    ///< viewer frames since the last measurement
+        double mFrameTimeRatio = 1.0;       ///< measured / predicted, a running mean (notifyFrameTime)
+        double mReportedMs = 0.0;           ///< frame times reported since the last measurement
+        unsigned mReportedFrames = 0;
+        double mPlanPredictedMs = 0.0;      ///< the prediction for the plan those frames drew
         bool mLodFrozen = false;
         ForestStats mStats;
         std::uint64_t mInstanceBufferBytes = 0;
