@@ -1007,11 +1007,12 @@ namespace TreeLod
                 for (std::size_t step = 0; step < steps; ++step)
                     predicted[step] += species->budget->visible.milliseconds(species->budget->ladderMsPerTree[step]);
         // Reported frame times since the last measurement against what was predicted for their plan:
-        // the running ratio (a quarter of the way to each new one, within [0.1, 10]).
+        // the running ratio, within [0.1, 10]; it rises at once (frames over the model go coarser
+        // in the next plan) and falls a quarter of the way to each lower ratio (finer slowly).
         if (mReportedFrames > 0 && mPlanPredictedMs > 0.0)
         {
             const double ratio = std::clamp(mReportedMs / mReportedFrames / mPlanPredictedMs, 0.1, 10.0);
-            mFrameTimeRatio = std::clamp(mFrameTimeRatio + 0.25 * (ratio - mFrameTimeRatio), 0.1, 10.0);
+            mFrameTimeRatio = ratio > mFrameTimeRatio ? ratio : mFrameTimeRatio + 0.25 * (ratio - mFrameTimeRatio);
         }
         mReportedMs = 0.0;
         mReportedFrames = 0;
