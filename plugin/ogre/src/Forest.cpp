@@ -803,7 +803,6 @@ namespace TreeLod
         const Ogre::String label =
             "Forest '" + mName + "' species " + std::to_string(s) + " ('" + asset.getName() + "'): ";
         const std::vector<ForestLevel> levels = levelsForChoices(asset, plan.curves, choices, label, source);
-        plan.choices = choices;
         const bool same = levels.size() == species.levels.size() &&
                           std::equal(levels.begin(), levels.end(), species.levels.begin(),
                                      [](const ForestLevel& a, const ForestLevel& b) {
@@ -811,6 +810,7 @@ namespace TreeLod
                                      });
         if (same)
         {
+            plan.choices = choices;
             updateShadowLevels(s);
             return;
         }
@@ -830,8 +830,7 @@ namespace TreeLod
                     return int(k);
             return -1;
         };
-        const int keptLast = findOld(count - 1, true);
-        if (keptLast < 0)
+        if (findOld(count - 1, true) < 0)
         {
             try
             {
@@ -910,6 +909,7 @@ namespace TreeLod
         species.levels = levels;
         species.parts = std::move(parts);
         species.residency = std::move(residency);
+        plan.choices = choices;
         mStats.levelCounts[s].assign(count, 0u);
         mStats.instanceBufferBytes = mInstanceBufferBytes;
         updateShadowLevels(s);
