@@ -822,9 +822,11 @@ namespace TreeLod
         std::vector<std::vector<std::unique_ptr<Part>>> parts(count);
         std::vector<Residency> residency(count, Residency::Absent);
         std::vector<bool> moved(species.levels.size(), false);
+        // An old resident level drawing what level l draws: with the same switch value and parts not
+        // taken yet (they are kept), or any (its drawables are uploaded).
         auto findOld = [&](std::size_t l, bool sameUpper) -> int {
             for (std::size_t k = 0; k < species.levels.size(); ++k)
-                if (!moved[k] && species.residency[k] == Residency::Resident &&
+                if (!(sameUpper && moved[k]) && species.residency[k] == Residency::Resident &&
                     sameDrawable(species.levels[k], levels[l]) &&
                     (!sameUpper || upperValue(species.levels, k) == upperValue(levels, l)))
                     return int(k);
