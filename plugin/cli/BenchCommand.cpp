@@ -333,7 +333,7 @@ namespace TreeLod
             return out;
         }
 
-        /// "auto" and auto with an error budget ("auto@0.02").
+        /// "auto", auto with an error budget ("auto@0.02") or a frame budget ("auto~40").
         bool isAutoRun(const std::string& technique) { return technique.rfind("auto", 0) == 0; }
 
         /// A run as the Pareto line names it: "lodf", or "lodf@0.5" at a bias other than 1.
@@ -888,7 +888,7 @@ namespace TreeLod
                 float budget = 0.0f;
                 const bool isAuto = parseAutoTechnique(t, budget);
                 if (!isAuto && bakeTechniqueOf(t).empty())
-                    return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: auto, auto@E, " +
+                    return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: auto, auto@E, auto~MS, " +
                                                                    knownSceneTechniques() + ")"));
                 drawn.push_back(t == "auto" ? "" : t);
                 if (isAuto)

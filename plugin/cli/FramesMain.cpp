@@ -141,7 +141,7 @@ namespace TreeLod
             {
                 float budget = 0.0f;
                 if (!parseAutoTechnique(t, budget) && bakeTechniqueOf(t).empty())
-                    return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: auto, auto@E, " +
+                    return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: auto, auto@E, auto~MS, " +
                                                                    knownSceneTechniques() + ")"));
                 if (args.skipComparisons || (t != REFERENCE_TECHNIQUE && t != FLOOR_TECHNIQUE && !isQuadFloor(t)))
                     techniques.push_back(t); // otherwise run once below, with the comparisons

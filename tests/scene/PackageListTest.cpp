@@ -150,8 +150,15 @@ namespace TreeLod
         EXPECT_FLOAT_EQ(budget, 0.05f);
         EXPECT_TRUE(parseAutoTechnique("auto@0", budget));
         EXPECT_EQ(budget, 0.0f);
-        for (const char* bad : {"auto@", "auto@x", "auto@1.5", "auto@-0.1", "auto@nan", "auto@0.1x", "lodf", "autox"})
-            EXPECT_FALSE(parseAutoTechnique(bad, budget)) << bad;
+        float frameBudget = -1.0f;
+        EXPECT_TRUE(parseAutoTechnique("auto~40", budget, &frameBudget));
+        EXPECT_TRUE(std::isnan(budget)) << "under a frame budget, the script's error budget to start from";
+        EXPECT_EQ(frameBudget, 40.0f);
+        EXPECT_TRUE(parseAutoTechnique("auto@0.05", budget, &frameBudget));
+        EXPECT_TRUE(std::isnan(frameBudget)) << "no frame budget: the script's";
+        for (const char* bad : {"auto@", "auto@x", "auto@1.5", "auto@-0.1", "auto@nan", "auto@0.1x", "lodf", "autox",
+                                "auto~", "auto~0", "auto~-5", "auto~inf", "auto~16ms"})
+            EXPECT_FALSE(parseAutoTechnique(bad, budget, &frameBudget)) << bad;
 
         Result<SceneScript> script = parseSceneScript(R"({"name": "t", "ground": {"kind": "plane", "size": 100},
             "species": [{"name": "s", "source": "preset:shrub", "leaves": 100, "techniques": "auto"}],
@@ -160,7 +167,7 @@ namespace TreeLod
             "resolution": [64, 64], "frames": 1})",
                                                       "t.json", "");
         ASSERT_TRUE(script.ok()) << script.error().message();
-        for (const std::string& choice : {std::string(""), std::string("auto@0.05")})
+        for (const std::string& choice : {std::string(""), std::string("auto@0.05"), std::string("auto~40")})
         {
             const auto packages = scenePackages(*script, {choice});
             ASSERT_EQ(packages.size(), 1u);

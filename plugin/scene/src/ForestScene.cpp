@@ -93,21 +93,25 @@ namespace TreeLod
         return info && info->forestLevels ? info->chunkTechnique : "";
     }
 
-    bool parseAutoTechnique(const std::string& technique, float& budget)
+    bool parseAutoTechnique(const std::string& technique, float& budget, float* frameBudgetMs)
     {
+        budget = std::numeric_limits<float>::quiet_NaN();
+        if (frameBudgetMs)
+            *frameBudgetMs = std::numeric_limits<float>::quiet_NaN();
         if (technique == "auto")
-        {
-            budget = std::numeric_limits<float>::quiet_NaN();
             return true;
-        }
-        if (technique.rfind("auto@", 0) != 0)
+        const bool frame = technique.rfind("auto~", 0) == 0;
+        if (!frame && technique.rfind("auto@", 0) != 0)
             return false;
         const std::string number = technique.substr(5);
         char* end = nullptr;
         const double value = std::strtod(number.c_str(), &end);
-        if (number.empty() || *end != '\0' || !(value >= 0.0 && value <= 1.0))
+        if (number.empty() || *end != '\0' || (frame ? !(value > 0.0 && value <= 1e6) : !(value >= 0.0 && value <= 1.0)))
             return false;
-        budget = float(value);
+        if (!frame)
+            budget = float(value);
+        else if (frameBudgetMs)
+            *frameBudgetMs = float(value);
         return true;
     }
 
@@ -284,7 +288,9 @@ namespace TreeLod
         mForestNode->attachObject(mForest);
         mForest->setUploadBudget(mOptions.uploadBudget);
         mForest->setShadowLodBias(mScript.shadows.lodBias);
-        mForest->setFrameBudgetMs(mScript.lod.frameBudgetMs);
+        float errorBudget = 0.0f, frameBudget = 0.0f;
+        parseAutoTechnique(mTechnique, errorBudget, &frameBudget);
+        mForest->setFrameBudgetMs(std::isnan(frameBudget) ? mScript.lod.frameBudgetMs : frameBudget);
 
         // Bands per species; then one bake request per distinct source with every technique its
         // species draw (two species sharing a file share one package and one asset).

@@ -46,9 +46,11 @@ namespace TreeLod
     /// plain Ogre BillboardSet per species, unlit).
     bool isQuadFloor(const std::string& technique);
 
-    /// Whether `technique` is budgeted auto: "auto" (`budget` = NaN: the script's) or "auto@E" with E
-    /// in [0, 1] (`budget` = E). False for anything else, "auto@" with a bad number included.
-    bool parseAutoTechnique(const std::string& technique, float& budget);
+    /// Whether `technique` is budgeted auto: "auto" (`budget` = NaN: the script's), "auto@E" with E
+    /// in [0, 1] (`budget` = E) or "auto~B", under a frame budget of B ms in (0, 1e6] (`budget` =
+    /// NaN, `*frameBudgetMs` = B; NaN for the others: the script's). False for anything else, a
+    /// bad number included.
+    bool parseAutoTechnique(const std::string& technique, float& budget, float* frameBudgetMs = nullptr);
 
     /// The techniques bakeTechniqueOf knows, for messages: "mesh, lodf, billboard-cloud, ...".
     std::string knownSceneTechniques();
