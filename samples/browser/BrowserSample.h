@@ -37,6 +37,9 @@ namespace TreeLod
 
         /// Per frame, before rendering: `seconds` since the last frame.
         virtual void frame(double seconds) = 0;
+        /// Per frame, after rendering: the wall time the frame took to render (the stats' "FPS
+        /// (render)"), for a frame budget to close its loop on.
+        virtual void frameTimed(double) {}
 
         /// The camera the user moves (CameraMan), its node, and how: orbit around
         /// getOrbitTarget() (a single tree) or free look (the forest).

@@ -134,6 +134,12 @@ namespace TreeLod
         applyCameraSpec(*mCamera, *mCameraNode, cameraAt(mScript, mPathTime));
     }
 
+    void ForestSample::frameTimed(double seconds)
+    {
+        // Under a frame budget (the script's lod.frameBudgetMs), the controller scales its model by it.
+        mScene->getForest().notifyFrameTime(float(seconds * 1000.0));
+    }
+
     void ForestSample::setScreenshotView(unsigned index, unsigned count)
     {
         mPlaying = false;

@@ -27,6 +27,7 @@ namespace TreeLod
         void attach(Ogre::RenderTarget& target, const PixelRect& area, int firstZOrder) override;
         void detach() override;
         void frame(double seconds) override;
+        void frameTimed(double seconds) override;
 
         Ogre::Camera& getCamera() override { return *mCamera; }
         Ogre::SceneNode& getCameraNode() override { return *mCameraNode; }

@@ -602,6 +602,8 @@ namespace TreeLod
     {
         const double seconds = secondsSince(mFrameStart);
         mFrameSeconds = mFrameSeconds > 0.0 && !mOptions.headless ? 0.9 * mFrameSeconds + 0.1 * seconds : seconds;
+        if (mCurrent >= 0)
+            mSamples[std::size_t(mCurrent)]->frameTimed(seconds);
         return true;
     }
 
