@@ -986,7 +986,8 @@ namespace TreeLod
 #endif
         cmd->add_option("--techniques", args->techniques,
                         "comma-separated techniques besides the reference (mesh) and the floor (impostor): auto (the "
-                        "script's choice) or any of " + known)
+                        "script's choice), auto@E (budgeted auto at error budget E), auto~MS (under a frame budget of "
+                        "MS milliseconds) or any of " + known)
             ->capture_default_str();
         cmd->add_option("--lod-bias", args->lodBiases, "comma-separated LoD biases (< 1 = less detail)")
             ->capture_default_str();
