@@ -1736,5 +1736,20 @@ namespace TreeLod
         writePng(OgreEnvironment::outDir() + "/forest-shadow-budget.png", sideBySide({viewCasters, coarseCasters}));
         // Bound under half the casters' difference: the view's casters in their place fail it.
         compareWithGolden(coarseCasters, "forest-shadow-budget", 0.005);
+
+        // A frame budget on a Forest whose error budget is off the ladder (never set: the default
+        // is on it; 0.04 is not): the controller's first choice is taken.
+        for (const float start : {-1.0f, 0.04f})
+        {
+            Forest* other = placeForest();
+            if (start >= 0.0f)
+                other->setErrorBudget(start);
+            other->addBudgetedSpecies(asset, costs);
+            other->addInstances(trees);
+            other->setFrameBudgetMs(1e6f);
+            r.render(view, 160, 90, 1);
+            r.render(view, 160, 90, 1);
+            EXPECT_EQ(other->getErrorBudget(), 0.0f) << "start " << start;
+        }
     }
 }

@@ -941,10 +941,14 @@ namespace TreeLod
                     "Forest::setErrorBudget");
         applyErrorBudget(budget);
         mUserErrorBudget = budget;
+        mFrameBudgetStep = mWantedBudgetStep = ladderStepOf(budget);
+    }
+
+    std::size_t Forest::ladderStepOf(float budget)
+    {
         const std::vector<float>& ladder = frameBudgetLadder();
-        mFrameBudgetStep = std::size_t(std::lower_bound(ladder.begin(), ladder.end(), budget) - ladder.begin());
-        mFrameBudgetStep = std::min(mFrameBudgetStep, ladder.size() - 1);
-        mWantedBudgetStep = mFrameBudgetStep;
+        const auto step = std::find(ladder.begin(), ladder.end(), budget);
+        return step == ladder.end() ? OFF_LADDER : std::size_t(step - ladder.begin());
     }
 
     void Forest::setShadowErrorBudget(float budget)
@@ -966,6 +970,7 @@ namespace TreeLod
                     "Forest::setFrameBudgetMs");
         const bool off = milliseconds == 0.0f && mFrameBudgetMs > 0.0f;
         mFrameBudgetMs = milliseconds;
+        mFrameBudgetStep = mWantedBudgetStep = ladderStepOf(mErrorBudget);
         mFrameBudgetFrames = 0;
         mStats.predictedMilliseconds = 0.0;
         mFrameTimeRatio = 1.0;
@@ -1312,7 +1317,8 @@ namespace TreeLod
         const bool shadowTexture =
             mManager && mManager->_getCurrentRenderStage() == Ogre::SceneManager::IRS_RENDER_TO_TEXTURE;
         const bool viewer = camera->getLodCamera() == camera && !shadowTexture;
-        if (viewer && mFrameBudgetMs > 0.0f && mWantedBudgetStep != mFrameBudgetStep)
+        if (viewer && mFrameBudgetMs > 0.0f && mWantedBudgetStep != mFrameBudgetStep &&
+            mWantedBudgetStep != OFF_LADDER)
         {
             // The frame budget's choice of the last measurement, before this camera culls.
             try

@@ -288,6 +288,9 @@ namespace TreeLod
         /// Plan every budgeted species for `budget` (replan where its levels change).
         void applyErrorBudget(float budget);
         void updateShadowLevels(std::uint32_t species);
+        static constexpr std::size_t OFF_LADDER = std::numeric_limits<std::size_t>::max();
+        /// The frameBudgetLadder() step that is `budget`, or OFF_LADDER.
+        static std::size_t ladderStepOf(float budget);
         /// The frame budget's measurement on the viewer's cull: prediction and the step it wants.
         void measureFrameBudget(const CameraState& state);
 
@@ -328,8 +331,10 @@ namespace TreeLod
         float mUserErrorBudget = DEFAULT_ERROR_BUDGET;  ///< the last setErrorBudget
         float mShadowErrorBudget = DEFAULT_SHADOW_ERROR_BUDGET;
         float mFrameBudgetMs = 0.0f;
-        std::size_t mFrameBudgetStep = 0;   ///< frameBudgetLadder() step in use
-        std::size_t mWantedBudgetStep = 0;  ///< the controller's choice, applied at the next viewer frame
+        /// frameBudgetLadder() step in use, OFF_LADDER when the error budget is not one of its steps
+        /// (the controller then takes its first choice whatever it is).
+        std::size_t mFrameBudgetStep = ladderStepOf(DEFAULT_ERROR_BUDGET);
+        std::size_t mWantedBudgetStep = mFrameBudgetStep; ///< the controller's choice, applied next viewer frame
         unsigned mFrameBudgetFrames = 0;    ///< viewer frames since the last measurement
         double mFrameTimeRatio = 1.0;       ///< measured / predicted, a running mean (notifyFrameTime)
         double mReportedMs = 0.0;           ///< frame times reported since the last measurement
