@@ -150,6 +150,12 @@ namespace TreeLod
             return std::move(*curves);
         }
 
+        /// The Forest level a curve names, drawn down to `minPixelCount`.
+        ForestLevel levelOfCurve(const ErrorCurveLevel& curve, Ogre::Real minPixelCount)
+        {
+            return ForestLevel{curve.technique, curve.techniqueLevel, curve.lowRes, minPixelCount};
+        }
+
         /// The Forest levels of a selection (LevelSelection.h): its runs' heights as LoD values.
         std::vector<ForestLevel> levelsForChoices(TreeAsset& asset, const ErrorCurves& curves,
                                                   const std::vector<LevelChoice>& choices, const Ogre::String& label,
@@ -157,16 +163,9 @@ namespace TreeLod
         {
             std::vector<ForestLevel> levels;
             for (const LevelChoice& choice : choices)
-            {
-                const ErrorCurveLevel& c = curves.levels[choice.curveLevel];
-                ForestLevel level;
-                level.technique = c.technique;
-                level.techniqueLevel = c.techniqueLevel;
-                level.lowRes = c.lowRes;
-                level.minPixelCount =
-                    choice.minHeightPx > 0.0f ? valueForHeight(asset, choice.minHeightPx, label, source) : 0.0f;
-                levels.push_back(level);
-            }
+                levels.push_back(levelOfCurve(
+                    curves.levels[choice.curveLevel],
+                    choice.minHeightPx > 0.0f ? valueForHeight(asset, choice.minHeightPx, label, source) : 0.0f));
             return levels;
         }
 
@@ -673,8 +672,7 @@ namespace TreeLod
     std::uint32_t Forest::addBudgetedSpecies(const TreeAssetPtr& asset, const std::vector<LevelCost>& costs)
     {
         const char* source = "Forest::addBudgetedSpecies";
-        const Ogre::String label = "Forest '" + mName + "' species " + std::to_string(mSpecies.size()) + " ('" +
-                                   (asset ? asset->getName() : Ogre::String("null")) + "'): ";
+        const Ogre::String label = speciesLabel(std::uint32_t(mSpecies.size()), asset.get());
         if (!asset)
             invalid(label + "no asset", source);
         auto plan = std::make_unique<BudgetPlan>();
@@ -699,8 +697,7 @@ namespace TreeLod
                                          std::unique_ptr<BudgetPlan> budget)
     {
         const char* source = "Forest::addSpecies";
-        const Ogre::String label = "Forest '" + mName + "' species " + std::to_string(mSpecies.size()) + " ('" +
-                                   (asset ? asset->getName() : Ogre::String("null")) + "'): ";
+        const Ogre::String label = speciesLabel(std::uint32_t(mSpecies.size()), asset.get());
         if (!asset)
             invalid(label + "no asset", source);
         // Planned from decoded chunks only (nothing uploaded but the bark mesh levelsForBands
@@ -710,17 +707,11 @@ namespace TreeLod
         if (budget)
         {
             // The kind's sphere holds every level a budget may choose: re-plans keep it.
-            std::vector<ForestLevel> candidates;
             for (const ErrorCurveLevel& c : budget->curves.levels)
                 if (findLevelCost(budget->costs, c.technique, c.techniqueLevel, c.lowRes) >= 0)
                 {
-                    ForestLevel level;
-                    level.technique = c.technique;
-                    level.techniqueLevel = c.techniqueLevel;
-                    level.lowRes = c.lowRes;
-                    level.minPixelCount = 0.0f;
                     Ogre::AxisAlignedBox box = asset->getBounds();
-                    checkLevels(*asset, {level}, label + "candidate ", source, box);
+                    checkLevels(*asset, {levelOfCurve(c, 0.0f)}, label + "candidate ", source, box);
                     drawn.merge(box);
                 }
         }
@@ -771,6 +762,12 @@ namespace TreeLod
         return added.value();
     }
 
+    Ogre::String Forest::speciesLabel(std::uint32_t species, const TreeAsset* asset) const
+    {
+        return "Forest '" + mName + "' species " + std::to_string(species) + " ('" +
+               (asset ? asset->getName() : Ogre::String("null")) + "'): ";
+    }
+
     bool Forest::isBudgeted(std::uint32_t species) const { return mSpecies.at(species)->budget != nullptr; }
 
     const std::vector<std::uint32_t>& Forest::getShadowLevels(std::uint32_t species) const
@@ -800,8 +797,7 @@ namespace TreeLod
         Species& species = *mSpecies[s];
         BudgetPlan& plan = *species.budget;
         TreeAsset& asset = *species.asset;
-        const Ogre::String label =
-            "Forest '" + mName + "' species " + std::to_string(s) + " ('" + asset.getName() + "'): ";
+        const Ogre::String label = speciesLabel(s, &asset);
         const std::vector<ForestLevel> levels = levelsForChoices(asset, plan.curves, choices, label, source);
         const bool same = levels.size() == species.levels.size() &&
                           std::equal(levels.begin(), levels.end(), species.levels.begin(),

@@ -279,6 +279,8 @@ namespace TreeLod
         class CameraListener;
 
         struct BudgetPlan;
+        /// "Forest 'NAME' species N ('ASSET'): ", the start of errors about a species.
+        Ogre::String speciesLabel(std::uint32_t species, const TreeAsset* asset) const;
         /// addSpecies and addBudgetedSpecies: `budget` is null for fixed levels.
         std::uint32_t addSpeciesImpl(const TreeAssetPtr& asset, const std::vector<ForestLevel>& levels,
                                      std::unique_ptr<BudgetPlan> budget);
@@ -336,7 +338,7 @@ namespace TreeLod
         std::size_t mFrameBudgetStep = ladderStepOf(DEFAULT_ERROR_BUDGET);
         std::size_t mWantedBudgetStep = mFrameBudgetStep; ///< the controller's choice, applied next viewer frame
         unsigned mFrameBudgetFrames = 0;    ///< viewer frames since the last measurement
-        double mFrameTimeRatio = 1.0;       ///< measured / predicted, a running mean (notifyFrameTime)
+        double mFrameTimeRatio = 1.0;       ///< measured / predicted: rises at once, falls slowly (notifyFrameTime)
         double mReportedMs = 0.0;           ///< frame times reported since the last measurement
         unsigned mReportedFrames = 0;
         double mPlanPredictedMs = 0.0;      ///< the prediction for the plan those frames drew
