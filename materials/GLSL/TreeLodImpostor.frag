@@ -27,16 +27,6 @@ out vec4 fragColour;
 
 #include "TreeLodShading.glsl"
 
-#ifndef CASTER
-// Least-squares fit of k^(1/2.2)-like scale over 8-bit albedo and k in [0, 1.2]: mean error
-// 1.3/255, worst 6.5/255 (dark albedo at k < 0.1) against the exact conversions.
-vec3 srgbScale(vec3 k)
-{
-    vec3 s1 = sqrt(k), s2 = sqrt(s1), s3 = sqrt(s2);
-    return 0.5454 * s1 + 0.9485 * s2 - 0.4960 * s3;
-}
-#endif
-
 void main()
 {
     vec4 texel = texture(colourMap, vUv);

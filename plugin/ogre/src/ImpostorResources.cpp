@@ -22,13 +22,70 @@ namespace TreeLod
                                                      [&asset] { return std::make_unique<ImpostorResources>(asset); });
     }
 
+    std::size_t makeImpostorQuad(const float (&vertices)[4][5], std::unique_ptr<Ogre::VertexData>& vertexData,
+                                 Ogre::HardwareIndexBufferSharedPtr& indexBuffer)
+    {
+        vertexData = std::make_unique<Ogre::VertexData>();
+        Ogre::VertexData& vd = *vertexData;
+        vd.vertexCount = 4;
+        const std::size_t offset = vd.vertexDeclaration->addElement(0, 0, Ogre::VET_FLOAT3, Ogre::VES_POSITION).getSize();
+        vd.vertexDeclaration->addElement(0, offset, Ogre::VET_FLOAT2, Ogre::VES_TEXTURE_COORDINATES, 0);
+        Ogre::HardwareVertexBufferSharedPtr buffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
+            sizeof(vertices[0]), 4, Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+        buffer->writeData(0, sizeof(vertices), vertices, true);
+        vd.vertexBufferBinding->setBinding(0, buffer);
+        const std::uint16_t indices[6] = {0, 1, 2, 0, 2, 3};
+        indexBuffer = Ogre::HardwareBufferManager::getSingleton().createIndexBuffer(
+            Ogre::HardwareIndexBuffer::IT_16BIT, 6, Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+        indexBuffer->writeData(0, sizeof(indices), indices, true);
+        return sizeof(vertices) + sizeof(indices);
+    }
+
+    void cloneImpostorMaterials(TreeAsset& asset, const Ogre::String& base, const Ogre::String& shadowedBase,
+                                const Ogre::String& material, const Ogre::String& shadowedMaterial,
+                                const std::vector<std::pair<Ogre::String, Ogre::String>>& textures,
+                                const std::function<void(Ogre::Pass&)>& configure)
+    {
+        auto clone = [&](const Ogre::String& from, const Ogre::String& name) {
+            Ogre::MaterialPtr m = cloneBaseMaterial(from, name, asset.getGroup(), asset.getName());
+            m->load();
+            for (Ogre::Technique* tech : m->getTechniques())
+                for (Ogre::Pass* pass : tech->getPasses())
+                {
+                    for (const auto& [unitName, texture] : textures)
+                        if (Ogre::TextureUnitState* unit = pass->getTextureUnitState(unitName))
+                            unit->setTextureName(texture);
+                    configure(*pass);
+                }
+            return m;
+        };
+        Ogre::MaterialPtr caster;
+        for (const Ogre::String& name : {material, shadowedMaterial})
+        {
+            Ogre::MaterialPtr m = clone(name == material ? base : shadowedBase, name);
+            Ogre::Technique* tech = m->getTechnique(0);
+            if (Ogre::MaterialPtr casterBase = tech->getShadowCasterMaterial())
+            {
+                if (!caster)
+                    caster = clone(casterBase->getName(), material + "/Caster");
+                tech->setShadowCasterMaterial(caster);
+            }
+        }
+    }
+
+    void removeImpostorMaterials(const Ogre::String& material, const Ogre::String& shadowedMaterial,
+                                 const Ogre::String& group)
+    {
+        for (const Ogre::String& m : {material, shadowedMaterial, material + "/Caster"})
+            Ogre::MaterialManager::getSingleton().remove(m, group);
+    }
+
     namespace
     {
         /// Remove what `gpu` names from Ogre's managers (whatever of it was made).
         void removeGpu(const ImpostorGpu& gpu, const Ogre::String& group)
         {
-            for (const Ogre::String& m : {gpu.material, gpu.shadowedMaterial, gpu.material + "/Caster"})
-                Ogre::MaterialManager::getSingleton().remove(m, group);
+            removeImpostorMaterials(gpu.material, gpu.shadowedMaterial, group);
             for (const Ogre::String& t : {gpu.texture, gpu.normalTexture})
                 Ogre::TextureManager::getSingleton().remove(t, group);
         }
@@ -77,59 +134,19 @@ namespace TreeLod
                                           {w, data.bottom, 0.0f, 1.0f, 1.0f},
                                           {w, data.top, 0.0f, 1.0f, 0.0f},
                                           {-w, data.top, 0.0f, 0.0f, 0.0f}};
-            gpu->vertexData = std::make_unique<Ogre::VertexData>();
-            Ogre::VertexData& vd = *gpu->vertexData;
-            vd.vertexCount = 4;
-            const std::size_t offset =
-                vd.vertexDeclaration->addElement(0, 0, Ogre::VET_FLOAT3, Ogre::VES_POSITION).getSize();
-            vd.vertexDeclaration->addElement(0, offset, Ogre::VET_FLOAT2, Ogre::VES_TEXTURE_COORDINATES, 0);
-            Ogre::HardwareVertexBufferSharedPtr buffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
-                sizeof(vertices[0]), 4, Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
-            buffer->writeData(0, sizeof(vertices), vertices, true);
-            vd.vertexBufferBinding->setBinding(0, buffer);
-            const std::uint16_t indices[6] = {0, 1, 2, 0, 2, 3};
-            gpu->indexBuffer = Ogre::HardwareBufferManager::getSingleton().createIndexBuffer(
-                Ogre::HardwareIndexBuffer::IT_16BIT, 6, Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
-            gpu->indexBuffer->writeData(0, sizeof(indices), indices, true);
-            gpu->gpuBytes = data.gpuBytes() + sizeof(vertices) + sizeof(indices);
+            gpu->gpuBytes = data.gpuBytes() + makeImpostorQuad(vertices, gpu->vertexData, gpu->indexBuffer);
 
             // Materials: clones of TreeLod/Impostor(Shadowed) and of their shadow caster, the textures
             // bound to units Colour and Normal, the alpha cutoff set.
-            auto configure = [&](const Ogre::MaterialPtr& material) {
-                material->load();
-                for (Ogre::Technique* tech : material->getTechniques())
-                    for (Ogre::Pass* pass : tech->getPasses())
-                    {
-                        if (Ogre::TextureUnitState* unit = pass->getTextureUnitState("Colour"))
-                            unit->setTextureName(gpu->texture);
-                        if (Ogre::TextureUnitState* unit = pass->getTextureUnitState("Normal"))
-                            unit->setTextureName(gpu->normalTexture);
-                        if (pass->hasFragmentProgram())
-                        {
-                            Ogre::GpuProgramParametersSharedPtr p = pass->getFragmentProgramParameters();
-                            p->setIgnoreMissingParams(true);
-                            p->setNamedConstant("alphaCutoff", data.alphaCutoff);
-                        }
-                    }
-            };
-            auto clone = [&](const Ogre::String& base, const Ogre::String& name) {
-                Ogre::MaterialPtr material = cloneBaseMaterial(base, name, mAsset.getGroup(), mAsset.getName());
-                configure(material);
-                return material;
-            };
-            Ogre::MaterialPtr caster;
-            for (const Ogre::String& name : {gpu->material, gpu->shadowedMaterial})
-            {
-                Ogre::MaterialPtr material =
-                    clone(name == gpu->material ? "TreeLod/Impostor" : "TreeLod/ImpostorShadowed", name);
-                Ogre::Technique* tech = material->getTechnique(0);
-                if (Ogre::MaterialPtr base = tech->getShadowCasterMaterial())
-                {
-                    if (!caster)
-                        caster = clone(base->getName(), prefix + "/Caster");
-                    tech->setShadowCasterMaterial(caster);
-                }
-            }
+            cloneImpostorMaterials(mAsset, "TreeLod/Impostor", "TreeLod/ImpostorShadowed", gpu->material,
+                                   gpu->shadowedMaterial, {{"Colour", gpu->texture}, {"Normal", gpu->normalTexture}},
+                                   [&](Ogre::Pass& pass) {
+                                       if (!pass.hasFragmentProgram())
+                                           return;
+                                       Ogre::GpuProgramParametersSharedPtr p = pass.getFragmentProgramParameters();
+                                       p->setIgnoreMissingParams(true);
+                                       p->setNamedConstant("alphaCutoff", data.alphaCutoff);
+                                   });
         }
         catch (...)
         {

@@ -48,7 +48,9 @@ namespace TreeLod
                           "one camera-facing quad with baked colour and normal textures: the cheapest level",
                           IMPOSTOR_CHUNK, ImpostorTreeFactory::FACTORY_TYPE_NAME,
                           TechniqueRegistry::byFactory(ImpostorTreeFactory::FACTORY_TYPE_NAME),
-                          std::make_shared<ImpostorTreeFactory>(), std::make_shared<ImpostorLevels>(),
+                          std::make_shared<ImpostorTreeFactory>(
+                              ImpostorTreeFactory::FACTORY_TYPE_NAME,
+                              [](TreeAsset& asset) { return ImpostorResources::of(asset).getGpu().quad(); }), std::make_shared<ImpostorLevels>(),
                           [](Ogre::MovableObject&) -> std::vector<TechniqueStateLine> {
                               return {{"one quad, 2 triangles", -1.0, ""}};
                           }});

@@ -2,8 +2,6 @@
 
 #include "TreeLod/ObjectParams.h"
 
-#include "TreeLod/ImpostorResources.h"
-
 #include <OgreException.h>
 #include <OgreHardwareBufferManager.h>
 #include <OgreMaterialManager.h>
@@ -14,23 +12,25 @@
 namespace TreeLod
 {
     const Ogre::String ImpostorTreeFactory::FACTORY_TYPE_NAME = "ImpostorTree";
+    const Ogre::String ImpostorTreeFactory::OCTAHEDRAL_TYPE_NAME = "OctahedralImpostorTree";
 
-    ImpostorTree::ImpostorTree(const Ogre::String& name, const TreeAssetPtr& asset)
-        : Ogre::MovableObject(name), mAsset(asset), mGpu(&ImpostorResources::of(*asset).getGpu())
+    ImpostorTree::ImpostorTree(const Ogre::String& name, const TreeAssetPtr& asset, const ImpostorQuad& quad,
+                               const Ogre::String& movableType)
+        : Ogre::MovableObject(name), mAsset(asset), mMovableType(movableType)
     {
         const Ogre::String& group = asset->getGroup();
-        mMaterial = Ogre::MaterialManager::getSingleton().getByName(mGpu->material, group);
-        mShadowedMaterial = Ogre::MaterialManager::getSingleton().getByName(mGpu->shadowedMaterial, group);
+        mMaterial = Ogre::MaterialManager::getSingleton().getByName(quad.material, group);
+        mShadowedMaterial = Ogre::MaterialManager::getSingleton().getByName(quad.shadowedMaterial, group);
         if (!mMaterial || !mShadowedMaterial)
             OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
-                        "impostor material '" + mGpu->material + "' or its shadowed variant not found",
-                        "ImpostorTree '" + name + "'");
+                        "impostor material '" + quad.material + "' or its shadowed variant not found",
+                        movableType + " '" + name + "'");
         mMaterial->load();
         mShadowedMaterial->load();
 
         // The asset's quad, plus one instance at the origin (position 0, scale 1, no rotation) as
         // constant per-vertex attributes uv4, uv5 in a buffer of its own.
-        mVertexData.reset(mGpu->vertexData->clone(false));
+        mVertexData.reset(quad.vertexData->clone(false));
         const unsigned short source = static_cast<unsigned short>(mVertexData->vertexDeclaration->getMaxSource() + 1);
         mVertexData->vertexDeclaration->addElement(source, 0, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 4);
         mVertexData->vertexDeclaration->addElement(source, 4 * sizeof(float), Ogre::VET_FLOAT2,
@@ -46,18 +46,17 @@ namespace TreeLod
         OgreAssert(mVertexData->vertexCount == 4, "the impostor is one quad");
         buffer->writeData(0, sizeof(instance), instance, true);
         mVertexData->vertexBufferBinding->setBinding(source, buffer);
-        mIndexData.indexBuffer = mGpu->indexBuffer;
+        mIndexData.indexBuffer = quad.indexBuffer;
         mIndexData.indexStart = 0;
         mIndexData.indexCount = 6;
 
-        const Ogre::Real w = mGpu->halfWidth;
-        mBounds = Ogre::AxisAlignedBox(-w, mGpu->bottom, -w, w, mGpu->top, w);
+        mBounds = quad.bounds;
         mRadius = Ogre::Math::boundingRadiusFromAABB(mBounds);
     }
 
     ImpostorTree::~ImpostorTree() = default;
 
-    const Ogre::String& ImpostorTree::getMovableType() const { return ImpostorTreeFactory::FACTORY_TYPE_NAME; }
+    const Ogre::String& ImpostorTree::getMovableType() const { return mMovableType; }
 
     void ImpostorTree::_updateRenderQueue(Ogre::RenderQueue* queue)
     {
@@ -98,6 +97,7 @@ namespace TreeLod
                                                                  const Ogre::NameValuePairList* params)
     {
         const ObjectParams p(params, "ImpostorTreeFactory::createInstanceImpl");
-        return new ImpostorTree(name, p.loadAsset(name, "ImpostorTree"));
+        const TreeAssetPtr asset = p.loadAsset(name, mType.c_str());
+        return new ImpostorTree(name, asset, mQuadOf(*asset), mType);
     }
 }

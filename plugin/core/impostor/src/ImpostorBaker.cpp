@@ -3,6 +3,7 @@
 
 #include "TreeLod/AmbientOcclusion.h"
 #include "TreeLod/Image.h"
+#include "TreeLod/ImpostorViews.h"
 #include "TreeLod/Package.h"
 #include "TreeLod/ReferenceRenderer.h"
 
@@ -19,81 +20,6 @@ namespace TreeLod
         constexpr int BLEED_RINGS = 8;
 
         std::uint32_t roundUp4(std::uint32_t v) { return (v + 3) / 4 * 4; }
-
-        /// Source texels [first, last) under destination texel d of a halving (an odd source's
-        /// last texel goes to the last destination texel, as GpuTexture's mip sizes floor).
-        std::pair<std::uint32_t, std::uint32_t> halvingRange(std::uint32_t d, std::uint32_t dstSize,
-                                                             std::uint32_t srcSize)
-        {
-            if (srcSize == 1)
-                return {0u, 1u};
-            return {2 * d, d + 1 == dstSize ? srcSize : 2 * d + 2};
-        }
-
-        /// The normal texture (ImpostorData.h): level 0 from `normalAo` (x, y, ao per texel),
-        /// each further level the coverage-weighted mean of its children (the plain mean where
-        /// none is covered), the normal renormalised.
-        GpuTexture normalMipChain(std::uint32_t width, std::uint32_t height, std::vector<glm::vec3> normalAo,
-                                  std::vector<float> coverage)
-        {
-            GpuTexture tex;
-            tex.name = "impostor normal";
-            tex.format = GpuTextureFormat::RGBA8;
-            tex.width = width;
-            tex.height = height;
-            tex.mipCount = fullMipCount(width, height);
-            tex.data.resize(gpuTextureBytes(tex.format, width, height, tex.mipCount));
-            auto unpack = [](const glm::vec3& v) {
-                return glm::vec3(v.x, v.y, std::sqrt(std::max(0.0f, 1.0f - v.x * v.x - v.y * v.y)));
-            };
-            for (std::uint32_t mip = 0; mip < tex.mipCount; ++mip)
-            {
-                const std::uint32_t w = tex.mipWidth(mip), h = tex.mipHeight(mip);
-                if (mip > 0)
-                {
-                    const std::uint32_t sw = tex.mipWidth(mip - 1), sh = tex.mipHeight(mip - 1);
-                    std::vector<glm::vec3> next(std::size_t(w) * h);
-                    std::vector<float> nextCoverage(next.size());
-                    for (std::uint32_t y = 0; y < h; ++y)
-                        for (std::uint32_t x = 0; x < w; ++x)
-                        {
-                            const auto [y0, y1] = halvingRange(y, h, sh);
-                            const auto [x0, x1] = halvingRange(x, w, sw);
-                            glm::vec3 weightedN(0.0f), plainN(0.0f);
-                            float weightedAo = 0.0f, plainAo = 0.0f, cov = 0.0f;
-                            int n = 0;
-                            for (std::uint32_t yy = y0; yy < y1; ++yy)
-                                for (std::uint32_t xx = x0; xx < x1; ++xx)
-                                {
-                                    const std::size_t i = std::size_t(yy) * sw + xx;
-                                    const glm::vec3 normal = unpack(normalAo[i]);
-                                    weightedN += coverage[i] * normal;
-                                    weightedAo += coverage[i] * normalAo[i].z;
-                                    plainN += normal;
-                                    plainAo += normalAo[i].z;
-                                    cov += coverage[i];
-                                    ++n;
-                                }
-                            glm::vec3 normal = cov > 0.0f ? weightedN : plainN;
-                            normal = glm::length(normal) > 1e-6f ? glm::normalize(normal) : glm::vec3(0, 0, 1);
-                            const std::size_t o = std::size_t(y) * w + x;
-                            next[o] = glm::vec3(normal.x, normal.y, cov > 0.0f ? weightedAo / cov : plainAo / float(n));
-                            nextCoverage[o] = cov / float(n);
-                        }
-                    normalAo = std::move(next);
-                    coverage = std::move(nextCoverage);
-                }
-                std::uint8_t* out = tex.data.data() + tex.mipOffset(mip);
-                for (std::size_t i = 0; i < normalAo.size(); ++i)
-                {
-                    out[4 * i + 0] = unitToByte(normalAo[i].x * 0.5f + 0.5f);
-                    out[4 * i + 1] = unitToByte(normalAo[i].y * 0.5f + 0.5f);
-                    out[4 * i + 2] = unitToByte(normalAo[i].z);
-                    out[4 * i + 3] = 255;
-                }
-            }
-            return tex;
-        }
 
         Result<void> checkOptions(const ImpostorOptions& o, const std::string& label)
         {
@@ -185,38 +111,19 @@ namespace TreeLod
         }
         report(progress, "impostor: render", 1.0f);
 
-        // 3. Per texel: linear albedo, normal (x, y) and AO; then bleed into uncovered texels.
+        // 3. Per texel: linear albedo, normal (x, y) and AO; then bleed into uncovered texels. The
+        // view is along -Z, so the quad frame is the model's: x right, y up, z to the viewer.
         report(progress, "impostor: textures", 0.0f);
-        const std::size_t count = std::size_t(W) * H;
-        std::vector<glm::vec3> albedo(count, glm::vec3(0.0f)), normalAo(count, glm::vec3(0.0f, 0.0f, 1.0f));
-        std::vector<std::uint8_t> covered(count, 0);
-        for (std::size_t i = 0; i < count; ++i)
-        {
-            if (!(plain.alpha[i] > 0.0f))
-                continue;
-            covered[i] = 1;
-            const glm::vec4& c = plain.colour.pixels[i];
-            albedo[i] = glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b));
-            float aoValue = 1.0f;
-            if (options.aoRays > 0)
-            {
-                const glm::vec4& d = occluded.colour.pixels[i];
-                const float withAo = srgbToLinear(d.r) + srgbToLinear(d.g) + srgbToLinear(d.b);
-                const float without = albedo[i].r + albedo[i].g + albedo[i].b;
-                aoValue = without > 1e-6f ? std::clamp(withAo / without, 0.0f, 1.0f) : 1.0f;
-            }
-            // The view is along -Z, so the quad frame is the model's: x right, y up, z to the viewer.
-            normalAo[i] = glm::vec3(plain.normal[i].x, plain.normal[i].y, aoValue);
-        }
-        bleedValues(albedo, covered, int(W), int(H), BLEED_RINGS, glm::vec3(0.2f));
-        bleedValues(normalAo, covered, int(W), int(H), BLEED_RINGS, glm::vec3(0.0f, 0.0f, 1.0f));
+        ImpostorView view = impostorView(plain, options.aoRays > 0 ? &occluded : nullptr, glm::vec3(1, 0, 0),
+                                         glm::vec3(0, 1, 0), [](std::size_t) { return 1.0f; });
+        bleedImpostorView(view, BLEED_RINGS, 1.0f);
 
-        const TextureImage colourImage = albedoTexture("impostor colour", int(W), int(H), albedo, plain.alpha);
+        const TextureImage colourImage = albedoTexture("impostor colour", int(W), int(H), view.albedo, view.coverage);
         MipChainOptions mips;
         mips.preserveAlphaCoverage = true;
         mips.alphaCutoff = options.alphaCutoff;
         data.colour = buildMipChain(colourImage, mips);
-        data.normal = normalMipChain(W, H, std::move(normalAo), std::move(plain.alpha));
+        data.normal = impostorNormalTexture("impostor normal", W, H, std::move(view.normalAo), std::move(view.coverage));
         report(progress, "impostor: textures", 0.5f);
 
         // 4. Block compression.

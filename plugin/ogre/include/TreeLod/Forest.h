@@ -158,7 +158,7 @@ namespace TreeLod
         static Ogre::Real pixelCountForHeight(TreeAsset& asset, Ogre::Real heightPixels);
 
         /// The techniques budgeted auto chooses among: the reference, lodf, both billboard clouds
-        /// and the impostor.
+        /// and both impostors.
         static std::vector<Ogre::String> getAutoTechniques();
 
         /// Budgeted auto (docs/forest.md, "Budgeted levels"): the levels chooseLevels

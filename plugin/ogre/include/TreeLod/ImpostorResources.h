@@ -3,12 +3,21 @@
 #pragma once
 
 #include "TreeLod/ImpostorData.h"
+#include "TreeLod/ImpostorTree.h"
 #include "TreeLod/TechniqueResources.h"
 
 #include <OgreHardwareIndexBuffer.h>
 #include <OgreVertexIndexData.h>
 
+#include <functional>
 #include <memory>
+#include <utility>
+#include <vector>
+
+namespace Ogre
+{
+    class Pass;
+}
 
 namespace TreeLod
 {
@@ -30,7 +39,30 @@ namespace TreeLod
         float halfWidth = 0.0f;        ///< the quad: x in [-halfWidth, halfWidth] (metres)
         float bottom = 0.0f, top = 0.0f; ///< y in [bottom, top] (metres)
         std::uint64_t gpuBytes = 0;    ///< textures + vertices + indices
+
+        /// What an ImpostorTree draws; bounds: the box swept by the quad turning about +Y.
+        ImpostorQuad quad() const
+        {
+            return {vertexData.get(), indexBuffer, material, shadowedMaterial,
+                    Ogre::AxisAlignedBox(-halfWidth, bottom, -halfWidth, halfWidth, top, halfWidth)};
+        }
     };
+
+    /// The impostor techniques' shared GPU pieces. makeImpostorQuad: one quad of `vertices`
+    /// (position x, y, z, uv0 u, v each; counter-clockwise seen from +Z) into `vertexData` and
+    /// `indexBuffer` (two triangles); returns the bytes uploaded.
+    std::size_t makeImpostorQuad(const float (&vertices)[4][5], std::unique_ptr<Ogre::VertexData>& vertexData,
+                                 Ogre::HardwareIndexBufferSharedPtr& indexBuffer);
+    /// Clones of `base` as `material` and of `shadowedBase` as `shadowedMaterial`, their shadow
+    /// caster cloned once as `<material>/Caster`, for asset `asset`; each loaded clone's passes
+    /// get `textures` (unit name -> texture) and `configure(pass)`. removeImpostorMaterials
+    /// removes what this made (whatever of it was made).
+    void cloneImpostorMaterials(TreeAsset& asset, const Ogre::String& base, const Ogre::String& shadowedBase,
+                                const Ogre::String& material, const Ogre::String& shadowedMaterial,
+                                const std::vector<std::pair<Ogre::String, Ogre::String>>& textures,
+                                const std::function<void(Ogre::Pass&)>& configure);
+    void removeImpostorMaterials(const Ogre::String& material, const Ogre::String& shadowedMaterial,
+                                 const Ogre::String& group);
 
     class ImpostorResources : public TechniqueResources
     {

@@ -1,12 +1,13 @@
-// ImpostorTree: a tree drawn as its one-quad impostor (chunk "impostor", ImpostorData.h): the
-// cheapest representation, the Forest's far level. MovableObject type "ImpostorTree".
+// ImpostorTree: a tree drawn as one camera-facing quad of an impostor technique: the one-quad
+// impostor (chunk "impostor", ImpostorData.h, MovableObject type "ImpostorTree") or the
+// octahedral impostor (chunk "octahedral-impostor", OctahedralImpostorData.h, type
+// "OctahedralImpostorTree"); each type has its own ImpostorTreeFactory.
 //
-// The quad turns about the tree's local +Y axis to face the camera (a cylindrical billboard) in
-// the impostor's vertex program, which reads the Forest's per-instance data (uv4 = position +
-// scale, uv5 = rotation; Forest.h); a single tree is one such instance at its own origin, given
-// as constant per-vertex attributes, so the materials and pictures are the Forest's.
-// Bounds: the box swept by the quad turning about +Y. Materials switch to the shadow-receiving
-// clone under an integrated texture shadow technique.
+// The quad turns to face the camera in the technique's vertex program, which reads the Forest's
+// per-instance data (uv4 = position + scale, uv5 = rotation; Forest.h); a single tree is one such
+// instance at its own origin, given as constant per-vertex attributes, so the materials and
+// pictures are the Forest's. Bounds: what the turning quad may cover (ImpostorQuad::bounds).
+// Materials switch to the shadow-receiving clone under an integrated texture shadow technique.
 //
 // Parameters (createMovableObject params, or the registry): asset (required), group.
 #pragma once
@@ -16,17 +17,29 @@
 #include <OgreMovableObject.h>
 #include <OgreRenderable.h>
 
+#include <functional>
 #include <memory>
 
 namespace TreeLod
 {
-    struct ImpostorGpu;
+    /// What an ImpostorTree draws: one instanced quad (4 vertices, 6 indices) of the asset's GPU
+    /// resources, which outlive the tree (the asset holds them).
+    struct ImpostorQuad
+    {
+        Ogre::VertexData* vertexData = nullptr;
+        Ogre::HardwareIndexBufferSharedPtr indexBuffer;
+        Ogre::String material;         ///< reads the instance data
+        Ogre::String shadowedMaterial; ///< receives integrated texture shadows
+        Ogre::AxisAlignedBox bounds;   ///< local: everything the quad may cover, turned any way
+    };
 
     class ImpostorTree : public Ogre::MovableObject, public Ogre::Renderable
     {
     public:
-        /// Builds the asset's impostor on first use; throws naming the asset when it has none.
-        ImpostorTree(const Ogre::String& name, const TreeAssetPtr& asset);
+        /// Draws `quad` of `asset` (the technique's resources, built by the caller) as an object of
+        /// MovableObject type `movableType`.
+        ImpostorTree(const Ogre::String& name, const TreeAssetPtr& asset, const ImpostorQuad& quad,
+                     const Ogre::String& movableType);
         ~ImpostorTree() override;
 
         const TreeAssetPtr& getAsset() const { return mAsset; }
@@ -47,7 +60,7 @@ namespace TreeLod
 
     private:
         TreeAssetPtr mAsset;
-        const ImpostorGpu* mGpu;
+        Ogre::String mMovableType;
         std::unique_ptr<Ogre::VertexData> mVertexData; ///< the asset's quad + the instance attributes
         Ogre::IndexData mIndexData;
         Ogre::MaterialPtr mMaterial;
@@ -59,10 +72,24 @@ namespace TreeLod
     class ImpostorTreeFactory : public Ogre::MovableObjectFactory
     {
     public:
+        /// The one-quad impostor's type.
         static const Ogre::String FACTORY_TYPE_NAME;
-        const Ogre::String& getType() const override { return FACTORY_TYPE_NAME; }
+        /// The octahedral impostor's type.
+        static const Ogre::String OCTAHEDRAL_TYPE_NAME;
+
+        /// Makes ImpostorTrees of `type` drawing quadOf(asset) (which builds the asset's resources
+        /// on first use and throws naming the asset when it lacks the technique's chunk).
+        ImpostorTreeFactory(const Ogre::String& type, std::function<ImpostorQuad(TreeAsset&)> quadOf)
+            : mType(type), mQuadOf(std::move(quadOf))
+        {
+        }
+        const Ogre::String& getType() const override { return mType; }
 
     protected:
         Ogre::MovableObject* createInstanceImpl(const Ogre::String& name, const Ogre::NameValuePairList* params) override;
+
+    private:
+        Ogre::String mType;
+        std::function<ImpostorQuad(TreeAsset&)> mQuadOf;
     };
 }

@@ -1,0 +1,155 @@
+#version 330 core
+// The octahedral impostor (OctahedralImpostorData.h), instanced by the Forest (Forest.h,
+// TreeLodInstance.glsl). Per instance, from the direction v towards the camera (CASTER: towards
+// the light) turned into the tree's own frame:
+// - the quad: corners (+-1, +-1) (vertex.xy) spread over the bounding cylinder's projection seen
+//   from v (octahedralHalfHeight), facing v, grown by the frames' margins;
+// - the three frames of the hemi-octahedral grid around v and their barycentric weights
+//   (Brucks 2018: the triangle of the grid cell v falls in);
+// - per frame: the frame coordinates of this corner projected along v onto the frame's plane
+//   (exact for a planar quad: the map is affine), the shift of those coordinates per unit of
+//   stored depth (the fragment stage's one-step parallax: a surface d in front of the plane is
+//   seen d / (v . t) further along v), and the sun in the frame's axes (lighting without turning
+//   anything per fragment, as TreeLodImpostor.vert).
+// The frame mapping mirrors OctahedralImpostorData.cpp (hemiOctahedralEncode/Decode,
+// octahedralFrameAxes, octahedralHalfHeight, octahedralFrameSide).
+// SHADOW_RECEIVER: the position in the sun's shadow texture. CASTER: clip z and w.
+uniform mat4 worldViewProj;
+uniform mat4 world;
+uniform vec4 cylinder; // radius, bottom, top, depth radius (metres, the tree's own frame)
+uniform vec4 atlas;    // frames a side N, frame texels F, margin texels, 0
+#ifdef CASTER
+uniform mat4 view;
+out vec2 vClipZW;
+#else
+uniform vec4 cameraPosition; // in the Forest's local space
+uniform vec4 sunDirection;   // world space, towards the sun
+out vec3 vSun0;
+out vec3 vSun1;
+out vec3 vSun2;
+out vec4 vParallax01; // frames 0 and 1: frame-coordinate shift per unit of (depth - 0.5)
+out vec2 vParallax2;
+#endif
+#ifdef SHADOW_RECEIVER
+uniform mat4 texViewProj;
+out vec4 vShadowPos;
+#endif
+
+in vec4 vertex;
+
+#include "TreeLodInstance.glsl"
+
+out vec4 vUv01; // frame coordinates (0..1 within a frame) of frames 0 and 1
+out vec2 vUv2;
+flat out vec4 vFrame01; // frame column, row of frames 0 and 1
+flat out vec2 vFrame2;
+flat out vec3 vWeights;
+
+vec2 hemiOctahedralEncode(vec3 d)
+{
+    d.y = max(d.y, 0.0);
+    float l1 = abs(d.x) + d.y + abs(d.z);
+    if (l1 <= 0.0)
+        return vec2(0.0);
+    vec2 xz = d.xz / l1;
+    return vec2(xz.x + xz.y, xz.x - xz.y);
+}
+
+vec3 hemiOctahedralDecode(vec2 p)
+{
+    float x = 0.5 * (p.x + p.y), z = 0.5 * (p.x - p.y);
+    return normalize(vec3(x, max(1.0 - abs(x) - abs(z), 0.0), z));
+}
+
+void frameAxes(vec3 towards, out vec3 right, out vec3 up)
+{
+    vec3 r = cross(vec3(0.0, 1.0, 0.0), towards);
+    float l = length(r);
+    right = l > 1e-6 ? r / l : vec3(1.0, 0.0, 0.0);
+    up = cross(towards, right);
+}
+
+float halfHeight(vec3 up) { return 0.5 * (cylinder.z - cylinder.y) * abs(up.y) + cylinder.x * length(up.xz); }
+
+float marginScale() { return atlas.y / (atlas.y - 2.0 * atlas.z); }
+
+/// A direction of the Forest's local space in the tree's own frame (the instance's rotation undone).
+vec3 intoTree(vec3 d) { return vec3(uv5.x * d.x - uv5.y * d.z, d.y, uv5.y * d.x + uv5.x * d.z); }
+
+/// Frame `cell`: this corner's frame coordinates (xy) and their shift per unit of encoded depth
+/// (zw); the sun in the frame's axes.
+vec4 frameCoordinates(vec2 cell, vec3 v, vec3 corner, vec3 sunInTree, out vec3 sunInFrame)
+{
+    vec3 t = hemiOctahedralDecode(cell / (atlas.x - 1.0) * 2.0 - 1.0);
+    vec3 right, up;
+    frameAxes(t, right, up);
+    float side = max(2.0 * cylinder.x, 2.0 * halfHeight(up)) * marginScale();
+    float vt = max(dot(v, t), 0.05);
+    vec3 onPlane = corner - v * (dot(corner, t) / vt);
+    vec2 uv = vec2(0.5 + dot(onPlane, right) / side, 0.5 - dot(onPlane, up) / side);
+    // Encoded depth e is d = (e - 0.5) * 2 * depth radius metres in front of the plane.
+    vec2 shift = (2.0 * cylinder.w / (vt * side)) * vec2(dot(v, right), -dot(v, up));
+    sunInFrame = vec3(dot(sunInTree, right), dot(sunInTree, up), dot(sunInTree, t));
+    return vec4(uv, shift);
+}
+
+void main()
+{
+    float centreY = 0.5 * (cylinder.y + cylinder.z);
+    vec3 centre = uv4.xyz + vec3(0.0, uv4.w * centreY, 0.0);
+#ifdef CASTER
+    vec3 away = transpose(mat3(world)) * vec3(view[0][2], view[1][2], view[2][2]);
+#else
+    vec3 away = cameraPosition.xyz - centre;
+#endif
+    vec3 v = dot(away, away) > 0.0 ? intoTree(normalize(away)) : vec3(0.0, 0.0, 1.0);
+
+    // The quad, facing v.
+    vec3 right, up;
+    frameAxes(v, right, up);
+    vec3 corner = (vertex.x * cylinder.x * right + vertex.y * halfHeight(up) * up) * marginScale();
+    vec4 position = vec4(centre + uv4.w * instanceDirection(corner), 1.0);
+    gl_Position = worldViewProj * position;
+
+    // The three frames around v.
+    vec2 grid = (hemiOctahedralEncode(v) * 0.5 + 0.5) * (atlas.x - 1.0);
+    vec2 base = clamp(floor(grid), vec2(0.0), vec2(atlas.x - 2.0));
+    vec2 f = clamp(grid - base, 0.0, 1.0);
+    vec2 cell0, cell1 = base + vec2(1.0, 0.0), cell2 = base + vec2(0.0, 1.0);
+    if (f.x + f.y <= 1.0)
+    {
+        cell0 = base;
+        vWeights = vec3(1.0 - f.x - f.y, f.x, f.y);
+    }
+    else
+    {
+        cell0 = base + vec2(1.0);
+        vWeights = vec3(f.x + f.y - 1.0, 1.0 - f.y, 1.0 - f.x);
+    }
+    vFrame01 = vec4(cell0, cell1);
+    vFrame2 = cell2;
+
+#ifdef CASTER
+    vec3 sunInTree = vec3(0.0);
+#else
+    vec3 sunInTree = intoTree(normalize(transpose(mat3(world)) * normalize(sunDirection.xyz)));
+#endif
+    vec3 sun0, sun1, sun2;
+    vec4 c0 = frameCoordinates(cell0, v, corner, sunInTree, sun0);
+    vec4 c1 = frameCoordinates(cell1, v, corner, sunInTree, sun1);
+    vec4 c2 = frameCoordinates(cell2, v, corner, sunInTree, sun2);
+    vUv01 = vec4(c0.xy, c1.xy);
+    vUv2 = c2.xy;
+#ifdef CASTER
+    vClipZW = gl_Position.zw;
+#else
+    vParallax01 = vec4(c0.zw, c1.zw);
+    vParallax2 = c2.zw;
+    vSun0 = sun0;
+    vSun1 = sun1;
+    vSun2 = sun2;
+#endif
+#ifdef SHADOW_RECEIVER
+    vShadowPos = texViewProj * (world * position);
+#endif
+}
