@@ -158,7 +158,8 @@ namespace TreeLod
         static Ogre::Real pixelCountForHeight(TreeAsset& asset, Ogre::Real heightPixels);
 
         /// The techniques budgeted auto chooses among: the reference, lodf, both billboard clouds
-        /// and both impostors.
+        /// and the impostor. Not the octahedral impostor: its in-forest error exceeds what its error
+        /// curve predicts, and auto chose worse with it (docs/octahedral-impostor.md, "On the front").
         static std::vector<Ogre::String> getAutoTechniques();
 
         /// Budgeted auto (docs/forest.md, "Budgeted levels"): the levels chooseLevels
