@@ -14,23 +14,6 @@ namespace TreeLod
         constexpr std::uint32_t KNOWN_FLAGS = 0;
         constexpr std::size_t QUAD_RECORD_BYTES = 5 * 4;
 
-        std::string size(std::uint32_t w, std::uint32_t h) { return std::to_string(w) + "x" + std::to_string(h); }
-
-        /// What is wrong with `tex` as a quad's texture, "" when nothing.
-        std::string textureProblem(const GpuTexture& tex)
-        {
-            if (tex.format != GpuTextureFormat::RGBA8 && tex.format != GpuTextureFormat::DXT5)
-                return "format " + std::to_string(std::uint32_t(tex.format)) + " (RGBA8 or DXT5 needed)";
-            if (tex.width < 1 || tex.height < 1 || tex.width > GPU_TEXTURE_MAX_SIZE || tex.height > GPU_TEXTURE_MAX_SIZE)
-                return "size " + size(tex.width, tex.height) + " outside 1.." + std::to_string(GPU_TEXTURE_MAX_SIZE);
-            if (tex.mipCount < 1 || tex.mipCount > fullMipCount(tex.width, tex.height))
-                return std::to_string(tex.mipCount) + " mip levels for a " + size(tex.width, tex.height) + " texture";
-            const std::uint64_t expected = gpuTextureBytes(tex.format, tex.width, tex.height, tex.mipCount);
-            if (tex.data.size() != expected)
-                return std::to_string(tex.data.size()) + " bytes of texel data, expected " + std::to_string(expected);
-            return {};
-        }
-
         std::string quadElement(std::size_t i) { return chunkElement(CROSSED_QUADS_CHUNK, 0) + ", quad " + std::to_string(i); }
     }
 
@@ -74,7 +57,7 @@ namespace TreeLod
                             "s from " + std::to_string(q.left) + " to " + std::to_string(q.right) + ", y from " +
                                 std::to_string(q.bottom) + " to " + std::to_string(q.top) +
                                 " (finite, right > left and top > bottom needed)");
-            const std::string problem = textureProblem(q.colour);
+            const std::string problem = gpuTextureProblem(q.colour, {GpuTextureFormat::RGBA8, GpuTextureFormat::DXT5});
             if (!problem.empty())
                 return fail(label, quadElement(i) + ", texture '" + q.colour.name + "'", problem);
         }

@@ -50,24 +50,6 @@ namespace TreeLod
                    a.hashY < std::uint64_t(b.hashY) + b.hashHeight && b.hashY < std::uint64_t(a.hashY) + a.hashHeight;
         }
 
-        /// Format, size, mip count and byte count, as readGpuTexture checks them.
-        std::string textureProblem(const GpuTexture& tex)
-        {
-            if (tex.format != GpuTextureFormat::RGBA8 && !isBlockCompressed(tex.format))
-                return "unknown format " + std::to_string(std::uint32_t(tex.format));
-            if (tex.width < 1 || tex.height < 1 || tex.width > GPU_TEXTURE_MAX_SIZE ||
-                tex.height > GPU_TEXTURE_MAX_SIZE)
-                return "size " + std::to_string(tex.width) + "x" + std::to_string(tex.height) + " outside 1.." +
-                       std::to_string(GPU_TEXTURE_MAX_SIZE);
-            if (tex.mipCount < 1 || tex.mipCount > fullMipCount(tex.width, tex.height))
-                return std::to_string(tex.mipCount) + " mip levels for a " + std::to_string(tex.width) + "x" +
-                       std::to_string(tex.height) + " texture";
-            const std::uint64_t expected = gpuTextureBytes(tex.format, tex.width, tex.height, tex.mipCount);
-            if (tex.data.size() != expected)
-                return std::to_string(tex.data.size()) + " bytes of texel data, expected " + std::to_string(expected);
-            return {};
-        }
-
     }
 
     // ---- list entries (§4.2, Fig. 8) -------------------------------------------------------
@@ -186,7 +168,8 @@ namespace TreeLod
             {&lowRes, "low-res texture"}};
         for (const auto& [tex, what] : textures)
         {
-            std::string problem = textureProblem(*tex);
+            std::string problem =
+                gpuTextureProblem(*tex, {GpuTextureFormat::RGBA8, GpuTextureFormat::DXT1, GpuTextureFormat::DXT5});
             if (!problem.empty())
                 return fail(label, name + " " + what + " '" + tex->name + "'", problem);
         }

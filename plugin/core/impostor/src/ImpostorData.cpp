@@ -14,25 +14,6 @@ namespace TreeLod
         constexpr std::uint32_t KNOWN_FLAGS = 0;
 
         std::string size(std::uint32_t w, std::uint32_t h) { return std::to_string(w) + "x" + std::to_string(h); }
-
-        /// What is wrong with `tex` as the colour (or normal) texture, "" when nothing.
-        std::string textureProblem(const GpuTexture& tex, bool colour)
-        {
-            const bool formatOk = tex.format == GpuTextureFormat::RGBA8 ||
-                                  tex.format == (colour ? GpuTextureFormat::DXT5 : GpuTextureFormat::DXT1);
-            if (!formatOk)
-                return "format " + std::to_string(std::uint32_t(tex.format)) +
-                       (colour ? " (RGBA8 or DXT5 needed)" : " (RGBA8 or DXT1 needed)");
-            if (tex.width < 1 || tex.height < 1 || tex.width > GPU_TEXTURE_MAX_SIZE ||
-                tex.height > GPU_TEXTURE_MAX_SIZE)
-                return "size " + size(tex.width, tex.height) + " outside 1.." + std::to_string(GPU_TEXTURE_MAX_SIZE);
-            if (tex.mipCount < 1 || tex.mipCount > fullMipCount(tex.width, tex.height))
-                return std::to_string(tex.mipCount) + " mip levels for a " + size(tex.width, tex.height) + " texture";
-            const std::uint64_t expected = gpuTextureBytes(tex.format, tex.width, tex.height, tex.mipCount);
-            if (tex.data.size() != expected)
-                return std::to_string(tex.data.size()) + " bytes of texel data, expected " + std::to_string(expected);
-            return {};
-        }
     }
 
     Result<void> ImpostorData::validate(const std::string& label) const
@@ -48,7 +29,8 @@ namespace TreeLod
         for (const GpuTexture* tex : {&colour, &normal})
         {
             const bool isColour = tex == &colour;
-            const std::string problem = textureProblem(*tex, isColour);
+            const std::string problem = gpuTextureProblem(
+                *tex, {GpuTextureFormat::RGBA8, isColour ? GpuTextureFormat::DXT5 : GpuTextureFormat::DXT1});
             if (!problem.empty())
                 return fail(label, name + (isColour ? ", colour texture '" : ", normal texture '") + tex->name + "'",
                             problem);

@@ -152,6 +152,31 @@ namespace TreeLod
         return format == GpuTextureFormat::DXT1 || format == GpuTextureFormat::DXT5;
     }
 
+    std::string gpuTextureProblem(const GpuTexture& tex, std::initializer_list<GpuTextureFormat> formats)
+    {
+        auto size = [](std::uint32_t w, std::uint32_t h) { return std::to_string(w) + "x" + std::to_string(h); };
+        if (std::find(formats.begin(), formats.end(), tex.format) == formats.end())
+        {
+            std::string names;
+            std::size_t i = 0;
+            for (GpuTextureFormat f : formats)
+            {
+                names += i == 0 ? "" : (i + 1 == formats.size() ? " or " : ", ");
+                names += f == GpuTextureFormat::RGBA8 ? "RGBA8" : f == GpuTextureFormat::DXT1 ? "DXT1" : "DXT5";
+                ++i;
+            }
+            return "format " + std::to_string(std::uint32_t(tex.format)) + " (" + names + " needed)";
+        }
+        if (tex.width < 1 || tex.height < 1 || tex.width > GPU_TEXTURE_MAX_SIZE || tex.height > GPU_TEXTURE_MAX_SIZE)
+            return "size " + size(tex.width, tex.height) + " outside 1.." + std::to_string(GPU_TEXTURE_MAX_SIZE);
+        if (tex.mipCount < 1 || tex.mipCount > fullMipCount(tex.width, tex.height))
+            return std::to_string(tex.mipCount) + " mip levels for a " + size(tex.width, tex.height) + " texture";
+        const std::uint64_t expected = gpuTextureBytes(tex.format, tex.width, tex.height, tex.mipCount);
+        if (tex.data.size() != expected)
+            return std::to_string(tex.data.size()) + " bytes of texel data, expected " + std::to_string(expected);
+        return {};
+    }
+
     void writeGpuTexture(ByteWriter& w, const GpuTexture& tex)
     {
         w.string(tex.name);

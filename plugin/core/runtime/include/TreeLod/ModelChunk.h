@@ -31,6 +31,7 @@
 #include "TreeLod/TreeModel.h"
 
 #include <cstdint>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,11 @@ namespace TreeLod
     /// Bytes of `mipCount` levels of a width x height texture in `format`.
     std::uint64_t gpuTextureBytes(GpuTextureFormat format, std::uint32_t width, std::uint32_t height,
                                   std::uint32_t mipCount);
+
+    /// What is wrong with `tex` as a chunk's texture, "" when nothing: a format other than
+    /// `formats` ("format 3 (RGBA8 or DXT1 needed)"), a size outside 1..GPU_TEXTURE_MAX_SIZE, a mip
+    /// count outside 1..fullMipCount, texel bytes that are not the size's.
+    std::string gpuTextureProblem(const GpuTexture& tex, std::initializer_list<GpuTextureFormat> formats);
 
     struct ReferenceChunk
     {
