@@ -309,6 +309,14 @@ namespace TreeLod
         return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
     }
 
+    Result<void> addReferenceChunkIfMissing(PackageWriter& writer, const TreeModel& model, const std::string& label,
+                                            const ProgressCallback& progress)
+    {
+        if (writer.hasChunk(REFERENCE_CHUNK, 0))
+            return {};
+        return addReferenceChunk(writer, model, label, progress);
+    }
+
     Result<void> addReferenceChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
                                    const ProgressCallback& progress)
     {

@@ -1282,12 +1282,8 @@ namespace TreeLod
         Result<void> addCloudChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
                                    const ProgressCallback& progress, const std::string& chunk, Bake bake)
         {
-            if (!writer.hasChunk(REFERENCE_CHUNK, 0))
-            {
-                Result<void> added = addReferenceChunk(writer, model, label, progress);
-                if (!added)
-                    return added;
-            }
+            if (Result<void> reference = addReferenceChunkIfMissing(writer, model, label, progress); !reference)
+                return reference;
             Result<BillboardCloudData> data = bake();
             if (!data)
                 return data.error();

@@ -147,12 +147,8 @@ namespace TreeLod
     Result<void> addImpostorChunk(PackageWriter& writer, const TreeModel& model, const ImpostorOptions& options,
                                   const std::string& label, const ProgressCallback& progress)
     {
-        if (!writer.hasChunk(REFERENCE_CHUNK, 0))
-        {
-            Result<void> added = addReferenceChunk(writer, model, label, progress);
-            if (!added)
-                return added;
-        }
+        if (Result<void> reference = addReferenceChunkIfMissing(writer, model, label, progress); !reference)
+            return reference;
         Result<ImpostorData> data = bakeImpostor(model, options, label, progress);
         if (!data)
             return data.error();

@@ -446,12 +446,8 @@ namespace TreeLod
     Result<void> addFoliageLodChunk(PackageWriter& writer, const TreeModel& model, const FoliageLodOptions& options,
                                     const std::string& label, const ProgressCallback& progress)
     {
-        if (!writer.hasChunk(REFERENCE_CHUNK, 0))
-        {
-            Result<void> added = addReferenceChunk(writer, model, label, progress);
-            if (!added)
-                return added;
-        }
+        if (Result<void> reference = addReferenceChunkIfMissing(writer, model, label, progress); !reference)
+            return reference;
         Result<FoliageLodData> data = buildFoliageLod(model, options, label, progress);
         if (!data)
             return data.error();

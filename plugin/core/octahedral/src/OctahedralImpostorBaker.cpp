@@ -192,12 +192,8 @@ namespace TreeLod
                                             const OctahedralImpostorOptions& options, const std::string& label,
                                             const ProgressCallback& progress)
     {
-        if (!writer.hasChunk(REFERENCE_CHUNK, 0))
-        {
-            Result<void> added = addReferenceChunk(writer, model, label, progress);
-            if (!added)
-                return added;
-        }
+        if (Result<void> reference = addReferenceChunkIfMissing(writer, model, label, progress); !reference)
+            return reference;
         Result<OctahedralImpostorData> data = bakeOctahedralImpostor(model, options, label, progress);
         if (!data)
             return data.error();

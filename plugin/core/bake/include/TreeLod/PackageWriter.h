@@ -104,6 +104,10 @@ namespace TreeLod
     /// to `writer`. `label` names the output in errors ("model 'oak', leaf 3: ...").
     Result<void> addReferenceChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
                                    const ProgressCallback& progress = {});
+    /// addReferenceChunk unless `writer` has the reference chunk already: what every technique's
+    /// package glue does first (the Forest takes a tree's bounds from the reference).
+    Result<void> addReferenceChunkIfMissing(PackageWriter& writer, const TreeModel& model, const std::string& label,
+                                            const ProgressCallback& progress = {});
 
     /// Add the "meta" chunk (level 0, format 1): meta.toJson() as UTF-8 text.
     Result<void> addMetaChunk(PackageWriter& writer, const PackageMeta& meta);
