@@ -240,6 +240,13 @@ TEST(Image, SrgbTransferMatchesStandardAndInverts)
         EXPECT_NEAR(linearToSrgb(srgbToLinear(c)), c, 1e-5) << c;
 }
 
+TEST(Image, EverySrgbByteSurvivesTheLinearRoundTrip)
+{
+    // OffscreenRenderer::render copies bytes at one sample per pixel on the strength of this.
+    for (int b = 0; b < 256; ++b)
+        EXPECT_EQ(int(linearToSrgbByte(srgbByteToLinear(std::uint8_t(b)))), b);
+}
+
 // ---- multi-scale RMSE (ellipsoids-and-lines paper §4) ---------------------------------
 
 TEST(MultiScaleRmse, IdenticalImagesGiveZeroInEveryBand)
@@ -624,4 +631,36 @@ TEST(Flip, DefaultPixelsPerDegreeIsSixtySeven)
 {
     // 0.7 m * (3840 px / 0.7 m) * pi / 180 = 67.02 pixels per degree.
     EXPECT_NEAR(flipDefaultPixelsPerDegree(), 67.02, 0.01);
+}
+
+TEST(Flip, APreparedReferenceGivesTheSameResultForEveryTest)
+{
+    const Image a = randomImage(33, 21, 8);
+    FlipOptions options;
+    options.pixelsPerDegree = 30.0;
+    Result<FlipReference> prepared = FlipReference::make(a, options);
+    ASSERT_TRUE(prepared.ok()) << prepared.error().message();
+    EXPECT_EQ(prepared->width(), 33);
+    EXPECT_EQ(prepared->height(), 21);
+    options.keepErrorMap = true;
+    for (std::uint32_t seed : {9u, 10u, 11u})
+    {
+        const Image b = randomImage(33, 21, seed);
+        Result<FlipResult> once = flip(a, b, options), reused = flip(*prepared, b, true);
+        ASSERT_TRUE(once.ok() && reused.ok());
+        EXPECT_GT(once->mean, 0.0);
+        EXPECT_EQ(once->mean, reused->mean);
+        EXPECT_EQ(once->max, reused->max);
+        EXPECT_EQ(once->weightedMedian, reused->weightedMedian);
+        EXPECT_EQ(once->errorMap, reused->errorMap);
+    }
+
+    Result<FlipResult> mismatch = flip(*prepared, Image(21, 33));
+    ASSERT_FALSE(mismatch.ok());
+    EXPECT_NE(mismatch.error().reason.find("33x21"), std::string::npos) << mismatch.error().reason;
+    EXPECT_NE(mismatch.error().reason.find("21x33"), std::string::npos) << mismatch.error().reason;
+    EXPECT_FALSE(FlipReference::make(Image()).ok());
+    options.pixelsPerDegree = std::nan("");
+    EXPECT_FALSE(FlipReference::make(a, options).ok());
+    EXPECT_FALSE(flip(FlipReference{}, a).ok());
 }

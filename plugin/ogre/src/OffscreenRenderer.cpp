@@ -311,15 +311,28 @@ namespace TreeLod
         mRoot->renderOneFrame(); // frame listeners, controllers
         rt->update();
 
-        std::vector<std::uint8_t> big(std::size_t(w) * h * 4);
-        Ogre::PixelBox box(Ogre::uint32(w), Ogre::uint32(h), 1, Ogre::PF_BYTE_RGBA, big.data());
-        rt->copyContentsToMemory(Ogre::Box(0, 0, Ogre::uint32(w), Ogre::uint32(h)), box,
-                                 Ogre::RenderTarget::FB_AUTO);
-
         RgbaImage out;
         out.width = width;
         out.height = height;
         out.pixels.resize(std::size_t(width) * height * 4);
+        std::vector<std::uint8_t> big;
+        // One sample: averaging one sRGB byte in linear light gives the byte back (a tested
+        // identity), so the pixels are read straight into the output.
+        std::uint8_t* read = out.pixels.data();
+        if (s > 1)
+        {
+            big.resize(std::size_t(w) * h * 4);
+            read = big.data();
+        }
+        Ogre::PixelBox box(Ogre::uint32(w), Ogre::uint32(h), 1, Ogre::PF_BYTE_RGBA, read);
+        rt->copyContentsToMemory(Ogre::Box(0, 0, Ogre::uint32(w), Ogre::uint32(h)), box,
+                                 Ogre::RenderTarget::FB_AUTO);
+        if (s == 1)
+        {
+            for (std::size_t i = 3; i < out.pixels.size(); i += 4)
+                out.pixels[i] = 255;
+            return out;
+        }
         const float norm = 1.0f / float(s * s);
         for (int y = 0; y < height; ++y)
             for (int x = 0; x < width; ++x)

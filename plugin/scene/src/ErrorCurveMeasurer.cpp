@@ -18,6 +18,8 @@
 #include <algorithm>
 #include <cmath>
 #include <future>
+#include <memory>
+#include <optional>
 
 namespace TreeLod
 {
@@ -58,18 +60,48 @@ namespace TreeLod
             double flip = 0.0, rmse = 0.0;
         };
 
-        Result<Scores> score(const Image& reference, const Image& test, const std::string& element)
+        /// One view's images: the CPU reference and each level's frame (same size).
+        struct ViewShots
         {
-            const Crop crop = cropAround(unite(treeExtent(reference), treeExtent(test)), reference.width,
-                                         reference.height);
-            const Image a = cropImage(reference, crop), b = cropImage(test, crop);
-            Result<FlipResult> f = flip(a, b);
-            if (!f)
-                return fail("", element, "FLIP: " + f.error().message());
-            Result<MultiScaleRmseResult> m = multiScaleRmse(a, b);
-            if (!m)
-                return fail("", element, "multi-scale RMSE: " + m.error().message());
-            return Scores{f->mean, m->combined};
+            Image reference;
+            std::vector<RgbaImage> levels;
+        };
+
+        /// Every level's scores against the reference over one square crop around the tree: the
+        /// union of the reference's and every level's tree pixels, so the levels of a view are
+        /// judged over the same pixels and the reference is filtered for FLIP once. A level drawn
+        /// byte for byte as an earlier one gets its scores. Errors name the level.
+        Result<std::vector<Scores>> scoreView(const ViewShots& shots, const std::vector<ForestLevel>& levels)
+        {
+            Extent extent = treeExtent(shots.reference);
+            for (const RgbaImage& shot : shots.levels)
+                extent = unite(extent, treeExtent(toImage(shot)));
+            const Crop crop = cropAround(extent, shots.reference.width, shots.reference.height);
+            const Image reference = cropImage(shots.reference, crop);
+            Result<FlipReference> prepared = FlipReference::make(reference);
+            if (!prepared)
+                return fail("", "reference", "FLIP: " + prepared.error().message());
+            std::vector<Scores> scores(shots.levels.size());
+            for (std::size_t l = 0; l < shots.levels.size(); ++l)
+            {
+                const auto same = std::find_if(shots.levels.begin(), shots.levels.begin() + std::ptrdiff_t(l),
+                                               [&](const RgbaImage& earlier) { return earlier.pixels == shots.levels[l].pixels; });
+                if (same != shots.levels.begin() + std::ptrdiff_t(l))
+                {
+                    scores[l] = scores[std::size_t(same - shots.levels.begin())];
+                    continue;
+                }
+                const std::string element = "level " + Forest::describeLevel(levels[l]);
+                const Image test = cropImage(toImage(shots.levels[l]), crop);
+                Result<FlipResult> f = flip(*prepared, test);
+                if (!f)
+                    return fail("", element, "FLIP: " + f.error().message());
+                Result<MultiScaleRmseResult> m = multiScaleRmse(reference, test);
+                if (!m)
+                    return fail("", element, "multi-scale RMSE: " + m.error().message());
+                scores[l] = Scores{f->mean, m->combined};
+            }
+            return scores;
         }
     }
 
@@ -123,6 +155,44 @@ namespace TreeLod
         const std::size_t meanViews = std::size_t(std::count_if(options.views.begin(), options.views.end(), meanView));
         const std::size_t total = options.heightsPx.size() * options.views.size();
         std::size_t done = 0;
+        // A view's scores are computed on another thread while Ogre (this thread, which owns the
+        // GL context) draws the next view: FLIP on the CPU overlaps the renderer's work. The
+        // scores do not depend on the thread count (ImageMetrics.h).
+        struct Pending
+        {
+            std::future<Result<std::vector<Scores>>> scores;
+            std::size_t height = 0;
+            bool inMean = false;
+        };
+        std::optional<Pending> pending;
+        auto collect = [&]() -> Result<void> {
+            if (!pending)
+                return {};
+            Result<std::vector<Scores>> s = pending->scores.get();
+            const Pending view = std::move(*pending);
+            pending.reset();
+            if (!s)
+                return s.error();
+            for (std::size_t l = 0; l < levels.size(); ++l)
+            {
+                ErrorCurveLevel& c = curves.levels[l];
+                const Scores& score = (*s)[l];
+                if (view.inMean)
+                {
+                    c.flip[view.height] += float(score.flip) / float(meanViews);
+                    c.rmse[view.height] += float(score.rmse) / float(meanViews);
+                }
+                c.flipMax[view.height] = std::max(c.flipMax[view.height], float(score.flip));
+            }
+            return {};
+        };
+        auto abandon = [&](const Error& error) -> Error {
+            if (pending)
+                pending->scores.wait(); // it reads only its own images
+            pending.reset();
+            renderer.clearContent();
+            return fail(label, error.element, error.reason);
+        };
         for (std::size_t h = 0; h < options.heightsPx.size(); ++h)
         {
             // One Forest per level, its bark at the mesh LoD level a Forest draws at this height.
@@ -141,58 +211,35 @@ namespace TreeLod
             }
             catch (const Ogre::Exception& e)
             {
-                renderer.clearContent();
-                return fail(label, "level " + Forest::describeLevel(levels[forests.size()]), e.getDescription());
+                return abandon(Error{"", "level " + Forest::describeLevel(levels[forests.size()]), e.getDescription()});
             }
             for (const glm::vec2& viewAngles : options.views)
             {
                 report(progress, "error curves", float(done++) / float(total));
                 const View view = makeView(lo, hi, options.heightsPx[h], viewAngles);
-                const Image reference = traceReference(cpu, view.camera, view.size, options.referenceSupersample);
-                // Each level's image is scored on another thread while Ogre (this thread, which owns
-                // the GL context) draws the next: FLIP on the CPU overlaps the renderer's work. The
-                // scores do not depend on the thread count (ImageMetrics.h).
-                std::vector<std::future<Result<Scores>>> scores;
+                auto shots = std::make_shared<ViewShots>();
+                shots->reference = traceReference(cpu, view.camera, view.size, options.referenceSupersample);
                 for (std::size_t l = 0; l < levels.size(); ++l)
                 {
                     forests[l]->setVisible(true);
-                    Image test;
                     try
                     {
-                        test = toImage(renderer.render(view.camera, view.size, view.size, 1));
+                        shots->levels.push_back(renderer.render(view.camera, view.size, view.size, 1));
                     }
                     catch (const Ogre::Exception& e)
                     {
-                        scores.clear(); // waits for the scores under way: they read `reference`
-                        renderer.clearContent();
-                        return fail(label, "level " + Forest::describeLevel(levels[l]), e.getDescription());
+                        return abandon(Error{"", "level " + Forest::describeLevel(levels[l]), e.getDescription()});
                     }
                     forests[l]->setVisible(false);
-                    scores.push_back(std::async(std::launch::async,
-                                                [&reference, test = std::move(test),
-                                                 element = "level " + Forest::describeLevel(levels[l])] {
-                                                    return score(reference, test, element);
-                                                }));
                 }
-                for (std::size_t l = 0; l < levels.size(); ++l)
-                {
-                    Result<Scores> s = scores[l].get();
-                    if (!s)
-                    {
-                        scores.clear();
-                        renderer.clearContent();
-                        return s.error();
-                    }
-                    ErrorCurveLevel& c = curves.levels[l];
-                    if (meanView(viewAngles))
-                    {
-                        c.flip[h] += float(s->flip) / float(meanViews);
-                        c.rmse[h] += float(s->rmse) / float(meanViews);
-                    }
-                    c.flipMax[h] = std::max(c.flipMax[h], float(s->flip));
-                }
+                if (Result<void> collected = collect(); !collected)
+                    return abandon(collected.error());
+                pending = Pending{std::async(std::launch::async, [shots, &levels] { return scoreView(*shots, levels); }),
+                                  h, meanView(viewAngles)};
             }
         }
+        if (Result<void> collected = collect(); !collected)
+            return abandon(collected.error());
         renderer.clearContent();
         report(progress, "error curves", 1.0f);
         for (ErrorCurveLevel& c : curves.levels)

@@ -380,19 +380,53 @@ namespace TreeLod
         return distance * (pixels / width) * (kPi / 180.0);
     }
 
+    struct FlipReference::Analysed
+    {
+        Kernels kernels;
+        Analysis analysis;
+    };
+
+    int FlipReference::width() const { return analysed ? analysed->analysis.L.width : 0; }
+    int FlipReference::height() const { return analysed ? analysed->analysis.L.height : 0; }
+
+    Result<FlipReference> FlipReference::make(const Image& reference, const FlipOptions& options)
+    {
+        if (auto error = checkComparable("FLIP", reference, reference))
+            return *error;
+        const double ppd = options.pixelsPerDegree == 0.0 ? flipDefaultPixelsPerDegree() : options.pixelsPerDegree;
+        if (!(ppd > 0.0) || !(ppd <= 10000.0))
+            return fail("", "FLIP", "pixels per degree must be in (0, 10000], got " + std::to_string(ppd));
+        auto analysed = std::make_shared<Analysed>(Analysed{makeKernels(ppd), Analysis(reference.width, reference.height)});
+        analyse(reference, analysed->kernels, analysed->analysis);
+        FlipReference prepared;
+        prepared.analysed = std::move(analysed);
+        return prepared;
+    }
+
     Result<FlipResult> flip(const Image& reference, const Image& test, const FlipOptions& options)
     {
         if (auto error = checkComparable("FLIP", reference, test))
             return *error;
-        double ppd = options.pixelsPerDegree == 0.0 ? flipDefaultPixelsPerDegree() : options.pixelsPerDegree;
-        if (!(ppd > 0.0) || !(ppd <= 10000.0))
-            return fail("", "FLIP", "pixels per degree must be in (0, 10000], got " + std::to_string(ppd));
+        Result<FlipReference> prepared = FlipReference::make(reference, options);
+        if (!prepared)
+            return prepared.error();
+        return flip(*prepared, test, options.keepErrorMap);
+    }
 
-        const int w = reference.width, h = reference.height;
-        const Kernels kernels = makeKernels(ppd);
-        Analysis ref(w, h), tst(w, h);
-        analyse(reference, kernels, ref);
-        analyse(test, kernels, tst);
+    Result<FlipResult> flip(const FlipReference& reference, const Image& test, bool keepErrorMap)
+    {
+        if (!reference.analysed)
+            return fail("", "FLIP", "the reference was not prepared");
+        const int w = reference.width(), h = reference.height();
+        if (test.width != w || test.height != h)
+            return fail("", "FLIP", "image sizes differ: reference " + std::to_string(w) + "x" + std::to_string(h) +
+                                        ", test " + std::to_string(test.width) + "x" + std::to_string(test.height));
+        if (test.pixels.size() != std::size_t(w) * h)
+            return fail("", "FLIP", "pixel array does not match the image size " + std::to_string(w) + "x" +
+                                        std::to_string(h));
+        const Analysis& ref = reference.analysed->analysis;
+        Analysis tst(w, h);
+        analyse(test, reference.analysed->kernels, tst);
 
         const float cmax = maxColourDifference();
         const float breakpoint = kPc * cmax;
@@ -445,7 +479,7 @@ namespace TreeLod
             median = 0.5 * (median + *std::max_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(mid)));
         result.weightedMedian = median;
 
-        if (options.keepErrorMap)
+        if (keepErrorMap)
             result.errorMap = std::move(errors);
         return result;
     }

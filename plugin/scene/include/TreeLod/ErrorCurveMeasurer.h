@@ -5,7 +5,8 @@
 // Forest draws it in a scene, at each screen height of ErrorCurveOptions::heightsPx and from
 // each view (azimuths around the tree and one from above), and compared with the CPU ray-traced
 // reference (ReferenceRenderer, supersampled) over a square crop around the tree (the union of
-// both images' tree pixels): FLIP (Andersson et al. 2020) and multi-scale RMSE (the
+// the reference's and every level's tree pixels in that view, so the levels are judged over the
+// same pixels): FLIP (Andersson et al. 2020) and multi-scale RMSE (the
 // ellipsoids-and-lines paper, §4). The curves the selection reads (flip, rmse) average the views
 // up to 60 degrees of elevation; the view from above counts in the worst view (flipMax) only: a
 // crown thinned from above is not what a camera near the ground sees of it. The view is sized so the tree's box height spans `heightPx`

@@ -9,6 +9,7 @@
 #include "TreeLod/Image.h"
 #include "TreeLod/Result.h"
 
+#include <memory>
 #include <vector>
 
 namespace TreeLod
@@ -55,6 +56,24 @@ namespace TreeLod
     /// FLIP error between `reference` and `test`. Symmetric in its two inputs.
     /// Borders are handled by clamp-to-edge in every filter.
     Result<FlipResult> flip(const Image& reference, const Image& test, const FlipOptions& options = {});
+
+    /// A reference image filtered once (colour CSF and feature detectors) for comparing several
+    /// test images with it: flip(FlipReference, test) equals flip(reference, test) exactly.
+    /// Shareable between threads.
+    class FlipReference
+    {
+    public:
+        /// Errors: an empty image or pixels per degree out of (0, 10000].
+        static Result<FlipReference> make(const Image& reference, const FlipOptions& options = {});
+        int width() const;
+        int height() const;
+
+        struct Analysed;
+        std::shared_ptr<const Analysed> analysed;
+    };
+
+    /// FLIP error between the prepared reference and `test` (its options; `keepErrorMap` here).
+    Result<FlipResult> flip(const FlipReference& reference, const Image& test, bool keepErrorMap = false);
 
     /// The error map as an opaque colour image (magma-like: black -> purple -> orange ->
     /// pale yellow as the error goes 0 -> 1), for difference views. Needs a result made
