@@ -439,11 +439,13 @@ namespace TreeLod
     TEST(ImpostorBaker, defaultBakeIsRgba8AndDxtKeepsTheCoverage)
     {
         ImpostorOptions options;
-        options.aoRays = 4; // the default's AO costs time, not bytes
         const TreeModel& m = generatedOak(1500);
         const ImpostorData raw = bakeOrFail(m, options);
         EXPECT_EQ(raw.colour.format, GpuTextureFormat::RGBA8);
         EXPECT_EQ(raw.normal.format, GpuTextureFormat::RGBA8);
+        // No AO by default (the polygonal tree draws its leaves without): B = 1 in every texel.
+        for (std::size_t t = 0; t < std::size_t(raw.normal.width) * raw.normal.height; ++t)
+            ASSERT_EQ(raw.normal.data[4 * t + 2], 255) << "texel " << t;
         EXPECT_EQ(std::max(raw.colour.width, raw.colour.height), 256u);
         EXPECT_EQ(raw.colour.mipCount, fullMipCount(raw.colour.width, raw.colour.height));
         EXPECT_EQ(raw.gpuBytes(), raw.colour.data.size() + raw.normal.data.size());

@@ -5,8 +5,9 @@
 //      every side; texels are square, `resolution` of them along the longer side.
 //   2. Render the tree with the CPU ReferenceRenderer, orthographic along -Z, transparent
 //      background (straight alpha = coverage), samplesPerPixel samples per texel: once lit by
-//      a white ambient light alone (albedo), once more with per-vertex ambient occlusion
-//      (albedo x AO, so AO = the ratio). The shading normals come with the first render.
+//      a white ambient light alone (albedo), and where asked (aoRays > 0) once more with
+//      per-vertex ambient occlusion (albedo x AO, so AO = the ratio). The shading normals come
+//      with the first render.
 //   3. Bleed colour, normal and AO into the uncovered texels (bleedValues), then mip chains:
 //      colour with the coverage of level 0 kept (buildMipChain), normal and AO weighted by
 //      coverage.
@@ -36,7 +37,10 @@ namespace TreeLod
         /// side gets what the tree's aspect asks for (a multiple of 4, at least 4 + 2 margins).
         std::uint32_t resolution = 256;
         int samplesPerPixel = 16;  ///< per texel, a square in [1, 256] (coverage in 1/n steps)
-        int aoRays = 32;           ///< per vertex (AmbientOcclusion.h); 0 = no AO (B = 1)
+        /// Per vertex (AmbientOcclusion.h); 0 = no AO (B = 1), the default: the polygonal tree
+        /// the impostor stands for draws its leaves without AO, and baked AO made far trees 10-20 %
+        /// darker than it (docs/impostor.md, "Ambient occlusion").
+        int aoRays = 0;
         float alphaCutoff = 0.5f;  ///< the quad's alpha test, in (0, 1]
         /// DXT5 colour, DXT1 normal (libsquish); else RGBA8, the default: the far level of every
         /// forest samples it on every fragment, and llvmpipe decodes DXT in software (the quad

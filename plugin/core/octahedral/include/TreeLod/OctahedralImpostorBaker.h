@@ -33,7 +33,7 @@ namespace TreeLod
         /// most GPU_TEXTURE_MAX_SIZE.
         std::uint32_t frameResolution = 128;
         int samplesPerPixel = 9;  ///< per texel, a square in [1, 256]
-        int aoRays = 32;          ///< per vertex (AmbientOcclusion.h); 0 = no AO
+        int aoRays = 0;           ///< per vertex (AmbientOcclusion.h); 0 = no AO, as ImpostorOptions
         float alphaCutoff = 0.5f; ///< the quad's alpha test, in (0, 1]
         bool compress = false;    ///< DXT5 colour and normal; RGBA8 by default, as the quad impostor
     };
