@@ -418,12 +418,8 @@ namespace TreeLod
         if (!reference.analysed)
             return fail("", "FLIP", "the reference was not prepared");
         const int w = reference.width(), h = reference.height();
-        if (test.width != w || test.height != h)
-            return fail("", "FLIP", "image sizes differ: reference " + std::to_string(w) + "x" + std::to_string(h) +
-                                        ", test " + std::to_string(test.width) + "x" + std::to_string(test.height));
-        if (test.pixels.size() != std::size_t(w) * h)
-            return fail("", "FLIP", "pixel array does not match the image size " + std::to_string(w) + "x" +
-                                        std::to_string(h));
+        if (auto error = checkComparable("FLIP", w, h, test))
+            return *error;
         const Analysis& ref = reference.analysed->analysis;
         Analysis tst(w, h);
         analyse(test, reference.analysed->kernels, tst);

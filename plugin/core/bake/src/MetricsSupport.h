@@ -4,6 +4,7 @@
 #include "TreeLod/Image.h"
 #include "TreeLod/Result.h"
 
+#include <algorithm>
 #include <optional>
 #include <string>
 
@@ -11,16 +12,25 @@ namespace TreeLod
 {
     /// An Error when the two images cannot be compared (different or zero size, or a
     /// pixel array that does not match the stated size); nothing otherwise.
+    /// The same for a reference known by its size alone (its pixels checked when it was prepared).
+    inline std::optional<Error> checkComparable(const char* metric, int width, int height, const Image& test)
+    {
+        auto size = [](int w, int h) { return std::to_string(w) + "x" + std::to_string(h); };
+        if (width != test.width || height != test.height)
+            return fail("", metric, "image sizes differ: reference " + size(width, height) + ", test " +
+                                        size(test.width, test.height));
+        if (width <= 0 || height <= 0)
+            return fail("", metric, "images are empty (" + size(width, height) + ")");
+        if (test.pixels.size() != std::size_t(width) * height)
+            return fail("", metric, "pixel array does not match the image size " + size(width, height));
+        return std::nullopt;
+    }
+
     inline std::optional<Error> checkComparable(const char* metric, const Image& reference, const Image& test)
     {
-        auto size = [](const Image& i) { return std::to_string(i.width) + "x" + std::to_string(i.height); };
-        if (reference.width != test.width || reference.height != test.height)
-            return fail("", metric, "image sizes differ: reference " + size(reference) + ", test " + size(test));
-        if (reference.width <= 0 || reference.height <= 0)
-            return fail("", metric, "images are empty (" + size(reference) + ")");
-        const std::size_t n = std::size_t(reference.width) * reference.height;
-        if (reference.pixels.size() != n || test.pixels.size() != n)
-            return fail("", metric, "pixel array does not match the image size " + size(reference));
-        return std::nullopt;
+        if (reference.pixels.size() != std::size_t(std::max(reference.width, 0)) * std::size_t(std::max(reference.height, 0)))
+            return fail("", metric, "pixel array does not match the image size " + std::to_string(reference.width) +
+                                        "x" + std::to_string(reference.height));
+        return checkComparable(metric, reference.width, reference.height, test);
     }
 }

@@ -38,7 +38,7 @@ namespace TreeLod
         std::uint32_t resolution = 256;
         int samplesPerPixel = 16;  ///< per texel, a square in [1, 256] (coverage in 1/n steps)
         /// Per vertex (AmbientOcclusion.h); 0 = no AO (B = 1), the default: the polygonal tree
-        /// the impostor stands for draws its leaves without AO, and baked AO made far trees 10-20 %
+        /// the impostor stands for draws its leaves without AO, and baked AO made trees 9-16 %
         /// darker than it (docs/impostor.md, "Ambient occlusion").
         int aoRays = 0;
         float alphaCutoff = 0.5f;  ///< the quad's alpha test, in (0, 1]
