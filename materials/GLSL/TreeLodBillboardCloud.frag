@@ -27,7 +27,6 @@ uniform int tileColumns;
 uniform int tileRows;
 uniform int orientationCount;
 uniform float leavesMaxLod;  // coarsest Leaves Texture mip that does not bleed between tiles
-uniform vec4 alphaCutoffs;   // per leaf material (tile block), up to four
 #endif
 // Custom parameter 0. x: list factor with the LoD bias applied; y: weight of the AO term.
 uniform vec4 lodParams;
@@ -51,6 +50,7 @@ out vec4 fragColour;
 #include "TreeLodShading.glsl"
 
 const float LOW_RES_ALPHA_CUTOFF = 0.25; // BillboardCloudData.h
+const float LEAVES_COVERAGE_CUTOFF = 0.5; // BillboardCloudData.h: every leaf image, its material's cutoff baked in
 const float TWO_PI = 6.28318530718;
 
 // The low-res AO (§5.2): covered texels hold 0.5 + 0.5 * ao, empty ones 0, so a filtered alpha
@@ -137,8 +137,7 @@ void main()
         // The Leaves Texture mip of this entry's footprint: texels per pixel = rho * tileSize / side.
         float lod = clamp(log2(max(rho * tileSize / edge, 1e-6)), 0.0, leavesMaxLod);
         vec4 leaf = textureLod(leavesColour, uv, lod);
-        int material = min(int(orientation / (2u * orientations)), 3);
-        if (leaf.a < alphaCutoffs[material])
+        if (leaf.a < LEAVES_COVERAGE_CUTOFF)
             continue;
         found = true;
 #ifndef CASTER

@@ -25,6 +25,7 @@ namespace TreeLod
             long long leaves = 0;
             double height = 0.0;
             int textureSize = 256;
+            std::uint32_t leafImages = 1, leafMaterials = 1;
             std::string output;
             bool quiet = false;
         };
@@ -47,6 +48,8 @@ namespace TreeLod
             options.leafCount = std::uint32_t(args.leaves);
             options.height = float(args.height);
             options.textureSize = args.textureSize;
+            options.leafImages = args.leafImages;
+            options.leafMaterials = args.leafMaterials;
 
             const auto start = std::chrono::steady_clock::now();
             Result<TreeModel> model = generateTree(options, makeProgress(args.quiet));
@@ -78,6 +81,12 @@ namespace TreeLod
         cmd->add_option("--leaves", args->leaves, "exact leaf count, 100..200000 (default: the preset's)");
         cmd->add_option("--height", args->height, "height of the stems in metres, 0.1..1000 (default: the preset's)");
         cmd->add_option("--texture-size", args->textureSize, "leaf texture size, power of two 16..4096")
+            ->capture_default_str();
+        cmd->add_option("--leaf-images", args->leafImages,
+                        "leaf images, 1..4; above 1 a 2x2 atlas, each leaf mapping one cell")
+            ->capture_default_str();
+        cmd->add_option("--leaf-materials", args->leafMaterials,
+                        "leaf materials, 1..16, each with its own tint and alpha cutoff")
             ->capture_default_str();
         cmd->add_option("-o,--output", args->output, ".glb file to write")->required();
         cmd->add_flag("-q,--quiet", args->quiet, "no progress display");

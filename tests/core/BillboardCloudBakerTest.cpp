@@ -218,9 +218,7 @@ namespace TreeLod
                                          sampler.walk(h.billboard, h.u, h.v, h.front))
                                     {
                                         const glm::vec4 s = tiles->sample(f.tile, f.local);
-                                        const float cutoff =
-                                            data.leafMaterials[f.tile / (2 * data.orientationCount())].alphaCutoff;
-                                        if (s.a >= cutoff)
+                                        if (s.a >= LEAVES_COVERAGE_CUTOFF)
                                         {
                                             opaque = true;
                                             albedo = glm::vec3(s);
@@ -370,6 +368,68 @@ namespace TreeLod
         EXPECT_TRUE(data.validate("one leaf").ok());
         // The billboard faces the leaf.
         EXPECT_GT(std::abs(glm::dot(data.billboards[0].normal, m.leaves[0].normal)), 0.999f);
+    }
+
+    namespace
+    {
+    /// Leaves on a 20 x 10 grid in the plane z = 0 (edge 0.2 m, 0.3 m apart) and one more leaf
+    /// of edge `odd` at (3, 4, 0.5), all facing +z; the bake's warnings.
+    TreeModel gridWithOddLeaf(float odd)
+    {
+        std::vector<LeafAt> leaves;
+        for (int i = 0; i < 200; ++i)
+            leaves.push_back({{0.3f * float(i % 20), 0.3f * float(i / 20), 0.0f}, {0, 0, 1}, 0.2f});
+        leaves.push_back({{3.0f, 4.0f, 0.5f}, {0, 0, 1}, odd});
+        return quadLeaves(leaves);
+    }
+
+    std::vector<std::string> bakeWarnings(const TreeModel& m, BillboardCloudData& data)
+    {
+        std::vector<std::string> warnings;
+        Result<BillboardCloudData> r =
+            bakeBillboardCloud(m, fastOptions(), "test tree", [&](const std::string& step, float) {
+                if (step.rfind("warning: ", 0) == 0)
+                    warnings.push_back(step);
+            });
+        if (!r)
+            ADD_FAILURE() << r.error().message();
+        else
+            data = std::move(r).value();
+        return warnings;
+    }
+    }
+
+    // A leaf 50x the median: the hash cells grow until its tile's side fits the entry's scale
+    // code (no entry at the top code, which would draw it smaller), with a warning naming it.
+    TEST(BillboardCloudBaker, aHugeLeafGrowsTheCellsInsteadOfShrinking)
+    {
+        BillboardCloudData normal, huge;
+        EXPECT_TRUE(bakeWarnings(gridWithOddLeaf(0.2f), normal).empty());
+        const std::vector<std::string> warnings = bakeWarnings(gridWithOddLeaf(10.0f), huge);
+        ASSERT_EQ(warnings.size(), 1u);
+        EXPECT_NE(warnings[0].find("test tree: leaf 200 (material 'Leaves')"), std::string::npos) << warnings[0];
+        EXPECT_NE(warnings[0].find("hash cells grow"), std::string::npos) << warnings[0];
+        EXPECT_GT(huge.levels[0].cellSize, 1.5f * normal.levels[0].cellSize);
+        ASSERT_FALSE(huge.entries.empty());
+        for (const BillboardListEntry& e : huge.entries)
+            ASSERT_LT(e.words[3] & 0xffu, 255u);
+        // The huge leaf's tile: 10 m edge / 0.75 (the tile margin) / cell, within the code's step.
+        float largest = 0.0f;
+        for (const BillboardListEntry& e : huge.entries)
+            largest = std::max(largest, e.side() * huge.levels[0].cellSize);
+        EXPECT_NEAR(largest, 10.0f / (1.0f - 2.0f * TILE_MARGIN), 0.03f * largest);
+    }
+
+    // A leaf under the smallest side the scale code holds is drawn at that side, and said so.
+    TEST(BillboardCloudBaker, aTinyLeafIsEnlargedWithAWarning)
+    {
+        BillboardCloudData data;
+        const std::vector<std::string> warnings = bakeWarnings(gridWithOddLeaf(0.002f), data);
+        ASSERT_EQ(warnings.size(), 1u);
+        EXPECT_NE(warnings[0].find("test tree: 1 leaves (the first is leaf 200, material 'Leaves')"),
+                  std::string::npos)
+            << warnings[0];
+        EXPECT_NE(warnings[0].find("drawn at that size"), std::string::npos) << warnings[0];
     }
 
     TEST(BillboardCloudBaker, noLeavesGivesAValidEmptyCloudWithBarkAo)
@@ -712,7 +772,7 @@ namespace TreeLod
                 const BillboardListEntry e0 = tiles.entryFor(p, cell, i0, j0);
                 const float c = std::cos(e0.rotation()), s = std::sin(e0.rotation()), side = e0.side();
                 const glm::vec2 centre(float(i0) + e0.centreX(), float(j0) + e0.centreY());
-                const float cutoff = data.leafMaterials[0].alphaCutoff;
+                const float cutoff = LEAVES_COVERAGE_CUTOFF;
                 for (std::uint32_t y = 0; y < 2 * T; ++y)
                     for (std::uint32_t x = 0; x < 2 * T; ++x)
                     {

@@ -94,7 +94,7 @@ namespace TreeLod
             d.orientationGrid = 2;
             d.tileColumns = 4;
             d.leavesMaxLod = 2;
-            d.leafMaterials = {{3, 0.5f}, {5, 0.3f}};
+            d.leafImages = {{3, 0.5f}, {5, 0.3f}};
             d.leavesColour = makeTexture("leaves colour", GpuTextureFormat::DXT5, 32, 32, 6, 1);
             d.leavesNormal = makeTexture("leaves normal", GpuTextureFormat::DXT1, 32, 32, 6, 2);
             d.lowRes = makeTexture("low-res", GpuTextureFormat::RGBA8, 16, 16, 1, 3);
@@ -187,11 +187,11 @@ namespace TreeLod
             EXPECT_EQ(a.tileColumns, b.tileColumns);
             EXPECT_EQ(a.orientationGrid, b.orientationGrid);
             EXPECT_EQ(a.leavesMaxLod, b.leavesMaxLod);
-            ASSERT_EQ(a.leafMaterials.size(), b.leafMaterials.size());
-            for (std::size_t m = 0; m < a.leafMaterials.size(); ++m)
+            ASSERT_EQ(a.leafImages.size(), b.leafImages.size());
+            for (std::size_t m = 0; m < a.leafImages.size(); ++m)
             {
-                EXPECT_EQ(a.leafMaterials[m].material, b.leafMaterials[m].material);
-                EXPECT_EQ(a.leafMaterials[m].alphaCutoff, b.leafMaterials[m].alphaCutoff);
+                EXPECT_EQ(a.leafImages[m].material, b.leafImages[m].material);
+                EXPECT_EQ(a.leafImages[m].alphaCutoff, b.leafImages[m].alphaCutoff);
             }
             expectTextureEqual(a.leavesColour, b.leavesColour);
             expectTextureEqual(a.leavesNormal, b.leavesNormal);
@@ -700,7 +700,7 @@ namespace TreeLod
         d.tileSize = 8;
         d.tileColumns = 4;
         d.orientationGrid = 2;
-        d.leafMaterials = {{0, 0.5f}, {1, 0.5f}};
+        d.leafImages = {{0, 0.5f}, {1, 0.5f}};
         d.leavesColour = makeTexture("c", GpuTextureFormat::RGBA8, 32, 32, 1, 1);
         d.leavesNormal = makeTexture("n", GpuTextureFormat::RGBA8, 32, 32, 1, 2);
         d.lowRes = makeTexture("l", GpuTextureFormat::RGBA8, 1, 1, 1, 3);
@@ -825,7 +825,7 @@ namespace TreeLod
         d.tileSize = 1;
         d.orientationGrid = 128; // 16384 orientations, 1 material: 32768 tiles of 1 texel
         d.tileColumns = 256;
-        d.leafMaterials = {{0, 0.5f}};
+        d.leafImages = {{0, 0.5f}};
         d.leavesColour = makeTexture("c", GpuTextureFormat::RGBA8, 256, 128, 1, 1);
         d.leavesNormal = makeTexture("n", GpuTextureFormat::RGBA8, 256, 128, 1, 2);
         d.lowRes = makeTexture("l", GpuTextureFormat::RGBA8, 1, 1, 1, 3);

@@ -223,7 +223,7 @@ namespace TreeLod
             c.data.orientationGrid = tiles.grid();
             c.data.tileSize = tiles.tileSize();
             c.data.tileColumns = tiles.tileColumns();
-            c.data.leafMaterials = tiles.materials();
+            c.data.leafImages = tiles.images();
             return c;
         }
 
@@ -852,9 +852,9 @@ namespace TreeLod
         leaves[1].centre = glm::vec3(1, 0, 0);
         const TreeModel model = quadModel(leaves, 2);
         const BillboardLeafTiles tiles(model, 32, 3);
-        ASSERT_EQ(tiles.materials().size(), 2u);
-        EXPECT_EQ(tiles.materials()[0].material, 0u);
-        EXPECT_EQ(tiles.materials()[1].material, 1u);
+        ASSERT_EQ(tiles.images().size(), 2u);
+        EXPECT_EQ(tiles.images()[0].material, 0u);
+        EXPECT_EQ(tiles.images()[1].material, 1u);
         EXPECT_EQ(tiles.tileCount(), 2u * 2u * 9u);
         EXPECT_EQ(tiles.tileColumns(), 8u);
         EXPECT_EQ(tiles.colour().width, 8 * 32);
@@ -990,5 +990,148 @@ namespace TreeLod
                 }
         }
         EXPECT_GT(float(agree) / float(total), 0.9f);
+    }
+
+    // A leaf atlas (2 x 2 leaf images) under six leaf materials with cutoffs 0.3 .. 0.7: one
+    // leaf image per (material, atlas cell), and every leaf, placed on a plane parallel to it,
+    // shows its own cell's silhouette as its material's alpha test cuts it.
+    TEST(BillboardLeafTiles, atlasCellsAndMaterialCutoffsGiveEachLeafItsOwnImage)
+    {
+        GeneratorOptions options;
+        options.preset = TreePreset::Oak;
+        options.seed = 3;
+        options.leafCount = 300;
+        options.textureSize = 128;
+        options.leafImages = 4;
+        options.leafMaterials = 6;
+        const Result<TreeModel> built = generateTree(options);
+        ASSERT_TRUE(built.ok()) << built.error().message();
+        const TreeModel& oak = built.value();
+        const BillboardLeafTiles tiles(oak, 64, 4);
+        ASSERT_EQ(tiles.images().size(), 24u);
+        EXPECT_TRUE(tiles.warnings().empty());
+        EXPECT_EQ(tiles.tileCount(), 24u * 32u);
+        for (std::size_t i = 0; i < tiles.images().size(); ++i)
+        {
+            const BillboardLeafImage& image = tiles.images()[i];
+            EXPECT_EQ(image.material, 1 + i / 4) << "image " << i;
+            EXPECT_EQ(image.alphaCutoff, oak.materials[image.material].alphaCutoff) << "image " << i;
+            EXPECT_EQ(image.uvMax - image.uvMin, glm::vec2(0.5f)) << "image " << i;
+        }
+        ASSERT_TRUE(writePng(testOut("billboard-leaves-atlas-colour.png").string(), toImage(tiles.colour())).ok());
+        std::mt19937 rng(8);
+        int agree = 0, total = 0;
+        const TextureImage& tex = oak.textures[std::size_t(oak.materials[1].texture)];
+        for (std::uint32_t i = 0; i < oak.leaves.size(); i += 3)
+        {
+            const Leaf& leaf = oak.leaves[i];
+            const std::int32_t image = tiles.imageOf(i);
+            ASSERT_GE(image, 0);
+            EXPECT_EQ(tiles.images()[std::size_t(image)].material, leaf.material);
+            EXPECT_EQ(tiles.images()[std::size_t(image)].uvMin, leaf.uvMin);
+            const Vertex* v = &oak.leafVertices[leaf.firstVertex];
+            const glm::vec3 centre = 0.25f * (v[0].position + v[1].position + v[2].position + v[3].position);
+            const float cellSize = 3.0f * glm::length(v[3].position - v[0].position);
+            const OneLeafCloud c = oneLeafCloud(tiles, i, centre, planeWithNormal(leaf.normal, centre, rng), cellSize);
+            const float cutoff = oak.materials[leaf.material].alphaCutoff;
+            for (int iy = 0; iy < 16; ++iy)
+                for (int ix = 0; ix < 16; ++ix)
+                {
+                    const float s = (ix + 0.5f) / 16.0f, t = (iy + 0.5f) / 16.0f;
+                    const glm::vec3 p = glm::mix(glm::mix(v[3].position, v[2].position, s),
+                                                 glm::mix(v[0].position, v[1].position, s), t);
+                    const glm::vec2 uv = glm::mix(glm::mix(v[3].uv, v[2].uv, s), glm::mix(v[0].uv, v[1].uv, s), t);
+                    const int tx = std::min(int(uv.x * tex.width), tex.width - 1),
+                              ty = std::min(int(uv.y * tex.height), tex.height - 1);
+                    const bool opaque = tex.rgba[(std::size_t(ty) * tex.width + tx) * 4 + 3] >= cutoff * 255.0f;
+                    agree += (shade(c, tiles, p, true).a >= LEAVES_COVERAGE_CUTOFF) == opaque;
+                    ++total;
+                }
+        }
+        EXPECT_GT(float(agree) / float(total), 0.9f);
+    }
+
+    // A lower cutoff keeps more of the leaf: the same texture under cutoffs 0.3, 0.5, 0.7 gives
+    // tiles of strictly decreasing coverage (the alpha test is baked into the coverage).
+    TEST(BillboardLeafTiles, eachMaterialsCutoffShapesItsTiles)
+    {
+        std::vector<QuadLeaf> leaves(3);
+        for (std::uint32_t k = 0; k < 3; ++k)
+        {
+            leaves[k].material = k;
+            leaves[k].centre = glm::vec3(float(k), 0, 0);
+        }
+        TreeModel model = quadModel(leaves, 3);
+        // Soft alpha: a ramp from the centre out, so the cutoff moves the edge.
+        TextureImage& tex = model.textures[0];
+        for (int y = 0; y < kTexSize; ++y)
+            for (int x = 0; x < kTexSize; ++x)
+            {
+                const float r = glm::length(glm::vec2(x + 0.5f, y + 0.5f) / float(kTexSize) - 0.5f) / 0.5f;
+                tex.rgba[(std::size_t(y) * kTexSize + x) * 4 + 3] = unitToByte(std::clamp(1.0f - r, 0.0f, 1.0f));
+            }
+        const float cutoffs[3] = {0.3f, 0.5f, 0.7f};
+        for (std::uint32_t k = 0; k < 3; ++k)
+            model.materials[k].alphaCutoff = cutoffs[k];
+        const BillboardLeafTiles tiles(model, 32, 3);
+        ASSERT_EQ(tiles.images().size(), 3u);
+        float covered[3] = {0, 0, 0};
+        const std::uint32_t straight = 4; // the centre of the 3 x 3 grid: d = n
+        for (std::uint32_t k = 0; k < 3; ++k)
+        {
+            EXPECT_EQ(tiles.images()[k].alphaCutoff, cutoffs[k]);
+            for (int y = 0; y < 32; ++y)
+                for (int x = 0; x < 32; ++x)
+                    covered[k] += tiles.sample(k * 18 + straight, glm::vec2(x + 0.5f, y + 0.5f) / 32.0f).a >=
+                                  LEAVES_COVERAGE_CUTOFF;
+        }
+        // A disc of radius 1 - cutoff (of the half edge): areas in ratio 0.49 : 0.25 : 0.09.
+        EXPECT_GT(covered[0], 1.5f * covered[1]);
+        EXPECT_GT(covered[1], 2.0f * covered[2]);
+        EXPECT_GT(covered[2], 0.0f);
+    }
+
+    // Jittered or trimmed UVs of one image stay one image; more than 64 disjoint rectangles
+    // in one material are drawn with the nearest of 64 images, and a warning names the
+    // material, how many leaves and the first.
+    TEST(BillboardLeafTiles, leafImagesGroupOverlappingRectanglesAndWarnPastTheLimit)
+    {
+        std::mt19937 rng(4);
+        std::uniform_real_distribution<float> jitter(-0.03f, 0.03f);
+        std::vector<QuadLeaf> leaves(70);
+        for (std::size_t k = 0; k < leaves.size(); ++k)
+            leaves[k].centre = glm::vec3(0.2f * float(k), 0, 0);
+        TreeModel jittered = quadModel(leaves);
+        for (std::size_t l = 0; l < jittered.leaves.size(); ++l)
+        {
+            const glm::vec2 shift(jitter(rng), jitter(rng));
+            for (std::uint32_t v = 0; v < 4; ++v)
+                jittered.leafVertices[jittered.leaves[l].firstVertex + v].uv += shift;
+            jittered.updateLeafRecord(l);
+        }
+        const BillboardLeafTiles one(jittered, 32, 3);
+        EXPECT_EQ(one.images().size(), 1u);
+        EXPECT_TRUE(one.warnings().empty());
+
+        TreeModel strips = quadModel(leaves);
+        for (std::size_t l = 0; l < strips.leaves.size(); ++l)
+        {
+            for (std::uint32_t v = 0; v < 4; ++v)
+            {
+                glm::vec2& uv = strips.leafVertices[strips.leaves[l].firstVertex + v].uv;
+                uv.x = (float(l) + uv.x) / 70.0f;
+            }
+            strips.updateLeafRecord(l);
+        }
+        const BillboardLeafTiles many(strips, 8, 1);
+        EXPECT_EQ(many.images().size(), 64u);
+        for (std::uint32_t l = 0; l < 64; ++l)
+            EXPECT_EQ(many.imageOf(l), std::int32_t(l));
+        EXPECT_EQ(many.imageOf(69), 63); // the nearest centre
+        ASSERT_EQ(many.warnings().size(), 1u);
+        const std::string& warning = many.warnings()[0];
+        EXPECT_NE(warning.find("'Leaves 0'"), std::string::npos) << warning;
+        EXPECT_NE(warning.find("6 leaves"), std::string::npos) << warning;
+        EXPECT_NE(warning.find("leaf 64"), std::string::npos) << warning;
     }
 }

@@ -11,6 +11,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 
 namespace TreeLod
@@ -18,12 +19,17 @@ namespace TreeLod
     namespace test
     {
         /// The generated oak (seed 1, 64-texel texture) with `leaves` leaves, `height` metres tall
-        /// (0: the preset's height), built once per (leaves, height); throws std::runtime_error
-        /// with the generator's message when it fails (gtest reports it as the test's failure).
-        inline const TreeModel& generatedOak(std::uint32_t leaves, float height = 0.0f)
+        /// (0: the preset's height), `images` leaf images in its texture (above 1 an atlas) and
+        /// `materials` leaf materials (GeneratorOptions), built once per combination; throws
+        /// std::runtime_error with the generator's message when it fails (gtest reports it as the
+        /// test's failure).
+        inline const TreeModel& generatedOak(std::uint32_t leaves, float height = 0.0f, std::uint32_t images = 1,
+                                             std::uint32_t materials = 1)
         {
-            static std::map<std::pair<std::uint32_t, float>, TreeModel> cache;
-            auto it = cache.find({leaves, height});
+            using Key = std::tuple<std::uint32_t, float, std::uint32_t, std::uint32_t>;
+            static std::map<Key, TreeModel> cache;
+            const Key key{leaves, height, images, materials};
+            auto it = cache.find(key);
             if (it == cache.end())
             {
                 GeneratorOptions options;
@@ -31,10 +37,12 @@ namespace TreeLod
                 options.leafCount = leaves;
                 options.height = height;
                 options.textureSize = 64;
+                options.leafImages = images;
+                options.leafMaterials = materials;
                 Result<TreeModel> m = generateTree(options);
                 if (!m)
                     throw std::runtime_error(m.error().message());
-                it = cache.emplace(std::make_pair(leaves, height), std::move(m).value()).first;
+                it = cache.emplace(key, std::move(m).value()).first;
             }
             return it->second;
         }

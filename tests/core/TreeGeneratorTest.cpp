@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -120,6 +121,109 @@ TEST(TreeGenerator, rejectsBadTextureSizeAndHeight)
     Result<TreeModel> model = generateTree(options);
     ASSERT_FALSE(model.ok());
     EXPECT_NE(model.error().element.find("--height"), std::string::npos);
+}
+
+// An atlas of 2 x 2 leaf images: every leaf maps exactly one cell, each image is used, the
+// cells hold different leaves; the branches and leaf positions are those of the plain tree.
+TEST(TreeGenerator, leafImagesMakeAnAtlasAndEveryLeafMapsOneCell)
+{
+    GeneratorOptions options;
+    options.leafCount = 800;
+    options.textureSize = 64;
+    const Result<TreeModel> plain = generateTree(options);
+    options.leafImages = 4;
+    const Result<TreeModel> atlas = generateTree(options);
+    ASSERT_TRUE(plain.ok() && atlas.ok());
+    EXPECT_TRUE(sameVertices(plain->barkVertices, atlas->barkVertices));
+    ASSERT_EQ(atlas->leaves.size(), plain->leaves.size());
+    const TextureImage& texture = atlas->textures[std::size_t(atlas->materials[1].texture)];
+    ASSERT_EQ(texture.width, 64);
+    std::size_t perCell[4] = {0, 0, 0, 0};
+    for (std::size_t l = 0; l < atlas->leaves.size(); ++l)
+    {
+        const Leaf& leaf = atlas->leaves[l];
+        const glm::vec2 cell = glm::floor(2.0f * (0.5f * (leaf.uvMin + leaf.uvMax)));
+        ASSERT_EQ(leaf.uvMax - leaf.uvMin, glm::vec2(0.5f)) << "leaf " << l;
+        ASSERT_EQ(leaf.uvMin, 0.5f * cell) << "leaf " << l;
+        ++perCell[std::size_t(cell.x + 2.0f * cell.y)];
+        EXPECT_EQ(leaf.centre, plain->leaves[l].centre);
+    }
+    for (std::size_t c = 0; c < 4; ++c)
+        EXPECT_GT(perCell[c], 150u) << "cell " << c;
+    // The cells' opaque texel counts differ (oak, birch, shrub and conifer leaves).
+    std::size_t opaque[4] = {0, 0, 0, 0};
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x)
+            opaque[(x / 32) + 2 * (y / 32)] += texture.rgba[(std::size_t(y) * 64 + std::size_t(x)) * 4 + 3] >= 128;
+    for (std::size_t a = 0; a < 4; ++a)
+    {
+        EXPECT_GT(opaque[a], 50u) << "cell " << a;
+        for (std::size_t b = a + 1; b < 4; ++b)
+            EXPECT_NE(opaque[a], opaque[b]) << "cells " << a << ", " << b;
+    }
+}
+
+// Several leaf materials: leaves dealt in turn, each material its own tint and cutoff, and the
+// .glb keeps them apart (alpha mode MASK, cutoff, factor).
+TEST(TreeGenerator, leafMaterialsDealLeavesAndRoundTrip)
+{
+    GeneratorOptions options;
+    options.leafCount = 600;
+    options.textureSize = 32;
+    options.leafMaterials = 6;
+    const Result<TreeModel> model = generateTree(options);
+    ASSERT_TRUE(model.ok()) << model.error().message();
+    ASSERT_EQ(model->materials.size(), 7u);
+    std::size_t count[7] = {0, 0, 0, 0, 0, 0, 0};
+    for (const Leaf& leaf : model->leaves)
+        ++count[leaf.material];
+    EXPECT_EQ(count[0], 0u);
+    for (std::size_t m = 1; m < 7; ++m)
+    {
+        EXPECT_EQ(count[m], 100u) << model->materials[m].name;
+        EXPECT_TRUE(model->materials[m].isLeaf);
+        for (std::size_t n = 1; n < m; ++n)
+            EXPECT_NE(model->materials[m].baseColour, model->materials[n].baseColour);
+    }
+    EXPECT_EQ(model->materials[1].name, "Leaves");
+    EXPECT_EQ(model->materials[1].alphaCutoff, 0.5f);
+    EXPECT_FLOAT_EQ(model->materials[2].alphaCutoff, 0.45f);
+    const std::filesystem::path path = testOut("generator-materials.glb");
+    ASSERT_TRUE(writeGlb(model.value(), path.string()).ok());
+    Result<TreeModel> back = importGltf(path.string());
+    ASSERT_TRUE(back.ok()) << back.error().message();
+    std::size_t leafMaterials = 0;
+    for (const Material& m : back->materials)
+        if (m.isLeaf)
+        {
+            ++leafMaterials;
+            const auto same = std::find_if(model->materials.begin(), model->materials.end(),
+                                           [&](const Material& o) { return o.name == m.name; });
+            ASSERT_NE(same, model->materials.end()) << m.name;
+            EXPECT_FLOAT_EQ(m.alphaCutoff, same->alphaCutoff) << m.name;
+            EXPECT_EQ(m.baseColour, same->baseColour) << m.name;
+        }
+    EXPECT_EQ(leafMaterials, 6u);
+}
+
+TEST(TreeGenerator, rejectsLeafImagesAndMaterialsOutOfRange)
+{
+    for (std::uint32_t images : {0u, 5u})
+    {
+        GeneratorOptions options;
+        options.leafImages = images;
+        Result<TreeModel> model = generateTree(options);
+        ASSERT_FALSE(model.ok());
+        EXPECT_EQ(model.error().element, "option --leaf-images");
+    }
+    for (std::uint32_t materials : {0u, 17u})
+    {
+        GeneratorOptions options;
+        options.leafMaterials = materials;
+        Result<TreeModel> model = generateTree(options);
+        ASSERT_FALSE(model.ok());
+        EXPECT_EQ(model.error().element, "option --leaf-materials");
+    }
 }
 
 // "broadleaf" is another name for the oak preset; unknown names are refused.

@@ -105,7 +105,7 @@ namespace TreeLod
                            std::to_string(model.barkVertices.size())));
         if (data->classic != classic)
             mAsset.raise(fail(mAsset.getName(), chunkElement(chunk, 0), classic ? "not a classic cloud" : "a classic cloud"));
-        for (const BillboardLeafMaterial& m : data->leafMaterials)
+        for (const BillboardLeafImage& m : data->leafImages)
             if (m.material >= model.materials.size())
                 mAsset.raise(fail(mAsset.getName(), chunkElement(chunk, 0),
                            "leaf material " + std::to_string(m.material) + " is not a material of the reference"));
@@ -260,9 +260,6 @@ namespace TreeLod
         const int tileSize = int(std::max<std::uint32_t>(data.tileSize, 1));
         const int columns = int(std::max<std::uint32_t>(data.tileColumns, 1));
         const int rows = std::max(1, int(data.leavesColour.height) / tileSize);
-        float cutoffs[4] = {0.5f, 0.5f, 0.5f, 0.5f};
-        for (std::size_t m = 0; m < data.leafMaterials.size() && m < 4; ++m)
-            cutoffs[m] = data.leafMaterials[m].alphaCutoff;
 
         auto configure = [&](const Ogre::MaterialPtr& material) {
             material->load();
@@ -282,7 +279,6 @@ namespace TreeLod
                     p->setNamedConstant("tileRows", rows);
                     p->setNamedConstant("orientationCount", int(std::max<std::uint32_t>(data.orientationCount(), 1)));
                     p->setNamedConstant("leavesMaxLod", float(data.leavesMaxLod));
-                    p->setNamedConstant("alphaCutoffs", Ogre::Vector4(cutoffs[0], cutoffs[1], cutoffs[2], cutoffs[3]));
                 }
         };
         auto clone = [&](const Ogre::String& base, const Ogre::String& name) {

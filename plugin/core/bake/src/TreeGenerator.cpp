@@ -809,6 +809,64 @@ namespace TreeLod
                 }
             }
         }
+        /// GeneratorOptions::leafImages: a 2 x 2 atlas of leaf images (this preset's first) and
+        /// each leaf's UVs moved into one cell. Images of other presets are stretched to this
+        /// preset's leaf aspect, as atlas leaves on a shared quad shape are.
+        TextureImage buildLeafAtlas(TreePreset preset, int size, std::uint32_t images, std::uint32_t seed,
+                                    TreeModel& model)
+        {
+            TextureImage atlas;
+            atlas.width = atlas.height = size;
+            atlas.rgba.assign(std::size_t(size) * std::size_t(size) * 4, 0);
+            const int cell = size / 2;
+            std::vector<TreePreset> order{preset};
+            for (TreePreset p : {TreePreset::Oak, TreePreset::Birch, TreePreset::Shrub, TreePreset::Conifer})
+                if (p != preset)
+                    order.push_back(p);
+            for (std::uint32_t i = 0; i < images; ++i)
+            {
+                const TextureImage image = drawLeafTexture(order[i], cell);
+                const int ox = int(i % 2) * cell, oy = int(i / 2) * cell;
+                for (int y = 0; y < cell; ++y)
+                    std::copy_n(&image.rgba[std::size_t(y) * std::size_t(cell) * 4], std::size_t(cell) * 4,
+                                &atlas.rgba[(std::size_t(oy + y) * std::size_t(size) + std::size_t(ox)) * 4]);
+            }
+            Random rnd(mixSeed(seed, 0xa71a5u));
+            for (std::size_t l = 0; l < model.leaves.size(); ++l)
+            {
+                const std::uint32_t i = std::min(std::uint32_t(rnd.unit() * float(images)), images - 1);
+                const glm::vec2 origin(float(i % 2), float(i / 2));
+                const Leaf& leaf = model.leaves[l];
+                for (std::uint32_t v = leaf.firstVertex; v < leaf.firstVertex + leaf.vertexCount; ++v)
+                    model.leafVertices[v].uv = 0.5f * (origin + model.leafVertices[v].uv);
+                model.updateLeafRecord(l);
+            }
+            return atlas;
+        }
+
+        /// GeneratorOptions::leafMaterials: copies of `leaf` with their own tint and cutoff,
+        /// leaves dealt to them in turn.
+        void splitLeafMaterials(const Material& leaf, const glm::vec3& meanColour, std::uint32_t count,
+                                TreeModel& model)
+        {
+            static const glm::vec3 kTints[] = {{1.0f, 1.0f, 1.0f},   {1.0f, 0.72f, 0.42f}, {0.78f, 1.0f, 0.8f},
+                                               {1.0f, 0.5f, 0.3f},   {0.92f, 0.95f, 0.55f}, {0.6f, 0.8f, 0.6f},
+                                               {1.0f, 0.85f, 0.25f}, {0.7f, 0.62f, 0.5f}};
+            const std::uint32_t first = std::uint32_t(model.materials.size());
+            for (std::uint32_t m = 0; m < count; ++m)
+            {
+                Material material = leaf;
+                const glm::vec3 tint = kTints[m % 8] * (m < 8 ? 1.0f : 0.8f);
+                material.name = m == 0 ? leaf.name : leaf.name + " " + std::to_string(m + 1);
+                material.baseColour = glm::vec4(tint, 1.0f);
+                material.backColour = glm::clamp(meanColour * tint * glm::vec3(1.9f, 1.5f, 0.8f), glm::vec3(0.0f),
+                                                 glm::vec3(1.0f));
+                material.alphaCutoff = m == 0 ? 0.5f : 0.3f + 0.05f * float((m * 3) % 9);
+                model.materials.push_back(material);
+            }
+            for (std::size_t l = 0; l < model.leaves.size(); ++l)
+                model.leaves[l].material = first + std::uint32_t(l % count);
+        }
     }
 
     std::uint32_t presetDefaultLeafCount(TreePreset preset) { return presetParams(preset).leaves; }
@@ -832,6 +890,13 @@ namespace TreeLod
         if (ts < 16 || ts > 4096 || (ts & (ts - 1)) != 0)
             return fail("", "option --texture-size",
                         "texture size " + std::to_string(ts) + " is not a power of two in 16..4096");
+
+        if (options.leafImages < 1 || options.leafImages > 4)
+            return fail("", "option --leaf-images",
+                        std::to_string(options.leafImages) + " leaf images; 1..4 are drawn");
+        if (options.leafMaterials < 1 || options.leafMaterials > 16)
+            return fail("", "option --leaf-materials",
+                        std::to_string(options.leafMaterials) + " leaf materials; 1..16 are made");
 
         TreeModel model;
         model.name = std::string(presetName(options.preset)) + " seed " + std::to_string(options.seed);
@@ -858,8 +923,10 @@ namespace TreeLod
         const std::string name = presetName(options.preset);
         TextureImage bark = drawBarkTexture(options.preset, std::max(16, ts / 2), std::max(16, ts / 2));
         bark.name = name + "_bark.png";
-        TextureImage leafTexture = drawLeafTexture(options.preset, ts);
-        leafTexture.name = name + "_leaf.png";
+        TextureImage leafTexture = options.leafImages > 1
+                                       ? buildLeafAtlas(options.preset, ts, options.leafImages, options.seed, model)
+                                       : drawLeafTexture(options.preset, ts);
+        leafTexture.name = name + (options.leafImages > 1 ? "_leaf_atlas.png" : "_leaf.png");
 
         Material barkMaterial;
         barkMaterial.name = "Bark";
@@ -877,7 +944,10 @@ namespace TreeLod
         model.textures.push_back(std::move(bark));
         model.textures.push_back(std::move(leafTexture));
         model.materials.push_back(barkMaterial);
-        model.materials.push_back(leafMaterial);
+        if (options.leafMaterials > 1)
+            splitLeafMaterials(leafMaterial, mean, options.leafMaterials, model);
+        else
+            model.materials.push_back(leafMaterial);
         model.updateBounds();
         report(progress, "draw textures", 1.0f);
         return model;

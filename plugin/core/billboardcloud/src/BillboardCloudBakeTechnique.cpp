@@ -18,8 +18,9 @@ namespace TreeLod
             Result<double> listFactor =
                 bakeOptionNumber(given, technique, "listFactor", options.listFactor, 0.0, 64.0, label);
             Result<double> aoRays = bakeOptionNumber(given, technique, "aoRays", options.aoRays, 0, 4096, label);
+            Result<double> tileSize = bakeOptionNumber(given, technique, "tileSize", options.tileSize, 8, 1024, label);
             Result<bool> compress = bakeOptionFlag(given, technique, "compress", options.compress, label);
-            for (const Result<double>* r : {&billboards, &listFactor, &aoRays})
+            for (const Result<double>* r : {&billboards, &listFactor, &aoRays, &tileSize})
                 if (!*r)
                     return r->error();
             if (!compress)
@@ -27,6 +28,7 @@ namespace TreeLod
             options.billboardCount = std::uint32_t(billboards.value());
             options.listFactor = float(listFactor.value());
             options.aoRays = int(aoRays.value());
+            options.tileSize = std::uint32_t(tileSize.value()); // a power of two: checked by the baker
             options.compress = compress.value();
             return {};
         }
@@ -54,6 +56,7 @@ namespace TreeLod
             return {{"billboardCount", "billboards of the finest cloud, 0 (from the leaf count) to 65535", "0"},
                     {"listFactor", "shader LoD: list entries per pixel of projected cell diagonal, 0 to 64", "4"},
                     {"aoRays", "ambient occlusion rays per leaf vertex, 0 to 4096", "32"},
+                    {"tileSize", "Leaves Texture tile edge in texels, a power of two in 8..1024", "64"},
                     {"compress", "DXT-compressed textures (true) or RGBA8 (false)", "true"}};
         }
 

@@ -110,7 +110,7 @@ namespace TreeLod
             /// Per side-0 tile (index = orientation field): tile-local texel centres - 0.5 of the
             /// texels with coverage > 0 on either view side.
             std::vector<std::vector<glm::vec2>> coverage;
-            std::vector<float> tileCutoff; ///< per tile: its material's alpha cutoff
+            float cellSize = 0.0f;  ///< metres per hash cell of the layered levels
 
             BakeContext(const TreeModel& m, const BillboardCloudOptions& o, const std::string& l,
                         const ProgressCallback& p)
@@ -144,6 +144,55 @@ namespace TreeLod
         }
 
         // ---- context: AO (§5.2), Leaves Texture (§3, §5), leaf sizes ----------------------------
+
+        /// Hash cell edge: cellLeafRatio median leaf lengths, grown until the largest tile fits the
+        /// entry's scale code (BillboardCloudData.h: at most 2^(127/32) cells), so no leaf is
+        /// drawn smaller than it is. Tiles below the code's smallest side (2^-4 cells) are drawn
+        /// at that side: a warning names how many and the first.
+        void chooseCellSize(BakeContext& ctx)
+        {
+            const BillboardLeafTiles& tiles = *ctx.tiles;
+            const float largestCode = BillboardListEntry::encode(0, 0, 0, false, 0, 1e30f).side();
+            const float smallestCode = BillboardListEntry::encode(0, 0, 0, false, 0, 1e-30f).side();
+            ctx.cellSize = ctx.options.cellLeafRatio * ctx.leafLength;
+            std::uint32_t largest = 0;
+            float largestSide = 0.0f;
+            for (std::uint32_t l = 0; l < ctx.model.leaves.size(); ++l)
+                if (const float side = tiles.sideRange(l).y; side > largestSide)
+                {
+                    largestSide = side;
+                    largest = l;
+                }
+            // 0.99: the code rounds to the nearest step, which must not round above the range.
+            if (largestSide > 0.99f * largestCode * ctx.cellSize)
+            {
+                const float grown = largestSide / (0.99f * largestCode);
+                report(ctx.progress,
+                       "warning: " + ctx.label + ": leaf " + std::to_string(largest) + " (material '" +
+                           ctx.model.materials[ctx.model.leaves[largest].material].name + "') is " +
+                           std::to_string(int(std::lround(largestSide / ctx.leafLength))) +
+                           " median leaf lengths across; hash cells grow " +
+                           std::to_string(grown / ctx.cellSize) + "x to hold its tile, so lists are longer",
+                       1.0f);
+                ctx.cellSize = grown;
+            }
+            std::uint32_t enlarged = 0, first = 0;
+            for (std::uint32_t l = 0; l < ctx.model.leaves.size(); ++l)
+            {
+                const float side = tiles.sideRange(l).x;
+                if (tiles.imageOf(l) >= 0 && side < smallestCode * ctx.cellSize)
+                    if (enlarged++ == 0)
+                        first = l;
+            }
+            if (enlarged > 0)
+                report(ctx.progress,
+                       "warning: " + ctx.label + ": " + std::to_string(enlarged) + " leaves (the first is leaf " +
+                           std::to_string(first) + ", material '" +
+                           ctx.model.materials[ctx.model.leaves[first].material].name + "') are under " +
+                           std::to_string(smallestCode * ctx.cellSize / ctx.leafLength) +
+                           " median leaf lengths and are drawn at that size",
+                       1.0f);
+        }
 
         Result<void> prepare(BakeContext& ctx)
         {
@@ -230,9 +279,9 @@ namespace TreeLod
             const std::uint32_t T = tiles.tileSize(), columns = tiles.tileColumns();
             const TextureImage& colour = tiles.colour();
             ctx.coverage.assign(tiles.tileCount(), {});
-            ctx.tileCutoff.assign(tiles.tileCount(), 0.5f);
-            for (std::uint32_t t = 0; t < tiles.tileCount(); ++t)
-                ctx.tileCutoff[t] = tiles.materials()[t / (2 * oc)].alphaCutoff;
+            for (const std::string& warning : tiles.warnings())
+                report(ctx.progress, "warning: " + ctx.label + ": " + warning, 1.0f);
+            chooseCellSize(ctx);
             tbb::parallel_for(std::uint32_t(0), tiles.tileCount(), [&](std::uint32_t t) {
                 if (t % (2 * oc) >= oc)
                     return; // side 1: merged into its side-0 tile
@@ -492,7 +541,7 @@ namespace TreeLod
             const std::uint32_t oc = ctx.orientationCount;
             struct Decoded
             {
-                float cx, cy, c, s, inverseSide, cutoff;
+                float cx, cy, c, s, inverseSide;
                 std::uint32_t tile;
                 bool mirror;
             };
@@ -508,7 +557,6 @@ namespace TreeLod
                 d.inverseSide = 1.0f / entry.side();
                 d.mirror = entry.mirrored();
                 d.tile = entry.orientation() + (d.mirror ? oc : 0u); // view side 0 XOR m
-                d.cutoff = ctx.tileCutoff[std::min<std::size_t>(d.tile, ctx.tileCutoff.size() - 1)];
             }
             const std::size_t texels = std::size_t(w) * h;
             std::vector<glm::vec3> albedo(texels, glm::vec3(0.0f));
@@ -537,7 +585,7 @@ namespace TreeLod
                                 if (!(local.x >= 0.0f && local.x <= 1.0f && local.y >= 0.0f && local.y <= 1.0f))
                                     continue;
                                 const glm::vec4 sample = tiles.sample(d.tile, local);
-                                if (sample.a < d.cutoff)
+                                if (sample.a < LEAVES_COVERAGE_CUTOFF)
                                     continue;
                                 const std::array<std::uint8_t, 4>& a = bb.entryAo[e];
                                 const float top = float(a[0]) + (float(a[1]) - float(a[0])) * local.x;
@@ -833,7 +881,7 @@ namespace TreeLod
         {
             LevelBuild level;
             level.layered = layered;
-            level.cellSize = ctx.options.cellLeafRatio * ctx.leafLength;
+            level.cellSize = ctx.cellSize;
             LeafClusteringOptions co;
             co.clusterCount = count;
             co.errorBound = ctx.options.maxPlaneError * ctx.diagonal;
@@ -1129,13 +1177,11 @@ namespace TreeLod
             data.tileSize = tiles.tileSize();
             data.tileColumns = tiles.tileColumns();
             data.orientationGrid = tiles.grid();
-            data.leafMaterials = tiles.materials();
+            data.leafImages = tiles.images();
             data.leavesMaxLod = tiles.maxLod();
             MipChainOptions mips;
             mips.preserveAlphaCoverage = true;
-            mips.alphaCutoff = data.leafMaterials.empty() ? 0.5f : data.leafMaterials[0].alphaCutoff;
-            if (!(mips.alphaCutoff > 0.0f && mips.alphaCutoff <= 1.0f))
-                mips.preserveAlphaCoverage = false;
+            mips.alphaCutoff = LEAVES_COVERAGE_CUTOFF;
             data.leavesColour = buildMipChain(tiles.colour(), mips);
             data.leavesNormal = normalMipChain(tiles.normal());
             data.leavesMaxLod = std::min(data.leavesMaxLod, data.leavesColour.mipCount - 1);

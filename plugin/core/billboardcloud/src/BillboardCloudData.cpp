@@ -22,7 +22,7 @@ namespace TreeLod
         constexpr std::size_t BILLBOARD_BYTES = 80;
         constexpr std::size_t ENTRY_BYTES = 8;   ///< u16 x 4 in the Lists atlas
         constexpr std::size_t ENTRY_AO_BYTES = 4; ///< RGBA8 in the AO atlas
-        constexpr std::size_t LEAF_MATERIAL_BYTES = 8;
+        constexpr std::size_t LEAF_IMAGE_BYTES = 24;
         constexpr std::uint32_t FLAG_CLASSIC = 1u;
         constexpr std::uint32_t MAX_TILES = 1u << 15; ///< orientation field of an entry: 15 bits
         constexpr double TWO_PI = 6.283185307179586;
@@ -198,8 +198,8 @@ namespace TreeLod
 
         // Leaves Texture (§3, §5).
         const std::uint64_t orientations = std::uint64_t(orientationGrid) * orientationGrid;
-        const std::uint64_t tiles = leafMaterials.size() * 2 * orientations;
-        if (!leafMaterials.empty())
+        const std::uint64_t tiles = leafImages.size() * 2 * orientations;
+        if (!leafImages.empty())
         {
             const std::string element = name + " leaves";
             if (tileSize == 0 || (tileSize & (tileSize - 1)) != 0)
@@ -216,18 +216,21 @@ namespace TreeLod
                                                 std::to_string(leavesColour.height) + " leaves texture");
             if (leavesNormal.width != leavesColour.width || leavesNormal.height != leavesColour.height)
                 return fail(label, element, "normal and colour textures differ in size");
-            for (std::size_t m = 0; m < leafMaterials.size(); ++m)
-                if (!finite(leafMaterials[m].alphaCutoff) || leafMaterials[m].alphaCutoff < 0.0f ||
-                    leafMaterials[m].alphaCutoff > 1.0f)
-                    return fail(label, name + " leaf material " + std::to_string(m),
-                                "alpha cutoff " + std::to_string(leafMaterials[m].alphaCutoff) + " outside [0, 1]");
+            for (std::size_t m = 0; m < leafImages.size(); ++m)
+                if (!finite(leafImages[m].alphaCutoff) || leafImages[m].alphaCutoff < 0.0f ||
+                    leafImages[m].alphaCutoff > 1.0f)
+                    return fail(label, name + " leaf image " + std::to_string(m),
+                                "alpha cutoff " + std::to_string(leafImages[m].alphaCutoff) + " outside [0, 1]");
+                else if (!finite(leafImages[m].uvMin.x + leafImages[m].uvMin.y + leafImages[m].uvMax.x +
+                                 leafImages[m].uvMax.y))
+                    return fail(label, name + " leaf image " + std::to_string(m), "UV rectangle is not finite");
         }
         if (leavesMaxLod >= leavesColour.mipCount || leavesMaxLod >= leavesNormal.mipCount)
             return fail(label, name + " leaves", "max LoD " + std::to_string(leavesMaxLod) + ", the textures have " +
                                                      std::to_string(leavesColour.mipCount) + " and " +
                                                      std::to_string(leavesNormal.mipCount) + " mip levels");
 
-        // Entries: side-0 tiles of an existing material block (§5).
+        // Entries: side-0 tiles of an existing leaf image (§5).
         for (std::size_t e = 0; e < entries.size(); ++e)
         {
             const std::uint32_t k = entries[e].orientation();
@@ -352,7 +355,7 @@ namespace TreeLod
         ByteWriter w;
         w.reserve(256 + data.levels.size() * LEVEL_BYTES + data.billboards.size() * BILLBOARD_BYTES +
                   data.hashAtlas.size() + data.entries.size() * ENTRY_BYTES + data.entryAo.size() +
-                  data.leafMaterials.size() * LEAF_MATERIAL_BYTES + data.leavesColour.data.size() +
+                  data.leafImages.size() * LEAF_IMAGE_BYTES + data.leavesColour.data.size() +
                   data.leavesNormal.data.size() + data.lowRes.data.size() + data.barkAo.size() + 4 * 64);
         w.u32(data.classic ? FLAG_CLASSIC : 0u);
         w.f32(data.listFactor);
@@ -400,12 +403,14 @@ namespace TreeLod
         w.u32(data.tileSize);
         w.u32(data.tileColumns);
         w.u32(data.orientationGrid);
-        w.u32(std::uint32_t(data.leafMaterials.size()));
+        w.u32(std::uint32_t(data.leafImages.size()));
         w.u32(data.leavesMaxLod);
-        for (const BillboardLeafMaterial& m : data.leafMaterials)
+        for (const BillboardLeafImage& m : data.leafImages)
         {
             w.u32(m.material);
             w.f32(m.alphaCutoff);
+            for (float f : {m.uvMin.x, m.uvMin.y, m.uvMax.x, m.uvMax.y})
+                w.f32(f);
         }
         writeGpuTexture(w, data.leavesColour);
         writeGpuTexture(w, data.leavesNormal);
@@ -502,13 +507,15 @@ namespace TreeLod
         data.tileSize = r.u32();
         data.tileColumns = r.u32();
         data.orientationGrid = r.u32();
-        const std::uint32_t materialCount = r.ok() ? r.count(LEAF_MATERIAL_BYTES) : 0;
+        const std::uint32_t imageCount = r.ok() ? r.count(LEAF_IMAGE_BYTES) : 0;
         data.leavesMaxLod = r.u32();
-        data.leafMaterials.resize(materialCount);
-        for (BillboardLeafMaterial& m : data.leafMaterials)
+        data.leafImages.resize(imageCount);
+        for (BillboardLeafImage& m : data.leafImages)
         {
             m.material = r.u32();
             m.alphaCutoff = r.f32();
+            for (float* f : {&m.uvMin.x, &m.uvMin.y, &m.uvMax.x, &m.uvMax.y})
+                *f = r.f32();
         }
         if (!r.ok() || !readGpuTexture(r, name + ", leaves colour texture", data.leavesColour) ||
             !readGpuTexture(r, name + ", leaves normal texture", data.leavesNormal) ||

@@ -149,6 +149,108 @@ namespace TreeLod
             return fit;
         }
 
+        constexpr std::uint32_t NO_IMAGE = ~0u;
+        /// Leaf images a material may have; the leaves of further UV rectangles are drawn with
+        /// the nearest of them, and a warning says so.
+        constexpr std::size_t MAX_IMAGES_PER_MATERIAL = 64;
+        /// A leaf belongs to an image when its UV rectangle overlaps the image's first one by at
+        /// least this intersection over union (atlas cells do not overlap; one image's jittered
+        /// or trimmed UVs do).
+        constexpr float SAME_IMAGE_IOU = 0.5f;
+
+        float rectIou(const glm::vec4& a, const glm::vec4& b)
+        {
+            const float pad = 1.0f / 4096.0f; // degenerate rectangles compare by position
+            const glm::vec2 aMin = glm::vec2(a.x, a.y) - pad, aMax = glm::vec2(a.z, a.w) + pad;
+            const glm::vec2 bMin = glm::vec2(b.x, b.y) - pad, bMax = glm::vec2(b.z, b.w) + pad;
+            const glm::vec2 i = glm::max(glm::min(aMax, bMax) - glm::max(aMin, bMin), glm::vec2(0.0f));
+            const float inter = i.x * i.y;
+            const glm::vec2 sa = aMax - aMin, sb = bMax - bMin;
+            const float uni = sa.x * sa.y + sb.x * sb.y - inter;
+            return uni > 0.0f ? inter / uni : 0.0f;
+        }
+
+        /// The leaf images (BillboardCloudData.h, "Leaves Texture"): per material some leaf uses,
+        /// in increasing material index, a leaf joins the image whose first UV rectangle overlaps
+        /// its own most when the IoU is at least SAME_IMAGE_IOU, else starts an image; an image's
+        /// rectangle is the union of its leaves'. Returns each leaf's image (NO_IMAGE for a leaf
+        /// of a material index out of range).
+        std::vector<std::uint32_t> groupLeafImages(const TreeModel& model, std::vector<BillboardLeafImage>& images,
+                                                   std::vector<std::string>& warnings)
+        {
+            std::vector<std::uint32_t> out(model.leaves.size(), NO_IMAGE);
+            std::vector<std::vector<std::uint32_t>> byMaterial(model.materials.size());
+            for (std::size_t l = 0; l < model.leaves.size(); ++l)
+                if (model.leaves[l].material < byMaterial.size())
+                    byMaterial[model.leaves[l].material].push_back(std::uint32_t(l));
+            for (std::size_t m = 0; m < byMaterial.size(); ++m)
+            {
+                if (byMaterial[m].empty())
+                    continue;
+                const std::size_t first = images.size();
+                std::vector<glm::vec4> keys; // each image's first rectangle
+                std::size_t merged = 0;
+                std::uint32_t firstMerged = 0;
+                for (std::uint32_t l : byMaterial[m])
+                {
+                    const Leaf& leaf = model.leaves[l];
+                    glm::vec4 r(leaf.uvMin, leaf.uvMax);
+                    if (!std::isfinite(r.x + r.y + r.z + r.w) || r.x > r.z || r.y > r.w)
+                        r = glm::vec4(0.0f);
+                    std::size_t best = keys.size();
+                    float bestIou = 0.0f;
+                    for (std::size_t i = 0; i < keys.size(); ++i)
+                        if (const float iou = rectIou(r, keys[i]); iou > bestIou)
+                        {
+                            bestIou = iou;
+                            best = i;
+                        }
+                    if (bestIou < SAME_IMAGE_IOU && keys.size() < MAX_IMAGES_PER_MATERIAL)
+                    {
+                        best = keys.size();
+                        keys.push_back(r);
+                        BillboardLeafImage image;
+                        image.material = std::uint32_t(m);
+                        image.alphaCutoff = model.materials[m].alphaCutoff;
+                        image.uvMin = glm::vec2(r.x, r.y);
+                        image.uvMax = glm::vec2(r.z, r.w);
+                        images.push_back(image);
+                    }
+                    else if (bestIou < SAME_IMAGE_IOU)
+                    {
+                        if (merged++ == 0)
+                            firstMerged = l;
+                        if (best == keys.size()) // no overlap at all: the nearest centre
+                        {
+                            float nearest = INFINITY;
+                            const glm::vec2 c(0.5f * (r.x + r.z), 0.5f * (r.y + r.w));
+                            for (std::size_t i = 0; i < keys.size(); ++i)
+                            {
+                                const glm::vec2 k(0.5f * (keys[i].x + keys[i].z), 0.5f * (keys[i].y + keys[i].w));
+                                if (const float d = glm::length(c - k); d < nearest)
+                                {
+                                    nearest = d;
+                                    best = i;
+                                }
+                            }
+                        }
+                    }
+                    BillboardLeafImage& image = images[first + best];
+                    image.uvMin = glm::min(image.uvMin, glm::vec2(r.x, r.y));
+                    image.uvMax = glm::max(image.uvMax, glm::vec2(r.z, r.w));
+                    out[l] = std::uint32_t(first + best);
+                }
+                if (merged > 0)
+                    warnings.push_back("leaf material '" + model.materials[m].name + "': its leaves map more than " +
+                                       std::to_string(MAX_IMAGES_PER_MATERIAL) +
+                                       " different texture rectangles; " + std::to_string(merged) +
+                                       " leaves (the first is leaf " + std::to_string(firstMerged) +
+                                       ") are drawn with the nearest of " +
+                                       std::to_string(MAX_IMAGES_PER_MATERIAL) + " leaf images");
+            }
+            return out;
+        }
+
         /// The tile frame of direction d (unit, d.z >= 0), in leaf-frame coordinates.
         glm::mat3 tileAxes(const glm::vec3& d)
         {
@@ -171,23 +273,16 @@ namespace TreeLod
     {
         const std::uint32_t orientationCount = mGrid * mGrid;
 
-        // Blocks: every material some leaf uses, in increasing material index.
-        mMaterialBlock.assign(model.materials.size(), -1);
-        std::vector<char> used(model.materials.size(), 0);
-        for (const Leaf& leaf : model.leaves)
-            if (leaf.material < used.size())
-                used[leaf.material] = 1;
-        for (std::size_t m = 0; m < used.size(); ++m)
-            if (used[m])
-            {
-                mMaterialBlock[m] = std::int32_t(mMaterials.size());
-                mMaterials.push_back({std::uint32_t(m), model.materials[m].alphaCutoff});
-            }
-        const std::size_t blocks = mMaterials.size();
+        // Leaf images (blocks): per material some leaf uses, in increasing material index, the
+        // UV rectangles its leaves map, grouped (leafImageGroups).
+        const std::vector<std::uint32_t> groups = groupLeafImages(model, mImages, mWarnings);
+        mLeafBlock.assign(model.leaves.size(), -1);
+        for (std::size_t l = 0; l < model.leaves.size(); ++l)
+            mLeafBlock[l] = groups[l] == NO_IMAGE ? -1 : std::int32_t(groups[l]);
+        const std::size_t blocks = mImages.size();
 
         // Leaf frames (header: w, t fitted to dP/du and -dP/dv, orthonormalised around n).
         std::vector<UvFit> fits(model.leaves.size());
-        std::vector<glm::vec2> uvMin(blocks, glm::vec2(1e30f)), uvMax(blocks, glm::vec2(-1e30f));
         mFrames.resize(model.leaves.size());
         for (std::size_t l = 0; l < model.leaves.size(); ++l)
         {
@@ -221,12 +316,6 @@ namespace TreeLod
             f.w = glm::normalize(glm::cross(t, n));
             f.t = t;
             f.n = n;
-            const std::int32_t block = leaf.material < mMaterialBlock.size() ? mMaterialBlock[leaf.material] : -1;
-            if (block >= 0)
-            {
-                uvMin[std::size_t(block)] = glm::min(uvMin[std::size_t(block)], leaf.uvMin);
-                uvMax[std::size_t(block)] = glm::max(uvMax[std::size_t(block)], leaf.uvMax);
-            }
         }
 
         // Canonical leaves: the union UV rectangle with the median aspect; per leaf its length
@@ -236,12 +325,10 @@ namespace TreeLod
         for (std::size_t l = 0; l < model.leaves.size(); ++l)
         {
             const Leaf& leaf = model.leaves[l];
-            const std::int32_t block = leaf.material < mMaterialBlock.size() ? mMaterialBlock[leaf.material] : -1;
-            const glm::vec2 size = block >= 0 ? glm::max(uvMax[std::size_t(block)] - uvMin[std::size_t(block)],
-                                                         glm::vec2(0.0f))
-                                              : glm::vec2(0.0f);
-            const glm::vec2 uvCentre =
-                block >= 0 ? 0.5f * (uvMin[std::size_t(block)] + uvMax[std::size_t(block)]) : glm::vec2(0.0f);
+            const std::int32_t block = mLeafBlock[l];
+            const BillboardLeafImage* image = block >= 0 ? &mImages[std::size_t(block)] : nullptr;
+            const glm::vec2 size = image ? glm::max(image->uvMax - image->uvMin, glm::vec2(0.0f)) : glm::vec2(0.0f);
+            const glm::vec2 uvCentre = image ? 0.5f * (image->uvMin + image->uvMax) : glm::vec2(0.0f);
             const UvFit& fit = fits[l];
             LeafFrame& f = mFrames[l];
             // Vertex extents in the leaf plane (fallback where the UV fit says nothing).
@@ -287,8 +374,7 @@ namespace TreeLod
         for (std::size_t l = 0; l < model.leaves.size(); ++l)
         {
             float length = lengthOf[l];
-            const std::int32_t block =
-                model.leaves[l].material < mMaterialBlock.size() ? mMaterialBlock[model.leaves[l].material] : -1;
+            const std::int32_t block = mLeafBlock[l];
             if (!(length > 0.0f) && block >= 0)
                 length = widthOf[l] / aspect[std::size_t(block)]; // a leaf with no extent along t
             mFrames[l].length = std::isfinite(length) ? std::max(length, 1e-6f) : 1e-6f;
@@ -346,7 +432,7 @@ namespace TreeLod
         std::vector<LinearImage> images(blocks);
         for (std::size_t b = 0; b < blocks; ++b)
         {
-            const std::int32_t tex = model.materials[mMaterials[b].material].texture;
+            const std::int32_t tex = model.materials[mImages[b].material].texture;
             if (tex < 0 || std::size_t(tex) >= model.textures.size())
                 continue;
             const TextureImage& src = model.textures[std::size_t(tex)];
@@ -366,10 +452,10 @@ namespace TreeLod
         tbb::parallel_for(std::size_t(0), blocks * orientationCount, [&](std::size_t job) {
             const std::size_t b = job / orientationCount;
             const std::uint32_t k = std::uint32_t(job % orientationCount);
-            const Material& material = model.materials[mMaterials[b].material];
+            const Material& material = model.materials[mImages[b].material];
             const LinearImage& image = images[b];
-            const glm::vec2 uv0 = uvMin[b].x <= uvMax[b].x ? uvMin[b] : glm::vec2(0.0f);
-            const glm::vec2 uvSize = uvMin[b].x <= uvMax[b].x ? uvMax[b] - uvMin[b] : glm::vec2(0.0f);
+            const glm::vec2 uv0 = mImages[b].uvMin;
+            const glm::vec2 uvSize = mImages[b].uvMax - mImages[b].uvMin;
             const float W = aspect[b];
             const glm::vec3 x = mTileAxes[k][0], y = mTileAxes[k][1], z = mTileAxes[k][2];
             const float E = mTileExtent[b * 2 * orientationCount + k];
@@ -518,7 +604,7 @@ namespace TreeLod
 
     std::uint32_t BillboardLeafTiles::tileCount() const
     {
-        return std::uint32_t(mMaterials.size()) * 2 * mGrid * mGrid;
+        return std::uint32_t(mImages.size()) * 2 * mGrid * mGrid;
     }
 
     LeafPlacement BillboardLeafTiles::place(std::uint32_t leaf, const glm::vec3& origin, const glm::vec3& U,
@@ -528,8 +614,7 @@ namespace TreeLod
         if (leaf >= mFrames.size() || mTileExtent.empty())
             return out;
         const LeafFrame& f = mFrames[leaf];
-        const std::uint32_t material = mModel.leaves[leaf].material;
-        const std::int32_t block = material < mMaterialBlock.size() ? mMaterialBlock[material] : -1;
+        const std::int32_t block = mLeafBlock[leaf];
         const std::uint32_t orientationCount = mGrid * mGrid;
 
         // The billboard normal in the leaf frame; the hemisphere d.z >= 0 holds the tiles, the
@@ -572,6 +657,21 @@ namespace TreeLod
         out.centre = glm::vec2(glm::dot(c, U), glm::dot(c, V));
         out.depth = glm::dot(c, N);
         return out;
+    }
+
+    glm::vec2 BillboardLeafTiles::sideRange(std::uint32_t leaf) const
+    {
+        const std::int32_t block = imageOf(leaf);
+        if (block < 0 || leaf >= mFrames.size())
+            return glm::vec2(0.0f);
+        const std::uint32_t orientationCount = mGrid * mGrid;
+        glm::vec2 range(INFINITY, 0.0f);
+        for (std::uint32_t k = 0; k < orientationCount; ++k)
+        {
+            const float extent = mTileExtent[std::size_t(block) * 2 * orientationCount + k];
+            range = glm::vec2(std::min(range.x, extent), std::max(range.y, extent));
+        }
+        return range * mFrames[leaf].length;
     }
 
     BillboardListEntry BillboardLeafTiles::entryFor(const LeafPlacement& placement, float cellSize, std::uint32_t i,

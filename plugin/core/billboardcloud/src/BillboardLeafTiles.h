@@ -7,12 +7,14 @@
 // the tip (decreasing texture v), both least-squares fits of dP/du and -dP/dv over the leaf's
 // vertices, orthonormalised around n = Leaf::normal (t first; w = cross(t, n) if the fit of
 // w fails; any unit vector orthogonal to n if both fail, e.g. a leaf with all UVs equal).
-// Canonical leaf of a material: its texture's full UV rectangle [uvMin, uvMax] of the
-// material's leaves (the union) on a flat rectangle in the (w, t) plane with the material's
-// median aspect (leaf width / length, from the leaves' fitted |dP/du| and |dP/dv| extents).
-// Deviation (docs/billboard-cloud.md): every leaf of a material is drawn with the canonical leaf's shape and
-// texture rectangle; non-planar leaves are drawn flat (the paper also stores one image per
-// orientation). A leaf whose texture is mirrored on it (fitted (w, t, n) left-handed) uses
+// Leaf images: a material's leaves are grouped by the UV rectangle they map (an atlas texture
+// holds several leaf images; BillboardCloudData.h, "Leaves Texture"), one tile block per image.
+// Canonical leaf of an image: its UV rectangle [uvMin, uvMax] (the union over its leaves) on a
+// flat rectangle in the (w, t) plane with the image's median aspect (leaf width / length,
+// from the leaves' fitted |dP/du| and |dP/dv| extents).
+// Deviation (docs/billboard-cloud.md): every leaf of an image is drawn with the canonical
+// leaf's shape and texture rectangle; non-planar leaves are drawn flat (the paper also stores
+// one image per orientation). A leaf whose texture is mirrored on it (fitted (w, t, n) left-handed) uses
 // the frame (w, t, -n): its image is right, but its front and back tints are swapped.
 #pragma once
 
@@ -23,6 +25,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace TreeLod
@@ -41,16 +44,23 @@ namespace TreeLod
     class BillboardLeafTiles
     {
     public:
-        /// Build the tiles of every leaf material that `model` uses (materials without leaves get
-        /// none). tileSize: power of two >= 8; grid >= 1.
+        /// Build the tiles of every leaf image that `model`'s leaves use (materials without leaves
+        /// get none). tileSize: power of two >= 8; grid >= 1.
         BillboardLeafTiles(const TreeModel& model, std::uint32_t tileSize, std::uint32_t grid);
 
         std::uint32_t tileSize() const { return mTileSize; }
         std::uint32_t grid() const { return mGrid; }
         std::uint32_t tileColumns() const { return mColumns; }
         std::uint32_t tileCount() const;
-        /// Model material indices that have tiles, in tile-block order, with their cutoffs.
-        const std::vector<BillboardLeafMaterial>& materials() const { return mMaterials; }
+        /// The leaf images in tile-block order (material, cutoff, UV rectangle).
+        const std::vector<BillboardLeafImage>& images() const { return mImages; }
+        /// The leaf image of leaf `leaf`, -1 for none (its material index is out of range).
+        std::int32_t imageOf(std::uint32_t leaf) const { return leaf < mLeafBlock.size() ? mLeafBlock[leaf] : -1; }
+        /// What the grouping could not keep apart (a material mapping more rectangles than it may
+        /// have images), for the baker to report.
+        const std::vector<std::string>& warnings() const { return mWarnings; }
+        /// The smallest and largest tile edge of leaf `leaf` over the orientations, metres.
+        glm::vec2 sideRange(std::uint32_t leaf) const;
 
         /// Leaf `leaf` on the plane (origin, U, V, N).
         LeafPlacement place(std::uint32_t leaf, const glm::vec3& origin, const glm::vec3& U, const glm::vec3& V,
@@ -85,8 +95,9 @@ namespace TreeLod
 
     private:
         std::uint32_t mTileSize = 0, mGrid = 0, mColumns = 0;
-        std::vector<BillboardLeafMaterial> mMaterials;
-        std::vector<std::int32_t> mMaterialBlock; ///< model material -> block, -1 none
+        std::vector<BillboardLeafImage> mImages;
+        std::vector<std::int32_t> mLeafBlock; ///< leaf -> image (tile block), -1 none
+        std::vector<std::string> mWarnings;
         struct LeafFrame
         {
             glm::vec3 w{1, 0, 0}, t{0, 1, 0}, n{0, 0, 1}; ///< right-handed; n = -Leaf::normal if the texture is mirrored

@@ -11,7 +11,8 @@
 // bark texture of textureSize/2 texels, textures[0]) and 1 "Leaves" (isLeaf, alpha-tested
 // at 0.5, double-sided, back colour = the leaf texture's mean colour made lighter and
 // yellower, textures[1]). Every leaf is one quad (4 vertices of its own, 2 triangles) whose
-// UVs cover the whole leaf texture (0..1). The skeleton has a node per stem point (the
+// UVs cover the whole leaf texture (0..1), unless leafImages or leafMaterials ask for an
+// atlas or several leaf materials (GeneratorOptions). The skeleton has a node per stem point (the
 // first node of a branch hangs off the parent's node at or below where it grows), parents
 // before children. Defaults: oak 12 m / 6000 leaves, conifer 16 m / 10000, birch 15 m /
 // 6000, shrub 2.5 m / 3000. Bark: 6.6k..13.8k triangles (all presets, seeds 1..100),
@@ -50,6 +51,13 @@ namespace TreeLod
         float height = 0.0f;         ///< metres, top of the stems (leaves may reach a little
                                      ///< higher); 0 = preset default; else 0.1..1000
         int textureSize = 256;       ///< leaf texture edge in texels, power of two, 16..4096
+        /// Leaf images, 1..4. Above 1 the leaf texture is an atlas of 2 x 2 cells (this preset's
+        /// leaf, then the other presets' leaves, each at half the texture size) and every leaf
+        /// maps one cell, chosen at random: the UV sub-rectangles of game and SpeedTree assets.
+        std::uint32_t leafImages = 1;
+        /// Leaf materials, 1..16 ("Leaves", "Leaves 2", ...): leaves are dealt to them in turn;
+        /// each has its own tint and alpha cutoff (0.5 for the first, 0.3..0.7 for the others).
+        std::uint32_t leafMaterials = 1;
     };
 
     /// The preset's leaf count and height when the options leave them 0.

@@ -46,20 +46,24 @@
 // Tiles of tileSize^2 texels in a grid of tileColumns columns, tile t at column t % columns,
 // row t / columns; within a tile, texel (x, y) covers local ((x + 0.5) / tileSize,
 // (y + 0.5) / tileSize) (y grows with billboard v, rows top to bottom in the image).
-// Tiles are laid out [leaf material][view side][orientation]:
-//     t = material * 2 * orientationCount + side * orientationCount + k
+// Tiles are laid out [leaf image][view side][orientation]:
+//     t = image * 2 * orientationCount + side * orientationCount + k
+// A leaf image is one leaf material's texture on one UV rectangle: a material whose leaves all
+// map the same rectangle has one image, an atlas material one per rectangle its leaves use.
 // orientation k is the direction d_k of the billboard normal in the leaf's frame (w = texture
 // u axis, t = towards the leaf tip (texture v = 0), n = leaf normal), k over a
 // orientationGrid x orientationGrid hemi-octahedral grid of the hemisphere d.n >= 0 (the
-// stored k already includes the material offset: k = material * 2 * orientationCount + k').
-// A tile is the leaf (its material's texture on its UV rectangle) projected orthographically
+// stored k already includes the image offset: k = image * 2 * orientationCount + k').
+// A tile is the leaf (its image's texture rectangle) projected orthographically
 // along d_k, in a square frame whose +y is the projected tip direction, scaled so the leaf
 // fits the inner (1 - 2 * TILE_MARGIN) of the tile. side 0 is the leaf as seen from the +d_k
 // side (its front), side 1 from the -d_k side (its back, backColour tint), same frame.
 // A leaf whose d has d.n < 0 uses d' = -d and mirror m = 1 (the frame is then mirrored).
 // The view side the shader reads is
 //     side = (camera on the billboard's +normal side ? 0 : 1) XOR m.
-// leavesColour: sRGB albedo (material base or back colour x texture) and alpha (coverage),
+// leavesColour: sRGB albedo (material base or back colour x texture) and alpha: the fraction
+// of the texel where the material's texture alpha passes its alphaCutoff, so one cutoff,
+// LEAVES_COVERAGE_CUTOFF, draws every image as its material's alpha test would;
 // leavesNormal: the normal facing that side's viewer in the tile frame (x right, y up,
 // z towards the +d_k viewer), encoded n * 0.5 + 0.5 in RGB. Both mip-mapped; level
 // leavesMaxLod is the coarsest a tile does not bleed into its neighbours at.
@@ -77,7 +81,7 @@
 // Its mip chain keeps coverage per level (as buildMipChain) and averages ao over covered texels.
 // The classic cloud's textures use the same encoding.
 //
-// ---- Chunk layout, formatVersion 1 (BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION) ----------------
+// ---- Chunk layout, formatVersion 2 (BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION) ----------------
 // Little-endian, "align16" and GpuTexture as in ModelChunk.h:
 //   u32 flags (bit 0 classic), f32 listFactor, f32x3 boundsMin, f32x3 boundsMax
 //   u32 levelCount, per level: u32 firstBillboard, billboardCount, layered (0/1),
@@ -88,8 +92,8 @@
 //   u32 hashAtlasWidth, hashAtlasHeight, align16, width * height * 4 bytes
 //   u32 listsAtlasWidth, listsAtlasHeight, u32 entryCount, align16, entryCount * 8 bytes (u16 x 4),
 //       then align16, entryCount * 4 bytes (AO atlas); texels past entryCount are zero on upload
-//   u32 tileSize, tileColumns, orientationGrid, leafMaterialCount, leavesMaxLod,
-//       per leaf material: u32 model material index, f32 alphaCutoff
+//   u32 tileSize, tileColumns, orientationGrid, leafImageCount, leavesMaxLod,
+//       per leaf image: u32 model material index, f32 alphaCutoff, f32x2 uvMin, f32x2 uvMax
 //   GpuTexture leavesColour, GpuTexture leavesNormal, GpuTexture lowRes  (as ModelChunk.h;
 //       a classic chunk and a cloud without leaves store 1x1 placeholders for the ones unused)
 //   u32 barkVertexCount, align16, u8 AO per reference bark vertex (0..255 = 0..1): the trunk
@@ -111,13 +115,14 @@ namespace TreeLod
 {
     constexpr const char* BILLBOARD_CLOUD_CHUNK = "billboard-cloud";
     constexpr const char* CLASSIC_BILLBOARD_CLOUD_CHUNK = "classic-billboard-cloud";
-    constexpr std::uint32_t BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION = 1;
+    constexpr std::uint32_t BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION = 2;
 
     constexpr std::uint32_t BILLBOARD_MAX_LIST_LENGTH = 255;        ///< hash A channel
     constexpr std::uint32_t BILLBOARD_MAX_ENTRIES = 1u << 24;       ///< hash RGB start
     constexpr float BILLBOARD_CENTRE_RANGE = 32.0f;                 ///< |cx|, |cy| < 32 cells
     constexpr float TILE_MARGIN = 0.0625f;                          ///< empty border of a tile
     constexpr float LOW_RES_ALPHA_CUTOFF = 0.25f;
+    constexpr float LEAVES_COVERAGE_CUTOFF = 0.5f; ///< Leaves Texture alpha drawn, every leaf image
 
     struct BillboardCloudLevel
     {
@@ -155,10 +160,13 @@ namespace TreeLod
                                          float rotation, float side);
     };
 
-    struct BillboardLeafMaterial
+    /// One leaf image of the Leaves Texture (a block of tiles): a leaf material, or one image of
+    /// a material whose texture is an atlas of several (leaves map different UV rectangles).
+    struct BillboardLeafImage
     {
         std::uint32_t material = 0; ///< index into the model's materials
-        float alphaCutoff = 0.5f;
+        float alphaCutoff = 0.5f;   ///< the material's, applied when the tiles were drawn
+        glm::vec2 uvMin{0.0f}, uvMax{0.0f}; ///< the image's rectangle in the material's texture
     };
 
     struct BillboardCloudData
@@ -177,12 +185,12 @@ namespace TreeLod
         std::vector<std::uint8_t> entryAo; ///< 4 per entry
 
         std::uint32_t tileSize = 0, tileColumns = 0, orientationGrid = 0, leavesMaxLod = 0;
-        std::vector<BillboardLeafMaterial> leafMaterials;
+        std::vector<BillboardLeafImage> leafImages;
         GpuTexture leavesColour, leavesNormal, lowRes;
         std::vector<std::uint8_t> barkAo; ///< one per reference bark vertex
 
         std::uint32_t orientationCount() const { return orientationGrid * orientationGrid; }
-        std::uint32_t tileCount() const { return std::uint32_t(leafMaterials.size()) * 2 * orientationCount(); }
+        std::uint32_t tileCount() const { return std::uint32_t(leafImages.size()) * 2 * orientationCount(); }
 
         /// Hash texel of cell (i, j) of billboard b: (start, length).
         std::pair<std::uint32_t, std::uint32_t> cell(std::uint32_t billboard, std::uint32_t i, std::uint32_t j) const;
