@@ -268,14 +268,8 @@ namespace TreeLod
                 row.treePx = extent.heightPx();
                 row.flipClassic = flipMean(crops[0], crops[1]);
                 row.flipLayered = flipMean(crops[0], crops[2]);
-                auto rmse = [](const Image& a, const Image& b) {
-                    Result<MultiScaleRmseResult> r = multiScaleRmse(a, b);
-                    if (!r)
-                        throw StudyError("multi-scale RMSE: " + r.error().message());
-                    return r->combined;
-                };
-                row.rmseClassic = rmse(crops[0], crops[1]);
-                row.rmseLayered = rmse(crops[0], crops[2]);
+                row.rmseClassic = multiScaleRmseOf(crops[0], crops[1]);
+                row.rmseLayered = multiScaleRmseOf(crops[0], crops[2]);
                 rows.push_back(row);
 
                 // reference | classic | multi-layered | FLIP of the multi-layered, magnified to one size
@@ -455,10 +449,7 @@ namespace TreeLod
                 renderer.clearContent();
                 scene.asset.reset();
             }
-            json["command"] = commandLine;
-            writeText(args.out + "/summary.md", md.str());
-            writeText(args.out + "/summary.json", json.dump(2) + "\n");
-            std::printf("%s", md.str().c_str());
+            writeSummary(args.out, md.str(), json, commandLine);
             return 0;
         }
     }
@@ -493,24 +484,6 @@ int main(int argc, char** argv)
     {
         return app.exit(e);
     }
-    std::string commandLine;
-    for (int i = 0; i < argc; ++i)
-        commandLine += (i ? " " : "") + std::string(i == 0 ? "treelod_bc_study" : argv[i]);
-    try
-    {
-        return TreeLod::run(args, commandLine);
-    }
-    catch (const TreeLod::StudyError& e)
-    {
-        std::fprintf(stderr, "treelod_bc_study: %s\n", e.what());
-    }
-    catch (const Ogre::Exception& e)
-    {
-        std::fprintf(stderr, "treelod_bc_study: %s\n", e.getFullDescription().c_str());
-    }
-    catch (const std::exception& e)
-    {
-        std::fprintf(stderr, "treelod_bc_study: %s\n", e.what());
-    }
-    return 2;
+    const std::string commandLine = TreeLod::studyCommandLine("treelod_bc_study", argc, argv);
+    return TreeLod::runStudy("treelod_bc_study", [&] { return TreeLod::run(args, commandLine); });
 }

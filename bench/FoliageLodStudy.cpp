@@ -1089,21 +1089,5 @@ int main(int argc, char** argv)
     {
         return app.exit(e) == 0 ? 0 : 2;
     }
-    try
-    {
-        return TreeLod::run(args);
-    }
-    catch (const TreeLod::StudyError& e)
-    {
-        std::fprintf(stderr, "treelod_lodf_study: %s\n", e.what());
-    }
-    catch (const Ogre::Exception& e)
-    {
-        std::fprintf(stderr, "treelod_lodf_study: %s\n", e.getFullDescription().c_str());
-    }
-    catch (const std::exception& e)
-    {
-        std::fprintf(stderr, "treelod_lodf_study: %s\n", e.what());
-    }
-    return 2;
+    return TreeLod::runStudy("treelod_lodf_study", [&] { return TreeLod::run(args); });
 }

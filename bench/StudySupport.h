@@ -1,4 +1,5 @@
-// Helpers shared by the headless studies in bench/ (treelod_lodf_study, treelod_bc_study):
+// Helpers shared by the headless studies in bench/ (treelod_lodf_study, treelod_bc_study,
+// treelod_corpus_study):
 // formatting, image conversion and metrics, tree extents and crops, panel composition, output.
 #pragma once
 
@@ -10,6 +11,9 @@
 #include "TreeLod/ReferenceRenderer.h"
 #include "TreeLod/RgbaImageConversion.h"
 #include "TreeLod/TreeViews.h"
+
+#include <OgreException.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -57,6 +61,38 @@ namespace TreeLod
         if (!r)
             throw StudyError("FLIP: " + r.error().message());
         return r->mean;
+    }
+
+    /// `run()`'s exit code; a StudyError, Ogre or other exception prints one line naming the
+    /// study and gives 2.
+    template <typename Run> int runStudy(const char* study, Run&& run)
+    {
+        try
+        {
+            return run();
+        }
+        catch (const StudyError& e)
+        {
+            std::fprintf(stderr, "%s: %s\n", study, e.what());
+        }
+        catch (const Ogre::Exception& e)
+        {
+            std::fprintf(stderr, "%s: %s\n", study, e.getFullDescription().c_str());
+        }
+        catch (const std::exception& e)
+        {
+            std::fprintf(stderr, "%s: %s\n", study, e.what());
+        }
+        return 2;
+    }
+
+    /// Multi-scale RMSE (combined over the bands) of `b` against `a`.
+    inline double multiScaleRmseOf(const Image& a, const Image& b)
+    {
+        Result<MultiScaleRmseResult> r = multiScaleRmse(a, b);
+        if (!r)
+            throw StudyError("multi-scale RMSE: " + r.error().message());
+        return r->combined;
     }
 
     inline double median(std::vector<double> v)
@@ -108,5 +144,24 @@ namespace TreeLod
         Result<void> r = writePng(path, image);
         if (!r)
             throw StudyError(r.error().message());
+    }
+
+    /// The command as typed, the program named `study` (for the summaries).
+    inline std::string studyCommandLine(const char* study, int argc, char** argv)
+    {
+        std::string line = study;
+        for (int i = 1; i < argc; ++i)
+            line += std::string(" ") + argv[i];
+        return line;
+    }
+
+    /// summary.md and summary.json (with "command") in `out`, and the Markdown on stdout.
+    inline void writeSummary(const std::string& out, const std::string& markdown, nlohmann::json json,
+                             const std::string& commandLine)
+    {
+        json["command"] = commandLine;
+        writeText(out + "/summary.md", markdown);
+        writeText(out + "/summary.json", json.dump(2) + "\n");
+        std::printf("%s", markdown.c_str());
     }
 }

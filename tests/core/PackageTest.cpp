@@ -855,6 +855,43 @@ TEST(MipChain, AlphaCoverageStaysWithinTwoPercentDownTo8x8)
     }
 }
 
+// Leaf materials sharing one texture under cutoffs 0.3, 0.7 and 0.3 again: two chains, each
+// keeping the coverage of its own cutoff, the third material on the first chain; the chunk
+// round-trips and the bark texture keeps its index.
+TEST(PackageWriter, ReferenceChunkKeepsEveryLeafMaterialsCoverageOnASharedTexture)
+{
+    TreeModel model = makeTree();
+    model.textures[1] = leafAlpha();
+    model.materials[1].alphaCutoff = 0.3f;
+    Material strict = model.materials[1];
+    strict.name = "Leaves strict";
+    strict.alphaCutoff = 0.7f;
+    Material loose = model.materials[1];
+    loose.name = "Leaves loose";
+    model.materials.push_back(strict);
+    model.materials.push_back(loose);
+    model.leaves[1].material = 2;
+    ASSERT_TRUE(model.validate().ok());
+    const ReferenceChunk chunk = makeReferenceChunk(model);
+    ASSERT_EQ(chunk.textures.size(), 3u);
+    EXPECT_EQ(chunk.model.materials[0].texture, 0);
+    EXPECT_EQ(chunk.model.materials[1].texture, 1);
+    EXPECT_EQ(chunk.model.materials[2].texture, 2);
+    EXPECT_EQ(chunk.model.materials[3].texture, 1);
+    EXPECT_EQ(chunk.textures[2].name, chunk.textures[1].name + " at cutoff 0.7");
+    for (const auto& [texture, cutoff] : {std::pair<int, float>{1, 0.3f}, {2, 0.7f}})
+    {
+        const GpuTexture& chain = chunk.textures[std::size_t(texture)];
+        const double c0 = coverage(chain, 0, cutoff);
+        for (std::uint32_t level = 1; chain.mipWidth(level) >= 8; ++level)
+            EXPECT_NEAR(coverage(chain, level, cutoff), c0, 0.02) << "cutoff " << cutoff << " level " << level;
+    }
+    Result<ReferenceChunk> back = decodeReferenceChunk(encodeReferenceChunk(chunk), "shared texture");
+    ASSERT_TRUE(back.ok()) << back.error().message();
+    EXPECT_EQ(back->textures.size(), 3u);
+    EXPECT_EQ(back->model.materials[2].texture, 2);
+}
+
 TEST(PackageWriter, AtomicWriteLeavesNoFileWhenTheDirectoryIsMissing)
 {
     const std::string dir = outDir() + "/no-such-dir";

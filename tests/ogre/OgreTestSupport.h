@@ -6,6 +6,7 @@
 #include "TreeLod/ImageMetrics.h"
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/RgbaImageConversion.h"
+#include "TreeLod/TreeViews.h"
 
 #include <OgreMovableObject.h>
 #include <OgreSceneManager.h>
@@ -196,15 +197,7 @@ namespace TreeLod
     // instead (then open them and look before committing). On a failure the render and the
     // FLIP heat map are left in build/test-out/ogre/ for inspection.
 
-    /// Fraction of pixels that differ from the background colour: a black, empty or
-    /// background-only picture cannot pass a golden test.
-    inline double treeCoverage(const Image& image, const glm::vec3& background)
-    {
-        std::size_t covered = 0;
-        for (const glm::vec4& p : image.pixels)
-            covered += glm::length(glm::vec3(p) - background) > 0.02f;
-        return double(covered) / double(image.pixels.size());
-    }
+    // treeCoverage (TreeViews.h): a black, empty or background-only picture cannot pass a golden test.
 
     /// Pixels both images cover (differ from the background) over the pixels either covers; 0
     /// when neither covers any.

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 namespace TreeLod
@@ -278,18 +279,46 @@ namespace TreeLod
         chunk.model = model;
         chunk.model.textures.clear();
         chunk.textures.reserve(model.textures.size());
+        std::vector<std::pair<std::size_t, std::size_t>> extra; // (material, texture) of further cutoffs
         for (std::size_t t = 0; t < model.textures.size(); ++t)
         {
             MipChainOptions options;
             options.preserveAlphaCoverage = false;
-            for (const Material& m : model.materials)
-                if (m.isLeaf && m.texture == std::int32_t(t))
+            std::vector<std::pair<float, std::int32_t>> cutoffs; // cutoff -> chunk texture
+            for (std::size_t m = 0; m < model.materials.size(); ++m)
+            {
+                const Material& material = model.materials[m];
+                if (!material.isLeaf || material.texture != std::int32_t(t))
+                    continue;
+                const auto same = std::find_if(cutoffs.begin(), cutoffs.end(),
+                                               [&](const auto& c) { return c.first == material.alphaCutoff; });
+                if (same != cutoffs.end())
+                    chunk.model.materials[m].texture = same->second;
+                else if (cutoffs.empty())
                 {
                     options.preserveAlphaCoverage = true;
-                    options.alphaCutoff = m.alphaCutoff;
-                    break;
+                    options.alphaCutoff = material.alphaCutoff;
+                    cutoffs.emplace_back(material.alphaCutoff, std::int32_t(t));
                 }
+                else
+                {
+                    const std::int32_t index = std::int32_t(model.textures.size() + extra.size());
+                    cutoffs.emplace_back(material.alphaCutoff, index);
+                    chunk.model.materials[m].texture = index;
+                    extra.emplace_back(m, t);
+                }
+            }
             chunk.textures.push_back(buildMipChain(model.textures[t], options));
+        }
+        for (const auto& [m, t] : extra)
+        {
+            MipChainOptions options;
+            options.alphaCutoff = model.materials[m].alphaCutoff;
+            GpuTexture chain = buildMipChain(model.textures[t], options);
+            char cutoff[32];
+            std::snprintf(cutoff, sizeof cutoff, "%g", double(options.alphaCutoff));
+            chain.name = chunk.textures[t].name + " at cutoff " + cutoff;
+            chunk.textures.push_back(std::move(chain));
         }
         return chunk;
     }

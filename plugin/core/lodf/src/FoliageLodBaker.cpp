@@ -26,6 +26,7 @@ namespace TreeLod
             glm::vec3 normal{0.0f, 1.0f, 0.0f};
             float area = 0.0f;       ///< area it stands for: the sum over the original leaves it replaces
             glm::vec2 uvMin{0.0f}, uvMax{0.0f};
+            std::vector<std::uint32_t> sources; ///< the cluster's original leaves (node ids) it replaces
         };
 
         struct Collapse
@@ -114,8 +115,32 @@ namespace TreeLod
             return (glm::length(a.centre - b.centre) + size * (orient + uv)) * std::sqrt(area / meanArea);
         }
 
-        /// eq. 1 and 3: the leaf that replaces a and b, on four of their vertices.
-        Node collapseLeaves(const TreeModel& m, const Node& a, const Node& b)
+        /// Weight of the corners' distance from the ideal leaf's corners (per corner, in leaf sizes)
+        /// against quadScore when the corners are chosen among the cluster's vertices.
+        constexpr float SHAPE_WEIGHT = 0.5f;
+
+        /// The score of quad `q` as the leaf standing for `target` m^2 around `centre`: relative
+        /// area miss + centre offset in leaf sizes + 4 when folded. Lower is better.
+        float quadScore(const TreeModel& m, const std::array<std::uint32_t, 4>& q, float target,
+                        const glm::vec3& centre)
+        {
+            const glm::vec3 p0 = m.leafVertices[q[0]].position, p1 = m.leafVertices[q[1]].position;
+            const glm::vec3 p2 = m.leafVertices[q[2]].position, p3 = m.leafVertices[q[3]].position;
+            const glm::vec3 n1 = glm::cross(p1 - p0, p2 - p0), n2 = glm::cross(p2 - p0, p3 - p0);
+            const bool folded = glm::dot(n1, n2) <= 0.0f;
+            return std::abs(quadArea(m, q) - target) / std::max(target, 1e-30f) +
+                   glm::length(0.25f * (p0 + p1 + p2 + p3) - centre) / std::sqrt(std::max(target, 1e-30f)) +
+                   (folded ? 4.0f : 0.0f);
+        }
+
+        /// eq. 1 and 3: the leaf that replaces a and b, on four existing vertices. Candidates: the
+        /// 16 ways of taking each texture corner from a or from b (the paper's), and the quad whose
+        /// corner r is, for each r, the corner-r vertex of an original leaf a and b replace nearest
+        /// to corner r of the ideal leaf (the area A_a + A_b around the pair's centre, in the
+        /// larger leaf's frame and aspect). Deviation (docs/lodf.md): the paper's two leaves alone
+        /// cannot reach that area a few collapses deep, and coarse levels thinned out.
+        Node collapseLeaves(const TreeModel& m, const Node& a, const Node& b, const std::vector<Node>& nodes,
+                           std::uint32_t originalCount)
         {
             const float target = a.area + b.area;
             const glm::vec3 centre = (a.centre * a.area + b.centre * b.area) / std::max(target, 1e-30f);
@@ -127,32 +152,90 @@ namespace TreeLod
                 std::array<std::uint32_t, 4> q;
                 for (int r = 0; r < 4; ++r)
                     q[r] = (mask >> r) & 1 ? b.corner[r] : a.corner[r];
-                const glm::vec3 p0 = m.leafVertices[q[0]].position, p1 = m.leafVertices[q[1]].position;
-                const glm::vec3 p2 = m.leafVertices[q[2]].position, p3 = m.leafVertices[q[3]].position;
-                const glm::vec3 n1 = glm::cross(p1 - p0, p2 - p0), n2 = glm::cross(p2 - p0, p3 - p0);
-                const bool folded = glm::dot(n1, n2) <= 0.0f;
-                const float area = quadArea(m, q);
-                const float score = std::abs(area - target) / std::max(target, 1e-30f) +
-                                    glm::length(0.25f * (p0 + p1 + p2 + p3) - centre) / std::sqrt(std::max(target, 1e-30f)) +
-                                    (folded ? 4.0f : 0.0f);
+                const float score = quadScore(m, q, target, centre);
                 if (score < bestScore)
                 {
                     bestScore = score;
                     out.corner = q;
                 }
             }
-            const glm::vec3 p0 = m.leafVertices[out.corner[0]].position, p1 = m.leafVertices[out.corner[1]].position;
-            const glm::vec3 p2 = m.leafVertices[out.corner[2]].position, p3 = m.leafVertices[out.corner[3]].position;
+            // The ideal leaf: the larger leaf's texture axes (u: corner 0 -> 1, v: corner 0 -> 3) in
+            // the plane of the mean normal, its aspect, area `target`.
+            const Node& big = a.area >= b.area ? a : b;
+            const auto pos = [&](std::uint32_t v) { return m.leafVertices[v].position; };
+            glm::vec3 n = a.normal * a.area + (glm::dot(a.normal, b.normal) < 0.0f ? -b.normal : b.normal) * b.area;
+            n = glm::length(n) > 1e-12f ? glm::normalize(n) : big.normal;
+            const glm::vec3 eu = pos(big.corner[1]) - pos(big.corner[0]) + pos(big.corner[2]) - pos(big.corner[3]);
+            const glm::vec3 ev = pos(big.corner[3]) - pos(big.corner[0]) + pos(big.corner[2]) - pos(big.corner[1]);
+            glm::vec3 u = eu - n * glm::dot(eu, n);
+            u = glm::length(u) > 1e-12f ? glm::normalize(u) : glm::vec3(0.0f);
+            glm::vec3 v = ev - n * glm::dot(ev, n) - u * glm::dot(ev, u);
+            if (glm::length(u) > 0.0f && glm::length(v) > 1e-12f)
+            {
+                const float aspect = std::clamp(glm::length(eu) / std::max(glm::length(ev), 1e-30f), 0.05f, 20.0f);
+                const float hu = 0.5f * std::sqrt(target * aspect), hv = 0.5f * std::sqrt(target / aspect);
+                u *= hu;
+                v = glm::normalize(v) * hv;
+                const glm::vec3 ideal[4] = {centre - u - v, centre + u - v, centre + u + v, centre - u + v};
+                const Node& image = nodes[big.sources.front()];
+                std::array<std::uint32_t, 4> q = out.corner;
+                for (int r = 0; r < 4; ++r)
+                {
+                    float nearest = std::numeric_limits<float>::max();
+                    for (std::uint32_t source = 0; source < originalCount; ++source)
+                        {
+                            const Node& o = nodes[source];
+                            if (!sameImage(o, image))
+                                continue;
+                            const float d = glm::length(pos(o.corner[r]) - ideal[r]);
+                            if (d < nearest)
+                            {
+                                nearest = d;
+                                q[r] = o.corner[r];
+                            }
+                        }
+                }
+                // Then each corner in turn moves to the candidate that scores best (two passes),
+                // scored also by its distance from the ideal corners so the quad keeps the leaf's
+                // shape and the image is not sheared.
+                const auto shaped = [&](const std::array<std::uint32_t, 4>& t) {
+                    float off = 0.0f;
+                    for (int r = 0; r < 4; ++r)
+                        off += glm::length(pos(t[r]) - ideal[r]);
+                    return quadScore(m, t, target, centre) + SHAPE_WEIGHT * off / std::sqrt(std::max(target, 1e-30f));
+                };
+                float score = shaped(q);
+                for (int pass = 0; pass < 2; ++pass)
+                    for (int r = 0; r < 4; ++r)
+                        for (std::uint32_t source = 0; source < originalCount; ++source)
+                        {
+                            const Node& o = nodes[source];
+                            if (!sameImage(o, image) || o.corner[r] == q[r])
+                                continue;
+                            std::array<std::uint32_t, 4> t = q;
+                            t[r] = o.corner[r];
+                            if (const float st = shaped(t); st < score)
+                            {
+                                score = st;
+                                q = t;
+                            }
+                        }
+                if (quadScore(m, q, target, centre) < bestScore)
+                    out.corner = q;
+            }
+            const glm::vec3 p0 = pos(out.corner[0]), p1 = pos(out.corner[1]), p2 = pos(out.corner[2]),
+                            p3 = pos(out.corner[3]);
             out.centre = 0.25f * (p0 + p1 + p2 + p3);
-            glm::vec3 n = glm::cross(p2 - p0, p3 - p1);
-            glm::vec3 mean = a.normal * a.area + (glm::dot(a.normal, b.normal) < 0.0f ? -b.normal : b.normal) * b.area;
-            if (glm::length(n) > 1e-12f)
-                out.normal = glm::normalize(glm::dot(n, mean) < 0.0f ? -n : n);
+            const glm::vec3 quadNormal = glm::cross(p2 - p0, p3 - p1);
+            if (glm::length(quadNormal) > 1e-12f)
+                out.normal = glm::normalize(glm::dot(quadNormal, n) < 0.0f ? -quadNormal : quadNormal);
             else
-                out.normal = glm::length(mean) > 1e-12f ? glm::normalize(mean) : a.normal;
+                out.normal = n;
             out.area = target;
             out.uvMin = sameImage(a, b) ? a.uvMin : glm::min(a.uvMin, b.uvMin);
             out.uvMax = sameImage(a, b) ? a.uvMax : glm::max(a.uvMax, b.uvMax);
+            out.sources = a.sources;
+            out.sources.insert(out.sources.end(), b.sources.begin(), b.sources.end());
             return out;
         }
 
@@ -162,7 +245,10 @@ namespace TreeLod
         {
             const std::uint32_t n = std::uint32_t(cluster.leaves.size());
             for (std::uint32_t i = 0; i < n; ++i)
+            {
                 cluster.nodes.push_back(originalNode(m, cluster.leaves[i]));
+                cluster.nodes.back().sources = {i};
+            }
             if (n < 2)
                 return;
             // slot -> node id; a collapse puts its new leaf in the slot of `a` and frees `b`'s.
@@ -211,7 +297,8 @@ namespace TreeLod
                 if (bi > bj)
                     std::swap(bi, bj);
                 const std::uint32_t na = slotNode[bi], nb = slotNode[bj];
-                cluster.nodes.push_back(collapseLeaves(m, cluster.nodes[na], cluster.nodes[nb]));
+                Node merged = collapseLeaves(m, cluster.nodes[na], cluster.nodes[nb], cluster.nodes, n);
+                cluster.nodes.push_back(std::move(merged));
                 running = std::max(running, bv);
                 cluster.collapses.push_back({na, nb, running});
                 slotNode[bi] = std::uint32_t(cluster.nodes.size() - 1);

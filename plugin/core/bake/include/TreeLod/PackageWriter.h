@@ -83,7 +83,10 @@ namespace TreeLod
 
     /// The reference chunk of `model`: the model without its decoded textures plus a mip chain
     /// per texture, alpha-coverage preserving (with that material's cutoff) for the textures
-    /// that a leaf material uses, plain box filtered for the others.
+    /// that a leaf material uses, plain box filtered for the others. Leaf materials that share a
+    /// texture under different cutoffs get a chain each: the first cutoff keeps the texture's
+    /// index, the others' chains are appended (named "<texture> at cutoff <c>") and those
+    /// materials point at them, so every material's coverage is kept at its own cutoff.
     ReferenceChunk makeReferenceChunk(const TreeModel& model);
 
 

@@ -41,6 +41,15 @@ namespace TreeLod
         return e;
     }
 
+    /// Fraction of pixels that differ from the background (the pixels treeExtent bounds).
+    inline double treeCoverage(const Image& image, const glm::vec3& background = LightingSpec().background)
+    {
+        std::size_t covered = 0;
+        for (const glm::vec4& p : image.pixels)
+            covered += glm::length(glm::vec3(p) - background) > 0.02f;
+        return image.pixels.empty() ? 0.0 : double(covered) / double(image.pixels.size());
+    }
+
     inline Extent unite(Extent a, const Extent& b)
     {
         a.minX = std::min(a.minX, b.minX);

@@ -1,0 +1,385 @@
+// treelod_corpus_study: every technique against the polygonal tree, on a corpus of trees (ours, our
+// generator's atlas and multi-material variants, and third-party trees when present), measured
+// headless through the plugin.
+//
+// Per tree, the package is baked with every technique asked for (their default options; the
+// classic billboard cloud at the multi-layered cloud's memory, García et al. 2007 Fig. 13). Per
+// view the reference ("mesh") and each technique are rendered by the same Ogre pipeline at S x S
+// supersampling, from azimuth 30 degrees at the crown's height:
+//   near: the tree 90 % of the view height; mid: a quarter of it; far: 30 px tall.
+// Image error is taken over the square around the reference tree (its box with a 15 % margin, the
+// same pixels for every technique and run): FLIP (mean), multi-scale RMSE, and the coverage (the
+// technique's tree pixels over the reference's, whole frame). The billboard
+// clouds are drawn without their AO term, since the polygonal reference has none.
+// Output in --out: summary.md (per tree and technique: near / mid / far), summary.json,
+// error.csv, and worst-<technique>.png: reference | technique | FLIP of the technique's worst case
+// (magnified crops).
+//
+// Tree specs: a .glb/.gltf path, or generated:PRESET[:LEAVES[:IMAGES[:MATERIALS]]] (TreeGenerator:
+// leaf count, leaf images in an atlas, leaf materials). Without --trees: the bundled trees, the
+// generated oak with a 2x2 leaf atlas under six leaf materials, and every .glb in
+// media/third-party/ (docs/measurements.md says how to make them).
+//
+// Needs an X server: xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" treelod_corpus_study [options]
+// Errors print one line and exit 2.
+#include "TreeLod/BakeTechniques.h"
+#include "TreeLod/GltfImporter.h"
+#include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/PackageWriter.h"
+#include "TreeLod/TechniqueRegistry.h"
+#include "TreeLod/TreeAssetManager.h"
+#include "TreeLod/TreeGenerator.h"
+
+#include "StudySupport.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+namespace TreeLod
+{
+    namespace
+    {
+        struct StudyArgs
+        {
+            std::vector<std::string> trees;
+            std::vector<std::string> techniques{"billboard-cloud", "classic-billboard-cloud", "lodf", "impostor",
+                                                "octahedral-impostor"};
+            int size = 512;
+            int supersample = 2;
+            std::string out = "out/corpus-study";
+        };
+
+        void progressLine(const std::string& line) { std::fprintf(stderr, "corpus-study: %s\n", line.c_str()); }
+
+        struct StudyTree
+        {
+            std::string label;
+            TreeModel model;
+        };
+
+        StudyTree loadTree(const std::string& spec)
+        {
+            StudyTree tree;
+            if (spec.rfind("generated:", 0) == 0)
+            {
+                std::vector<std::string> fields;
+                std::stringstream in(spec.substr(10));
+                for (std::string f; std::getline(in, f, ':');)
+                    fields.push_back(f);
+                GeneratorOptions options;
+                if (fields.empty() || !parsePreset(fields[0], options.preset))
+                    throw StudyError("tree '" + spec + "': no preset (generated:PRESET[:LEAVES[:IMAGES[:MATERIALS]]])");
+                try
+                {
+                    if (fields.size() > 1)
+                        options.leafCount = std::uint32_t(std::stoul(fields[1]));
+                    if (fields.size() > 2)
+                        options.leafImages = std::uint32_t(std::stoul(fields[2]));
+                    if (fields.size() > 3)
+                        options.leafMaterials = std::uint32_t(std::stoul(fields[3]));
+                }
+                catch (const std::exception&)
+                {
+                    throw StudyError("tree '" + spec + "': LEAVES, IMAGES and MATERIALS are whole numbers");
+                }
+                Result<TreeModel> model = generateTree(options);
+                if (!model)
+                    throw StudyError("tree '" + spec + "': " + model.error().message());
+                tree.model = std::move(model.value());
+                tree.label = spec;
+            }
+            else
+            {
+                Result<TreeModel> model = importGltf(spec);
+                if (!model)
+                    throw StudyError(model.error().message());
+                tree.model = std::move(model.value());
+                tree.label = std::filesystem::path(spec).filename().string();
+            }
+            return tree;
+        }
+
+        std::vector<std::uint8_t> bakePackage(const StudyTree& tree, const StudyArgs& args)
+        {
+            PackageWriter writer;
+            for (const std::string& name : args.techniques)
+            {
+                const BakeTechnique* technique = findBakeTechnique(name);
+                if (!technique)
+                    throw StudyError("technique '" + name + "': not a baker (" + knownBakeTechniques() + ")");
+                progressLine("baking " + name + " of " + tree.label);
+                Result<void> baked = technique->bake(writer, tree.model, {}, tree.label, [](const std::string& step,
+                                                                                             float) {
+                    if (step.rfind("warning: ", 0) == 0)
+                        progressLine(step);
+                });
+                if (!baked)
+                    throw StudyError(baked.error().message());
+            }
+            return writer.toBytes();
+        }
+
+        struct View
+        {
+            const char* name;
+            double fraction; ///< tree height / view height; 0: `px`
+            double px;
+        };
+        const View VIEWS[] = {{"near", 0.9, 0.0}, {"mid", 0.25, 0.0}, {"far", 0.0, 30.0}};
+
+        struct Row
+        {
+            std::string tree, technique, view;
+            int treePx = 0;
+            double flip = 0.0, rmse = 0.0;
+            double coverage = 0.0; ///< tree pixels of the technique / tree pixels of the reference
+        };
+
+        struct Worst
+        {
+            double flip = -1.0;
+            std::string where;
+            Image reference, image, heat;
+        };
+
+        void measureTree(OffscreenRenderer& renderer, const StudyTree& tree, const TreeAssetPtr& asset,
+                         const StudyArgs& args, std::vector<Row>& rows, std::map<std::string, Worst>& worst)
+        {
+            renderer.clearContent();
+            Ogre::SceneNode* node = renderer.getContentNode().createChildSceneNode();
+            std::vector<std::pair<std::string, Ogre::MovableObject*>> objects;
+            TechniqueRegistry& registry = TechniqueRegistry::getSingleton();
+            for (const std::string& technique : [&] {
+                     std::vector<std::string> all{"mesh"};
+                     all.insert(all.end(), args.techniques.begin(), args.techniques.end());
+                     return all;
+                 }())
+            {
+                Ogre::NameValuePairList params;
+                if (technique.find("billboard-cloud") != std::string::npos)
+                    params["ambientOcclusion"] = "false";
+                Ogre::MovableObject* object = registry.createInstance(technique, renderer.getSceneManager(),
+                                                                      "corpus-" + technique, *asset, params);
+                node->attachObject(object);
+                objects.emplace_back(technique, object);
+            }
+            auto show = [&](std::size_t only) {
+                for (std::size_t i = 0; i < objects.size(); ++i)
+                    objects[i].second->setVisible(i == only);
+            };
+
+            glm::vec3 lo = tree.model.boundsMin, hi = tree.model.boundsMax;
+            if (!tree.model.leafVertices.empty())
+            {
+                lo = glm::vec3(std::numeric_limits<float>::max());
+                hi = -lo;
+                for (const Vertex& v : tree.model.leafVertices)
+                {
+                    lo = glm::min(lo, v.position);
+                    hi = glm::max(hi, v.position);
+                }
+            }
+            const glm::vec3 crown = 0.5f * (lo + hi);
+            const double height = tree.model.boundsMax.y - tree.model.boundsMin.y;
+            for (const View& view : VIEWS)
+            {
+                const double px = view.fraction > 0.0 ? view.fraction * args.size : view.px;
+                const double distance = distanceForHeight(height, px, args.size, STUDY_FOV_Y_DEGREES);
+                const double azimuth = STUDY_PI / 6.0;
+                CameraSpec camera;
+                camera.position = crown + glm::vec3(float(distance * std::sin(azimuth)), 0.0f,
+                                                    float(distance * std::cos(azimuth)));
+                camera.target = crown;
+                camera.fovYDegrees = STUDY_FOV_Y_DEGREES;
+                camera.farClip = float(4.0 * distance + 2.0 * height);
+                progressLine(format("%s, %s: tree %.0f px tall at %.1f m", tree.label.c_str(), view.name, px, distance));
+                std::vector<Image> images(objects.size());
+                for (std::size_t i = 0; i < objects.size(); ++i)
+                {
+                    show(i);
+                    images[i] = toImage(renderer.render(camera, args.size, args.size, args.supersample));
+                }
+                const Crop crop = cropAround(treeExtent(images[0]), args.size, args.size);
+                const Image reference = cropImage(images[0], crop);
+                for (std::size_t i = 1; i < objects.size(); ++i)
+                {
+                    Row row;
+                    row.tree = tree.label;
+                    row.technique = objects[i].first;
+                    row.view = view.name;
+                    row.treePx = treeExtent(images[0]).heightPx();
+                    const Image test = cropImage(images[i], crop);
+                    FlipOptions keep;
+                    keep.keepErrorMap = true;
+                    Result<FlipResult> flipped = flip(reference, test, keep);
+                    if (!flipped)
+                        throw StudyError("FLIP: " + flipped.error().message());
+                    row.flip = flipped->mean;
+                    row.rmse = multiScaleRmseOf(reference, test);
+                    row.coverage = treeCoverage(images[i]) / std::max(treeCoverage(images[0]), 1e-9);
+                    rows.push_back(row);
+                    Worst& w = worst[row.technique];
+                    if (row.flip > w.flip)
+                    {
+                        w.flip = row.flip;
+                        w.where = tree.label + ", " + view.name;
+                        w.reference = reference;
+                        w.image = test;
+                        w.heat = flipHeatmap(flipped.value());
+                    }
+                }
+            }
+            renderer.clearContent();
+        }
+
+        const Row* findRow(const std::vector<Row>& rows, const std::string& tree, const std::string& technique,
+                           const std::string& view)
+        {
+            for (const Row& r : rows)
+                if (r.tree == tree && r.technique == technique && r.view == view)
+                    return &r;
+            return nullptr;
+        }
+
+        int run(StudyArgs args, const std::string& commandLine)
+        {
+            if (args.trees.empty())
+            {
+                args.trees = {"media/oak.glb", "media/conifer.glb", "media/birch.glb", "generated:oak:3000:4:6"};
+                std::vector<std::string> thirdParty;
+                if (std::filesystem::is_directory("media/third-party"))
+                    for (const auto& entry : std::filesystem::directory_iterator("media/third-party"))
+                        if (entry.path().extension() == ".glb")
+                            thirdParty.push_back(entry.path().string());
+                std::sort(thirdParty.begin(), thirdParty.end());
+                if (thirdParty.empty())
+                    progressLine("no third-party trees in media/third-party/ (docs/measurements.md: how to make them)");
+                args.trees.insert(args.trees.end(), thirdParty.begin(), thirdParty.end());
+            }
+            std::filesystem::create_directories(args.out);
+            OffscreenRenderer renderer;
+            renderer.setLighting(LightingSpec());
+            std::vector<Row> rows;
+            std::map<std::string, Worst> worst;
+            std::vector<std::string> labels;
+            for (std::size_t t = 0; t < args.trees.size(); ++t)
+            {
+                const StudyTree tree = loadTree(args.trees[t]);
+                labels.push_back(tree.label);
+                TreeAssetPtr asset = TreeAssetManager::getSingleton().loadFromBytes(
+                    format("corpus-%zu.treelod", t), Ogre::RGN_DEFAULT, bakePackage(tree, args));
+                measureTree(renderer, tree, asset, args, rows, worst);
+                TreeAssetManager::getSingleton().remove(asset);
+            }
+
+            std::ostringstream md;
+            nlohmann::json json;
+            md << "# Every technique against the polygonal tree, over a corpus\n\n";
+            md << "Command: `" << commandLine << "`\n\n";
+            md << "FLIP (mean) over the square around the tree, " << args.size << "x" << args.size << ", "
+               << args.supersample << "x" << args.supersample
+               << " supersampled; near: the tree fills 90 % of the view, mid: a quarter, far: 30 px tall.\n\n";
+            md << "Coverage: the technique's tree pixels over the reference's (1 = as covered).\n\n";
+            md << "| tree | technique | FLIP near | FLIP mid | FLIP far | ms-RMSE near | ms-RMSE mid | ms-RMSE far | "
+                  "coverage near | coverage mid | coverage far |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+            std::string csv = "tree,technique,view,treePx,flip,rmse,coverage\n";
+            for (const std::string& tree : labels)
+                for (const std::string& technique : args.techniques)
+                {
+                    md << "| " << tree << " | " << technique;
+                    for (double Row::*metric : {&Row::flip, &Row::rmse, &Row::coverage})
+                        for (const View& view : VIEWS)
+                            if (const Row* r = findRow(rows, tree, technique, view.name))
+                                md << format(metric == &Row::coverage ? " | %.3f" : " | %.4f", r->*metric);
+                    md << " |\n";
+                }
+            for (const Row& r : rows)
+            {
+                csv += format("\"%s\",%s,%s,%d,%.6f,%.6f,%.4f\n", r.tree.c_str(), r.technique.c_str(), r.view.c_str(),
+                              r.treePx, r.flip, r.rmse, r.coverage);
+                json["rows"].push_back({{"tree", r.tree},
+                                        {"technique", r.technique},
+                                        {"view", r.view},
+                                        {"treePx", r.treePx},
+                                        {"flip", r.flip},
+                                        {"rmse", r.rmse},
+                                        {"coverage", r.coverage}});
+            }
+
+            // The issue's targets, where both techniques were measured.
+            const bool clouds = std::count(args.techniques.begin(), args.techniques.end(), "billboard-cloud") &&
+                                std::count(args.techniques.begin(), args.techniques.end(), "classic-billboard-cloud");
+            if (clouds)
+            {
+                md << "\n## Multi-layered against classic cloud at equal memory (FLIP)\n\n"
+                      "| tree | near | mid | far |\n|---|---|---|---|\n";
+                int wins = 0, cases = 0;
+                for (const std::string& tree : labels)
+                {
+                    md << "| " << tree;
+                    for (const View& view : VIEWS)
+                    {
+                        const Row* l = findRow(rows, tree, "billboard-cloud", view.name);
+                        const Row* c = findRow(rows, tree, "classic-billboard-cloud", view.name);
+                        if (!l || !c)
+                            continue;
+                        ++cases;
+                        wins += l->flip <= c->flip;
+                        md << format(" | %.4f vs %.4f %s", l->flip, c->flip, l->flip <= c->flip ? "(layered)" : "(classic)");
+                    }
+                    md << " |\n";
+                }
+                md << format("\nThe multi-layered cloud is at or below the classic one in %d of %d cases.\n", wins, cases);
+                json["layeredWins"] = wins;
+                json["cloudCases"] = cases;
+            }
+
+            md << "\n## Worst case of each technique\n\n";
+            for (auto& [technique, w] : worst)
+            {
+                const int panel = 256;
+                const Crop whole{0, 0, w.reference.width};
+                const Image p0 = magnify(w.reference, whole, panel), p1 = magnify(w.image, whole, panel),
+                            p2 = magnify(w.heat, whole, panel);
+                const std::string file = "worst-" + technique + ".png";
+                writeImage(args.out + "/" + file, composePanels({{&p0, &p1, &p2}}));
+                md << format("- %s: FLIP %.4f (%s), `%s` (reference | %s | FLIP)\n", technique.c_str(), w.flip,
+                             w.where.c_str(), file.c_str(), technique.c_str());
+                json["worst"][technique] = {{"flip", w.flip}, {"where", w.where}, {"picture", file}};
+            }
+            writeText(args.out + "/error.csv", csv);
+            writeSummary(args.out, md.str(), json, commandLine);
+            return 0;
+        }
+    }
+}
+
+int main(int argc, char** argv)
+{
+    TreeLod::StudyArgs args;
+    CLI::App app{"Every technique against the polygonal tree over a corpus of trees: tree-box FLIP and multi-scale "
+                 "RMSE near, mid and far. Needs an X server (xvfb-run)."};
+    app.add_option("--trees", args.trees,
+                   "trees: .glb/.gltf paths or generated:PRESET[:LEAVES[:IMAGES[:MATERIALS]]] (default: the bundled "
+                   "trees, generated:oak:3000:4:6 and media/third-party/*.glb)");
+    app.add_option("--techniques", args.techniques, "techniques to bake and compare")->capture_default_str();
+    app.add_option("--size", args.size, "image size")->capture_default_str()->check(CLI::Range(64, 4096));
+    app.add_option("--supersample", args.supersample, "samples per pixel per axis")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 8));
+    app.add_option("--out", args.out, "output directory")->capture_default_str();
+    try
+    {
+        app.parse(argc, argv);
+    }
+    catch (const CLI::ParseError& e)
+    {
+        return app.exit(e);
+    }
+    const std::string commandLine = TreeLod::studyCommandLine("treelod_corpus_study", argc, argv);
+    return TreeLod::runStudy("treelod_corpus_study", [&] { return TreeLod::run(args, commandLine); });
+}
