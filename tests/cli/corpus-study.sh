@@ -12,7 +12,7 @@ cd "$src"
   --supersample 1 --out "$out/run" > "$out/stdout.txt" 2> "$out/stderr.txt" || fail "exit $? ($(tail -1 "$out/stderr.txt"))"
 csv="$out/run/error.csv"
 [ "$(head -1 "$csv")" = "tree,technique,view,treePx,flip,rmse,coverage" ] || fail "CSV header: $(head -1 "$csv")"
-[ "$(($(wc -l < "$csv") - 1))" = 12 ] || fail "$csv: $(($(wc -l < "$csv") - 1)) rows, expected 2 trees x 2 techniques x 3 views"
+[ "$(($(wc -l < "$csv") - 1))" = 16 ] || fail "$csv: $(($(wc -l < "$csv") - 1)) rows, expected 2 trees x 2 techniques x 4 views"
 python3 - "$csv" <<'PY' || fail "metrics out of range"
 import csv, math, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
