@@ -10,7 +10,8 @@
 //   from 60 degrees above the crown's height (where flat billboards and leaves are seen edge-on).
 // Image error is taken over the square around the reference tree (its box with a 15 % margin, the
 // same pixels for every technique and run): FLIP (mean), multi-scale RMSE, and the coverage (the
-// technique's tree pixels over the reference's, whole frame). The billboard
+// technique's tree pixels over the reference's, whole frame); and each technique's chunk bytes.
+// The billboard
 // clouds are drawn without their AO term, since the polygonal reference has none.
 // Output in --out: summary.md (per tree and technique: near / mid / far), summary.json,
 // error.csv, and worst-<technique>.png: reference | technique | FLIP of the technique's worst case
@@ -50,6 +51,7 @@ namespace TreeLod
             std::vector<std::string> trees;
             std::vector<std::string> techniques{"billboard-cloud", "classic-billboard-cloud", "lodf", "impostor",
                                                 "octahedral-impostor"};
+            std::vector<std::string> options; ///< TECHNIQUE.NAME=VALUE, as `treelod bake --option`
             int size = 512;
             int supersample = 2;
             std::string out = "out/corpus-study";
@@ -105,22 +107,38 @@ namespace TreeLod
             return tree;
         }
 
-        std::vector<std::uint8_t> bakePackage(const StudyTree& tree, const StudyArgs& args)
+        /// The package of every technique; `chunkBytes` gets each technique's chunk size (level 0).
+        std::vector<std::uint8_t> bakePackage(const StudyTree& tree, const StudyArgs& args,
+                                              std::map<std::string, std::uint64_t>& chunkBytes)
         {
+            std::map<std::string, BakeOptions> options;
+            for (const std::string& text : args.options)
+            {
+                Result<BakeOptionAssignment> parsed = parseBakeOptionAssignment(text);
+                if (!parsed)
+                    throw StudyError(parsed.error().message());
+                if (!std::count(args.techniques.begin(), args.techniques.end(), parsed->technique))
+                    throw StudyError("option '" + text + "': '" + parsed->technique + "' is not among --techniques");
+                options[parsed->technique][parsed->name] = parsed->value;
+            }
             PackageWriter writer;
             for (const std::string& name : args.techniques)
             {
                 const BakeTechnique* technique = findBakeTechnique(name);
                 if (!technique)
                     throw StudyError("technique '" + name + "': not a baker (" + knownBakeTechniques() + ")");
+                if (Result<void> checked = checkBakeOptions(*technique, options[name], tree.label); !checked)
+                    throw StudyError(checked.error().message());
                 progressLine("baking " + name + " of " + tree.label);
-                Result<void> baked = technique->bake(writer, tree.model, {}, tree.label, [](const std::string& step,
-                                                                                             float) {
+                Result<void> baked = technique->bake(writer, tree.model, options[name], tree.label,
+                                                     [](const std::string& step, float) {
                     if (step.rfind("warning: ", 0) == 0)
                         progressLine(step);
                 });
                 if (!baked)
                     throw StudyError(baked.error().message());
+                const std::vector<std::uint8_t>* chunk = writer.chunkBytes(name, 0);
+                chunkBytes[name] = chunk ? chunk->size() : 0;
             }
             return writer.toBytes();
         }
@@ -141,6 +159,7 @@ namespace TreeLod
             int treePx = 0;
             double flip = 0.0, rmse = 0.0;
             double coverage = 0.0; ///< tree pixels of the technique / tree pixels of the reference
+            std::uint64_t bytes = 0; ///< the technique's chunk in the package
         };
 
         struct Worst
@@ -151,7 +170,8 @@ namespace TreeLod
         };
 
         void measureTree(OffscreenRenderer& renderer, const StudyTree& tree, const TreeAssetPtr& asset,
-                         const StudyArgs& args, std::vector<Row>& rows, std::map<std::string, Worst>& worst)
+                         const std::map<std::string, std::uint64_t>& chunkBytes, const StudyArgs& args,
+                         std::vector<Row>& rows, std::map<std::string, Worst>& worst)
         {
             renderer.clearContent();
             Ogre::SceneNode* node = renderer.getContentNode().createChildSceneNode();
@@ -226,6 +246,7 @@ namespace TreeLod
                     row.flip = flipped->mean;
                     row.rmse = multiScaleRmseOf(reference, test);
                     row.coverage = treeCoverage(images[i]) / std::max(treeCoverage(images[0]), 1e-9);
+                    row.bytes = chunkBytes.at(row.technique);
                     rows.push_back(row);
                     Worst& w = worst[row.technique];
                     if (row.flip > w.flip)
@@ -275,9 +296,10 @@ namespace TreeLod
             {
                 const StudyTree tree = loadTree(args.trees[t]);
                 labels.push_back(tree.label);
+                std::map<std::string, std::uint64_t> chunkBytes;
                 TreeAssetPtr asset = TreeAssetManager::getSingleton().loadFromBytes(
-                    format("corpus-%zu.treelod", t), Ogre::RGN_DEFAULT, bakePackage(tree, args));
-                measureTree(renderer, tree, asset, args, rows, worst);
+                    format("corpus-%zu.treelod", t), Ogre::RGN_DEFAULT, bakePackage(tree, args, chunkBytes));
+                measureTree(renderer, tree, asset, chunkBytes, args, rows, worst);
                 TreeAssetManager::getSingleton().remove(asset);
             }
 
@@ -294,11 +316,11 @@ namespace TreeLod
             for (const char* metric : {"FLIP", "ms-RMSE", "coverage"})
                 for (const View& view : VIEWS)
                     md << " | " << metric << " " << view.name;
-            md << " |\n|---|---|";
-            for (std::size_t i = 0; i < 3 * std::size(VIEWS); ++i)
+            md << " | chunk KB |\n|---|---|";
+            for (std::size_t i = 0; i < 3 * std::size(VIEWS) + 1; ++i)
                 md << "---|";
             md << "\n";
-            std::string csv = "tree,technique,view,treePx,flip,rmse,coverage\n";
+            std::string csv = "tree,technique,view,treePx,flip,rmse,coverage,bytes\n";
             for (const std::string& tree : labels)
                 for (const std::string& technique : args.techniques)
                 {
@@ -307,19 +329,22 @@ namespace TreeLod
                         for (const View& view : VIEWS)
                             if (const Row* r = findRow(rows, tree, technique, view.name))
                                 md << format(metric == &Row::coverage ? " | %.3f" : " | %.4f", r->*metric);
+                    if (const Row* r = findRow(rows, tree, technique, VIEWS[0].name))
+                        md << format(" | %.0f", double(r->bytes) / 1024.0);
                     md << " |\n";
                 }
             for (const Row& r : rows)
             {
-                csv += format("\"%s\",%s,%s,%d,%.6f,%.6f,%.4f\n", r.tree.c_str(), r.technique.c_str(), r.view.c_str(),
-                              r.treePx, r.flip, r.rmse, r.coverage);
+                csv += format("\"%s\",%s,%s,%d,%.6f,%.6f,%.4f,%llu\n", r.tree.c_str(), r.technique.c_str(),
+                              r.view.c_str(), r.treePx, r.flip, r.rmse, r.coverage, (unsigned long long)r.bytes);
                 json["rows"].push_back({{"tree", r.tree},
                                         {"technique", r.technique},
                                         {"view", r.view},
                                         {"treePx", r.treePx},
                                         {"flip", r.flip},
                                         {"rmse", r.rmse},
-                                        {"coverage", r.coverage}});
+                                        {"coverage", r.coverage},
+                                        {"bytes", r.bytes}});
             }
 
             // The issue's targets, where both techniques were measured.
@@ -384,6 +409,7 @@ int main(int argc, char** argv)
                    "trees: .glb/.gltf paths or generated:PRESET[:LEAVES[:IMAGES[:MATERIALS]]] (default: the bundled "
                    "trees, generated:oak:3000:4:6 and media/third-party/*.glb)");
     app.add_option("--techniques", args.techniques, "techniques to bake and compare")->capture_default_str();
+    app.add_option("--option", args.options, "a baker's option, TECHNIQUE.NAME=VALUE (as treelod bake --option)");
     app.add_option("--size", args.size, "image size")->capture_default_str()->check(CLI::Range(64, 4096));
     app.add_option("--supersample", args.supersample, "samples per pixel per axis")
         ->capture_default_str()

@@ -61,12 +61,10 @@ namespace TreeLod
             nlohmann::json optionsJson = {{"leafMaterials", args.leafMaterials}};
             for (const std::string& option : args.options)
             {
-                const std::size_t dot = option.find('.'), equals = option.find('=');
-                if (dot == std::string::npos || equals == std::string::npos || dot > equals)
-                    return printError(fail("", "option --option '" + option + "'", "expected TECHNIQUE.NAME=VALUE"));
-                const std::string technique = option.substr(0, dot);
-                const std::string name = option.substr(dot + 1, equals - dot - 1);
-                const std::string value = option.substr(equals + 1);
+                Result<BakeOptionAssignment> parsed = parseBakeOptionAssignment(option);
+                if (!parsed)
+                    return printError(parsed.error());
+                const auto& [technique, name, value] = parsed.value();
                 const BakeTechnique* t = findBakeTechnique(technique);
                 if (!t || std::find(techniques.begin(), techniques.end(), t) == techniques.end())
                     return printError(fail("", "option --option '" + option + "'",

@@ -11,14 +11,14 @@ cd "$src"
 "$study" --trees generated:birch:300 generated:oak:400:4:3 --techniques lodf impostor --size 128 \
   --supersample 1 --out "$out/run" > "$out/stdout.txt" 2> "$out/stderr.txt" || fail "exit $? ($(tail -1 "$out/stderr.txt"))"
 csv="$out/run/error.csv"
-[ "$(head -1 "$csv")" = "tree,technique,view,treePx,flip,rmse,coverage" ] || fail "CSV header: $(head -1 "$csv")"
+[ "$(head -1 "$csv")" = "tree,technique,view,treePx,flip,rmse,coverage,bytes" ] || fail "CSV header: $(head -1 "$csv")"
 [ "$(($(wc -l < "$csv") - 1))" = 16 ] || fail "$csv: $(($(wc -l < "$csv") - 1)) rows, expected 2 trees x 2 techniques x 4 views"
 python3 - "$csv" <<'PY' || fail "metrics out of range"
 import csv, math, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 for r in rows:
     flip, rmse, cov, px = float(r["flip"]), float(r["rmse"]), float(r["coverage"]), int(r["treePx"])
-    assert 0 <= flip <= 1 and 0 <= rmse <= 1 and 0.3 < cov < 2 and px > 0, r
+    assert 0 <= flip <= 1 and 0 <= rmse <= 1 and 0.3 < cov < 2 and px > 0 and int(r["bytes"]) > 1000, r
 # The tree is about 90 % of the view near (leaves and perspective add a little) and 30 px far;
 # lodf draws every leaf near.
 for r in rows:

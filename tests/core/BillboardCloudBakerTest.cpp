@@ -432,6 +432,41 @@ namespace TreeLod
         EXPECT_NE(warnings[0].find("drawn at that size"), std::string::npos) << warnings[0];
     }
 
+    // The Leaves Texture budget: 24 leaf images (a 2x2 atlas under six materials) at 64-texel
+    // tiles would take 4.9 M texels; the default 2^21 halves the tiles to 32 and says so; no
+    // budget keeps 64; one leaf image keeps 64 under the budget.
+    TEST(BillboardCloudBaker, manyLeafImagesHalveTheTilesWithinTheBudgetAndSaySo)
+    {
+        const TreeModel& atlas = generatedOak(400, 0.0f, 4, 6);
+        BillboardCloudOptions options = fastOptions();
+        options.tileSize = 64;
+        std::vector<std::string> warnings;
+        const auto log = [&](const std::string& step, float) {
+            if (step.rfind("warning: ", 0) == 0)
+                warnings.push_back(step);
+        };
+        Result<BillboardCloudData> budgeted = bakeBillboardCloud(atlas, options, "atlas", log);
+        ASSERT_TRUE(budgeted.ok()) << budgeted.error().message();
+        EXPECT_EQ(budgeted->leafImages.size(), 24u);
+        EXPECT_EQ(budgeted->tileSize, 32u);
+        EXPECT_LE(std::uint64_t(budgeted->leavesColour.width) * budgeted->leavesColour.height,
+                  options.maxLeavesTexels);
+        ASSERT_EQ(warnings.size(), 1u);
+        EXPECT_NE(warnings[0].find("24 leaf images: tiles of 32 texels"), std::string::npos) << warnings[0];
+
+        options.maxLeavesTexels = 0;
+        Result<BillboardCloudData> unlimited = bakeBillboardCloud(atlas, options, "atlas");
+        ASSERT_TRUE(unlimited.ok());
+        EXPECT_EQ(unlimited->tileSize, 64u);
+
+        options.maxLeavesTexels = BillboardCloudOptions().maxLeavesTexels;
+        warnings.clear();
+        Result<BillboardCloudData> one = bakeBillboardCloud(generatedOak(400), options, "oak", log);
+        ASSERT_TRUE(one.ok());
+        EXPECT_EQ(one->tileSize, 64u);
+        EXPECT_TRUE(warnings.empty());
+    }
+
     TEST(BillboardCloudBaker, noLeavesGivesAValidEmptyCloudWithBarkAo)
     {
         const TreeModel m = quadLeaves({}, true);

@@ -105,6 +105,14 @@ namespace TreeLod
         return nullptr;
     }
 
+    Result<BakeOptionAssignment> parseBakeOptionAssignment(const std::string& text)
+    {
+        const std::size_t dot = text.find('.'), equals = text.find('=');
+        if (dot == std::string::npos || equals == std::string::npos || dot > equals)
+            return fail("", "option --option '" + text + "'", "expected TECHNIQUE.NAME=VALUE");
+        return BakeOptionAssignment{text.substr(0, dot), text.substr(dot + 1, equals - dot - 1), text.substr(equals + 1)};
+    }
+
     std::string knownBakeTechniques()
     {
         std::string list;

@@ -19,8 +19,10 @@ namespace TreeLod
                 bakeOptionNumber(given, technique, "listFactor", options.listFactor, 0.0, 64.0, label);
             Result<double> aoRays = bakeOptionNumber(given, technique, "aoRays", options.aoRays, 0, 4096, label);
             Result<double> tileSize = bakeOptionNumber(given, technique, "tileSize", options.tileSize, 8, 1024, label);
+            Result<double> maxTexels = bakeOptionNumber(given, technique, "maxLeavesTexels", double(options.maxLeavesTexels),
+                                                        0, double(1u << 28), label);
             Result<bool> compress = bakeOptionFlag(given, technique, "compress", options.compress, label);
-            for (const Result<double>* r : {&billboards, &listFactor, &aoRays, &tileSize})
+            for (const Result<double>* r : {&billboards, &listFactor, &aoRays, &tileSize, &maxTexels})
                 if (!*r)
                     return r->error();
             if (!compress)
@@ -29,6 +31,7 @@ namespace TreeLod
             options.listFactor = float(listFactor.value());
             options.aoRays = int(aoRays.value());
             options.tileSize = std::uint32_t(tileSize.value()); // a power of two: checked by the baker
+            options.maxLeavesTexels = std::uint64_t(maxTexels.value());
             options.compress = compress.value();
             return {};
         }
@@ -57,6 +60,9 @@ namespace TreeLod
                     {"listFactor", "shader LoD: list entries per pixel of projected cell diagonal, 0 to 64", "4"},
                     {"aoRays", "ambient occlusion rays per leaf vertex, 0 to 4096", "32"},
                     {"tileSize", "Leaves Texture tile edge in texels, a power of two in 8..1024", "64"},
+                    {"maxLeavesTexels",
+                     "Leaves Texture budget in texels, 0 (none) to 2^28: the tile edge halves to fit, not below 16",
+                     "2097152"},
                     {"compress", "DXT-compressed textures (true) or RGBA8 (false)", "true"}};
         }
 

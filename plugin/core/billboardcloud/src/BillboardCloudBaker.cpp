@@ -271,9 +271,18 @@ namespace TreeLod
 
             // §3, §5: the Leaves Texture.
             report(ctx.progress, "billboard leaf tiles", 0.0f);
-            ctx.tiles = std::make_unique<BillboardLeafTiles>(model, ctx.options.tileSize, ctx.options.orientationGrid);
+            ctx.tiles = std::make_unique<BillboardLeafTiles>(model, ctx.options.tileSize, ctx.options.orientationGrid,
+                                                             ctx.options.maxLeavesTexels);
             report(ctx.progress, "billboard leaf tiles", 1.0f);
             const BillboardLeafTiles& tiles = *ctx.tiles;
+            if (tiles.tileSize() < ctx.options.tileSize)
+                report(ctx.progress,
+                       "warning: " + ctx.label + ": " + std::to_string(tiles.images().size()) +
+                           " leaf images: tiles of " +
+                           std::to_string(tiles.tileSize()) + " texels keep the Leaves Texture within " +
+                           std::to_string(ctx.options.maxLeavesTexels) + " texels (tileSize " +
+                           std::to_string(ctx.options.tileSize) + " asked)",
+                       1.0f);
             const std::uint32_t oc = tiles.grid() * tiles.grid();
             ctx.orientationCount = oc;
             const std::uint32_t T = tiles.tileSize(), columns = tiles.tileColumns();

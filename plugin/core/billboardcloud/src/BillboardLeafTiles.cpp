@@ -268,7 +268,8 @@ namespace TreeLod
         }
     }
 
-    BillboardLeafTiles::BillboardLeafTiles(const TreeModel& model, std::uint32_t tileSize, std::uint32_t grid)
+    BillboardLeafTiles::BillboardLeafTiles(const TreeModel& model, std::uint32_t tileSize, std::uint32_t grid,
+                                           std::uint64_t maxTexels)
         : mTileSize(std::max<std::uint32_t>(tileSize, 8)), mGrid(std::max<std::uint32_t>(grid, 1)), mModel(model)
     {
         const std::uint32_t orientationCount = mGrid * mGrid;
@@ -280,6 +281,9 @@ namespace TreeLod
         for (std::size_t l = 0; l < model.leaves.size(); ++l)
             mLeafBlock[l] = groups[l] == NO_IMAGE ? -1 : std::int32_t(groups[l]);
         const std::size_t blocks = mImages.size();
+        while (maxTexels > 0 && mTileSize > 16 &&
+               std::uint64_t(blocks) * 2 * orientationCount * mTileSize * mTileSize > maxTexels)
+            mTileSize /= 2;
 
         // Leaf frames (header: w, t fitted to dP/du and -dP/dv, orthonormalised around n).
         std::vector<UvFit> fits(model.leaves.size());

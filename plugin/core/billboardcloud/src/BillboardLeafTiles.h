@@ -45,8 +45,10 @@ namespace TreeLod
     {
     public:
         /// Build the tiles of every leaf image that `model`'s leaves use (materials without leaves
-        /// get none). tileSize: power of two >= 8; grid >= 1.
-        BillboardLeafTiles(const TreeModel& model, std::uint32_t tileSize, std::uint32_t grid);
+        /// get none). tileSize: power of two >= 8; grid >= 1. maxTexels > 0: the tile edge halves
+        /// (not below 16) while the tiles would take more texels (tileSize() tells what was used).
+        BillboardLeafTiles(const TreeModel& model, std::uint32_t tileSize, std::uint32_t grid,
+                           std::uint64_t maxTexels = 0);
 
         std::uint32_t tileSize() const { return mTileSize; }
         std::uint32_t grid() const { return mGrid; }

@@ -50,6 +50,14 @@ namespace TreeLod
     /// An error naming `label` and "option '<technique>.<name>'" for a name `technique` does not
     /// declare (the declared ones listed).
     Result<void> checkBakeOptions(const BakeTechnique& technique, const BakeOptions& options, const std::string& label);
+    /// One "TECHNIQUE.NAME=VALUE" (`treelod bake --option`), split.
+    struct BakeOptionAssignment
+    {
+        std::string technique, name, value;
+    };
+    /// Splits `text`; an error naming "option --option '<text>'" when it has no '.' before an '='.
+    Result<BakeOptionAssignment> parseBakeOptionAssignment(const std::string& text);
+
     /// Option `name` of `options` as a number in [lo, hi], `fallback` when absent; errors name `label`
     /// and "option '<technique>.<name>'".
     Result<double> bakeOptionNumber(const BakeOptions& options, const std::string& technique, const std::string& name,

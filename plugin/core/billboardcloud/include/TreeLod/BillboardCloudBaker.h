@@ -44,7 +44,12 @@ namespace TreeLod
         /// Low-res texel edge of level 0 in median leaf lengths (levels 1 and 2: 2x and 4x).
         float lowResLeafRatio = 0.75f;
         std::uint32_t tileSize = 64;      ///< Leaves Texture tile edge, power of two >= 8
-        /// Orientations per leaf material = grid^2; odd, so that one cell is centred on the leaf
+        /// Leaves Texture budget: while the leaf images' tiles would take more texels, the tile
+        /// edge halves (not below 16; reported). 2^21 texels (about 4 MB with DXT and mips) keep
+        /// 64-texel tiles up to 8 leaf images; a 2x2 atlas under six materials (24 images) gets
+        /// 32 (docs/billboard-cloud.md). 0: no budget.
+        std::uint64_t maxLeavesTexels = std::uint64_t(1) << 21;
+        /// Orientations per leaf image = grid^2; odd, so that one cell is centred on the leaf
         /// normal (the most common direction: billboards are fitted to leaf planes).
         std::uint32_t orientationGrid = 5;
         std::uint32_t listsAtlasWidth = 1024; ///< grows (power of two up to 4096) when needed
