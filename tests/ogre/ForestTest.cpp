@@ -1595,7 +1595,7 @@ namespace TreeLod
                               x.lowRes == y.lowRes && x.minPixelCount == y.minPixelCount;
                    });
         };
-        const std::vector<ForestLevel> planned = Forest::levelsForErrorBudget(*asset, costs, 0.03f);
+        const std::vector<ForestLevel> planned = Forest::levelsForErrorBudget(*asset, costs, DEFAULT_ERROR_BUDGET);
         ASSERT_GE(planned.size(), 2u);
 
         // The same levels added as fixed: the picture a budgeted species must give. A frame budget
@@ -1647,7 +1647,7 @@ namespace TreeLod
         EXPECT_EQ(forest->getLevels(s)[0].technique, "impostor");
         const Image cheapest = toImage(r.render(view, 320, 180, 1));
         EXPECT_EQ(forest->getStats().levelCounts.at(s), (std::vector<std::uint32_t>{forest->getStats().visibleInstances}));
-        forest->setErrorBudget(0.03f);
+        forest->setErrorBudget(DEFAULT_ERROR_BUDGET);
         EXPECT_TRUE(sameLevels(forest->getLevels(s), planned));
         const Image again = toImage(r.render(view, 320, 180, 1));
         EXPECT_EQ(forest->getStats().levelCounts.at(s), firstCounts);
@@ -1662,7 +1662,7 @@ namespace TreeLod
         }
         for (const float bad : {std::nanf(""), -1.0f, INFINITY})
             EXPECT_THROW(forest->setFrameBudgetMs(bad), Ogre::InvalidParametersException) << bad;
-        EXPECT_EQ(forest->getErrorBudget(), 0.03f) << "refused budgets change nothing";
+        EXPECT_EQ(forest->getErrorBudget(), DEFAULT_ERROR_BUDGET) << "refused budgets change nothing";
 
         // A frame budget nothing fits: the cheapest step, taken the viewer frame after a measurement.
         forest->setFrameBudgetMs(1e-6f);
@@ -1704,7 +1704,7 @@ namespace TreeLod
         EXPECT_LE(forest->getStats().predictedMilliseconds, 0.5 * meshMs);
         // Off: the error budget set last.
         forest->setFrameBudgetMs(0.0f);
-        EXPECT_EQ(forest->getErrorBudget(), 0.03f);
+        EXPECT_EQ(forest->getErrorBudget(), DEFAULT_ERROR_BUDGET);
         EXPECT_TRUE(sameLevels(forest->getLevels(s), planned));
 
         // Shadow casters: their own budget picks coarser levels for them; the view keeps its own.
@@ -1722,7 +1722,7 @@ namespace TreeLod
         // Re-planned while the shadow camera has buckets of its own: they move with the view's.
         forest->setErrorBudget(0.05f);
         const Image coarserView = toImage(r.render(view, 320, 180, 1));
-        forest->setErrorBudget(0.03f);
+        forest->setErrorBudget(DEFAULT_ERROR_BUDGET);
         const Image replannedCasters = toImage(r.render(view, 320, 180, 1));
         EXPECT_LT(flipMean(viewCasters, replannedCasters), 2e-4);
         EXPECT_GT(treeCoverage(coarserView, BACKGROUND), 0.15);

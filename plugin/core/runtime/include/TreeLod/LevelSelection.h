@@ -28,8 +28,10 @@ namespace TreeLod
     /// The technique whose curve is the floor of every budget (TechniqueRegistry's REFERENCE_TECHNIQUE).
     constexpr const char* LEVEL_SELECTION_REFERENCE = "mesh";
 
-    /// The error budget the Forest starts with (Forest::setErrorBudget, scene scripts' "lod" maxError).
-    constexpr float DEFAULT_ERROR_BUDGET = 0.03f;
+    /// The error budget the Forest starts with (Forest::setErrorBudget, scene scripts' "lod" maxError):
+    /// the FLIP a level may add over the polygonal tree's own, the margin the project's accuracy
+    /// target allows (docs/measurements.md, "Budgeted auto").
+    constexpr float DEFAULT_ERROR_BUDGET = 0.02f;
     /// The shadow casters' error budget the Forest starts with (Forest::setShadowErrorBudget): coarser
     /// than the view's, as a shadow shows a tree's outline blurred and from one side.
     constexpr float DEFAULT_SHADOW_ERROR_BUDGET = 0.08f;
