@@ -5,6 +5,8 @@
 // (docs/billboard-cloud.md):
 //   - leaf length (cell and texel sizes are multiples of the median): the leaf's diameter,
 //     2 x the largest distance of its vertices from its centre (the diagonal of a quad leaf);
+//   - hash cells grow past cellLeafRatio median leaf lengths when the largest leaf's tile would
+//     not fit the entry's scale code, instead of drawing that leaf smaller (chooseCellSize);
 //   - clustering: BillboardClustering.h (plane error + spatial and orientation terms, error
 //     bound); a quad is padded to whole square cells, so every billboard's cells are square;
 //   - hash lists (§4.2): computed exactly instead of point sprites + depth peeling: a cell lists a

@@ -157,9 +157,9 @@ namespace TreeLod
         /// conversion. Throws Ogre::InvalidParametersException for a tree without height.
         static Ogre::Real pixelCountForHeight(TreeAsset& asset, Ogre::Real heightPixels);
 
-        /// The techniques budgeted auto chooses among: the reference, lodf, both billboard clouds
-        /// and the impostor. Not the octahedral impostor: its in-forest error exceeds what its error
-        /// curve predicts, and auto chose worse with it (docs/octahedral-impostor.md, "On the front").
+        /// The techniques budgeted auto chooses among: the reference, lodf, both billboard clouds,
+        /// the octahedral impostor and the impostor (docs/octahedral-impostor.md, "On the front":
+        /// baked with AO it made auto worse; without, auto is faster and more accurate with it).
         static std::vector<Ogre::String> getAutoTechniques();
 
         /// Budgeted auto (docs/forest.md, "Budgeted levels"): the levels chooseLevels
