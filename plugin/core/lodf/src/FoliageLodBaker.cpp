@@ -26,7 +26,7 @@ namespace TreeLod
             glm::vec3 normal{0.0f, 1.0f, 0.0f};
             float area = 0.0f;       ///< area it stands for: the sum over the original leaves it replaces
             glm::vec2 uvMin{0.0f}, uvMax{0.0f};
-            std::vector<std::uint32_t> sources; ///< the cluster's original leaves (node ids) it replaces
+            std::uint32_t imageSource = 0; ///< an original leaf (node id) whose leaf image it shows
         };
 
         struct Collapse
@@ -177,7 +177,7 @@ namespace TreeLod
                 u *= hu;
                 v = glm::normalize(v) * hv;
                 const glm::vec3 ideal[4] = {centre - u - v, centre + u - v, centre + u + v, centre - u + v};
-                const Node& image = nodes[big.sources.front()];
+                const Node& image = nodes[big.imageSource];
                 std::array<std::uint32_t, 4> q = out.corner;
                 for (int r = 0; r < 4; ++r)
                 {
@@ -234,8 +234,7 @@ namespace TreeLod
             out.area = target;
             out.uvMin = sameImage(a, b) ? a.uvMin : glm::min(a.uvMin, b.uvMin);
             out.uvMax = sameImage(a, b) ? a.uvMax : glm::max(a.uvMax, b.uvMax);
-            out.sources = a.sources;
-            out.sources.insert(out.sources.end(), b.sources.begin(), b.sources.end());
+            out.imageSource = a.imageSource;
             return out;
         }
 
@@ -247,7 +246,7 @@ namespace TreeLod
             for (std::uint32_t i = 0; i < n; ++i)
             {
                 cluster.nodes.push_back(originalNode(m, cluster.leaves[i]));
-                cluster.nodes.back().sources = {i};
+                cluster.nodes.back().imageSource = i;
             }
             if (n < 2)
                 return;
