@@ -78,10 +78,12 @@ namespace TreeLod
 
         using test::generatedOak;
 
-        /// Options that keep a test fast: 1 AO ray, 16-texel tiles, no DXT.
+        /// Options that keep a test fast: 1 AO ray, 16-texel tiles, no DXT, the default clustering
+        /// weights unjudged.
         BillboardCloudOptions fastOptions()
         {
             BillboardCloudOptions o;
+            o.clusteringTries = 1;
             o.aoRays = 1;
             o.tileSize = 16;
             o.compress = false;
@@ -887,6 +889,7 @@ namespace TreeLod
         const TreeModel& m = generatedOak(1500);
         BillboardCloudOptions options = fastOptions();
         options.compress = true;
+        options.clusteringTries = CLUSTERING_TRIES_MAX; // the judge's ray tracing too
         BillboardCloudStats stats;
         const BillboardCloudData data = bakeOrFail(m, options, &stats);
         ASSERT_TRUE(data.validate("oak").ok());
@@ -919,6 +922,118 @@ namespace TreeLod
         Result<BillboardCloudData> c3 = decodeBillboardCloudChunk(classicBytes, "oak classic");
         ASSERT_TRUE(c3.ok()) << c3.error().message();
         EXPECT_TRUE(c3->classic);
+    }
+
+    TEST(BillboardClustering, theJudgeSeesWhatAFrondLosesFromAbove)
+    {
+        // A frond: two rows of 12 horizontal leaves (0.2 m) whose centres lie in the vertical
+        // plane z = 0 (x 0..2.2 m, rows 0.25 m apart). Plane fit prefers that vertical plane
+        // (vertices 0.1 m off it) to the horizontal one between the rows (0.125 m off), but
+        // flattened onto the vertical plane the leaves are slivers from above, while flattened
+        // onto the horizontal plane they only move up or down.
+        std::vector<LeafAt> leaves;
+        for (int i = 0; i < 24; ++i)
+            leaves.push_back({{0.2f * float(i % 12), 1.0f + 0.25f * float(i / 12), 0.0f}, {0, 1, 0}, 0.2f});
+        const TreeModel m = quadLeaves(leaves);
+        auto onePlane = [&](const glm::vec3& n, float d) {
+            LeafClustering c;
+            c.normal = {n};
+            c.offset = {d};
+            c.centroid = {glm::vec3(1.1f, 1.3f, 0.0f)};
+            c.members = {{}};
+            for (std::uint32_t i = 0; i < m.leaves.size(); ++i)
+            {
+                c.members[0].push_back(i);
+                c.error.push_back(0.0f);
+            }
+            return c;
+        };
+        const LeafClustering vertical = onePlane({0, 0, 1}, 0.0f), horizontal = onePlane({0, 1, 0}, 1.125f);
+        for (const LeafClustering* c : {&vertical, &horizontal})
+        {
+            const TreeModel flat = flattenedOntoClusters(m, *c);
+            ASSERT_EQ(flat.leafVertices.size(), m.leafVertices.size());
+            for (std::size_t v = 0; v < flat.leafVertices.size(); ++v)
+            {
+                EXPECT_NEAR(glm::dot(c->normal[0], flat.leafVertices[v].position), c->offset[0], 1e-5f);
+                EXPECT_EQ(flat.leafVertices[v].normal, m.leafVertices[v].normal);
+                EXPECT_EQ(flat.leafVertices[v].uv, m.leafVertices[v].uv);
+            }
+        }
+        const ClusteringJudge judge(m, glm::vec3(-0.1f, 0.9f, -0.1f), glm::vec3(2.3f, 1.7f, 0.1f), {});
+        // Each leaf on its own plane is the tree itself.
+        LeafClustering exact;
+        for (std::uint32_t i = 0; i < m.leaves.size(); ++i)
+        {
+            exact.normal.push_back(m.leaves[i].normal);
+            exact.offset.push_back(glm::dot(m.leaves[i].normal, m.leaves[i].centre));
+            exact.centroid.push_back(m.leaves[i].centre);
+            exact.members.push_back({i});
+            exact.error.push_back(0.0f);
+        }
+        const double exactError = judge.error(exact), verticalError = judge.error(vertical),
+                     horizontalError = judge.error(horizontal);
+        std::cout << "frond FLIP: leaves' own planes " << exactError << ", vertical " << verticalError
+                  << ", horizontal " << horizontalError << "\n";
+        EXPECT_LT(exactError, 1e-6);
+        EXPECT_GT(verticalError, 0.02);
+        EXPECT_LT(horizontalError, 0.85 * verticalError);
+        // ... where plane fit alone judges the other way.
+        float verticalFit = 0.0f, horizontalFit = 0.0f;
+        for (const Vertex& v : m.leafVertices)
+        {
+            verticalFit = std::max(verticalFit, std::abs(v.position.z));
+            horizontalFit = std::max(horizontalFit, std::abs(v.position.y - 1.125f));
+        }
+        EXPECT_LT(verticalFit, horizontalFit);
+    }
+
+    TEST(BillboardCloudBaker, judgedClusteringKeepsTheTryOfLeastImageError)
+    {
+        const TreeModel& m = generatedOak(1500);
+        BillboardCloudOptions options = fastOptions();
+        BillboardCloudStats unjudged;
+        bakeOrFail(m, options, &unjudged);
+        for (const JudgedClustering& c : unjudged.clustering)
+            EXPECT_EQ(c.error, 0.0); // one try: nothing judged
+
+        options.clusteringTries = CLUSTERING_TRIES_MAX;
+        BillboardCloudStats judged;
+        const BillboardCloudData data = bakeOrFail(m, options, &judged);
+        EXPECT_TRUE(data.validate("oak").ok());
+        for (int l = 0; l < 3; ++l)
+        {
+            const JudgedClustering& c = judged.clustering[l];
+            std::cout << "level " << l << ": kept weights " << c.spatialWeight << ", " << c.orientationWeight
+                      << ": FLIP " << c.error << " (default weights " << c.defaultError << ")\n";
+            EXPECT_GT(c.error, 0.0);
+            EXPECT_LE(c.error, c.defaultError);
+            EXPECT_LT(c.defaultError, 0.5);
+        }
+        // The kept clustering is the one rebuilt with the kept weights, judged the same.
+        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+        for (const std::vector<Vertex>* vs : {&m.barkVertices, &m.leafVertices})
+            for (const Vertex& v : *vs)
+            {
+                lo = glm::min(lo, v.position);
+                hi = glm::max(hi, v.position);
+            }
+        LeafClusteringOptions co;
+        co.clusterCount = judged.billboards[0];
+        co.errorBound = options.maxPlaneError * glm::length(hi - lo);
+        co.spatialWeight = judged.clustering[0].spatialWeight;
+        co.orientationWeight = judged.clustering[0].orientationWeight;
+        const ClusteringJudge judge(m, lo, hi, {});
+        EXPECT_DOUBLE_EQ(judge.error(clusterLeaves(m, co)), judged.clustering[0].error);
+
+        for (std::uint32_t tries : {0u, CLUSTERING_TRIES_MAX + 1})
+        {
+            options.clusteringTries = tries;
+            Result<BillboardCloudData> r = bakeBillboardCloud(m, options, "tries.glb");
+            ASSERT_FALSE(r.ok());
+            EXPECT_NE(r.error().message().find("clusteringTries"), std::string::npos) << r.error().message();
+            EXPECT_NE(r.error().message().find("tries.glb"), std::string::npos) << r.error().message();
+        }
     }
 
     TEST(BillboardCloudBaker, packageGlueAddsReferenceAndCloudChunks)

@@ -21,8 +21,10 @@ namespace TreeLod
             Result<double> tileSize = bakeOptionNumber(given, technique, "tileSize", options.tileSize, 8, 1024, label);
             Result<double> maxTexels = bakeOptionNumber(given, technique, "maxLeavesTexels", double(options.maxLeavesTexels),
                                                         0, double(1u << 28), label);
+            Result<double> tries = bakeOptionNumber(given, technique, "clusteringTries", options.clusteringTries, 1,
+                                                    CLUSTERING_TRIES_MAX, label);
             Result<bool> compress = bakeOptionFlag(given, technique, "compress", options.compress, label);
-            for (const Result<double>* r : {&billboards, &listFactor, &aoRays, &tileSize, &maxTexels})
+            for (const Result<double>* r : {&billboards, &listFactor, &aoRays, &tileSize, &maxTexels, &tries})
                 if (!*r)
                     return r->error();
             if (!compress)
@@ -32,6 +34,7 @@ namespace TreeLod
             options.aoRays = int(aoRays.value());
             options.tileSize = std::uint32_t(tileSize.value()); // a power of two: checked by the baker
             options.maxLeavesTexels = std::uint64_t(maxTexels.value());
+            options.clusteringTries = std::uint32_t(tries.value());
             options.compress = compress.value();
             return {};
         }
@@ -63,6 +66,9 @@ namespace TreeLod
                     {"maxLeavesTexels",
                      "Leaves Texture budget in texels, 0 (none) to 2^28: the tile edge halves to fit, not below 16",
                      "2097152"},
+                    {"clusteringTries",
+                     "clusterings tried per level, 1 to 6, the one kept judged by image error from around and above",
+                     "6"},
                     {"compress", "DXT-compressed textures (true) or RGBA8 (false)", "true"}};
         }
 

@@ -113,6 +113,7 @@ namespace TreeLod
             /// texels with coverage > 0 on either view side.
             std::vector<std::vector<glm::vec2>> coverage;
             float cellSize = 0.0f;  ///< metres per hash cell of the layered levels
+            std::unique_ptr<ClusteringJudge> judge; ///< when clusteringTries > 1
 
             BakeContext(const TreeModel& m, const BillboardCloudOptions& o, const std::string& l,
                         const ProgressCallback& p)
@@ -140,6 +141,9 @@ namespace TreeLod
                 return bad("listsAtlasWidth", std::to_string(o.listsAtlasWidth) + " is not a power of two in 1..4096");
             if (!(o.listFactor > 0.0f) || !std::isfinite(o.listFactor))
                 return bad("listFactor", std::to_string(o.listFactor) + " is not a finite number > 0");
+            if (o.clusteringTries < 1 || o.clusteringTries > CLUSTERING_TRIES_MAX)
+                return bad("clusteringTries",
+                           std::to_string(o.clusteringTries) + " is not in 1.." + std::to_string(CLUSTERING_TRIES_MAX));
             if (o.aoRays < 1)
                 return bad("aoRays", std::to_string(o.aoRays) + " is not >= 1");
             return {};
@@ -228,6 +232,11 @@ namespace TreeLod
             ctx.diagonal = glm::length(hi - lo);
             if (!std::isfinite(ctx.diagonal))
                 return fail(ctx.label, "model '" + model.name + "'", "bounding box too large for single precision");
+            if (ctx.options.clusteringTries > 1 && !model.leaves.empty())
+            {
+                report(ctx.progress, "billboard clustering views", 0.0f);
+                ctx.judge = std::make_unique<ClusteringJudge>(model, lo, hi, ClusteringJudge::Options{});
+            }
             const bool hasBark = barkLo.x <= barkHi.x, hasLeaves = leafLo.x <= leafHi.x;
             // Trunk axis: the vertical through the mean of the lowest tenth of the bark (its base),
             // else through the centre of the bounds.
@@ -885,7 +894,49 @@ namespace TreeLod
             float cellSize = 0.0f, lowResTexel = 0.0f;
             bool layered = false;
             float meanError = 0.0f, maxError = 0.0f;
+            JudgedClustering judged;
         };
+
+        /// (spatialWeight, orientationWeight) of each try, the defaults first.
+        constexpr std::array<std::pair<float, float>, CLUSTERING_TRIES_MAX> CLUSTERING_WEIGHTS{
+            {{0.5f, 4.0f}, {0.5f, 12.0f}, {0.25f, 4.0f}, {1.0f, 4.0f}, {0.5f, 1.0f}, {0.25f, 12.0f}}};
+
+        /// §4.1's clustering into `count` planes, tried with clusteringTries weight pairs and judged
+        /// by image error over views around and above (ClusteringJudge); the first of the least.
+        LeafClustering chooseClustering(const BakeContext& ctx, std::uint32_t count, const std::string& step,
+                                        JudgedClustering& judged)
+        {
+            std::uint32_t bestTry = 0;
+            LeafClusteringOptions co;
+            co.clusterCount = count;
+            co.errorBound = ctx.options.maxPlaneError * ctx.diagonal;
+            const std::uint32_t tries = std::min<std::uint32_t>(ctx.options.clusteringTries, CLUSTERING_TRIES_MAX);
+            judged = {};
+            LeafClustering best;
+            double bestError = std::numeric_limits<double>::infinity();
+            for (std::uint32_t t = 0; t < tries; ++t)
+            {
+                co.spatialWeight = CLUSTERING_WEIGHTS[t].first;
+                co.orientationWeight = CLUSTERING_WEIGHTS[t].second;
+                LeafClustering clustering = clusterLeaves(ctx.model, co);
+                if (tries == 1)
+                    return clustering;
+                const double e = ctx.judge->error(clustering);
+                report(ctx.progress, step, 0.5f * float(t + 1) / float(tries));
+                if (e < bestError)
+                {
+                    bestError = e;
+                    bestTry = t;
+                    best = std::move(clustering);
+                }
+                if (t == 0)
+                    judged.defaultError = e;
+            }
+            judged.error = bestError;
+            judged.spatialWeight = CLUSTERING_WEIGHTS[bestTry].first;
+            judged.orientationWeight = CLUSTERING_WEIGHTS[bestTry].second;
+            return best;
+        }
 
         /// §4.1: clusters -> billboards with lists (all levels: the low-res pass reads them).
         LevelBuild buildLevel(const BakeContext& ctx, std::uint32_t count, bool layered, const std::string& step)
@@ -893,11 +944,8 @@ namespace TreeLod
             LevelBuild level;
             level.layered = layered;
             level.cellSize = ctx.cellSize;
-            LeafClusteringOptions co;
-            co.clusterCount = count;
-            co.errorBound = ctx.options.maxPlaneError * ctx.diagonal;
             report(ctx.progress, step, 0.0f);
-            const LeafClustering clustering = clusterLeaves(ctx.model, co);
+            const LeafClustering clustering = chooseClustering(ctx, count, step, level.judged);
             double sum = 0.0;
             for (float e : clustering.error)
             {
@@ -1079,6 +1127,8 @@ namespace TreeLod
             }
             s.meanPlaneError = levels[0].meanError;
             s.maxPlaneError = levels[0].maxError;
+            for (int l = 0; l < 3; ++l)
+                s.clustering[l] = levels[std::size_t(l)].judged;
 
             // §5.1: low-res images from the layered representation.
             report(ctx.progress, "billboard low-res", 0.0f);
@@ -1239,6 +1289,7 @@ namespace TreeLod
             s.billboards[0] = std::uint32_t(level.billboards.size());
             s.meanPlaneError = level.meanError;
             s.maxPlaneError = level.maxError;
+            s.clustering[0] = level.judged;
 
             // Texel size for the budget: bytes ~ texels x (1 DXT5, 4 RGBA8) x 4/3 (mips). The
             // atlas size follows from the rect sizes alone, so it is solved before rendering:

@@ -2,6 +2,10 @@
 // §4.1 (contract and deviations in BillboardClustering.h).
 #include "BillboardClustering.h"
 
+#include "TreeLod/ImageMetrics.h"
+#include "TreeLod/ReferenceRenderer.h"
+#include "TreeLod/TreeViews.h"
+
 #include <Eigen/Dense>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -295,5 +299,67 @@ namespace TreeLod
         out.error = std::move(error);
         out.members = std::move(members);
         return out;
+    }
+
+    TreeModel flattenedOntoClusters(const TreeModel& model, const LeafClustering& clustering)
+    {
+        TreeModel flat = model;
+        for (std::size_t k = 0; k < clustering.members.size(); ++k)
+        {
+            const glm::vec3 n = clustering.normal[k];
+            const float d = clustering.offset[k];
+            for (std::uint32_t i : clustering.members[k])
+            {
+                const Leaf& leaf = model.leaves[i];
+                for (std::uint32_t v = leaf.firstVertex; v < leaf.firstVertex + leaf.vertexCount; ++v)
+                {
+                    glm::vec3& p = flat.leafVertices[v].position;
+                    p -= (glm::dot(n, p) - d) * n;
+                }
+            }
+        }
+        return flat;
+    }
+
+    struct ClusteringJudge::View
+    {
+        CameraSpec camera;
+        int size = 0;
+        Image reference;
+        Extent extent;
+    };
+
+    ClusteringJudge::ClusteringJudge(const TreeModel& model, const glm::vec3& lo, const glm::vec3& hi,
+                                     const Options& options)
+        : mModel(model), mOptions(options)
+    {
+        const ReferenceRenderer renderer(model);
+        for (int size : options.sizes)
+            for (const glm::vec2& v : options.views)
+            {
+                View view;
+                view.camera = CameraSpec::framing(lo, hi, v.x, v.y);
+                view.size = size;
+                view.reference = traceReference(renderer, view.camera, size, options.supersample);
+                view.extent = treeExtent(view.reference);
+                mViews.push_back(std::move(view));
+            }
+    }
+
+    ClusteringJudge::~ClusteringJudge() = default;
+
+    double ClusteringJudge::error(const LeafClustering& clustering) const
+    {
+        const TreeModel flat = flattenedOntoClusters(mModel, clustering);
+        const ReferenceRenderer renderer(flat);
+        double sum = 0.0;
+        for (const View& view : mViews)
+        {
+            const Image test = traceReference(renderer, view.camera, view.size, mOptions.supersample);
+            const Crop crop = cropAround(unite(view.extent, treeExtent(test)), test.width, test.height);
+            const Result<FlipResult> f = flip(cropImage(view.reference, crop), cropImage(test, crop));
+            sum += f ? f->mean : 1.0;
+        }
+        return mViews.empty() ? 0.0 : sum / double(mViews.size());
     }
 }

@@ -28,12 +28,19 @@
 
 namespace TreeLod
 {
+    constexpr std::uint32_t CLUSTERING_TRIES_MAX = 6;
+
     struct BillboardCloudOptions
     {
         /// Billboards of the finest cloud; 0 = derived from the leaf count
         /// (clamp(1.5 * sqrt(leaves), 8, 260), the paper's 60-260 for trees). Never more than
         /// the leaves.
         std::uint32_t billboardCount = 0;
+        /// Clusterings tried per cloud level, with different spatial and orientation weights
+        /// (BillboardClustering.h); the one kept has the least image error of its leaves
+        /// flattened onto their billboards, seen from around and above the tree
+        /// (ClusteringJudge). 1: the default weights, unjudged. At most CLUSTERING_TRIES_MAX.
+        std::uint32_t clusteringTries = CLUSTERING_TRIES_MAX;
         /// Plane-fitting error bound: the largest distance of a leaf vertex from its billboard,
         /// as a fraction of the tree's bounding-box diagonal.
         float maxPlaneError = 0.04f;
@@ -69,6 +76,14 @@ namespace TreeLod
         std::uint64_t memoryBytes = 0;
     };
 
+    /// How a cloud level's clustering was chosen (BillboardCloudOptions::clusteringTries).
+    struct JudgedClustering
+    {
+        double error = 0.0;        ///< its image error (ClusteringJudge: mean FLIP), 0 when unjudged
+        double defaultError = 0.0; ///< that of the default weights' clustering
+        float spatialWeight = 0.5f, orientationWeight = 4.0f; ///< the weights kept
+    };
+
     struct BillboardCloudStats
     {
         std::uint32_t leaves = 0;
@@ -78,6 +93,7 @@ namespace TreeLod
         std::uint32_t truncatedCells = 0; ///< lists cut at 255 entries (reported, never silent)
         float meanPlaneError = 0.0f;      ///< metres, finest cloud
         float maxPlaneError = 0.0f;
+        JudgedClustering clustering[3]; ///< per level (the classic cloud: level 0)
         std::uint64_t gpuBytes = 0;
     };
 
