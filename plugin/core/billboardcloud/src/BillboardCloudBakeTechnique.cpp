@@ -21,10 +21,12 @@ namespace TreeLod
             Result<double> tileSize = bakeOptionNumber(given, technique, "tileSize", options.tileSize, 8, 1024, label);
             Result<double> maxTexels = bakeOptionNumber(given, technique, "maxLeavesTexels", double(options.maxLeavesTexels),
                                                         0, double(1u << 28), label);
+            Result<double> planeError =
+                bakeOptionNumber(given, technique, "maxPlaneError", options.maxPlaneError, 0.0, 1.0, label);
             Result<double> tries = bakeOptionNumber(given, technique, "clusteringTries", options.clusteringTries, 1,
                                                     CLUSTERING_TRIES_MAX, label);
             Result<bool> compress = bakeOptionFlag(given, technique, "compress", options.compress, label);
-            for (const Result<double>* r : {&billboards, &listFactor, &aoRays, &tileSize, &maxTexels, &tries})
+            for (const Result<double>* r : {&billboards, &listFactor, &aoRays, &tileSize, &maxTexels, &planeError, &tries})
                 if (!*r)
                     return r->error();
             if (!compress)
@@ -34,6 +36,7 @@ namespace TreeLod
             options.aoRays = int(aoRays.value());
             options.tileSize = std::uint32_t(tileSize.value()); // a power of two: checked by the baker
             options.maxLeavesTexels = std::uint64_t(maxTexels.value());
+            options.maxPlaneError = float(planeError.value());
             options.clusteringTries = std::uint32_t(tries.value());
             options.compress = compress.value();
             return {};
@@ -66,6 +69,10 @@ namespace TreeLod
                     {"maxLeavesTexels",
                      "Leaves Texture budget in texels, 0 (none) to 2^28: the tile edge halves to fit, not below 16",
                      "2097152"},
+                    {"maxPlaneError",
+                     "plane-fitting bound: largest leaf vertex distance from its billboard over the tree's "
+                     "box diagonal, 0 to 1",
+                     "0.02"},
                     {"clusteringTries",
                      "clusterings tried per level, 1 to 6, the one kept judged by image error from around and above",
                      "6"},

@@ -140,10 +140,11 @@ namespace TreeLod
         /// larger leaf's frame and aspect). Deviation (docs/lodf.md): the paper's two leaves alone
         /// cannot reach that area a few collapses deep, and coarse levels thinned out.
         Node collapseLeaves(const TreeModel& m, const Node& a, const Node& b, const std::vector<Node>& nodes,
-                           std::uint32_t originalCount)
+                           std::uint32_t originalCount, const glm::vec3* centreOf = nullptr)
         {
             const float target = a.area + b.area;
-            const glm::vec3 centre = (a.centre * a.area + b.centre * b.area) / std::max(target, 1e-30f);
+            const glm::vec3 centre =
+                centreOf ? *centreOf : (a.centre * a.area + b.centre * b.area) / std::max(target, 1e-30f);
             float bestScore = std::numeric_limits<float>::max();
             Node out;
             out.corner = a.corner; // kept if every score is NaN (extreme coordinates)
@@ -238,8 +239,90 @@ namespace TreeLod
             return out;
         }
 
-        /// §3 / FSA: collapse the cheapest pair until one leaf is left. Row minima make it
-        /// O(n^2) per cluster in practice.
+        /// Crossed leaves: two originals of one leaf image are parts of one crossed leaf when their
+        /// centres lie within CROSSED_CENTRE leaf sizes of each other and their planes differ
+        /// (|n_a . n_b| < CROSSED_PARALLEL), as ez-tree's "double billboards" and needle sprigs.
+        constexpr float CROSSED_CENTRE = 0.05f, CROSSED_PARALLEL = 0.9f;
+
+        /// The cluster's originals grouped into crossed leaves (a plain leaf is a group of one),
+        /// each group in increasing node order, groups by their first node.
+        std::vector<std::vector<std::uint32_t>> crossedGroups(const std::vector<Node>& nodes, std::uint32_t n)
+        {
+            std::vector<std::uint32_t> group(n);
+            std::iota(group.begin(), group.end(), 0u);
+            for (std::uint32_t i = 0; i < n; ++i)
+                for (std::uint32_t j = i + 1; j < n; ++j)
+                {
+                    const Node& a = nodes[i];
+                    const Node& b = nodes[j];
+                    if (group[j] != j || !sameImage(a, b) ||
+                        std::abs(glm::dot(a.normal, b.normal)) >= CROSSED_PARALLEL ||
+                        !(glm::length(a.centre - b.centre) < CROSSED_CENTRE * std::sqrt(std::min(a.area, b.area))))
+                        continue;
+                    group[j] = group[i];
+                }
+            std::vector<std::vector<std::uint32_t>> groups;
+            std::vector<std::uint32_t> index(n, 0);
+            for (std::uint32_t i = 0; i < n; ++i)
+            {
+                if (group[i] == i)
+                {
+                    index[i] = std::uint32_t(groups.size());
+                    groups.emplace_back();
+                }
+                groups[index[group[i]]].push_back(i);
+            }
+            return groups;
+        }
+
+        /// The parts of `u` and `v` collapsed with each other: each part of the one with fewer
+        /// parts (u on a tie) with the most parallel free part of the other, in order.
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> matchParts(const std::vector<Node>& nodes,
+                                                                        const std::vector<std::uint32_t>& u,
+                                                                        const std::vector<std::uint32_t>& v)
+        {
+            const bool swap = v.size() < u.size();
+            const std::vector<std::uint32_t>& few = swap ? v : u;
+            const std::vector<std::uint32_t>& many = swap ? u : v;
+            std::vector<char> used(many.size(), 0);
+            std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+            for (std::uint32_t a : few)
+            {
+                std::size_t best = 0;
+                float bestDot = -1.0f;
+                for (std::size_t k = 0; k < many.size(); ++k)
+                    if (!used[k])
+                    {
+                        const float d = std::abs(glm::dot(nodes[a].normal, nodes[many[k]].normal));
+                        if (d > bestDot)
+                        {
+                            bestDot = d;
+                            best = k;
+                        }
+                    }
+                used[best] = 1;
+                pairs.push_back(swap ? std::make_pair(many[best], a) : std::make_pair(a, many[best]));
+            }
+            return pairs;
+        }
+
+        /// The cost of collapsing two crossed leaves: the largest of their part pairs' (a plain
+        /// leaf's is collapseCost).
+        float groupCost(const std::vector<Node>& nodes, const std::vector<std::uint32_t>& u,
+                        const std::vector<std::uint32_t>& v, float meanArea)
+        {
+            if (u.size() == 1 && v.size() == 1)
+                return collapseCost(nodes[u[0]], nodes[v[0]], meanArea);
+            float cost = 0.0f;
+            for (const auto& [a, b] : matchParts(nodes, u, v))
+                cost = std::max(cost, collapseCost(nodes[a], nodes[b], meanArea));
+            return cost;
+        }
+
+        /// §3 / FSA: collapse the cheapest pair until one leaf is left. Crossed leaves collapse as
+        /// one, part with part (matchParts), so they stay crossed; only the cluster's last
+        /// collapses merge the parts of its one remaining crossed leaf. Row minima make it O(n^2)
+        /// per cluster in practice.
         void simplifyCluster(const TreeModel& m, ClusterBuild& cluster, float meanArea)
         {
             const std::uint32_t n = std::uint32_t(cluster.leaves.size());
@@ -250,20 +333,29 @@ namespace TreeLod
             }
             if (n < 2)
                 return;
-            // slot -> node id; a collapse puts its new leaf in the slot of `a` and frees `b`'s.
-            std::vector<std::uint32_t> slotNode(n);
-            std::iota(slotNode.begin(), slotNode.end(), 0u);
-            std::vector<char> alive(n, 1);
-            std::vector<float> cost(std::size_t(n) * n, 0.0f);
-            auto at = [&](std::uint32_t i, std::uint32_t j) -> float& { return cost[std::size_t(i) * n + j]; };
-            for (std::uint32_t i = 0; i < n; ++i)
-                for (std::uint32_t j = i + 1; j < n; ++j)
-                    at(i, j) = at(j, i) = collapseCost(cluster.nodes[i], cluster.nodes[j], meanArea);
-            std::vector<std::uint32_t> best(n);
+            float running = 0.0f;
+            auto collapse = [&](std::uint32_t a, std::uint32_t b, float cost, const glm::vec3* centre = nullptr) {
+                Node merged = collapseLeaves(m, cluster.nodes[a], cluster.nodes[b], cluster.nodes, n, centre);
+                cluster.nodes.push_back(std::move(merged));
+                running = std::max(running, cost);
+                cluster.collapses.push_back({a, b, running});
+                return std::uint32_t(cluster.nodes.size() - 1);
+            };
+            // slot -> the parts (node ids) of a crossed or plain leaf; a collapse puts the new leaf
+            // in the slot of `a` and frees `b`'s.
+            std::vector<std::vector<std::uint32_t>> slot = crossedGroups(cluster.nodes, n);
+            const std::uint32_t S = std::uint32_t(slot.size());
+            std::vector<char> alive(S, 1);
+            std::vector<float> cost(std::size_t(S) * S, 0.0f);
+            auto at = [&](std::uint32_t i, std::uint32_t j) -> float& { return cost[std::size_t(i) * S + j]; };
+            for (std::uint32_t i = 0; i < S; ++i)
+                for (std::uint32_t j = i + 1; j < S; ++j)
+                    at(i, j) = at(j, i) = groupCost(cluster.nodes, slot[i], slot[j], meanArea);
+            std::vector<std::uint32_t> best(S);
             auto refreshRow = [&](std::uint32_t i) {
                 float v = std::numeric_limits<float>::max();
                 std::uint32_t b = i;
-                for (std::uint32_t j = 0; j < n; ++j)
+                for (std::uint32_t j = 0; j < S; ++j)
                     if (j != i && alive[j] && at(i, j) < v)
                     {
                         v = at(i, j);
@@ -271,21 +363,20 @@ namespace TreeLod
                     }
                 best[i] = b;
             };
-            for (std::uint32_t i = 0; i < n; ++i)
+            for (std::uint32_t i = 0; i < S; ++i)
                 refreshRow(i);
-            float running = 0.0f;
-            for (std::uint32_t step = 1; step < n; ++step)
+            for (std::uint32_t step = 1; step < S; ++step)
             {
-                std::uint32_t bi = n, bj = n;
+                std::uint32_t bi = S, bj = S;
                 float bv = std::numeric_limits<float>::max();
-                for (std::uint32_t i = 0; i < n; ++i)
+                for (std::uint32_t i = 0; i < S; ++i)
                     if (alive[i] && best[i] != i && at(i, best[i]) < bv)
                     {
                         bv = at(i, best[i]);
                         bi = i;
                         bj = best[i];
                     }
-                if (bi == n)
+                if (bi == S)
                 {
                     // Every cost NaN or infinite (finite but extreme coordinates): collapse the
                     // first two live leaves, the structure stays valid.
@@ -295,19 +386,28 @@ namespace TreeLod
                 }
                 if (bi > bj)
                     std::swap(bi, bj);
-                const std::uint32_t na = slotNode[bi], nb = slotNode[bj];
-                Node merged = collapseLeaves(m, cluster.nodes[na], cluster.nodes[nb], cluster.nodes, n);
-                cluster.nodes.push_back(std::move(merged));
-                running = std::max(running, bv);
-                cluster.collapses.push_back({na, nb, running});
-                slotNode[bi] = std::uint32_t(cluster.nodes.size() - 1);
+                // Matched parts collapse (one step each); the larger leaf's unmatched parts stay.
+                const auto pairs = matchParts(cluster.nodes, slot[bi], slot[bj]);
+                // Later parts are centred where the first one came to lie, so the leaf stays crossed.
+                std::vector<std::uint32_t> parts;
+                for (const auto& [a, b] : pairs)
+                {
+                    const glm::vec3 first = parts.empty() ? glm::vec3(0.0f) : cluster.nodes[parts[0]].centre;
+                    parts.push_back(collapse(a, b, bv, parts.empty() ? nullptr : &first));
+                }
+                for (const std::vector<std::uint32_t>* side : {&slot[bi], &slot[bj]})
+                    for (std::uint32_t p : *side)
+                        if (std::none_of(pairs.begin(), pairs.end(),
+                                         [&](const auto& q) { return q.first == p || q.second == p; }))
+                            parts.push_back(p);
+                slot[bi] = std::move(parts);
+                slot[bj].clear();
                 alive[bj] = 0;
-                const Node& created = cluster.nodes.back();
-                for (std::uint32_t k = 0; k < n; ++k)
+                for (std::uint32_t k = 0; k < S; ++k)
                     if (alive[k] && k != bi)
-                        at(bi, k) = at(k, bi) = collapseCost(created, cluster.nodes[slotNode[k]], meanArea);
+                        at(bi, k) = at(k, bi) = groupCost(cluster.nodes, slot[bi], slot[k], meanArea);
                 refreshRow(bi);
-                for (std::uint32_t k = 0; k < n; ++k)
+                for (std::uint32_t k = 0; k < S; ++k)
                 {
                     if (!alive[k] || k == bi)
                         continue;
@@ -316,6 +416,23 @@ namespace TreeLod
                     else if (at(k, bi) < at(k, best[k]))
                         best[k] = bi;
                 }
+            }
+            // The last crossed leaf's parts, cheapest pair first, down to one leaf.
+            std::vector<std::uint32_t>& last = slot[std::uint32_t(std::find(alive.begin(), alive.end(), 1) - alive.begin())];
+            while (last.size() > 1)
+            {
+                std::size_t bi = 0, bj = 1;
+                float bv = std::numeric_limits<float>::max();
+                for (std::size_t i = 0; i < last.size(); ++i)
+                    for (std::size_t j = i + 1; j < last.size(); ++j)
+                        if (const float c = collapseCost(cluster.nodes[last[i]], cluster.nodes[last[j]], meanArea); c < bv)
+                        {
+                            bv = c;
+                            bi = i;
+                            bj = j;
+                        }
+                last[bi] = collapse(last[bi], last[bj], bv);
+                last.erase(last.begin() + std::ptrdiff_t(bj));
             }
         }
 
