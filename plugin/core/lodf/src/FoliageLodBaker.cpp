@@ -26,7 +26,7 @@ namespace TreeLod
             glm::vec3 normal{0.0f, 1.0f, 0.0f};
             float area = 0.0f;       ///< area it stands for: the sum over the original leaves it replaces
             glm::vec2 uvMin{0.0f}, uvMax{0.0f};
-            std::uint32_t imageSource = 0; ///< an original part (ClusterBuild::parts) whose leaf image it shows
+            std::uint32_t imageSource = 0; ///< an original leaf (node id) whose leaf image it shows
         };
 
         struct Collapse
@@ -35,20 +35,11 @@ namespace TreeLod
             float cost = 0.0f;          ///< running maximum in the cluster (monotone)
         };
 
-        /// A leaf while collapsing: one quad, or several for a crossed leaf, and its triangles.
-        struct Shape
-        {
-            std::vector<std::uint32_t> parts;   ///< into ClusterBuild::parts
-            std::vector<std::uint32_t> indices; ///< its triangles (absolute leaf vertex indices)
-        };
-
         struct ClusterBuild
         {
             std::uint32_t material = 0;
             std::vector<std::uint32_t> leaves; ///< model leaf indices, the cluster's originals
-            std::vector<Node> parts;           ///< the originals' quads (the first originalParts), then created ones
-            std::uint32_t originalParts = 0;
-            std::vector<Shape> nodes;          ///< originals then created (Collapse ids)
+            std::vector<Node> nodes;           ///< originals then created
             std::vector<Collapse> collapses;
         };
 
@@ -61,36 +52,30 @@ namespace TreeLod
             return 0.5f * glm::length(glm::cross(p2 - p0, p3 - p1));
         }
 
-        /// The four of `vertices` nearest the corners of their texture rectangle (or, without a UV
-        /// extent, nearest the corners of their extent in the plane of `normal`).
-        Node quadNode(const TreeModel& m, const std::vector<std::uint32_t>& vertices, const glm::vec3& centre,
-                      const glm::vec3& normal, float area)
+        /// The four vertices of leaf `i` nearest its texture rectangle's corners (or, for a leaf
+        /// without a UV extent, nearest the corners of its extent in its own plane).
+        Node originalNode(const TreeModel& m, std::size_t i)
         {
+            const Leaf& leaf = m.leaves[i];
             Node node;
-            node.centre = centre;
-            node.normal = normal;
-            glm::vec2 uvLo(std::numeric_limits<float>::max()), uvHi(-std::numeric_limits<float>::max());
-            for (std::uint32_t v : vertices)
-            {
-                uvLo = glm::min(uvLo, m.leafVertices[v].uv);
-                uvHi = glm::max(uvHi, m.leafVertices[v].uv);
-            }
-            node.uvMin = uvLo;
-            node.uvMax = uvHi;
-            const glm::vec2 uvExtent = uvHi - uvLo;
+            node.centre = leaf.centre;
+            node.normal = leaf.normal;
+            node.uvMin = leaf.uvMin;
+            node.uvMax = leaf.uvMax;
+            const glm::vec2 uvExtent = leaf.uvMax - leaf.uvMin;
             const bool useUv = uvExtent.x > 1e-6f && uvExtent.y > 1e-6f;
             glm::vec3 axisU(1.0f, 0.0f, 0.0f);
             if (!useUv)
             {
-                axisU = glm::cross(normal, std::abs(normal.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0));
+                axisU = glm::cross(leaf.normal, std::abs(leaf.normal.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0));
                 axisU = glm::normalize(axisU);
             }
-            const glm::vec3 axisV = glm::cross(normal, axisU);
-            std::vector<glm::vec2> t(vertices.size());
+            const glm::vec3 axisV = glm::cross(leaf.normal, axisU);
+            std::vector<glm::vec2> t(leaf.vertexCount);
             glm::vec2 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-            for (std::size_t k = 0; k < vertices.size(); ++k)
+            for (std::uint32_t k = 0; k < leaf.vertexCount; ++k)
             {
-                const Vertex& v = m.leafVertices[vertices[k]];
+                const Vertex& v = m.leafVertices[leaf.firstVertex + k];
                 t[k] = useUv ? v.uv : glm::vec2(glm::dot(v.position, axisU), glm::dot(v.position, axisV));
                 lo = glm::min(lo, t[k]);
                 hi = glm::max(hi, t[k]);
@@ -100,96 +85,20 @@ namespace TreeLod
             for (int r = 0; r < 4; ++r)
             {
                 float best = std::numeric_limits<float>::max();
-                for (std::size_t k = 0; k < vertices.size(); ++k)
+                for (std::uint32_t k = 0; k < leaf.vertexCount; ++k)
                 {
                     glm::vec2 d = (t[k] - lo) / extent - CORNERS[r];
                     float e = glm::dot(d, d);
                     if (e < best)
                     {
                         best = e;
-                        node.corner[r] = vertices[k];
+                        node.corner[r] = leaf.firstVertex + k;
                     }
                 }
             }
             float q = quadArea(m, node.corner);
-            node.area = q > 1e-12f ? q : area;
+            node.area = q > 1e-12f ? q : leaf.area;
             return node;
-        }
-
-        /// A part of a multi-polygon leaf: its triangles in one plane (normals within
-        /// PART_PARALLEL), at least two, showing at least PART_IMAGE of the leaf's texture
-        /// rectangle (a blade of a crossed leaf, not a strip of a bent one).
-        constexpr float PART_PARALLEL = 0.95f, PART_IMAGE = 0.8f;
-
-        /// Leaf `i` as quads: one per part when every part of it is one (crossed blades sharing an
-        /// edge, as in a leaf modelled as one mesh), else one for the whole leaf.
-        std::vector<Node> originalParts(const TreeModel& m, std::size_t i)
-        {
-            const Leaf& leaf = m.leaves[i];
-            const auto whole = [&]() {
-                std::vector<std::uint32_t> vertices(leaf.vertexCount);
-                std::iota(vertices.begin(), vertices.end(), leaf.firstVertex);
-                Node node = quadNode(m, vertices, leaf.centre, leaf.normal, leaf.area);
-                node.uvMin = leaf.uvMin;
-                node.uvMax = leaf.uvMax;
-                return std::vector<Node>{node};
-            };
-            const std::uint32_t triangles = leaf.indexCount / 3;
-            if (triangles < 4)
-                return whole();
-            struct Part
-            {
-                glm::vec3 normal{0.0f}, centre{0.0f};
-                float area = 0.0f;
-                std::vector<std::uint32_t> vertices;
-                std::uint32_t triangles = 0;
-            };
-            std::vector<Part> parts;
-            for (std::uint32_t t = 0; t < triangles; ++t)
-            {
-                const std::uint32_t* q = &m.leafIndices[leaf.firstIndex + 3 * t];
-                const glm::vec3 a = m.leafVertices[q[0]].position, b = m.leafVertices[q[1]].position,
-                                c = m.leafVertices[q[2]].position;
-                const glm::vec3 cross = glm::cross(b - a, c - a);
-                const float area = 0.5f * glm::length(cross);
-                if (!(area > 0.0f))
-                    continue;
-                const glm::vec3 n = cross / (2.0f * area);
-                auto part = std::find_if(parts.begin(), parts.end(), [&](const Part& p) {
-                    return std::abs(glm::dot(p.normal, n)) > PART_PARALLEL;
-                });
-                if (part == parts.end())
-                {
-                    parts.push_back({n, glm::vec3(0.0f), 0.0f, {}, 0});
-                    part = parts.end() - 1;
-                }
-                part->centre += area * (a + b + c) / 3.0f;
-                part->area += area;
-                part->triangles += 1;
-                for (int k = 0; k < 3; ++k)
-                    if (std::find(part->vertices.begin(), part->vertices.end(), q[k]) == part->vertices.end())
-                        part->vertices.push_back(q[k]);
-            }
-            const glm::vec2 leafUv = leaf.uvMax - leaf.uvMin;
-            if (parts.size() < 2 || !(leafUv.x * leafUv.y > 0.0f))
-                return whole();
-            std::vector<Node> out;
-            for (Part& p : parts)
-            {
-                glm::vec2 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-                for (std::uint32_t v : p.vertices)
-                {
-                    lo = glm::min(lo, m.leafVertices[v].uv);
-                    hi = glm::max(hi, m.leafVertices[v].uv);
-                }
-                const glm::vec2 uv = hi - lo;
-                if (p.triangles < 2 || uv.x * uv.y < PART_IMAGE * leafUv.x * leafUv.y)
-                    return whole();
-                out.push_back(quadNode(m, p.vertices, p.centre / p.area, p.normal, p.area));
-                out.back().uvMin = leaf.uvMin; // one leaf image
-                out.back().uvMax = leaf.uvMax;
-            }
-            return out;
         }
 
         bool sameImage(const Node& a, const Node& b)
@@ -330,26 +239,24 @@ namespace TreeLod
             return out;
         }
 
-        /// Crossed leaves built of separate quads: two one-quad originals of one leaf image are
-        /// parts of one crossed leaf when their centres lie within CROSSED_CENTRE leaf sizes of
-        /// each other and their planes differ (|n_a . n_b| < CROSSED_PARALLEL), as ez-tree's
-        /// "double billboards" and needle sprigs.
+        /// Crossed leaves: two originals of one leaf image are parts of one crossed leaf when their
+        /// centres lie within CROSSED_CENTRE leaf sizes of each other and their planes differ
+        /// (|n_a . n_b| < CROSSED_PARALLEL), as ez-tree's "double billboards" and needle sprigs.
         constexpr float CROSSED_CENTRE = 0.05f, CROSSED_PARALLEL = 0.9f;
 
         /// The cluster's originals grouped into crossed leaves (a plain leaf is a group of one),
         /// each group in increasing node order, groups by their first node.
-        std::vector<std::vector<std::uint32_t>> crossedGroups(const ClusterBuild& cluster, std::uint32_t n)
+        std::vector<std::vector<std::uint32_t>> crossedGroups(const std::vector<Node>& nodes, std::uint32_t n)
         {
             std::vector<std::uint32_t> group(n);
             std::iota(group.begin(), group.end(), 0u);
             for (std::uint32_t i = 0; i < n; ++i)
                 for (std::uint32_t j = i + 1; j < n; ++j)
                 {
-                    if (group[j] != j || cluster.nodes[i].parts.size() != 1 || cluster.nodes[j].parts.size() != 1)
-                        continue;
-                    const Node& a = cluster.parts[cluster.nodes[i].parts[0]];
-                    const Node& b = cluster.parts[cluster.nodes[j].parts[0]];
-                    if (!sameImage(a, b) || std::abs(glm::dot(a.normal, b.normal)) >= CROSSED_PARALLEL ||
+                    const Node& a = nodes[i];
+                    const Node& b = nodes[j];
+                    if (group[j] != j || !sameImage(a, b) ||
+                        std::abs(glm::dot(a.normal, b.normal)) >= CROSSED_PARALLEL ||
                         !(glm::length(a.centre - b.centre) < CROSSED_CENTRE * std::sqrt(std::min(a.area, b.area))))
                         continue;
                     group[j] = group[i];
@@ -368,9 +275,9 @@ namespace TreeLod
             return groups;
         }
 
-        /// The parts (ids into `parts`) of `u` and `v` collapsed with each other: each part of the
-        /// one with fewer parts (u on a tie) with the most parallel free part of the other, in order.
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> matchParts(const std::vector<Node>& parts,
+        /// The parts of `u` and `v` collapsed with each other: each part of the one with fewer
+        /// parts (u on a tie) with the most parallel free part of the other, in order.
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> matchParts(const std::vector<Node>& nodes,
                                                                         const std::vector<std::uint32_t>& u,
                                                                         const std::vector<std::uint32_t>& v)
         {
@@ -386,7 +293,7 @@ namespace TreeLod
                 for (std::size_t k = 0; k < many.size(); ++k)
                     if (!used[k])
                     {
-                        const float d = std::abs(glm::dot(parts[a].normal, parts[many[k]].normal));
+                        const float d = std::abs(glm::dot(nodes[a].normal, nodes[many[k]].normal));
                         if (d > bestDot)
                         {
                             bestDot = d;
@@ -399,77 +306,51 @@ namespace TreeLod
             return pairs;
         }
 
-        /// The cost of collapsing two leaves: the largest of their part pairs' (one-quad leaves:
-        /// collapseCost).
-        float shapeCost(const std::vector<Node>& parts, const Shape& u, const Shape& v, float meanArea)
+        /// The cost of collapsing two crossed leaves: the largest of their part pairs' (a plain
+        /// leaf's is collapseCost).
+        float groupCost(const std::vector<Node>& nodes, const std::vector<std::uint32_t>& u,
+                        const std::vector<std::uint32_t>& v, float meanArea)
         {
+            if (u.size() == 1 && v.size() == 1)
+                return collapseCost(nodes[u[0]], nodes[v[0]], meanArea);
             float cost = 0.0f;
-            for (const auto& [a, b] : matchParts(parts, u.parts, v.parts))
-                cost = std::max(cost, collapseCost(parts[a], parts[b], meanArea));
+            for (const auto& [a, b] : matchParts(nodes, u, v))
+                cost = std::max(cost, collapseCost(nodes[a], nodes[b], meanArea));
             return cost;
         }
 
-        void appendQuad(std::vector<std::uint32_t>& indices, const std::array<std::uint32_t, 4>& q)
-        {
-            indices.insert(indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
-        }
-
-        /// §3 / FSA: collapse the cheapest pair until one leaf is left. A crossed leaf (several
-        /// quads: the parts of a multi-polygon original, or one-quad originals through one
-        /// centre, joined first at no cost and with no change to the picture) collapses part with
-        /// part (matchParts) and stays crossed, down to the cluster's root. Row minima make it
-        /// O(n^2) per cluster in practice.
+        /// §3 / FSA: collapse the cheapest pair until one leaf is left. Crossed leaves collapse as
+        /// one, part with part (matchParts), so they stay crossed; only the cluster's last
+        /// collapses merge the parts of its one remaining crossed leaf. Row minima make it O(n^2)
+        /// per cluster in practice.
         void simplifyCluster(const TreeModel& m, ClusterBuild& cluster, float meanArea)
         {
             const std::uint32_t n = std::uint32_t(cluster.leaves.size());
             for (std::uint32_t i = 0; i < n; ++i)
             {
-                const Leaf& leaf = m.leaves[cluster.leaves[i]];
-                Shape shape;
-                for (Node& part : originalParts(m, cluster.leaves[i]))
-                {
-                    part.imageSource = std::uint32_t(cluster.parts.size());
-                    shape.parts.push_back(part.imageSource);
-                    cluster.parts.push_back(part);
-                }
-                shape.indices.assign(m.leafIndices.begin() + leaf.firstIndex,
-                                     m.leafIndices.begin() + leaf.firstIndex + leaf.indexCount);
-                cluster.nodes.push_back(std::move(shape));
+                cluster.nodes.push_back(originalNode(m, cluster.leaves[i]));
+                cluster.nodes.back().imageSource = i;
             }
-            cluster.originalParts = std::uint32_t(cluster.parts.size());
             if (n < 2)
                 return;
             float running = 0.0f;
-            auto record = [&](std::uint32_t a, std::uint32_t b, float cost, Shape shape) {
-                cluster.nodes.push_back(std::move(shape));
+            auto collapse = [&](std::uint32_t a, std::uint32_t b, float cost, const glm::vec3* centre = nullptr) {
+                Node merged = collapseLeaves(m, cluster.nodes[a], cluster.nodes[b], cluster.nodes, n, centre);
+                cluster.nodes.push_back(std::move(merged));
                 running = std::max(running, cost);
                 cluster.collapses.push_back({a, b, running});
                 return std::uint32_t(cluster.nodes.size() - 1);
             };
-            // slot -> node id; a collapse puts its new leaf in the slot of `a` and frees `b`'s.
-            // One-quad originals through one centre are joined first (cost 0, the same triangles).
-            std::vector<std::uint32_t> slotNode;
-            for (const std::vector<std::uint32_t>& group : crossedGroups(cluster, n))
-            {
-                std::uint32_t node = group[0];
-                for (std::size_t k = 1; k < group.size(); ++k)
-                {
-                    Shape joined = cluster.nodes[node];
-                    const Shape& other = cluster.nodes[group[k]];
-                    joined.parts.insert(joined.parts.end(), other.parts.begin(), other.parts.end());
-                    joined.indices.insert(joined.indices.end(), other.indices.begin(), other.indices.end());
-                    node = record(node, group[k], 0.0f, std::move(joined));
-                }
-                slotNode.push_back(node);
-            }
-            const std::uint32_t S = std::uint32_t(slotNode.size());
+            // slot -> the parts (node ids) of a crossed or plain leaf; a collapse puts the new leaf
+            // in the slot of `a` and frees `b`'s.
+            std::vector<std::vector<std::uint32_t>> slot = crossedGroups(cluster.nodes, n);
+            const std::uint32_t S = std::uint32_t(slot.size());
             std::vector<char> alive(S, 1);
             std::vector<float> cost(std::size_t(S) * S, 0.0f);
             auto at = [&](std::uint32_t i, std::uint32_t j) -> float& { return cost[std::size_t(i) * S + j]; };
-            auto shapeAt = [&](std::uint32_t slot) -> const Shape& { return cluster.nodes[slotNode[slot]]; };
             for (std::uint32_t i = 0; i < S; ++i)
                 for (std::uint32_t j = i + 1; j < S; ++j)
-                    at(i, j) = at(j, i) = shapeCost(cluster.parts, shapeAt(i), shapeAt(j), meanArea);
+                    at(i, j) = at(j, i) = groupCost(cluster.nodes, slot[i], slot[j], meanArea);
             std::vector<std::uint32_t> best(S);
             auto refreshRow = [&](std::uint32_t i) {
                 float v = std::numeric_limits<float>::max();
@@ -505,41 +386,26 @@ namespace TreeLod
                 }
                 if (bi > bj)
                     std::swap(bi, bj);
-                // Matched parts collapse (eq. 3, later parts centred on the first, so the leaf stays
-                // crossed); the larger leaf's unmatched parts stay as they are.
-                const Shape& u = shapeAt(bi);
-                const Shape& v = shapeAt(bj);
-                const auto pairs = matchParts(cluster.parts, u.parts, v.parts);
-                Shape merged;
+                // Matched parts collapse (one step each); the larger leaf's unmatched parts stay.
+                const auto pairs = matchParts(cluster.nodes, slot[bi], slot[bj]);
+                // Later parts are centred where the first one came to lie, so the leaf stays crossed.
+                std::vector<std::uint32_t> parts;
                 for (const auto& [a, b] : pairs)
                 {
-                    const glm::vec3 first = merged.parts.empty() ? glm::vec3(0.0f) : cluster.parts[merged.parts[0]].centre;
-                    Node part = collapseLeaves(m, cluster.parts[a], cluster.parts[b], cluster.parts,
-                                               cluster.originalParts, merged.parts.empty() ? nullptr : &first);
-                    merged.parts.push_back(std::uint32_t(cluster.parts.size()));
-                    cluster.parts.push_back(part);
+                    const glm::vec3 first = parts.empty() ? glm::vec3(0.0f) : cluster.nodes[parts[0]].centre;
+                    parts.push_back(collapse(a, b, bv, parts.empty() ? nullptr : &first));
                 }
-                for (const Shape* side : {&u, &v})
-                    for (std::uint32_t p : side->parts)
+                for (const std::vector<std::uint32_t>* side : {&slot[bi], &slot[bj]})
+                    for (std::uint32_t p : *side)
                         if (std::none_of(pairs.begin(), pairs.end(),
                                          [&](const auto& q) { return q.first == p || q.second == p; }))
-                            merged.parts.push_back(p);
-                // A collapse never adds indices (the cluster's region): parts beyond what the two
-                // leaves' triangles pay for are dropped, smallest first.
-                const std::size_t budget = (u.indices.size() + v.indices.size()) / 6;
-                if (merged.parts.size() > budget)
-                {
-                    std::stable_sort(merged.parts.begin() + std::ptrdiff_t(pairs.size()), merged.parts.end(),
-                                     [&](std::uint32_t x, std::uint32_t y) { return cluster.parts[x].area > cluster.parts[y].area; });
-                    merged.parts.resize(std::max<std::size_t>(budget, 1));
-                }
-                for (std::uint32_t p : merged.parts)
-                    appendQuad(merged.indices, cluster.parts[p].corner);
-                slotNode[bi] = record(slotNode[bi], slotNode[bj], bv, std::move(merged));
+                            parts.push_back(p);
+                slot[bi] = std::move(parts);
+                slot[bj].clear();
                 alive[bj] = 0;
                 for (std::uint32_t k = 0; k < S; ++k)
                     if (alive[k] && k != bi)
-                        at(bi, k) = at(k, bi) = shapeCost(cluster.parts, shapeAt(bi), shapeAt(k), meanArea);
+                        at(bi, k) = at(k, bi) = groupCost(cluster.nodes, slot[bi], slot[k], meanArea);
                 refreshRow(bi);
                 for (std::uint32_t k = 0; k < S; ++k)
                 {
@@ -550,6 +416,23 @@ namespace TreeLod
                     else if (at(k, bi) < at(k, best[k]))
                         best[k] = bi;
                 }
+            }
+            // The last crossed leaf's parts, cheapest pair first, down to one leaf.
+            std::vector<std::uint32_t>& last = slot[std::uint32_t(std::find(alive.begin(), alive.end(), 1) - alive.begin())];
+            while (last.size() > 1)
+            {
+                std::size_t bi = 0, bj = 1;
+                float bv = std::numeric_limits<float>::max();
+                for (std::size_t i = 0; i < last.size(); ++i)
+                    for (std::size_t j = i + 1; j < last.size(); ++j)
+                        if (const float c = collapseCost(cluster.nodes[last[i]], cluster.nodes[last[j]], meanArea); c < bv)
+                        {
+                            bv = c;
+                            bi = i;
+                            bj = j;
+                        }
+                last[bi] = collapse(last[bi], last[bj], bv);
+                last.erase(last.begin() + std::ptrdiff_t(bj));
             }
         }
 
@@ -657,9 +540,7 @@ namespace TreeLod
             for (std::uint32_t s = 0; s < clusters[c].collapses.size(); ++s)
             {
                 const float cost = clusters[c].collapses[s].cost;
-                // (lower_bound: a cost equal to a band's first goes in the band before, so the
-                // free joins of crossed leaves, cost 0, come first.)
-                const auto band = std::uint32_t(std::lower_bound(bandEnd.begin(), bandEnd.end(), cost) - bandEnd.begin());
+                const auto band = std::uint32_t(std::upper_bound(bandEnd.begin(), bandEnd.end(), cost) - bandEnd.begin());
                 // costBands 0: the paper's pure cost order (rank = the cost's bits, monotone for
                 // non-negative floats); else the band's clusters in a fixed pseudo-random order.
                 std::uint32_t costBits;
@@ -697,20 +578,24 @@ namespace TreeLod
             auto addEntry = [&](std::uint32_t node) {
                 FoliageLodEntry e;
                 e.firstIndex = std::uint32_t(data.indices.size());
-                const std::vector<std::uint32_t>& indices = b.nodes[node].indices;
-                data.indices.insert(data.indices.end(), indices.begin(), indices.end());
-                e.indexCount = std::uint32_t(indices.size());
                 if (node < n)
                 {
+                    const Leaf& leaf = model.leaves[b.leaves[node]];
                     e.leaf = b.leaves[node];
                     e.created = 0;
-                    k.slotCount += e.indexCount;
+                    data.indices.insert(data.indices.end(), model.leafIndices.begin() + leaf.firstIndex,
+                                        model.leafIndices.begin() + leaf.firstIndex + leaf.indexCount);
+                    e.indexCount = leaf.indexCount;
+                    k.slotCount += leaf.indexCount;
                 }
                 else
                 {
                     const std::uint32_t step = node - n; // 0-based collapse that created it
                     e.leaf = createdNumber[c][step];
                     e.created = step + 1;
+                    const auto& q = b.nodes[node].corner;
+                    data.indices.insert(data.indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+                    e.indexCount = 6;
                 }
                 data.entries.push_back(e);
             };

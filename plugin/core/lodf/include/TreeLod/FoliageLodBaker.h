@@ -23,16 +23,13 @@
 //    the new quad. Deviation (docs/lodf.md): eq. 3 takes the corners from a and b only; a few
 //    collapses deep their vertices cannot reach the area the leaf stands for, and the crowns of
 //    third-party trees thinned out at distance (ez-tree oak at 30 px: FLIP 0.102 against 0.069).
-//    Crossed leaves (deviation, docs/lodf.md): a leaf may be several quads. A multi-polygon
-//    original whose triangles lie in several planes, each showing the whole leaf image (blades
-//    of a crossed leaf modelled as one mesh), is one quad per plane; one-quad originals of one
-//    image through one centre (within 5 % of a leaf size) in different planes, as ez-tree's
-//    "double billboards" and needle sprigs, are joined first, at cost 0 and with their own
-//    triangles. Two leaves collapse part with part (each part of the one with fewer parts with
-//    the most parallel free part of the other; cost: the largest of those pairs'), the later
-//    parts centred on the first, so a crossed leaf stays crossed down to the cluster's root.
-//    Collapsed as flat leaves, crossed leaves lost a quarter of their area by L/2 and their
-//    crossing by L/4.
+//    Crossed leaves (deviation, docs/lodf.md): originals of one leaf image through one centre
+//    (within 5 % of a leaf size) in different planes, as ez-tree's "double billboards" and needle
+//    sprigs, are one crossed leaf. Two crossed leaves collapse part with part (each part of the
+//    one with fewer parts with the most parallel free part of the other; cost: the largest of
+//    those pairs'), one step per pair, the later parts centred on the first; only a cluster's
+//    last steps merge the parts of its one remaining crossed leaf. Collapsed as flat leaves,
+//    crossed leaves lost a quarter of their area by L/2 and their crossing by L/4.
 // 4. Order (Fig. 8): Changed_group lists the collapses by cost band (`costBands` equal-count bands
 //    of each collapse's running-maximum cost in its cluster), and inside a band cluster by cluster
 //    (clusters in a fixed pseudo-random order, so no region of the crown simplifies first).

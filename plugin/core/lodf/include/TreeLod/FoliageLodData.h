@@ -6,8 +6,8 @@
 // of one group (Figs. 4-7): its entries are ordered as the paper's Fig. 7 orders them, the
 // two leaves of the cluster's first collapse, then the two of its second, ..., the cluster's
 // root (its coarsest leaf) last. A collapse never adds vertices (eq. 3): a created leaf is a
-// quad (one per part of a crossed leaf) over vertices of the leaves it replaces, so all
-// vertices are the reference chunk's leaf vertices and live on the GPU once.
+// quad over four vertices of the leaves it replaces, so all vertices are the reference
+// chunk's leaf vertices and live on the GPU once.
 //
 // Deviation from Fig. 7 (documented in docs/lodf.md): the paper gives each entry a fixed `next`
 // position; a fixed chain cannot represent every state in general (in the paper's own
@@ -44,7 +44,7 @@ namespace TreeLod
         std::uint32_t leaf = 0;       ///< leaf number: < L an original (TreeModel::leaves), L + k created by collapse k
         std::uint32_t created = 0;    ///< cluster-local collapse step that creates it, 0 for originals
         std::uint32_t firstIndex = 0; ///< its triangles in FoliageLodData::indices
-        std::uint32_t indexCount = 0; ///< multiple of 3 (6 per quad of a created leaf)
+        std::uint32_t indexCount = 0; ///< multiple of 3 (6 for a created quad)
     };
 
     /// One independent group (§3.1): the leaves of one binary tree.
