@@ -1027,6 +1027,28 @@ namespace TreeLod
         const ClusteringJudge judge(m, lo, hi, {});
         EXPECT_DOUBLE_EQ(judge.error(clusterLeaves(m, co)), judged.clustering[0].error);
 
+        // With a memory bound, the kept clustering's billboards cover at most 5 % more area than
+        // the default weights'.
+        options.clusteringAreaGrowth = 0.05f;
+        BillboardCloudStats bounded;
+        bakeOrFail(m, options, &bounded);
+        LeafClusteringOptions plain = co;
+        plain.spatialWeight = LeafClusteringOptions().spatialWeight;
+        plain.orientationWeight = LeafClusteringOptions().orientationWeight;
+        co.spatialWeight = bounded.clustering[0].spatialWeight;
+        co.orientationWeight = bounded.clustering[0].orientationWeight;
+        const double keptArea = billboardArea(m, clusterLeaves(m, co)), plainArea = billboardArea(m, clusterLeaves(m, plain));
+        std::cout << "billboard area: kept " << keptArea << " m^2 with a 5 % bound, default weights " << plainArea
+                  << " m^2\n";
+        EXPECT_GT(plainArea, 0.0);
+        EXPECT_LE(keptArea, 1.05 * plainArea);
+        EXPECT_LE(bounded.clustering[0].error, bounded.clustering[0].defaultError);
+        options.clusteringAreaGrowth = -1.0f;
+        Result<BillboardCloudData> negative = bakeBillboardCloud(m, options, "growth.glb");
+        ASSERT_FALSE(negative.ok());
+        EXPECT_NE(negative.error().message().find("clusteringAreaGrowth"), std::string::npos);
+        options.clusteringAreaGrowth = 0.0f;
+
         for (std::uint32_t tries : {0u, CLUSTERING_TRIES_MAX + 1})
         {
             options.clusteringTries = tries;

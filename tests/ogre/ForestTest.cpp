@@ -644,9 +644,11 @@ namespace TreeLod
         const Image away = toImage(r.render(moved, 128, 128, 1));
         writePng(OgreEnvironment::outDir() + "/forest-1000km.png", sideBySide({atOrigin, away}));
         EXPECT_GT(treeCoverage(atOrigin, BACKGROUND), 0.1);
-        // Vertices step by up to 6 cm (about 0.6 px here), which moves leaf edges: 0.897 of the
-        // covered pixels overlap with the billboard clouds' judged clustering.
-        EXPECT_GT(coveredOverlap(atOrigin, away, BACKGROUND), 0.85);
+        // Vertices step by up to 6 cm (about 0.6 px here), which moves leaf edges: about 0.9 of
+        // the covered pixels overlap.
+        const double overlap = coveredOverlap(atOrigin, away, BACKGROUND);
+        std::cout << "covered pixels overlapping 1000 km away: " << overlap << "\n";
+        EXPECT_GT(overlap, 0.85);
         EXPECT_LT(flipMean(atOrigin, away), 0.1);
     }
 

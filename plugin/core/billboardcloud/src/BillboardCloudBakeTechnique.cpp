@@ -25,8 +25,10 @@ namespace TreeLod
                 bakeOptionNumber(given, technique, "maxPlaneError", options.maxPlaneError, 0.0, 1.0, label);
             Result<double> tries = bakeOptionNumber(given, technique, "clusteringTries", options.clusteringTries, 1,
                                                     CLUSTERING_TRIES_MAX, label);
+            Result<double> areaGrowth = bakeOptionNumber(given, technique, "clusteringAreaGrowth",
+                                                         options.clusteringAreaGrowth, 0.0, 100.0, label);
             Result<bool> compress = bakeOptionFlag(given, technique, "compress", options.compress, label);
-            for (const Result<double>* r : {&billboards, &listFactor, &aoRays, &tileSize, &maxTexels, &planeError, &tries})
+            for (const Result<double>* r : {&billboards, &listFactor, &aoRays, &tileSize, &maxTexels, &planeError, &tries, &areaGrowth})
                 if (!*r)
                     return r->error();
             if (!compress)
@@ -38,6 +40,7 @@ namespace TreeLod
             options.maxLeavesTexels = std::uint64_t(maxTexels.value());
             options.maxPlaneError = float(planeError.value());
             options.clusteringTries = std::uint32_t(tries.value());
+            options.clusteringAreaGrowth = float(areaGrowth.value());
             options.compress = compress.value();
             return {};
         }
@@ -76,6 +79,10 @@ namespace TreeLod
                     {"clusteringTries",
                      "clusterings tried per level, 1 to 6, the one kept judged by image error from around and above",
                      "6"},
+                    {"clusteringAreaGrowth",
+                     "largest growth of billboard area (memory) a judged clustering may take over the default "
+                     "weights', 0 (no bound) to 100",
+                     "0.05"},
                     {"compress", "DXT-compressed textures (true) or RGBA8 (false)", "true"}};
         }
 

@@ -144,6 +144,9 @@ namespace TreeLod
             if (o.clusteringTries < 1 || o.clusteringTries > CLUSTERING_TRIES_MAX)
                 return bad("clusteringTries",
                            std::to_string(o.clusteringTries) + " is not in 1.." + std::to_string(CLUSTERING_TRIES_MAX));
+            if (!(o.clusteringAreaGrowth >= 0.0f) || !std::isfinite(o.clusteringAreaGrowth))
+                return bad("clusteringAreaGrowth",
+                           std::to_string(o.clusteringAreaGrowth) + " is not a finite number >= 0");
             if (o.aoRays < 1)
                 return bad("aoRays", std::to_string(o.aoRays) + " is not >= 1");
             return {};
@@ -902,7 +905,9 @@ namespace TreeLod
             {{0.5f, 4.0f}, {0.5f, 12.0f}, {0.25f, 4.0f}, {1.0f, 4.0f}, {0.5f, 1.0f}, {0.25f, 12.0f}}};
 
         /// §4.1's clustering into `count` planes, tried with clusteringTries weight pairs and judged
-        /// by image error over views around and above (ClusteringJudge); the first of the least.
+        /// by image error over views around and above (ClusteringJudge): the first of the least
+        /// error among those whose billboard area (billboardArea: hash and low-res texels) is
+        /// within clusteringAreaGrowth of the default weights' clustering.
         LeafClustering chooseClustering(const BakeContext& ctx, std::uint32_t count, const std::string& step,
                                         JudgedClustering& judged)
         {
@@ -912,6 +917,7 @@ namespace TreeLod
             co.errorBound = ctx.options.maxPlaneError * ctx.diagonal;
             const std::uint32_t tries = std::min<std::uint32_t>(ctx.options.clusteringTries, CLUSTERING_TRIES_MAX);
             judged = {};
+            double defaultArea = 0.0;
             LeafClustering best;
             double bestError = std::numeric_limits<double>::infinity();
             for (std::uint32_t t = 0; t < tries; ++t)
@@ -921,6 +927,12 @@ namespace TreeLod
                 LeafClustering clustering = clusterLeaves(ctx.model, co);
                 if (tries == 1)
                     return clustering;
+                const double area = billboardArea(ctx.model, clustering);
+                if (t == 0)
+                    defaultArea = area;
+                else if (ctx.options.clusteringAreaGrowth > 0.0f &&
+                         area > (1.0 + double(ctx.options.clusteringAreaGrowth)) * defaultArea)
+                    continue;
                 const double e = ctx.judge->error(clustering);
                 report(ctx.progress, step, 0.5f * float(t + 1) / float(tries));
                 if (e < bestError)

@@ -301,6 +301,53 @@ namespace TreeLod
         return out;
     }
 
+    double billboardArea(const TreeModel& model, const LeafClustering& clustering)
+    {
+        std::vector<double> area(clustering.members.size(), 0.0);
+        tbb::parallel_for(std::size_t(0), clustering.members.size(), [&](std::size_t k) {
+            const glm::dvec3 n(clustering.normal[k]);
+            const glm::dvec3 a = glm::normalize(glm::cross(n, std::abs(n.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
+            const glm::dvec3 b = glm::cross(n, a);
+            std::vector<glm::dvec2> points;
+            glm::dvec2 mean(0.0);
+            for (std::uint32_t i : clustering.members[k])
+            {
+                const Leaf& leaf = model.leaves[i];
+                for (std::uint32_t v = leaf.firstVertex; v < leaf.firstVertex + leaf.vertexCount; ++v)
+                {
+                    const glm::dvec3 p(model.leafVertices[v].position - clustering.centroid[k]);
+                    points.emplace_back(glm::dot(p, a), glm::dot(p, b));
+                    mean += points.back();
+                }
+            }
+            if (points.empty())
+                return;
+            mean /= double(points.size());
+            double sxx = 0.0, sxy = 0.0, syy = 0.0;
+            for (const glm::dvec2& p : points)
+            {
+                const glm::dvec2 d = p - mean;
+                sxx += d.x * d.x;
+                sxy += d.x * d.y;
+                syy += d.y * d.y;
+            }
+            const double angle = 0.5 * std::atan2(2.0 * sxy, sxx - syy);
+            const glm::dvec2 u(std::cos(angle), std::sin(angle)), w(-u.y, u.x);
+            glm::dvec2 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+            for (const glm::dvec2& p : points)
+            {
+                const glm::dvec2 q(glm::dot(p, u), glm::dot(p, w));
+                lo = glm::min(lo, q);
+                hi = glm::max(hi, q);
+            }
+            area[k] = (hi.x - lo.x) * (hi.y - lo.y);
+        });
+        double sum = 0.0;
+        for (double x : area)
+            sum += x;
+        return sum;
+    }
+
     TreeModel flattenedOntoClusters(const TreeModel& model, const LeafClustering& clustering)
     {
         TreeModel flat = model;

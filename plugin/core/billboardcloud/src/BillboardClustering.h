@@ -65,6 +65,11 @@ namespace TreeLod
     /// Cluster all leaves of `model` (validated, at least one leaf).
     LeafClustering clusterLeaves(const TreeModel& model, const LeafClusteringOptions& options);
 
+    /// The area of the clustering's billboards: per cluster, the rectangle on its plane, along the
+    /// 2D principal axes of its leaves' vertices, that bounds them (the baker's quads, before
+    /// padding to whole hash cells). Hash and low-res texels grow with it.
+    double billboardArea(const TreeModel& model, const LeafClustering& clustering);
+
     /// `model` with every leaf flattened onto its cluster's plane (each vertex moved along the
     /// plane normal; normals, UVs and materials kept). That is what a cloud shows of its leaves:
     /// a leaf's Leaves Texture tile is its orthographic projection onto the billboard (García et
