@@ -990,8 +990,8 @@ namespace TreeLod
         // Collapsed part with part, more of them stay crossed and the covered area is kept. Created
         // leaves have no new vertices, so a part's quad lands where the cluster's vertices allow
         // and some parts drift apart. Measured (crossed share of the area / area kept, at L/2, L/4,
-        // L/8): 0.59 / 0.98, 0.48 / 1.04, 0.25 / 0.85; collapsed leaf by leaf, as flat leaves are,
-        // 0.40 / 0.73, 0.06 / 0.83, 0.00 / 0.80.
+        // L/8): 0.59 / 0.98, 0.48 / 1.04, 0.25 / 0.85; collapsed leaf by leaf, as flat leaves are
+        // (crossedLeaves false), 0.40 / 0.73, 0.06 / 0.83, 0.00 / 0.80.
         std::mt19937 rng(7);
         std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
         std::vector<LeafAt> leaves;
@@ -1010,6 +1010,10 @@ namespace TreeLod
         const std::uint32_t L = d.maxLeafCount();
         EXPECT_NEAR(crossedShare(foliageLodModel(m, d, L)), 1.0, 1e-9);
         const double full = leafArea(m);
+        FoliageLodOptions flatOptions;
+        flatOptions.crossedLeaves = false;
+        const FoliageLodData flat = buildOrFail(m, flatOptions);
+        ASSERT_EQ(flat.maxLeafCount(), L);
         struct Bound
         {
             std::uint32_t count;
@@ -1024,6 +1028,11 @@ namespace TreeLod
             EXPECT_GE(share, b.share) << b.count;
             EXPECT_GE(area, b.area) << b.count;
             EXPECT_LE(area, 1.1) << b.count;
+            const TreeModel flatLod = foliageLodModel(m, flat, b.count);
+            const double flatShare = crossedShare(flatLod), flatArea = leafArea(flatLod) / full;
+            std::cout << "[ lodf     ]   as flat leaves: " << flatShare << " crossed, area kept " << flatArea << "\n";
+            EXPECT_GT(share, flatShare + 0.15) << b.count;
+            EXPECT_GT(area, flatArea) << b.count;
         }
         // The coarsest level is one leaf per cluster.
         EXPECT_EQ(foliageLodModel(m, d, d.minLeafCount()).leaves.size(), d.clusters.size());

@@ -19,8 +19,12 @@ namespace TreeLod
                 bakeOptionNumber(given, FOLIAGE_LOD_CHUNK, "costBands", options.costBands, 0, 64, label);
             if (!costBands)
                 return costBands.error();
+            Result<bool> crossed = bakeOptionFlag(given, FOLIAGE_LOD_CHUNK, "crossedLeaves", options.crossedLeaves, label);
+            if (!crossed)
+                return crossed.error();
             options.clusterSize = std::uint32_t(clusterSize.value());
             options.costBands = std::uint32_t(costBands.value());
+            options.crossedLeaves = crossed.value();
             return addFoliageLodChunk(writer, model, options, label, progress);
         }
 
@@ -29,6 +33,8 @@ namespace TreeLod
              "LoDF continuous foliage by leaf collapse, Rebollo et al. 2006 (adds reference)",
              &bake,
              {{"clusterSize", "leaves per independent cluster, 1 to 4096", "64"},
-              {"costBands", "bands of Changed_group, 0 (the paper's global order) to 64", "4"}}});
+              {"costBands", "bands of Changed_group, 0 (the paper's global order) to 64", "4"},
+              {"crossedLeaves", "quads through one centre collapse part with part (true) or as flat leaves (false)",
+               "true"}}});
     }
 }

@@ -244,9 +244,10 @@ namespace TreeLod
         /// (|n_a . n_b| < CROSSED_PARALLEL), as ez-tree's "double billboards" and needle sprigs.
         constexpr float CROSSED_CENTRE = 0.05f, CROSSED_PARALLEL = 0.9f;
 
-        /// The cluster's originals grouped into crossed leaves (a plain leaf is a group of one),
-        /// each group in increasing node order, groups by their first node.
-        std::vector<std::vector<std::uint32_t>> crossedGroups(const std::vector<Node>& nodes, std::uint32_t n)
+        /// The cluster's originals grouped into crossed leaves (a plain leaf is a group of one; every
+        /// leaf without `crossed`), each group in increasing node order, groups by their first node.
+        std::vector<std::vector<std::uint32_t>> crossedGroups(const std::vector<Node>& nodes, std::uint32_t n,
+                                                              bool crossed)
         {
             std::vector<std::uint32_t> group(n);
             std::iota(group.begin(), group.end(), 0u);
@@ -255,7 +256,7 @@ namespace TreeLod
                 {
                     const Node& a = nodes[i];
                     const Node& b = nodes[j];
-                    if (group[j] != j || !sameImage(a, b) ||
+                    if (!crossed || group[j] != j || !sameImage(a, b) ||
                         std::abs(glm::dot(a.normal, b.normal)) >= CROSSED_PARALLEL ||
                         !(glm::length(a.centre - b.centre) < CROSSED_CENTRE * std::sqrt(std::min(a.area, b.area))))
                         continue;
@@ -323,7 +324,7 @@ namespace TreeLod
         /// one, part with part (matchParts), so they stay crossed; only the cluster's last
         /// collapses merge the parts of its one remaining crossed leaf. Row minima make it O(n^2)
         /// per cluster in practice.
-        void simplifyCluster(const TreeModel& m, ClusterBuild& cluster, float meanArea)
+        void simplifyCluster(const TreeModel& m, ClusterBuild& cluster, float meanArea, bool crossed)
         {
             const std::uint32_t n = std::uint32_t(cluster.leaves.size());
             for (std::uint32_t i = 0; i < n; ++i)
@@ -343,7 +344,7 @@ namespace TreeLod
             };
             // slot -> the parts (node ids) of a crossed or plain leaf; a collapse puts the new leaf
             // in the slot of `a` and frees `b`'s.
-            std::vector<std::vector<std::uint32_t>> slot = crossedGroups(cluster.nodes, n);
+            std::vector<std::vector<std::uint32_t>> slot = crossedGroups(cluster.nodes, n, crossed);
             const std::uint32_t S = std::uint32_t(slot.size());
             std::vector<char> alive(S, 1);
             std::vector<float> cost(std::size_t(S) * S, 0.0f);
@@ -516,7 +517,7 @@ namespace TreeLod
         for (std::size_t first = 0; first < clusters.size(); first += batch)
         {
             const std::size_t last = std::min(clusters.size(), first + batch);
-            tbb::parallel_for(first, last, [&](std::size_t c) { simplifyCluster(model, clusters[c], meanArea); });
+            tbb::parallel_for(first, last, [&](std::size_t c) { simplifyCluster(model, clusters[c], meanArea, options.crossedLeaves); });
             done = last;
             report(progress, "lodf collapse", float(done) / float(clusters.size()));
         }

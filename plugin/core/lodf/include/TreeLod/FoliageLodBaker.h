@@ -58,6 +58,9 @@ namespace TreeLod
         /// Bands of Changed_group (1..64); 0 = the paper's pure global cost order (every
         /// change then touches most clusters). 1 = cluster by cluster.
         std::uint32_t costBands = 4;
+        /// Crossed leaves (step 3) collapse part with part; false: every quad as a flat leaf, as
+        /// the paper's (the baseline of docs/lodf.md's measurements).
+        bool crossedLeaves = true;
     };
 
     /// Build F^r for `model` (validated first). Errors name `label`. A tree without leaves
