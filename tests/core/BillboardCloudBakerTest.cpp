@@ -112,20 +112,24 @@ namespace TreeLod
             return root / name;
         }
 
-        /// The baker's clustering of the finest cloud, recomputed (same options and bound).
-        LeafClustering finestClustering(const TreeModel& m, const BillboardCloudOptions& options, std::uint32_t count)
+        /// The box of all of `m`'s vertices, as the baker computes it.
+        std::pair<glm::vec3, glm::vec3> vertexBounds(const TreeModel& m)
         {
             glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-            for (const Vertex& v : m.barkVertices)
-            {
-                lo = glm::min(lo, v.position);
-                hi = glm::max(hi, v.position);
-            }
-            for (const Vertex& v : m.leafVertices)
-            {
-                lo = glm::min(lo, v.position);
-                hi = glm::max(hi, v.position);
-            }
+            for (const std::vector<Vertex>* vs : {&m.barkVertices, &m.leafVertices})
+                for (const Vertex& v : *vs)
+                {
+                    lo = glm::min(lo, v.position);
+                    hi = glm::max(hi, v.position);
+                }
+            return {lo, hi};
+        }
+
+        /// The baker's clustering of the finest cloud, recomputed (same options and bound, the
+        /// default weights).
+        LeafClustering finestClustering(const TreeModel& m, const BillboardCloudOptions& options, std::uint32_t count)
+        {
+            const auto [lo, hi] = vertexBounds(m);
             LeafClusteringOptions co;
             co.clusterCount = count;
             co.errorBound = options.maxPlaneError * glm::length(hi - lo);
@@ -1012,13 +1016,7 @@ namespace TreeLod
             EXPECT_LT(c.defaultError, 0.5);
         }
         // The kept clustering is the one rebuilt with the kept weights, judged the same.
-        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-        for (const std::vector<Vertex>* vs : {&m.barkVertices, &m.leafVertices})
-            for (const Vertex& v : *vs)
-            {
-                lo = glm::min(lo, v.position);
-                hi = glm::max(hi, v.position);
-            }
+        const auto [lo, hi] = vertexBounds(m);
         LeafClusteringOptions co;
         co.clusterCount = judged.billboards[0];
         co.errorBound = options.maxPlaneError * glm::length(hi - lo);

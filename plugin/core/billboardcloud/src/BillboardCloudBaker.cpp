@@ -900,9 +900,16 @@ namespace TreeLod
             JudgedClustering judged;
         };
 
-        /// (spatialWeight, orientationWeight) of each try, the defaults first.
+        /// (spatialWeight, orientationWeight) of each try, LeafClusteringOptions' defaults first.
+        constexpr float SPATIAL = LeafClusteringOptions{}.spatialWeight;
+        constexpr float ORIENTATION = LeafClusteringOptions{}.orientationWeight;
         constexpr std::array<std::pair<float, float>, CLUSTERING_TRIES_MAX> CLUSTERING_WEIGHTS{
-            {{0.5f, 4.0f}, {0.5f, 12.0f}, {0.25f, 4.0f}, {1.0f, 4.0f}, {0.5f, 1.0f}, {0.25f, 12.0f}}};
+            {{SPATIAL, ORIENTATION},
+             {SPATIAL, 3.0f * ORIENTATION},
+             {0.5f * SPATIAL, ORIENTATION},
+             {2.0f * SPATIAL, ORIENTATION},
+             {SPATIAL, 0.25f * ORIENTATION},
+             {0.5f * SPATIAL, 3.0f * ORIENTATION}}};
 
         /// §4.1's clustering into `count` planes, tried with clusteringTries weight pairs and judged
         /// by image error over views around and above (ClusteringJudge): the first of the least
@@ -926,7 +933,11 @@ namespace TreeLod
                 co.orientationWeight = CLUSTERING_WEIGHTS[t].second;
                 LeafClustering clustering = clusterLeaves(ctx.model, co);
                 if (tries == 1)
+                {
+                    judged.spatialWeight = co.spatialWeight;
+                    judged.orientationWeight = co.orientationWeight;
                     return clustering;
+                }
                 const double area = billboardArea(ctx.model, clustering);
                 if (t == 0)
                     defaultArea = area;

@@ -37,7 +37,6 @@
 #include <glm/glm.hpp>
 
 #include <cstdint>
-#include <memory>
 #include <vector>
 
 namespace TreeLod

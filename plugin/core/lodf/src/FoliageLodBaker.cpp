@@ -251,12 +251,12 @@ namespace TreeLod
         {
             std::vector<std::uint32_t> group(n);
             std::iota(group.begin(), group.end(), 0u);
-            for (std::uint32_t i = 0; i < n; ++i)
+            for (std::uint32_t i = 0; i < n && crossed; ++i)
                 for (std::uint32_t j = i + 1; j < n; ++j)
                 {
                     const Node& a = nodes[i];
                     const Node& b = nodes[j];
-                    if (!crossed || group[j] != j || !sameImage(a, b) ||
+                    if (group[j] != j || !sameImage(a, b) ||
                         std::abs(glm::dot(a.normal, b.normal)) >= CROSSED_PARALLEL ||
                         !(glm::length(a.centre - b.centre) < CROSSED_CENTRE * std::sqrt(std::min(a.area, b.area))))
                         continue;
