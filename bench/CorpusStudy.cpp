@@ -5,7 +5,9 @@
 // Per tree, the package is baked with every technique asked for (their default options; the
 // classic billboard cloud at the multi-layered cloud's memory, García et al. 2007 Fig. 13). Per
 // view the reference ("mesh") and each technique are rendered by the same Ogre pipeline at S x S
-// supersampling, from azimuth 30 degrees at the crown's height:
+// supersampling, from azimuth 30 degrees at the crown's height (--azimuths N: from N azimuths 360/N
+// apart starting there, the metrics averaged; one 30 px view moves by a few thousandths of FLIP
+// with the azimuth alone):
 //   near: the tree 90 % of the view height; mid: a quarter of it; far: 30 px tall; above: as mid,
 //   from 60 degrees above the crown's height (where flat billboards and leaves are seen edge-on).
 // Image error is taken over the square around the reference tree (its box with a 15 % margin, the
@@ -17,8 +19,8 @@
 // error.csv, and worst-<technique>.png: reference | technique | FLIP of the technique's worst case
 // (magnified crops).
 //
-// Tree specs: a .glb/.gltf path, or generated:PRESET[:LEAVES[:IMAGES[:MATERIALS]]] (TreeGenerator:
-// leaf count, leaf images in an atlas, leaf materials). Without --trees: the bundled trees, the
+// Tree specs: a .glb/.gltf path, or generated:PRESET[:LEAVES[:IMAGES[:MATERIALS[:FOLD]]]] (TreeGenerator:
+// leaf count, leaf images in an atlas, leaf materials, leaf fold in degrees). Without --trees: the bundled trees, the
 // generated oak with a 2x2 leaf atlas under six leaf materials, and every .glb in
 // media/third-party/ (docs/measurements.md says how to make them).
 //
@@ -52,8 +54,10 @@ namespace TreeLod
             std::vector<std::string> techniques{"billboard-cloud", "classic-billboard-cloud", "lodf", "impostor",
                                                 "octahedral-impostor"};
             std::vector<std::string> options; ///< TECHNIQUE.NAME=VALUE, as `treelod bake --option`
+            std::vector<std::string> params;  ///< TECHNIQUE.NAME=VALUE, the object's createMovableObject parameters
             int size = 512;
             int supersample = 2;
+            int azimuths = 1;
             std::string out = "out/corpus-study";
         };
 
@@ -76,7 +80,8 @@ namespace TreeLod
                     fields.push_back(f);
                 GeneratorOptions options;
                 if (fields.empty() || !parsePreset(fields[0], options.preset))
-                    throw StudyError("tree '" + spec + "': no preset (generated:PRESET[:LEAVES[:IMAGES[:MATERIALS]]])");
+                    throw StudyError("tree '" + spec +
+                                     "': no preset (generated:PRESET[:LEAVES[:IMAGES[:MATERIALS[:FOLD]]]])");
                 try
                 {
                     if (fields.size() > 1)
@@ -85,10 +90,12 @@ namespace TreeLod
                         options.leafImages = std::uint32_t(std::stoul(fields[2]));
                     if (fields.size() > 3)
                         options.leafMaterials = std::uint32_t(std::stoul(fields[3]));
+                    if (fields.size() > 4)
+                        options.leafFold = std::stof(fields[4]);
                 }
                 catch (const std::exception&)
                 {
-                    throw StudyError("tree '" + spec + "': LEAVES, IMAGES and MATERIALS are whole numbers");
+                    throw StudyError("tree '" + spec + "': LEAVES, IMAGES and MATERIALS are whole numbers, FOLD degrees");
                 }
                 Result<TreeModel> model = generateTree(options);
                 if (!model)
@@ -186,6 +193,17 @@ namespace TreeLod
                 Ogre::NameValuePairList params;
                 if (technique.find("billboard-cloud") != std::string::npos)
                     params["ambientOcclusion"] = "false";
+                for (const std::string& text : args.params)
+                {
+                    Result<BakeOptionAssignment> parsed = parseBakeOptionAssignment(text);
+                    if (!parsed)
+                        throw StudyError("--param: " + parsed.error().message());
+                    if (parsed->technique != "mesh" &&
+                        !std::count(args.techniques.begin(), args.techniques.end(), parsed->technique))
+                        throw StudyError("--param '" + text + "': '" + parsed->technique + "' is not among --techniques");
+                    if (parsed->technique == technique)
+                        params[parsed->name] = parsed->value;
+                }
                 Ogre::MovableObject* object = registry.createInstance(technique, renderer.getSceneManager(),
                                                                       "corpus-" + technique, *asset, params);
                 node->attachObject(object);
@@ -213,49 +231,60 @@ namespace TreeLod
             {
                 const double px = view.fraction > 0.0 ? view.fraction * args.size : view.px;
                 const double distance = distanceForHeight(height, px, args.size, STUDY_FOV_Y_DEGREES);
-                const double azimuth = STUDY_PI / 6.0, elevation = view.elevation * STUDY_PI / 180.0;
-                CameraSpec camera;
-                camera.position = crown + float(distance) * glm::vec3(float(std::cos(elevation) * std::sin(azimuth)),
-                                                                      float(std::sin(elevation)),
-                                                                      float(std::cos(elevation) * std::cos(azimuth)));
-                camera.target = crown;
-                camera.fovYDegrees = STUDY_FOV_Y_DEGREES;
-                camera.farClip = float(4.0 * distance + 2.0 * height);
                 progressLine(format("%s, %s: tree %.0f px tall at %.1f m", tree.label.c_str(), view.name, px, distance));
-                std::vector<Image> images(objects.size());
-                for (std::size_t i = 0; i < objects.size(); ++i)
+                const std::size_t firstRow = rows.size();
+                for (int k = 0; k < args.azimuths; ++k)
                 {
-                    show(i);
-                    images[i] = toImage(renderer.render(camera, args.size, args.size, args.supersample));
-                }
-                const Crop crop = cropAround(treeExtent(images[0]), args.size, args.size);
-                const Image reference = cropImage(images[0], crop);
-                for (std::size_t i = 1; i < objects.size(); ++i)
-                {
-                    Row row;
-                    row.tree = tree.label;
-                    row.technique = objects[i].first;
-                    row.view = view.name;
-                    row.treePx = treeExtent(images[0]).heightPx();
-                    const Image test = cropImage(images[i], crop);
-                    FlipOptions keep;
-                    keep.keepErrorMap = true;
-                    Result<FlipResult> flipped = flip(reference, test, keep);
-                    if (!flipped)
-                        throw StudyError("FLIP: " + flipped.error().message());
-                    row.flip = flipped->mean;
-                    row.rmse = multiScaleRmseOf(reference, test);
-                    row.coverage = treeCoverage(images[i]) / std::max(treeCoverage(images[0]), 1e-9);
-                    row.bytes = chunkBytes.at(row.technique);
-                    rows.push_back(row);
-                    Worst& w = worst[row.technique];
-                    if (row.flip > w.flip)
+                    const double azimuth = STUDY_PI / 6.0 + 2.0 * STUDY_PI * k / args.azimuths;
+                    const double elevation = view.elevation * STUDY_PI / 180.0;
+                    CameraSpec camera;
+                    camera.position = crown + float(distance) * glm::vec3(float(std::cos(elevation) * std::sin(azimuth)),
+                                                                          float(std::sin(elevation)),
+                                                                          float(std::cos(elevation) * std::cos(azimuth)));
+                    camera.target = crown;
+                    camera.fovYDegrees = STUDY_FOV_Y_DEGREES;
+                    camera.farClip = float(4.0 * distance + 2.0 * height);
+                    std::vector<Image> images(objects.size());
+                    for (std::size_t i = 0; i < objects.size(); ++i)
                     {
-                        w.flip = row.flip;
-                        w.where = tree.label + ", " + view.name;
-                        w.reference = reference;
-                        w.image = test;
-                        w.heat = flipHeatmap(flipped.value());
+                        show(i);
+                        images[i] = toImage(renderer.render(camera, args.size, args.size, args.supersample));
+                    }
+                    const Crop crop = cropAround(treeExtent(images[0]), args.size, args.size);
+                    const Image reference = cropImage(images[0], crop);
+                    for (std::size_t i = 1; i < objects.size(); ++i)
+                    {
+                        if (k == 0)
+                        {
+                            Row row;
+                            row.tree = tree.label;
+                            row.technique = objects[i].first;
+                            row.view = view.name;
+                            row.treePx = treeExtent(images[0]).heightPx();
+                            row.bytes = chunkBytes.at(row.technique);
+                            rows.push_back(row);
+                        }
+                        Row& row = rows[firstRow + i - 1];
+                        const Image test = cropImage(images[i], crop);
+                        FlipOptions keep;
+                        keep.keepErrorMap = true;
+                        Result<FlipResult> flipped = flip(reference, test, keep);
+                        if (!flipped)
+                            throw StudyError("FLIP: " + flipped.error().message());
+                        row.flip += flipped->mean / args.azimuths;
+                        row.rmse += multiScaleRmseOf(reference, test) / args.azimuths;
+                        row.coverage +=
+                            treeCoverage(images[i]) / std::max(treeCoverage(images[0]), 1e-9) / args.azimuths;
+                        Worst& w = worst[row.technique];
+                        if (flipped->mean > w.flip)
+                        {
+                            w.flip = flipped->mean;
+                            w.where = tree.label + ", " + view.name +
+                                      (args.azimuths > 1 ? format(", azimuth %.0f", azimuth * 180.0 / STUDY_PI) : "");
+                            w.reference = reference;
+                            w.image = test;
+                            w.heat = flipHeatmap(flipped.value());
+                        }
                     }
                 }
             }
@@ -310,7 +339,9 @@ namespace TreeLod
             md << "FLIP (mean) over the square around the tree, " << args.size << "x" << args.size << ", "
                << args.supersample << "x" << args.supersample
                << " supersampled; near: the tree fills 90 % of the view, mid: a quarter, far: 30 px tall, all "
-                  "at the crown's height; above: as mid, from 60 degrees up.\n\n";
+                  "at the crown's height; above: as mid, from 60 degrees up; "
+               << (args.azimuths > 1 ? format("the mean over %d azimuths from 30 degrees.\n\n", args.azimuths)
+                                     : std::string("from azimuth 30 degrees.\n\n"));
             md << "Coverage: the technique's tree pixels over the reference's (1 = as covered).\n\n";
             md << "| tree | technique";
             for (const char* metric : {"FLIP", "ms-RMSE", "coverage"})
@@ -406,14 +437,19 @@ int main(int argc, char** argv)
     CLI::App app{"Every technique against the polygonal tree over a corpus of trees: tree-box FLIP and multi-scale "
                  "RMSE near, mid and far. Needs an X server (xvfb-run)."};
     app.add_option("--trees", args.trees,
-                   "trees: .glb/.gltf paths or generated:PRESET[:LEAVES[:IMAGES[:MATERIALS]]] (default: the bundled "
+                   "trees: .glb/.gltf paths or generated:PRESET[:LEAVES[:IMAGES[:MATERIALS[:FOLD]]]] (default: the bundled "
                    "trees, generated:oak:3000:4:6 and media/third-party/*.glb)");
     app.add_option("--techniques", args.techniques, "techniques to bake and compare")->capture_default_str();
     app.add_option("--option", args.options, "a baker's option, TECHNIQUE.NAME=VALUE (as treelod bake --option)");
+    app.add_option("--param", args.params,
+                   "an object parameter, TECHNIQUE.NAME=VALUE (as createMovableObject's, e.g. billboard-cloud.level=1)");
     app.add_option("--size", args.size, "image size")->capture_default_str()->check(CLI::Range(64, 4096));
     app.add_option("--supersample", args.supersample, "samples per pixel per axis")
         ->capture_default_str()
         ->check(CLI::Range(1, 8));
+    app.add_option("--azimuths", args.azimuths, "views per distance, 360/N degrees apart from 30 (metrics averaged)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 64));
     app.add_option("--out", args.out, "output directory")->capture_default_str();
     try
     {

@@ -26,6 +26,7 @@ namespace TreeLod
             double height = 0.0;
             int textureSize = 256;
             std::uint32_t leafImages = 1, leafMaterials = 1;
+            float leafFold = 0.0f;
             std::string output;
             bool quiet = false;
         };
@@ -50,6 +51,7 @@ namespace TreeLod
             options.textureSize = args.textureSize;
             options.leafImages = args.leafImages;
             options.leafMaterials = args.leafMaterials;
+            options.leafFold = args.leafFold;
 
             const auto start = std::chrono::steady_clock::now();
             Result<TreeModel> model = generateTree(options, makeProgress(args.quiet));
@@ -87,6 +89,9 @@ namespace TreeLod
             ->capture_default_str();
         cmd->add_option("--leaf-materials", args->leafMaterials,
                         "leaf materials, 1..16, each with its own tint and alpha cutoff")
+            ->capture_default_str();
+        cmd->add_option("--leaf-fold", args->leafFold,
+                        "degrees, 0..80: each leaf two quads folded along its midrib, wings raised by this angle")
             ->capture_default_str();
         cmd->add_option("-o,--output", args->output, ".glb file to write")->required();
         cmd->add_flag("-q,--quiet", args->quiet, "no progress display");

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 using namespace TreeLod;
 
@@ -223,6 +224,60 @@ TEST(TreeGenerator, rejectsLeafImagesAndMaterialsOutOfRange)
         Result<TreeModel> model = generateTree(options);
         ASSERT_FALSE(model.ok());
         EXPECT_EQ(model.error().element, "option --leaf-materials");
+    }
+}
+
+// A folded leaf is one mesh of two quads along its midrib: the same tree otherwise, each wing in
+// its own plane raised by the fold, the whole leaf mapped once, one leaf again after a round
+// trip through glTF (the importer's leaves are connected meshes).
+TEST(TreeGenerator, leafFoldMakesEveryLeafTwoQuadsInOneMesh)
+{
+    GeneratorOptions flatOptions;
+    flatOptions.preset = TreePreset::Birch;
+    flatOptions.leafCount = 300;
+    flatOptions.textureSize = 32;
+    GeneratorOptions foldOptions = flatOptions;
+    foldOptions.leafFold = 40.0f;
+    Result<TreeModel> flat = generateTree(flatOptions), folded = generateTree(foldOptions);
+    ASSERT_TRUE(flat.ok() && folded.ok());
+    ASSERT_TRUE(folded->validate()) << folded->validate().error().message();
+    ASSERT_EQ(folded->leaves.size(), flat->leaves.size());
+    EXPECT_EQ(folded->barkVertices.size(), flat->barkVertices.size());
+    for (std::size_t l = 0; l < folded->leaves.size(); ++l)
+    {
+        const Leaf& leaf = folded->leaves[l];
+        ASSERT_EQ(leaf.vertexCount, 6u);
+        ASSERT_EQ(leaf.indexCount, 12u);
+        EXPECT_EQ(leaf.uvMin, glm::vec2(0.0f));
+        EXPECT_EQ(leaf.uvMax, glm::vec2(1.0f));
+        // Wings raised by 40 degrees each: the leaf area is the flat one's, its projection on
+        // the face cos(40) of it, and the wings' normals 80 degrees apart.
+        EXPECT_NEAR(leaf.area, flat->leaves[l].area, 1e-3f * flat->leaves[l].area);
+        const auto& v = folded->leafVertices;
+        const glm::vec3 leftNormal = v[leaf.firstVertex].normal, rightNormal = v[leaf.firstVertex + 2].normal;
+        EXPECT_NEAR(glm::dot(leftNormal, rightNormal), std::cos(glm::radians(80.0f)), 1e-3f) << l;
+        EXPECT_GT(glm::dot(leaf.normal, flat->leaves[l].normal), 0.999f) << l;
+        for (std::uint32_t t = leaf.firstIndex; t < leaf.firstIndex + leaf.indexCount; t += 3)
+        {
+            const glm::vec3 a = v[folded->leafIndices[t]].position, b = v[folded->leafIndices[t + 1]].position,
+                            c = v[folded->leafIndices[t + 2]].position;
+            EXPECT_GT(glm::dot(glm::cross(b - a, c - a), leaf.normal), 0.0f) << "leaf " << l << " faces away";
+        }
+    }
+    const std::filesystem::path path = testOut("generator-folded.glb");
+    ASSERT_TRUE(writeGlb(*folded, path.string()).ok());
+    Result<TreeModel> back = importGltf(path.string());
+    ASSERT_TRUE(back.ok()) << back.error().message();
+    ASSERT_EQ(back->leaves.size(), folded->leaves.size());
+    for (const Leaf& leaf : back->leaves)
+        EXPECT_EQ(leaf.vertexCount, 6u);
+    for (float bad : {-1.0f, 81.0f, std::numeric_limits<float>::quiet_NaN()})
+    {
+        GeneratorOptions options;
+        options.leafFold = bad;
+        Result<TreeModel> model = generateTree(options);
+        ASSERT_FALSE(model.ok()) << bad;
+        EXPECT_EQ(model.error().element, "option --leaf-fold");
     }
 }
 

@@ -809,6 +809,48 @@ namespace TreeLod
                 }
             }
         }
+        /// GeneratorOptions::leafFold: each quad leaf (base - w, base + w, tip + w, tip - w, as
+        /// buildLeaves makes them) becomes two quads sharing the midrib, each wing raised by
+        /// `degrees` towards the face; u = 0.5 on the midrib. Same draws, so the same tree.
+        void foldLeaves(float degrees, TreeModel& model)
+        {
+            const float c = std::cos(radians(degrees)), s = std::sin(radians(degrees));
+            std::vector<Vertex> vertices;
+            std::vector<std::uint32_t> indices;
+            vertices.reserve(model.leafVertices.size() / 2 * 3);
+            indices.reserve(model.leafIndices.size() * 2);
+            for (std::size_t l = 0; l < model.leaves.size(); ++l)
+            {
+                Leaf& leaf = model.leaves[l];
+                const Vertex* q = &model.leafVertices[leaf.firstVertex];
+                const glm::vec3 face = q[0].normal;
+                const glm::vec3 w = 0.5f * (q[1].position - q[0].position);
+                const glm::vec3 base = 0.5f * (q[0].position + q[1].position), tip = 0.5f * (q[2].position + q[3].position);
+                const glm::vec3 lift = face * (glm::length(w) * s);
+                const glm::vec3 left = -w * c + lift, right = w * c + lift;
+                const auto facing = [&](const glm::vec3& n) { return glm::normalize(glm::dot(n, face) < 0.0f ? -n : n); };
+                const glm::vec3 leftNormal = facing(glm::cross(tip - base, left));
+                const glm::vec3 rightNormal = facing(glm::cross(tip - base, right));
+                const std::uint32_t v0 = std::uint32_t(vertices.size());
+                vertices.push_back({base + left, leftNormal, {0.0f, 1.0f}});
+                vertices.push_back({base, face, {0.5f, 1.0f}});
+                vertices.push_back({base + right, rightNormal, {1.0f, 1.0f}});
+                vertices.push_back({tip + left, leftNormal, {0.0f, 0.0f}});
+                vertices.push_back({tip, face, {0.5f, 0.0f}});
+                vertices.push_back({tip + right, rightNormal, {1.0f, 0.0f}});
+                leaf.firstVertex = v0;
+                leaf.vertexCount = 6;
+                leaf.firstIndex = std::uint32_t(indices.size());
+                leaf.indexCount = 12;
+                for (std::uint32_t k : {0u, 1u, 4u, 0u, 4u, 3u, 1u, 2u, 5u, 1u, 5u, 4u})
+                    indices.push_back(v0 + k);
+            }
+            model.leafVertices = std::move(vertices);
+            model.leafIndices = std::move(indices);
+            for (std::size_t l = 0; l < model.leaves.size(); ++l)
+                model.updateLeafRecord(l);
+        }
+
         /// GeneratorOptions::leafImages: a 2 x 2 atlas of leaf images (this preset's first) and
         /// each leaf's UVs moved into one cell. Images of other presets are stretched to this
         /// preset's leaf aspect, as atlas leaves on a shared quad shape are.
@@ -894,6 +936,9 @@ namespace TreeLod
         if (options.leafImages < 1 || options.leafImages > 4)
             return fail("", "option --leaf-images",
                         std::to_string(options.leafImages) + " leaf images; 1..4 are drawn");
+        if (!(options.leafFold >= 0.0f && options.leafFold <= 80.0f))
+            return fail("", "option --leaf-fold", "leaf fold " + std::to_string(options.leafFold) +
+                                                      " degrees is outside 0..80");
         if (options.leafMaterials < 1 || options.leafMaterials > 16)
             return fail("", "option --leaf-materials",
                         std::to_string(options.leafMaterials) + " leaf materials; 1..16 are made");
@@ -917,6 +962,8 @@ namespace TreeLod
 
         const float aspect = leafAspect(options.preset);
         buildLeaves(stems, p, height, leafCount, aspect, options.seed, model, progress);
+        if (options.leafFold > 0.0f)
+            foldLeaves(options.leafFold, model);
         report(progress, "generate leaves", 1.0f);
 
         report(progress, "draw textures", 0.0f);

@@ -27,8 +27,11 @@ namespace TreeLod
                                                     CLUSTERING_TRIES_MAX, label);
             Result<double> areaGrowth = bakeOptionNumber(given, technique, "clusteringAreaGrowth",
                                                          options.clusteringAreaGrowth, 0.0, 100.0, label);
+            Result<double> lowResRatio = bakeOptionNumber(given, technique, "lowResLeafRatio", options.lowResLeafRatio,
+                                                          0.05, 16.0, label);
             Result<bool> compress = bakeOptionFlag(given, technique, "compress", options.compress, label);
-            for (const Result<double>* r : {&billboards, &listFactor, &aoRays, &tileSize, &maxTexels, &planeError, &tries, &areaGrowth})
+            for (const Result<double>* r : {&billboards, &listFactor, &aoRays, &tileSize, &maxTexels, &planeError, &tries, &areaGrowth,
+                                       &lowResRatio})
                 if (!*r)
                     return r->error();
             if (!compress)
@@ -41,6 +44,7 @@ namespace TreeLod
             options.maxPlaneError = float(planeError.value());
             options.clusteringTries = std::uint32_t(tries.value());
             options.clusteringAreaGrowth = float(areaGrowth.value());
+            options.lowResLeafRatio = float(lowResRatio.value());
             options.compress = compress.value();
             return {};
         }
@@ -83,6 +87,9 @@ namespace TreeLod
                      "largest growth of billboard area (memory) a judged clustering may take over the default "
                      "weights', 0 (no bound) to 100",
                      "0.05"},
+                    {"lowResLeafRatio",
+                     "low-res texel edge of the finest level in median leaf lengths (coarser levels 2x, 4x), 0.05 to 16",
+                     "0.75"},
                     {"compress", "DXT-compressed textures (true) or RGBA8 (false)", "true"}};
         }
 

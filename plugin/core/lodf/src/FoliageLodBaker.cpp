@@ -18,7 +18,9 @@ namespace TreeLod
 {
     namespace
     {
-        /// A leaf while collapsing: original or created, by its four corner vertices.
+        /// A leaf while collapsing: original or created, by its four corner vertices, or, for a
+        /// leaf in several planes (one mesh: a bent leaf, a sprig in one piece), one such quad
+        /// per plane in `parts` (then the other fields are the whole leaf's).
         struct Node
         {
             std::array<std::uint32_t, 4> corner{}; ///< vertices at texture corners (0,0) (1,0) (1,1) (0,1)
@@ -26,7 +28,8 @@ namespace TreeLod
             glm::vec3 normal{0.0f, 1.0f, 0.0f};
             float area = 0.0f;       ///< area it stands for: the sum over the original leaves it replaces
             glm::vec2 uvMin{0.0f}, uvMax{0.0f};
-            std::uint32_t imageSource = 0; ///< an original leaf (node id) whose leaf image it shows
+            std::uint32_t imageSource = 0; ///< a corner source (ClusterBuild::sources) whose leaf image it shows
+            std::vector<Node> parts;       ///< one-quad nodes, largest first; empty for a leaf in one plane
         };
 
         struct Collapse
@@ -40,6 +43,9 @@ namespace TreeLod
             std::uint32_t material = 0;
             std::vector<std::uint32_t> leaves; ///< model leaf indices, the cluster's originals
             std::vector<Node> nodes;           ///< originals then created
+            /// The originals' one-quad nodes (a leaf in several planes: each part), whose corner
+            /// vertices created leaves take (collapseLeaves).
+            std::vector<Node> sources;
             std::vector<Collapse> collapses;
         };
 
@@ -52,30 +58,24 @@ namespace TreeLod
             return 0.5f * glm::length(glm::cross(p2 - p0, p3 - p1));
         }
 
-        /// The four vertices of leaf `i` nearest its texture rectangle's corners (or, for a leaf
-        /// without a UV extent, nearest the corners of its extent in its own plane).
-        Node originalNode(const TreeModel& m, std::size_t i)
+        /// Corners of `node` (normal and UV rectangle set): the four of `vertices` nearest the
+        /// corners of their UV extent, or, without one, of their extent in the node's plane.
+        void setCorners(const TreeModel& m, const std::vector<std::uint32_t>& vertices, Node& node)
         {
-            const Leaf& leaf = m.leaves[i];
-            Node node;
-            node.centre = leaf.centre;
-            node.normal = leaf.normal;
-            node.uvMin = leaf.uvMin;
-            node.uvMax = leaf.uvMax;
-            const glm::vec2 uvExtent = leaf.uvMax - leaf.uvMin;
+            const glm::vec2 uvExtent = node.uvMax - node.uvMin;
             const bool useUv = uvExtent.x > 1e-6f && uvExtent.y > 1e-6f;
             glm::vec3 axisU(1.0f, 0.0f, 0.0f);
             if (!useUv)
             {
-                axisU = glm::cross(leaf.normal, std::abs(leaf.normal.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0));
+                axisU = glm::cross(node.normal, std::abs(node.normal.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0));
                 axisU = glm::normalize(axisU);
             }
-            const glm::vec3 axisV = glm::cross(leaf.normal, axisU);
-            std::vector<glm::vec2> t(leaf.vertexCount);
+            const glm::vec3 axisV = glm::cross(node.normal, axisU);
+            std::vector<glm::vec2> t(vertices.size());
             glm::vec2 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-            for (std::uint32_t k = 0; k < leaf.vertexCount; ++k)
+            for (std::size_t k = 0; k < vertices.size(); ++k)
             {
-                const Vertex& v = m.leafVertices[leaf.firstVertex + k];
+                const Vertex& v = m.leafVertices[vertices[k]];
                 t[k] = useUv ? v.uv : glm::vec2(glm::dot(v.position, axisU), glm::dot(v.position, axisV));
                 lo = glm::min(lo, t[k]);
                 hi = glm::max(hi, t[k]);
@@ -85,17 +85,143 @@ namespace TreeLod
             for (int r = 0; r < 4; ++r)
             {
                 float best = std::numeric_limits<float>::max();
-                for (std::uint32_t k = 0; k < leaf.vertexCount; ++k)
+                for (std::size_t k = 0; k < vertices.size(); ++k)
                 {
                     glm::vec2 d = (t[k] - lo) / extent - CORNERS[r];
                     float e = glm::dot(d, d);
                     if (e < best)
                     {
                         best = e;
-                        node.corner[r] = leaf.firstVertex + k;
+                        node.corner[r] = vertices[k];
                     }
                 }
             }
+        }
+
+        /// Crossed leaves: two originals of one leaf image are parts of one crossed leaf when their
+        /// centres lie within CROSSED_CENTRE leaf sizes of each other and their planes differ
+        /// (|n_a . n_b| < CROSSED_PARALLEL), as ez-tree's "double billboards" and needle sprigs.
+        /// A leaf's triangles lie in one plane while |n_a . n_b| >= CROSSED_PARALLEL.
+        constexpr float CROSSED_CENTRE = 0.05f, CROSSED_PARALLEL = 0.9f;
+        /// A plane of a leaf under this share of its area joins the most parallel larger one.
+        constexpr float PART_AREA = 0.1f;
+
+        /// Leaf `leaf`, one mesh in several planes, as one quad per plane: its triangles grouped by
+        /// normal (each with the plane of the most parallel seed within CROSSED_PARALLEL, the
+        /// largest triangles seeding), planes under PART_AREA of the leaf's area, or beyond the
+        /// indexCount / 6 that its index slots hold (a created quad takes six), joined to the most
+        /// parallel kept one. Each part's UV rectangle is its own vertices' extent. Empty when
+        /// fewer than two planes remain.
+        std::vector<Node> planeParts(const TreeModel& m, const Leaf& leaf)
+        {
+            struct Plane
+            {
+                glm::vec3 seed{0.0f}, normalSum{0.0f}, weighted{0.0f};
+                float area = 0.0f;
+                std::vector<std::uint32_t> vertices;
+            };
+            std::vector<std::uint32_t> triangles(leaf.indexCount / 3);
+            std::iota(triangles.begin(), triangles.end(), 0u);
+            const auto corner = [&](std::uint32_t t, int k) {
+                return m.leafIndices[leaf.firstIndex + 3 * t + std::uint32_t(k)];
+            };
+            const auto cross = [&](std::uint32_t t) {
+                const glm::vec3 a = m.leafVertices[corner(t, 0)].position, b = m.leafVertices[corner(t, 1)].position,
+                                c = m.leafVertices[corner(t, 2)].position;
+                return glm::cross(b - a, c - a);
+            };
+            std::stable_sort(triangles.begin(), triangles.end(),
+                             [&](std::uint32_t x, std::uint32_t y) { return glm::length(cross(x)) > glm::length(cross(y)); });
+            std::vector<Plane> planes;
+            const auto add = [](Plane& p, const glm::vec3& n, float area, const glm::vec3& centre,
+                                const std::vector<std::uint32_t>& vertices) {
+                p.normalSum += (glm::dot(n, p.seed) < 0.0f ? -n : n) * area;
+                p.weighted += centre * area;
+                p.area += area;
+                for (std::uint32_t v : vertices)
+                    if (std::find(p.vertices.begin(), p.vertices.end(), v) == p.vertices.end())
+                        p.vertices.push_back(v);
+            };
+            for (std::uint32_t t : triangles)
+            {
+                const glm::vec3 c = cross(t);
+                const float twice = glm::length(c);
+                if (!(twice > 0.0f) || !std::isfinite(twice))
+                    continue;
+                const glm::vec3 n = c / twice;
+                std::size_t best = planes.size();
+                float bestDot = CROSSED_PARALLEL;
+                for (std::size_t p = 0; p < planes.size(); ++p)
+                    if (const float d = std::abs(glm::dot(planes[p].seed, n)); d >= bestDot)
+                    {
+                        bestDot = d;
+                        best = p;
+                    }
+                if (best == planes.size())
+                {
+                    planes.emplace_back();
+                    planes.back().seed = n;
+                }
+                const glm::vec3 centre = (m.leafVertices[corner(t, 0)].position + m.leafVertices[corner(t, 1)].position +
+                                          m.leafVertices[corner(t, 2)].position) / 3.0f;
+                add(planes[best], n, 0.5f * twice, centre, {corner(t, 0), corner(t, 1), corner(t, 2)});
+            }
+            std::stable_sort(planes.begin(), planes.end(), [](const Plane& x, const Plane& y) { return x.area > y.area; });
+            std::size_t keep = std::min<std::size_t>(planes.size(), leaf.indexCount / 6);
+            while (keep > 1 && planes[keep - 1].area < PART_AREA * leaf.area)
+                --keep;
+            if (keep < 2)
+                return {};
+            for (std::size_t p = keep; p < planes.size(); ++p)
+            {
+                std::size_t into = 0;
+                for (std::size_t q = 1; q < keep; ++q)
+                    if (std::abs(glm::dot(planes[q].seed, planes[p].seed)) > std::abs(glm::dot(planes[into].seed, planes[p].seed)))
+                        into = q;
+                const glm::vec3 n = glm::length(planes[p].normalSum) > 0.0f ? glm::normalize(planes[p].normalSum) : planes[p].seed;
+                add(planes[into], n, planes[p].area, planes[p].weighted / planes[p].area, planes[p].vertices);
+            }
+            std::vector<Node> parts(keep);
+            for (std::size_t p = 0; p < keep; ++p)
+            {
+                Node& part = parts[p];
+                part.centre = planes[p].weighted / planes[p].area;
+                part.normal = glm::length(planes[p].normalSum) > 0.0f ? glm::normalize(planes[p].normalSum) : planes[p].seed;
+                part.area = planes[p].area;
+                part.uvMin = glm::vec2(std::numeric_limits<float>::max());
+                part.uvMax = -part.uvMin;
+                for (std::uint32_t v : planes[p].vertices)
+                {
+                    part.uvMin = glm::min(part.uvMin, m.leafVertices[v].uv);
+                    part.uvMax = glm::max(part.uvMax, m.leafVertices[v].uv);
+                }
+                setCorners(m, planes[p].vertices, part);
+            }
+            return parts;
+        }
+
+        /// Leaf `i` as a node: the four vertices nearest its texture rectangle's corners (or, for a
+        /// leaf without a UV extent, nearest the corners of its extent in its own plane); with
+        /// `planes`, a leaf in several planes as one quad per plane (planeParts).
+        Node originalNode(const TreeModel& m, std::size_t i, bool planes)
+        {
+            const Leaf& leaf = m.leaves[i];
+            Node node;
+            node.centre = leaf.centre;
+            node.normal = leaf.normal;
+            node.uvMin = leaf.uvMin;
+            node.uvMax = leaf.uvMax;
+            if (planes)
+                node.parts = planeParts(m, leaf);
+            if (!node.parts.empty())
+            {
+                node.corner = node.parts[0].corner;
+                node.area = leaf.area;
+                return node;
+            }
+            std::vector<std::uint32_t> vertices(leaf.vertexCount);
+            std::iota(vertices.begin(), vertices.end(), leaf.firstVertex);
+            setCorners(m, vertices, node);
             float q = quadArea(m, node.corner);
             node.area = q > 1e-12f ? q : leaf.area;
             return node;
@@ -139,8 +265,8 @@ namespace TreeLod
         /// to corner r of the ideal leaf (the area A_a + A_b around the pair's centre, in the
         /// larger leaf's frame and aspect). Deviation (docs/lodf.md): the paper's two leaves alone
         /// cannot reach that area a few collapses deep, and coarse levels thinned out.
-        Node collapseLeaves(const TreeModel& m, const Node& a, const Node& b, const std::vector<Node>& nodes,
-                           std::uint32_t originalCount, const glm::vec3* centreOf = nullptr)
+        Node collapseLeaves(const TreeModel& m, const Node& a, const Node& b, const std::vector<Node>& sources,
+                            const glm::vec3* centreOf = nullptr)
         {
             const float target = a.area + b.area;
             const glm::vec3 centre =
@@ -178,14 +304,13 @@ namespace TreeLod
                 u *= hu;
                 v = glm::normalize(v) * hv;
                 const glm::vec3 ideal[4] = {centre - u - v, centre + u - v, centre + u + v, centre - u + v};
-                const Node& image = nodes[big.imageSource];
+                const Node& image = sources[big.imageSource];
                 std::array<std::uint32_t, 4> q = out.corner;
                 for (int r = 0; r < 4; ++r)
                 {
                     float nearest = std::numeric_limits<float>::max();
-                    for (std::uint32_t source = 0; source < originalCount; ++source)
+                    for (const Node& o : sources)
                         {
-                            const Node& o = nodes[source];
                             if (!sameImage(o, image))
                                 continue;
                             const float d = glm::length(pos(o.corner[r]) - ideal[r]);
@@ -208,9 +333,8 @@ namespace TreeLod
                 float score = shaped(q);
                 for (int pass = 0; pass < 2; ++pass)
                     for (int r = 0; r < 4; ++r)
-                        for (std::uint32_t source = 0; source < originalCount; ++source)
+                        for (const Node& o : sources)
                         {
-                            const Node& o = nodes[source];
                             if (!sameImage(o, image) || o.corner[r] == q[r])
                                 continue;
                             std::array<std::uint32_t, 4> t = q;
@@ -239,13 +363,8 @@ namespace TreeLod
             return out;
         }
 
-        /// Crossed leaves: two originals of one leaf image are parts of one crossed leaf when their
-        /// centres lie within CROSSED_CENTRE leaf sizes of each other and their planes differ
-        /// (|n_a . n_b| < CROSSED_PARALLEL), as ez-tree's "double billboards" and needle sprigs.
-        constexpr float CROSSED_CENTRE = 0.05f, CROSSED_PARALLEL = 0.9f;
-
-        /// The cluster's originals grouped into crossed leaves (a plain leaf is a group of one; every
-        /// leaf without `crossed`), each group in increasing node order, groups by their first node.
+        /// The cluster's originals grouped into crossed leaves (a plain leaf, or one in several
+        /// planes, is a group of one; every leaf without `crossed`), each group in increasing node order, groups by their first node.
         std::vector<std::vector<std::uint32_t>> crossedGroups(const std::vector<Node>& nodes, std::uint32_t n,
                                                               bool crossed)
         {
@@ -256,7 +375,7 @@ namespace TreeLod
                 {
                     const Node& a = nodes[i];
                     const Node& b = nodes[j];
-                    if (group[j] != j || !sameImage(a, b) ||
+                    if (group[j] != j || !a.parts.empty() || !b.parts.empty() || !sameImage(a, b) ||
                         std::abs(glm::dot(a.normal, b.normal)) >= CROSSED_PARALLEL ||
                         !(glm::length(a.centre - b.centre) < CROSSED_CENTRE * std::sqrt(std::min(a.area, b.area))))
                         continue;
@@ -276,35 +395,120 @@ namespace TreeLod
             return groups;
         }
 
-        /// The parts of `u` and `v` collapsed with each other: each part of the one with fewer
-        /// parts (u on a tie) with the most parallel free part of the other, in order.
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> matchParts(const std::vector<Node>& nodes,
-                                                                        const std::vector<std::uint32_t>& u,
-                                                                        const std::vector<std::uint32_t>& v)
+        /// Which parts collapse with which: each of the side with fewer parts (u on a tie), in
+        /// order, with the most parallel free part of the other. Pairs of (u index, v index).
+        std::vector<std::pair<std::size_t, std::size_t>> matchByNormal(const std::vector<glm::vec3>& u,
+                                                                        const std::vector<glm::vec3>& v)
         {
             const bool swap = v.size() < u.size();
-            const std::vector<std::uint32_t>& few = swap ? v : u;
-            const std::vector<std::uint32_t>& many = swap ? u : v;
+            const std::vector<glm::vec3>& few = swap ? v : u;
+            const std::vector<glm::vec3>& many = swap ? u : v;
             std::vector<char> used(many.size(), 0);
-            std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-            for (std::uint32_t a : few)
+            std::vector<std::pair<std::size_t, std::size_t>> pairs;
+            for (std::size_t a = 0; a < few.size(); ++a)
             {
                 std::size_t best = 0;
                 float bestDot = -1.0f;
                 for (std::size_t k = 0; k < many.size(); ++k)
                     if (!used[k])
-                    {
-                        const float d = std::abs(glm::dot(nodes[a].normal, nodes[many[k]].normal));
-                        if (d > bestDot)
+                        if (const float d = std::abs(glm::dot(few[a], many[k])); d > bestDot)
                         {
                             bestDot = d;
                             best = k;
                         }
-                    }
                 used[best] = 1;
-                pairs.push_back(swap ? std::make_pair(many[best], a) : std::make_pair(a, many[best]));
+                pairs.push_back(swap ? std::make_pair(best, a) : std::make_pair(a, best));
             }
             return pairs;
+        }
+
+        /// The parts of `u` and `v` (node ids) collapsed with each other (matchByNormal).
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> matchParts(const std::vector<Node>& nodes,
+                                                                        const std::vector<std::uint32_t>& u,
+                                                                        const std::vector<std::uint32_t>& v)
+        {
+            std::vector<glm::vec3> nu, nv;
+            for (std::uint32_t a : u)
+                nu.push_back(nodes[a].normal);
+            for (std::uint32_t b : v)
+                nv.push_back(nodes[b].normal);
+            std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+            for (const auto& [i, j] : matchByNormal(nu, nv))
+                pairs.emplace_back(u[i], v[j]);
+            return pairs;
+        }
+
+        /// A node's one-quad parts: its `parts`, or itself.
+        std::vector<const Node*> quadsOf(const Node& a)
+        {
+            std::vector<const Node*> quads;
+            for (const Node& p : a.parts)
+                quads.push_back(&p);
+            if (quads.empty())
+                quads.push_back(&a);
+            return quads;
+        }
+
+        std::vector<std::pair<std::size_t, std::size_t>> matchQuads(const std::vector<const Node*>& u,
+                                                                     const std::vector<const Node*>& v)
+        {
+            std::vector<glm::vec3> nu, nv;
+            for (const Node* a : u)
+                nu.push_back(a->normal);
+            for (const Node* b : v)
+                nv.push_back(b->normal);
+            return matchByNormal(nu, nv);
+        }
+
+        /// The cost of collapsing two leaves: collapseCost, or, for leaves in several planes, the
+        /// largest of their matched planes'.
+        float nodeCost(const Node& a, const Node& b, float meanArea)
+        {
+            if (a.parts.empty() && b.parts.empty())
+                return collapseCost(a, b, meanArea);
+            const std::vector<const Node*> u = quadsOf(a), v = quadsOf(b);
+            float cost = 0.0f;
+            for (const auto& [i, j] : matchQuads(u, v))
+                cost = std::max(cost, collapseCost(*u[i], *v[j], meanArea));
+            return cost;
+        }
+
+        /// The leaf that replaces a and b (collapseLeaves); leaves in several planes collapse plane
+        /// with plane (matchQuads), the larger one's unmatched planes kept, so they stay in
+        /// several planes and never take more index slots than the larger of the two.
+        Node mergeNodes(const TreeModel& m, const Node& a, const Node& b, const std::vector<Node>& sources,
+                        const glm::vec3* centreOf)
+        {
+            if (a.parts.empty() && b.parts.empty())
+                return collapseLeaves(m, a, b, sources, centreOf);
+            const std::vector<const Node*> u = quadsOf(a), v = quadsOf(b);
+            const auto pairs = matchQuads(u, v);
+            Node out;
+            for (const auto& [i, j] : pairs)
+                out.parts.push_back(collapseLeaves(m, *u[i], *v[j], sources));
+            const std::vector<const Node*>& more = u.size() >= v.size() ? u : v;
+            for (std::size_t k = 0; k < more.size(); ++k)
+                if (std::none_of(pairs.begin(), pairs.end(),
+                                 [&](const auto& q) { return (&more == &u ? q.first : q.second) == k; }))
+                    out.parts.push_back(*more[k]);
+            std::stable_sort(out.parts.begin(), out.parts.end(),
+                             [](const Node& x, const Node& y) { return x.area > y.area; });
+            glm::vec3 normal(0.0f), weighted(0.0f);
+            for (const Node& p : out.parts)
+            {
+                out.area += p.area;
+                weighted += p.centre * p.area;
+                normal += (glm::dot(p.normal, out.parts[0].normal) < 0.0f ? -p.normal : p.normal) * p.area;
+            }
+            out.centre = weighted / std::max(out.area, 1e-30f);
+            out.normal = glm::length(normal) > 1e-12f ? glm::normalize(normal) : out.parts[0].normal;
+            out.corner = out.parts[0].corner;
+            out.uvMin = sameImage(a, b) ? a.uvMin : glm::min(a.uvMin, b.uvMin);
+            out.uvMax = sameImage(a, b) ? a.uvMax : glm::max(a.uvMax, b.uvMax);
+            out.imageSource = out.parts[0].imageSource;
+            if (out.parts.size() == 1)
+                return std::move(out.parts[0]);
+            return out;
         }
 
         /// The cost of collapsing two crossed leaves: the largest of their part pairs' (a plain
@@ -313,30 +517,39 @@ namespace TreeLod
                         const std::vector<std::uint32_t>& v, float meanArea)
         {
             if (u.size() == 1 && v.size() == 1)
-                return collapseCost(nodes[u[0]], nodes[v[0]], meanArea);
+                return nodeCost(nodes[u[0]], nodes[v[0]], meanArea);
             float cost = 0.0f;
             for (const auto& [a, b] : matchParts(nodes, u, v))
-                cost = std::max(cost, collapseCost(nodes[a], nodes[b], meanArea));
+                cost = std::max(cost, nodeCost(nodes[a], nodes[b], meanArea));
             return cost;
         }
 
         /// §3 / FSA: collapse the cheapest pair until one leaf is left. Crossed leaves collapse as
         /// one, part with part (matchParts), so they stay crossed; only the cluster's last
-        /// collapses merge the parts of its one remaining crossed leaf. Row minima make it O(n^2)
-        /// per cluster in practice.
+        /// collapses merge the parts of its one remaining crossed leaf. With `crossed`, a leaf
+        /// that is one mesh in several planes collapses plane with plane (mergeNodes). Row minima
+        /// make it O(n^2) per cluster in practice.
         void simplifyCluster(const TreeModel& m, ClusterBuild& cluster, float meanArea, bool crossed)
         {
             const std::uint32_t n = std::uint32_t(cluster.leaves.size());
             for (std::uint32_t i = 0; i < n; ++i)
             {
-                cluster.nodes.push_back(originalNode(m, cluster.leaves[i]));
-                cluster.nodes.back().imageSource = i;
+                Node node = originalNode(m, cluster.leaves[i], crossed);
+                for (Node& part : node.parts)
+                {
+                    part.imageSource = std::uint32_t(cluster.sources.size());
+                    cluster.sources.push_back(part);
+                }
+                node.imageSource = node.parts.empty() ? std::uint32_t(cluster.sources.size()) : node.parts[0].imageSource;
+                if (node.parts.empty())
+                    cluster.sources.push_back(node);
+                cluster.nodes.push_back(std::move(node));
             }
             if (n < 2)
                 return;
             float running = 0.0f;
             auto collapse = [&](std::uint32_t a, std::uint32_t b, float cost, const glm::vec3* centre = nullptr) {
-                Node merged = collapseLeaves(m, cluster.nodes[a], cluster.nodes[b], cluster.nodes, n, centre);
+                Node merged = mergeNodes(m, cluster.nodes[a], cluster.nodes[b], cluster.sources, centre);
                 cluster.nodes.push_back(std::move(merged));
                 running = std::max(running, cost);
                 cluster.collapses.push_back({a, b, running});
@@ -426,7 +639,7 @@ namespace TreeLod
                 float bv = std::numeric_limits<float>::max();
                 for (std::size_t i = 0; i < last.size(); ++i)
                     for (std::size_t j = i + 1; j < last.size(); ++j)
-                        if (const float c = collapseCost(cluster.nodes[last[i]], cluster.nodes[last[j]], meanArea); c < bv)
+                        if (const float c = nodeCost(cluster.nodes[last[i]], cluster.nodes[last[j]], meanArea); c < bv)
                         {
                             bv = c;
                             bi = i;
@@ -594,9 +807,12 @@ namespace TreeLod
                     const std::uint32_t step = node - n; // 0-based collapse that created it
                     e.leaf = createdNumber[c][step];
                     e.created = step + 1;
-                    const auto& q = b.nodes[node].corner;
-                    data.indices.insert(data.indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
-                    e.indexCount = 6;
+                    for (const Node* quad : quadsOf(b.nodes[node]))
+                    {
+                        const auto& q = quad->corner;
+                        data.indices.insert(data.indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+                    }
+                    e.indexCount = std::uint32_t(data.indices.size()) - e.firstIndex;
                 }
                 data.entries.push_back(e);
             };

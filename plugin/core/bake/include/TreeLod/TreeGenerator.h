@@ -58,6 +58,10 @@ namespace TreeLod
         /// Leaf materials, 1..16 ("Leaves", "Leaves 2", ...): leaves are dealt to them in turn;
         /// each has its own tint and alpha cutoff (0.5 for the first, 0.3..0.7 for the others).
         std::uint32_t leafMaterials = 1;
+        /// Leaf fold in degrees, 0..80: above 0 every leaf is one mesh of two quads folded along
+        /// its midrib, each wing raised by this angle towards the leaf's face (the wings keep their
+        /// width); 0: one flat quad.
+        float leafFold = 0.0f;
     };
 
     /// The preset's leaf count and height when the options leave them 0.

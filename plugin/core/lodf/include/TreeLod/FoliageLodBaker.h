@@ -30,6 +30,13 @@
 //    those pairs'), one step per pair, the later parts centred on the first; only a cluster's
 //    last steps merge the parts of its one remaining crossed leaf. Collapsed as flat leaves,
 //    crossed leaves lost a quarter of their area by L/2 and their crossing by L/4.
+//    Leaves in several planes (deviation, docs/lodf.md): a leaf that is one mesh in several planes
+//    (a folded leaf, a sprig in one piece) is one quad per plane (its triangles grouped by normal;
+//    planes under 10 % of its area, or more than its index slots hold, joined to the most
+//    parallel one), and collapses plane with plane as crossed parts do, but in one step: the
+//    created leaf has one quad per plane of the larger of the two (index slots suffice, as
+//    the larger leaf had them). As one flat quad, at most 17 % of a folded test crown's area
+//    stayed folded at L/2.
 // 4. Order (Fig. 8): Changed_group lists the collapses by cost band (`costBands` equal-count bands
 //    of each collapse's running-maximum cost in its cluster), and inside a band cluster by cluster
 //    (clusters in a fixed pseudo-random order, so no region of the crown simplifies first).
@@ -58,8 +65,10 @@ namespace TreeLod
         /// Bands of Changed_group (1..64); 0 = the paper's pure global cost order (every
         /// change then touches most clusters). 1 = cluster by cluster.
         std::uint32_t costBands = 4;
-        /// Crossed leaves (step 3) collapse part with part; false: every quad as a flat leaf, as
-        /// the paper's (the baseline of docs/lodf.md's measurements).
+        /// Leaves in several planes collapse plane with plane: crossed quads through one centre
+        /// (step 3) part with part, and a leaf that is one mesh in several planes (a folded leaf,
+        /// a sprig in one piece) into created leaves of one quad per plane. False: every leaf
+        /// collapses into one flat quad, as the paper's (the baseline of docs/lodf.md).
         bool crossedLeaves = true;
     };
 
