@@ -28,7 +28,8 @@ namespace TreeLod
         if (!data)
             mAsset.raise(data.error());
         const TreeModel& model = mAsset.getReference().model;
-        if (data->leafVertexCount != model.leafVertices.size() || data->originalLeafCount != model.leaves.size())
+        // Originals are leaves or planes of leaves (FoliageLodData::originalLeafCount).
+        if (data->leafVertexCount != model.leafVertices.size() || data->originalLeafCount < model.leaves.size())
             mAsset.raise(fail(mAsset.getName(), chunkElement(FOLIAGE_LOD_CHUNK, 0),
                        "made for " + std::to_string(data->originalLeafCount) + " leaves / " +
                            std::to_string(data->leafVertexCount) + " vertices, the reference has " +

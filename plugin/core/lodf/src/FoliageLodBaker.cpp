@@ -18,9 +18,7 @@ namespace TreeLod
 {
     namespace
     {
-        /// A leaf while collapsing: original or created, by its four corner vertices, or, for a
-        /// leaf in several planes (one mesh: a bent leaf, a sprig in one piece), one such quad
-        /// per plane in `parts` (then the other fields are the whole leaf's).
+        /// A leaf while collapsing: original or created, by its four corner vertices.
         struct Node
         {
             std::array<std::uint32_t, 4> corner{}; ///< vertices at texture corners (0,0) (1,0) (1,1) (0,1)
@@ -28,8 +26,16 @@ namespace TreeLod
             glm::vec3 normal{0.0f, 1.0f, 0.0f};
             float area = 0.0f;       ///< area it stands for: the sum over the original leaves it replaces
             glm::vec2 uvMin{0.0f}, uvMax{0.0f};
-            std::uint32_t imageSource = 0; ///< a corner source (ClusterBuild::sources) whose leaf image it shows
-            std::vector<Node> parts;       ///< one-quad nodes, largest first; empty for a leaf in one plane
+            std::uint32_t imageSource = 0; ///< an original (node id) whose leaf image it shows
+        };
+
+        /// An original of LoDF: a leaf, or, with FoliageLodOptions::crossedLeaves, one plane of a
+        /// leaf that is one mesh in several planes (planeParts).
+        struct Unit
+        {
+            std::uint32_t leaf = 0;                ///< model leaf index
+            std::uint32_t firstIndex = 0, indexCount = 0; ///< its triangles, in the unit index pool
+            Node node;
         };
 
         struct Collapse
@@ -41,11 +47,8 @@ namespace TreeLod
         struct ClusterBuild
         {
             std::uint32_t material = 0;
-            std::vector<std::uint32_t> leaves; ///< model leaf indices, the cluster's originals
+            std::vector<std::uint32_t> leaves; ///< unit indices, the cluster's originals
             std::vector<Node> nodes;           ///< originals then created
-            /// The originals' one-quad nodes (a leaf in several planes: each part), whose corner
-            /// vertices created leaves take (collapseLeaves).
-            std::vector<Node> sources;
             std::vector<Collapse> collapses;
         };
 
@@ -106,19 +109,24 @@ namespace TreeLod
         /// A plane of a leaf under this share of its area joins the most parallel larger one.
         constexpr float PART_AREA = 0.1f;
 
+        struct PlanePart
+        {
+            Node node;
+            std::vector<std::uint32_t> indices; ///< its triangles (leaf vertex ids)
+        };
+
         /// Leaf `leaf`, one mesh in several planes, as one quad per plane: its triangles grouped by
         /// normal (each with the plane of the most parallel seed within CROSSED_PARALLEL, the
-        /// largest triangles seeding), planes under PART_AREA of the leaf's area, or beyond the
-        /// indexCount / 6 that its index slots hold (a created quad takes six), joined to the most
-        /// parallel kept one. Each part's UV rectangle is its own vertices' extent. Empty when
-        /// fewer than two planes remain.
-        std::vector<Node> planeParts(const TreeModel& m, const Leaf& leaf)
+        /// largest triangles seeding), planes under PART_AREA of the leaf's area joined to the
+        /// most parallel larger one. Each part's UV rectangle is its own vertices' extent. Empty
+        /// when fewer than two planes remain.
+        std::vector<PlanePart> planeParts(const TreeModel& m, const Leaf& leaf)
         {
             struct Plane
             {
                 glm::vec3 seed{0.0f}, normalSum{0.0f}, weighted{0.0f};
                 float area = 0.0f;
-                std::vector<std::uint32_t> vertices;
+                std::vector<std::uint32_t> vertices, indices;
             };
             std::vector<std::uint32_t> triangles(leaf.indexCount / 3);
             std::iota(triangles.begin(), triangles.end(), 0u);
@@ -134,11 +142,12 @@ namespace TreeLod
                              [&](std::uint32_t x, std::uint32_t y) { return glm::length(cross(x)) > glm::length(cross(y)); });
             std::vector<Plane> planes;
             const auto add = [](Plane& p, const glm::vec3& n, float area, const glm::vec3& centre,
-                                const std::vector<std::uint32_t>& vertices) {
+                                const std::vector<std::uint32_t>& indices) {
                 p.normalSum += (glm::dot(n, p.seed) < 0.0f ? -n : n) * area;
                 p.weighted += centre * area;
                 p.area += area;
-                for (std::uint32_t v : vertices)
+                p.indices.insert(p.indices.end(), indices.begin(), indices.end());
+                for (std::uint32_t v : indices)
                     if (std::find(p.vertices.begin(), p.vertices.end(), v) == p.vertices.end())
                         p.vertices.push_back(v);
             };
@@ -167,7 +176,7 @@ namespace TreeLod
                 add(planes[best], n, 0.5f * twice, centre, {corner(t, 0), corner(t, 1), corner(t, 2)});
             }
             std::stable_sort(planes.begin(), planes.end(), [](const Plane& x, const Plane& y) { return x.area > y.area; });
-            std::size_t keep = std::min<std::size_t>(planes.size(), leaf.indexCount / 6);
+            std::size_t keep = planes.size();
             while (keep > 1 && planes[keep - 1].area < PART_AREA * leaf.area)
                 --keep;
             if (keep < 2)
@@ -179,12 +188,13 @@ namespace TreeLod
                     if (std::abs(glm::dot(planes[q].seed, planes[p].seed)) > std::abs(glm::dot(planes[into].seed, planes[p].seed)))
                         into = q;
                 const glm::vec3 n = glm::length(planes[p].normalSum) > 0.0f ? glm::normalize(planes[p].normalSum) : planes[p].seed;
-                add(planes[into], n, planes[p].area, planes[p].weighted / planes[p].area, planes[p].vertices);
+                add(planes[into], n, planes[p].area, planes[p].weighted / planes[p].area, planes[p].indices);
             }
-            std::vector<Node> parts(keep);
+            std::vector<PlanePart> parts(keep);
             for (std::size_t p = 0; p < keep; ++p)
             {
-                Node& part = parts[p];
+                parts[p].indices = std::move(planes[p].indices);
+                Node& part = parts[p].node;
                 part.centre = planes[p].weighted / planes[p].area;
                 part.normal = glm::length(planes[p].normalSum) > 0.0f ? glm::normalize(planes[p].normalSum) : planes[p].seed;
                 part.area = planes[p].area;
@@ -201,9 +211,8 @@ namespace TreeLod
         }
 
         /// Leaf `i` as a node: the four vertices nearest its texture rectangle's corners (or, for a
-        /// leaf without a UV extent, nearest the corners of its extent in its own plane); with
-        /// `planes`, a leaf in several planes as one quad per plane (planeParts).
-        Node originalNode(const TreeModel& m, std::size_t i, bool planes)
+        /// leaf without a UV extent, nearest the corners of its extent in its own plane).
+        Node originalNode(const TreeModel& m, std::size_t i)
         {
             const Leaf& leaf = m.leaves[i];
             Node node;
@@ -211,14 +220,6 @@ namespace TreeLod
             node.normal = leaf.normal;
             node.uvMin = leaf.uvMin;
             node.uvMax = leaf.uvMax;
-            if (planes)
-                node.parts = planeParts(m, leaf);
-            if (!node.parts.empty())
-            {
-                node.corner = node.parts[0].corner;
-                node.area = leaf.area;
-                return node;
-            }
             std::vector<std::uint32_t> vertices(leaf.vertexCount);
             std::iota(vertices.begin(), vertices.end(), leaf.firstVertex);
             setCorners(m, vertices, node);
@@ -265,8 +266,8 @@ namespace TreeLod
         /// to corner r of the ideal leaf (the area A_a + A_b around the pair's centre, in the
         /// larger leaf's frame and aspect). Deviation (docs/lodf.md): the paper's two leaves alone
         /// cannot reach that area a few collapses deep, and coarse levels thinned out.
-        Node collapseLeaves(const TreeModel& m, const Node& a, const Node& b, const std::vector<Node>& sources,
-                            const glm::vec3* centreOf = nullptr)
+        Node collapseLeaves(const TreeModel& m, const Node& a, const Node& b, const std::vector<Node>& nodes,
+                            std::uint32_t originalCount, const glm::vec3* centreOf = nullptr)
         {
             const float target = a.area + b.area;
             const glm::vec3 centre =
@@ -304,13 +305,14 @@ namespace TreeLod
                 u *= hu;
                 v = glm::normalize(v) * hv;
                 const glm::vec3 ideal[4] = {centre - u - v, centre + u - v, centre + u + v, centre - u + v};
-                const Node& image = sources[big.imageSource];
+                const Node& image = nodes[big.imageSource];
                 std::array<std::uint32_t, 4> q = out.corner;
                 for (int r = 0; r < 4; ++r)
                 {
                     float nearest = std::numeric_limits<float>::max();
-                    for (const Node& o : sources)
+                    for (std::uint32_t source = 0; source < originalCount; ++source)
                         {
+                            const Node& o = nodes[source];
                             if (!sameImage(o, image))
                                 continue;
                             const float d = glm::length(pos(o.corner[r]) - ideal[r]);
@@ -333,8 +335,9 @@ namespace TreeLod
                 float score = shaped(q);
                 for (int pass = 0; pass < 2; ++pass)
                     for (int r = 0; r < 4; ++r)
-                        for (const Node& o : sources)
+                        for (std::uint32_t source = 0; source < originalCount; ++source)
                         {
+                            const Node& o = nodes[source];
                             if (!sameImage(o, image) || o.corner[r] == q[r])
                                 continue;
                             std::array<std::uint32_t, 4> t = q;
@@ -363,11 +366,14 @@ namespace TreeLod
             return out;
         }
 
-        /// The cluster's originals grouped into crossed leaves (a plain leaf, or one in several
-        /// planes, is a group of one; every leaf without `crossed`), each group in increasing node order, groups by their first node.
-        std::vector<std::vector<std::uint32_t>> crossedGroups(const std::vector<Node>& nodes, std::uint32_t n,
-                                                              bool crossed)
+        /// The cluster's originals grouped into leaves of several planes: the planes of one mesh
+        /// (`leafOf`: the same model leaf) and crossed leaves (a plain leaf is a group of one;
+        /// without `crossed`, every original), each group in increasing node order, groups by
+        /// their first node.
+        std::vector<std::vector<std::uint32_t>> crossedGroups(const std::vector<Node>& nodes,
+                                                              const std::vector<std::uint32_t>& leafOf, bool crossed)
         {
+            const std::uint32_t n = std::uint32_t(leafOf.size());
             std::vector<std::uint32_t> group(n);
             std::iota(group.begin(), group.end(), 0u);
             for (std::uint32_t i = 0; i < n && crossed; ++i)
@@ -375,9 +381,11 @@ namespace TreeLod
                 {
                     const Node& a = nodes[i];
                     const Node& b = nodes[j];
-                    if (group[j] != j || !a.parts.empty() || !b.parts.empty() || !sameImage(a, b) ||
-                        std::abs(glm::dot(a.normal, b.normal)) >= CROSSED_PARALLEL ||
-                        !(glm::length(a.centre - b.centre) < CROSSED_CENTRE * std::sqrt(std::min(a.area, b.area))))
+                    const bool oneMesh = leafOf[i] == leafOf[j];
+                    if (group[j] != j ||
+                        (!oneMesh && (!sameImage(a, b) || std::abs(glm::dot(a.normal, b.normal)) >= CROSSED_PARALLEL ||
+                                      !(glm::length(a.centre - b.centre) <
+                                        CROSSED_CENTRE * std::sqrt(std::min(a.area, b.area))))))
                         continue;
                     group[j] = group[i];
                 }
@@ -438,118 +446,41 @@ namespace TreeLod
             return pairs;
         }
 
-        /// A node's one-quad parts: its `parts`, or itself.
-        std::vector<const Node*> quadsOf(const Node& a)
-        {
-            std::vector<const Node*> quads;
-            for (const Node& p : a.parts)
-                quads.push_back(&p);
-            if (quads.empty())
-                quads.push_back(&a);
-            return quads;
-        }
-
-        std::vector<std::pair<std::size_t, std::size_t>> matchQuads(const std::vector<const Node*>& u,
-                                                                     const std::vector<const Node*>& v)
-        {
-            std::vector<glm::vec3> nu, nv;
-            for (const Node* a : u)
-                nu.push_back(a->normal);
-            for (const Node* b : v)
-                nv.push_back(b->normal);
-            return matchByNormal(nu, nv);
-        }
-
-        /// The cost of collapsing two leaves: collapseCost, or, for leaves in several planes, the
-        /// largest of their matched planes'.
-        float nodeCost(const Node& a, const Node& b, float meanArea)
-        {
-            if (a.parts.empty() && b.parts.empty())
-                return collapseCost(a, b, meanArea);
-            const std::vector<const Node*> u = quadsOf(a), v = quadsOf(b);
-            float cost = 0.0f;
-            for (const auto& [i, j] : matchQuads(u, v))
-                cost = std::max(cost, collapseCost(*u[i], *v[j], meanArea));
-            return cost;
-        }
-
-        /// The leaf that replaces a and b (collapseLeaves); leaves in several planes collapse plane
-        /// with plane (matchQuads), the larger one's unmatched planes kept, so they stay in
-        /// several planes and never take more index slots than the larger of the two.
-        Node mergeNodes(const TreeModel& m, const Node& a, const Node& b, const std::vector<Node>& sources,
-                        const glm::vec3* centreOf)
-        {
-            if (a.parts.empty() && b.parts.empty())
-                return collapseLeaves(m, a, b, sources, centreOf);
-            const std::vector<const Node*> u = quadsOf(a), v = quadsOf(b);
-            const auto pairs = matchQuads(u, v);
-            Node out;
-            for (const auto& [i, j] : pairs)
-                out.parts.push_back(collapseLeaves(m, *u[i], *v[j], sources));
-            const std::vector<const Node*>& more = u.size() >= v.size() ? u : v;
-            for (std::size_t k = 0; k < more.size(); ++k)
-                if (std::none_of(pairs.begin(), pairs.end(),
-                                 [&](const auto& q) { return (&more == &u ? q.first : q.second) == k; }))
-                    out.parts.push_back(*more[k]);
-            std::stable_sort(out.parts.begin(), out.parts.end(),
-                             [](const Node& x, const Node& y) { return x.area > y.area; });
-            glm::vec3 normal(0.0f), weighted(0.0f);
-            for (const Node& p : out.parts)
-            {
-                out.area += p.area;
-                weighted += p.centre * p.area;
-                normal += (glm::dot(p.normal, out.parts[0].normal) < 0.0f ? -p.normal : p.normal) * p.area;
-            }
-            out.centre = weighted / std::max(out.area, 1e-30f);
-            out.normal = glm::length(normal) > 1e-12f ? glm::normalize(normal) : out.parts[0].normal;
-            out.corner = out.parts[0].corner;
-            out.uvMin = sameImage(a, b) ? a.uvMin : glm::min(a.uvMin, b.uvMin);
-            out.uvMax = sameImage(a, b) ? a.uvMax : glm::max(a.uvMax, b.uvMax);
-            out.imageSource = out.parts[0].imageSource;
-            if (out.parts.size() == 1)
-                return std::move(out.parts[0]);
-            return out;
-        }
-
         /// The cost of collapsing two crossed leaves: the largest of their part pairs' (a plain
         /// leaf's is collapseCost).
         float groupCost(const std::vector<Node>& nodes, const std::vector<std::uint32_t>& u,
                         const std::vector<std::uint32_t>& v, float meanArea)
         {
             if (u.size() == 1 && v.size() == 1)
-                return nodeCost(nodes[u[0]], nodes[v[0]], meanArea);
+                return collapseCost(nodes[u[0]], nodes[v[0]], meanArea);
             float cost = 0.0f;
             for (const auto& [a, b] : matchParts(nodes, u, v))
-                cost = std::max(cost, nodeCost(nodes[a], nodes[b], meanArea));
+                cost = std::max(cost, collapseCost(nodes[a], nodes[b], meanArea));
             return cost;
         }
 
         /// §3 / FSA: collapse the cheapest pair until one leaf is left. Crossed leaves collapse as
         /// one, part with part (matchParts), so they stay crossed; only the cluster's last
-        /// collapses merge the parts of its one remaining crossed leaf. With `crossed`, a leaf
-        /// that is one mesh in several planes collapses plane with plane (mergeNodes). Row minima
-        /// make it O(n^2) per cluster in practice.
-        void simplifyCluster(const TreeModel& m, ClusterBuild& cluster, float meanArea, bool crossed)
+        /// collapses merge the parts of its one remaining crossed leaf. The planes of a leaf that
+        /// is one mesh (units of one model leaf) are such parts too, each later one centred where
+        /// its own pair lies rather than on the first. Row minima make it O(n^2) per cluster in
+        /// practice.
+        void simplifyCluster(const TreeModel& m, const std::vector<Unit>& units, ClusterBuild& cluster,
+                             float meanArea, bool crossed)
         {
             const std::uint32_t n = std::uint32_t(cluster.leaves.size());
+            std::vector<std::uint32_t> leafOf(n);
             for (std::uint32_t i = 0; i < n; ++i)
             {
-                Node node = originalNode(m, cluster.leaves[i], crossed);
-                for (Node& part : node.parts)
-                {
-                    part.imageSource = std::uint32_t(cluster.sources.size());
-                    cluster.sources.push_back(part);
-                }
-                node.imageSource = node.parts.empty() ? std::uint32_t(cluster.sources.size()) : node.parts[0].imageSource;
-                if (node.parts.empty())
-                    cluster.sources.push_back(node);
-                cluster.nodes.push_back(std::move(node));
+                cluster.nodes.push_back(units[cluster.leaves[i]].node);
+                cluster.nodes.back().imageSource = i;
+                leafOf[i] = units[cluster.leaves[i]].leaf;
             }
             if (n < 2)
                 return;
             float running = 0.0f;
             auto collapse = [&](std::uint32_t a, std::uint32_t b, float cost, const glm::vec3* centre = nullptr) {
-                Node merged = mergeNodes(m, cluster.nodes[a], cluster.nodes[b], cluster.sources, centre);
+                Node merged = collapseLeaves(m, cluster.nodes[a], cluster.nodes[b], cluster.nodes, n, centre);
                 cluster.nodes.push_back(std::move(merged));
                 running = std::max(running, cost);
                 cluster.collapses.push_back({a, b, running});
@@ -557,8 +488,14 @@ namespace TreeLod
             };
             // slot -> the parts (node ids) of a crossed or plain leaf; a collapse puts the new leaf
             // in the slot of `a` and frees `b`'s.
-            std::vector<std::vector<std::uint32_t>> slot = crossedGroups(cluster.nodes, n, crossed);
+            std::vector<std::vector<std::uint32_t>> slot = crossedGroups(cluster.nodes, leafOf, crossed);
             const std::uint32_t S = std::uint32_t(slot.size());
+            // A slot whose parts all come from one mesh: its later parts keep their own centres.
+            std::vector<char> oneMesh(S, 0);
+            for (std::uint32_t k = 0; k < S; ++k)
+                oneMesh[k] = slot[k].size() > 1 && std::all_of(slot[k].begin(), slot[k].end(), [&](std::uint32_t p) {
+                                 return leafOf[p] == leafOf[slot[k][0]];
+                             });
             std::vector<char> alive(S, 1);
             std::vector<float> cost(std::size_t(S) * S, 0.0f);
             auto at = [&](std::uint32_t i, std::uint32_t j) -> float& { return cost[std::size_t(i) * S + j]; };
@@ -604,10 +541,11 @@ namespace TreeLod
                 const auto pairs = matchParts(cluster.nodes, slot[bi], slot[bj]);
                 // Later parts are centred where the first one came to lie, so the leaf stays crossed.
                 std::vector<std::uint32_t> parts;
+                const bool ownCentres = oneMesh[bi] || oneMesh[bj];
                 for (const auto& [a, b] : pairs)
                 {
                     const glm::vec3 first = parts.empty() ? glm::vec3(0.0f) : cluster.nodes[parts[0]].centre;
-                    parts.push_back(collapse(a, b, bv, parts.empty() ? nullptr : &first));
+                    parts.push_back(collapse(a, b, bv, parts.empty() || ownCentres ? nullptr : &first));
                 }
                 for (const std::vector<std::uint32_t>* side : {&slot[bi], &slot[bj]})
                     for (std::uint32_t p : *side)
@@ -615,6 +553,7 @@ namespace TreeLod
                                          [&](const auto& q) { return q.first == p || q.second == p; }))
                             parts.push_back(p);
                 slot[bi] = std::move(parts);
+                oneMesh[bi] = char(ownCentres);
                 slot[bj].clear();
                 alive[bj] = 0;
                 for (std::uint32_t k = 0; k < S; ++k)
@@ -639,7 +578,7 @@ namespace TreeLod
                 float bv = std::numeric_limits<float>::max();
                 for (std::size_t i = 0; i < last.size(); ++i)
                     for (std::size_t j = i + 1; j < last.size(); ++j)
-                        if (const float c = nodeCost(cluster.nodes[last[i]], cluster.nodes[last[j]], meanArea); c < bv)
+                        if (const float c = collapseCost(cluster.nodes[last[i]], cluster.nodes[last[j]], meanArea); c < bv)
                         {
                             bv = c;
                             bi = i;
@@ -651,7 +590,7 @@ namespace TreeLod
         }
 
         /// §3.1: spatially compact clusters of at most `size` leaves (median splits).
-        void splitClusters(const TreeModel& m, std::vector<std::uint32_t> leaves, std::uint32_t size,
+        void splitClusters(const std::vector<Unit>& units, std::vector<std::uint32_t> leaves, std::uint32_t size,
                            std::uint32_t material, std::vector<ClusterBuild>& out)
         {
             if (leaves.size() <= size)
@@ -665,8 +604,8 @@ namespace TreeLod
             glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
             for (std::uint32_t i : leaves)
             {
-                lo = glm::min(lo, m.leaves[i].centre);
-                hi = glm::max(hi, m.leaves[i].centre);
+                lo = glm::min(lo, units[i].node.centre);
+                hi = glm::max(hi, units[i].node.centre);
             }
             const glm::vec3 e = hi - lo;
             const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
@@ -675,13 +614,13 @@ namespace TreeLod
             const std::size_t half = (blocks / 2) * size;
             std::nth_element(leaves.begin(), leaves.begin() + std::ptrdiff_t(half), leaves.end(),
                              [&](std::uint32_t a, std::uint32_t b) {
-                                 float ca = m.leaves[a].centre[axis], cb = m.leaves[b].centre[axis];
+                                 float ca = units[a].node.centre[axis], cb = units[b].node.centre[axis];
                                  return ca < cb || (ca == cb && a < b);
                              });
             std::vector<std::uint32_t> right(leaves.begin() + std::ptrdiff_t(half), leaves.end());
             leaves.resize(half);
-            splitClusters(m, std::move(leaves), size, material, out);
-            splitClusters(m, std::move(right), size, material, out);
+            splitClusters(units, std::move(leaves), size, material, out);
+            splitClusters(units, std::move(right), size, material, out);
         }
 
         std::uint64_t mix64(std::uint64_t x)
@@ -703,7 +642,30 @@ namespace TreeLod
         Result<void> valid = model.validate(label);
         if (!valid)
             return valid.error();
-        const std::uint32_t L = std::uint32_t(model.leaves.size());
+        // The originals: leaves, and with crossedLeaves each plane of a leaf in several planes.
+        std::vector<Unit> units;
+        std::vector<std::uint32_t> unitIndices;
+        units.reserve(model.leaves.size());
+        for (std::uint32_t i = 0; i < model.leaves.size(); ++i)
+        {
+            const Leaf& leaf = model.leaves[i];
+            std::vector<PlanePart> parts;
+            if (options.crossedLeaves)
+                parts = planeParts(model, leaf);
+            if (parts.empty())
+            {
+                Unit u{i, std::uint32_t(unitIndices.size()), leaf.indexCount, originalNode(model, i)};
+                unitIndices.insert(unitIndices.end(), model.leafIndices.begin() + leaf.firstIndex,
+                                   model.leafIndices.begin() + leaf.firstIndex + leaf.indexCount);
+                units.push_back(std::move(u));
+            }
+            for (PlanePart& part : parts)
+            {
+                units.push_back({i, std::uint32_t(unitIndices.size()), std::uint32_t(part.indices.size()), part.node});
+                unitIndices.insert(unitIndices.end(), part.indices.begin(), part.indices.end());
+            }
+        }
+        const std::uint32_t L = std::uint32_t(units.size());
         FoliageLodData data;
         data.originalLeafCount = L;
         data.leafVertexCount = std::uint32_t(model.leafVertices.size());
@@ -713,15 +675,15 @@ namespace TreeLod
         // §3.1: independent groups, per material, then in spatial order.
         std::vector<std::vector<std::uint32_t>> byMaterial(model.materials.size());
         for (std::uint32_t i = 0; i < L; ++i)
-            byMaterial[model.leaves[i].material].push_back(i);
+            byMaterial[model.leaves[units[i].leaf].material].push_back(i);
         std::vector<ClusterBuild> clusters;
         for (std::uint32_t mat = 0; mat < byMaterial.size(); ++mat)
             if (!byMaterial[mat].empty())
-                splitClusters(model, std::move(byMaterial[mat]), options.clusterSize, mat, clusters);
+                splitClusters(units, std::move(byMaterial[mat]), options.clusterSize, mat, clusters);
 
         double areaSum = 0.0;
-        for (const Leaf& leaf : model.leaves)
-            areaSum += leaf.area;
+        for (const Unit& u : units)
+            areaSum += u.node.area;
         const float meanArea = float(std::max(areaSum / L, 1e-20));
 
         // §3 / FSA, cluster by cluster in parallel (each cluster's result depends on it alone).
@@ -730,7 +692,8 @@ namespace TreeLod
         for (std::size_t first = 0; first < clusters.size(); first += batch)
         {
             const std::size_t last = std::min(clusters.size(), first + batch);
-            tbb::parallel_for(first, last, [&](std::size_t c) { simplifyCluster(model, clusters[c], meanArea, options.crossedLeaves); });
+            tbb::parallel_for(first, last, [&](std::size_t c) { simplifyCluster(model, units, clusters[c], meanArea, options.crossedLeaves);
+            });
             done = last;
             report(progress, "lodf collapse", float(done) / float(clusters.size()));
         }
@@ -794,25 +757,22 @@ namespace TreeLod
                 e.firstIndex = std::uint32_t(data.indices.size());
                 if (node < n)
                 {
-                    const Leaf& leaf = model.leaves[b.leaves[node]];
+                    const Unit& u = units[b.leaves[node]];
                     e.leaf = b.leaves[node];
                     e.created = 0;
-                    data.indices.insert(data.indices.end(), model.leafIndices.begin() + leaf.firstIndex,
-                                        model.leafIndices.begin() + leaf.firstIndex + leaf.indexCount);
-                    e.indexCount = leaf.indexCount;
-                    k.slotCount += leaf.indexCount;
+                    data.indices.insert(data.indices.end(), unitIndices.begin() + u.firstIndex,
+                                        unitIndices.begin() + u.firstIndex + u.indexCount);
+                    e.indexCount = u.indexCount;
+                    k.slotCount += u.indexCount;
                 }
                 else
                 {
                     const std::uint32_t step = node - n; // 0-based collapse that created it
                     e.leaf = createdNumber[c][step];
                     e.created = step + 1;
-                    for (const Node* quad : quadsOf(b.nodes[node]))
-                    {
-                        const auto& q = quad->corner;
-                        data.indices.insert(data.indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
-                    }
-                    e.indexCount = std::uint32_t(data.indices.size()) - e.firstIndex;
+                    const auto& q = b.nodes[node].corner;
+                    data.indices.insert(data.indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+                    e.indexCount = 6;
                 }
                 data.entries.push_back(e);
             };

@@ -31,11 +31,10 @@
 //    last steps merge the parts of its one remaining crossed leaf. Collapsed as flat leaves,
 //    crossed leaves lost a quarter of their area by L/2 and their crossing by L/4.
 //    Leaves in several planes (deviation, docs/lodf.md): a leaf that is one mesh in several planes
-//    (a folded leaf, a sprig in one piece) is one quad per plane (its triangles grouped by normal;
-//    planes under 10 % of its area, or more than its index slots hold, joined to the most
-//    parallel one), and collapses plane with plane as crossed parts do, but in one step: the
-//    created leaf has one quad per plane of the larger of the two (index slots suffice, as
-//    the larger leaf had them). As one flat quad, at most 17 % of a folded test crown's area
+//    (a folded leaf, a sprig in one piece) is one original per plane (its triangles grouped by
+//    normal; planes under 10 % of its area joined to the most parallel other), so L counts
+//    quads, and its planes collapse part with part as a crossed leaf's do, each later part
+//    centred on its own pair. Collapsed as one flat quad, 2 % of a folded test crown's area
 //    stayed folded at L/2.
 // 4. Order (Fig. 8): Changed_group lists the collapses by cost band (`costBands` equal-count bands
 //    of each collapse's running-maximum cost in its cluster), and inside a band cluster by cluster
@@ -65,9 +64,9 @@ namespace TreeLod
         /// Bands of Changed_group (1..64); 0 = the paper's pure global cost order (every
         /// change then touches most clusters). 1 = cluster by cluster.
         std::uint32_t costBands = 4;
-        /// Leaves in several planes collapse plane with plane: crossed quads through one centre
-        /// (step 3) part with part, and a leaf that is one mesh in several planes (a folded leaf,
-        /// a sprig in one piece) into created leaves of one quad per plane. False: every leaf
+        /// Leaves in several planes collapse part with part (step 3): crossed quads through one
+        /// centre, and the planes of a leaf that is one mesh (a folded leaf, a sprig in one
+        /// piece), each plane then an original of its own. False: every leaf is one original and
         /// collapses into one flat quad, as the paper's (the baseline of docs/lodf.md).
         bool crossedLeaves = true;
     };

@@ -41,7 +41,7 @@ namespace TreeLod
     /// One leaf of a cluster's array (Fig. 7).
     struct FoliageLodEntry
     {
-        std::uint32_t leaf = 0;       ///< leaf number: < L an original (TreeModel::leaves), L + k created by collapse k
+        std::uint32_t leaf = 0;       ///< leaf number: < L an original, L + k created by collapse k
         std::uint32_t created = 0;    ///< cluster-local collapse step that creates it, 0 for originals
         std::uint32_t firstIndex = 0; ///< its triangles in FoliageLodData::indices
         std::uint32_t indexCount = 0; ///< multiple of 3 (6 for a created quad)
@@ -62,7 +62,9 @@ namespace TreeLod
 
     struct FoliageLodData
     {
-        std::uint32_t originalLeafCount = 0; ///< L
+        /// L: the model's leaves, a leaf that is one mesh in several planes counted once per
+        /// plane (FoliageLodBaker.h), so at least TreeModel::leaves.size()
+        std::uint32_t originalLeafCount = 0;
         std::uint32_t leafVertexCount = 0;   ///< vertices the indices address (reference chunk)
         std::vector<FoliageLodCluster> clusters; ///< sorted by material; regions consecutive
         std::vector<FoliageLodEntry> entries;
