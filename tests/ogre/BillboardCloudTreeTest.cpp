@@ -378,7 +378,7 @@ namespace TreeLod
         OffscreenRenderer& r = OgreEnvironment::renderer();
         r.render(camera(oak.model, "orbit:30,10,1"), 96, 96, 1);
         EXPECT_EQ(tree->getMaterialLodIndex(), 0u);
-        r.render(camera(oak.model, "orbit:30,10,40"), 96, 96, 1);
+        r.render(camera(oak.model, "orbit:30,10,80"), 96, 96, 1);
         EXPECT_LT(tree->getPixelCountValue(), threshold);
         EXPECT_EQ(tree->getMaterialLodIndex(), 1u);
         Ogre::MaterialPtr material = Ogre::MaterialManager::getSingleton().getByName(gpu.levels[1].material,

@@ -70,7 +70,7 @@ namespace TreeLod
         std::vector<BakeOptionInfo> cloudOptions()
         {
             return {{"billboardCount", "billboards of the finest cloud, 0 (from the leaf count) to 65535", "0"},
-                    {"listFactor", "shader LoD: list entries per pixel of projected cell diagonal, 0 to 64", "4"},
+                    {"listFactor", "shader LoD: list entries per pixel of projected cell diagonal, 0 to 64", "8"},
                     {"aoRays", "ambient occlusion rays per leaf vertex, 0 to 4096", "32"},
                     {"tileSize", "Leaves Texture tile edge in texels, a power of two in 8..1024", "64"},
                     {"maxLeavesTexels",

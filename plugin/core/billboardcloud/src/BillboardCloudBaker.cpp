@@ -1102,7 +1102,7 @@ namespace TreeLod
         {
             std::uint32_t c = options.billboardCount;
             if (c == 0)
-                c = std::uint32_t(std::clamp(std::lround(1.5 * std::sqrt(double(leaves))), 8l, 260l));
+                c = std::uint32_t(std::clamp(std::lround(3.0 * std::sqrt(double(leaves))), 8l, 260l));
             return std::clamp<std::uint32_t>(c, 1, std::max<std::uint32_t>(leaves, 1));
         }
 

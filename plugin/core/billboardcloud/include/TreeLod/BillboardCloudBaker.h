@@ -36,8 +36,8 @@ namespace TreeLod
     struct BillboardCloudOptions
     {
         /// Billboards of the finest cloud; 0 = derived from the leaf count
-        /// (clamp(1.5 * sqrt(leaves), 8, 260), the paper's 60-260 for trees). Never more than
-        /// the leaves.
+        /// (clamp(3 * sqrt(leaves), 8, 260), the paper's 60-260 for trees; 164 for 3000 leaves,
+        /// about its Table 1's counts). Never more than the leaves.
         std::uint32_t billboardCount = 0;
         /// Clusterings tried per cloud level, with different spatial and orientation weights
         /// (BillboardClustering.h); the one kept has the least image error of its leaves
@@ -71,9 +71,11 @@ namespace TreeLod
         std::uint32_t orientationGrid = 5;
         std::uint32_t listsAtlasWidth = 1024; ///< grows (power of two up to 4096) when needed
         /// Shader LoD factor stored in the chunk: list entries walked per pixel of projected cell
-        /// diagonal. 4 measured best against 1 and 2 on the 20k-leaf oak (docs/measurements.md,
-        /// treelod_bc_study).
-        float listFactor = 4.0f;
+        /// diagonal. 8: on the corpus, far views (30 px) at or below the classic cloud at equal
+        /// memory on every tree, where 4 lost on the ez-tree pine (0.043 against 0.037), at no
+        /// frame time measurable on llvmpipe; 4 measured better than 1 and 2 on the 20k-leaf oak
+        /// (docs/measurements.md, treelod_corpus_study and treelod_bc_study).
+        float listFactor = 8.0f;
         bool compress = true;              ///< DXT5 leaves colour and low-res, DXT1 normals (libsquish)
         int aoRays = 32;                   ///< per leaf vertex (AmbientOcclusion.h)
     };
