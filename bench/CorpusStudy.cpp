@@ -20,8 +20,9 @@
 // (magnified crops).
 //
 // Tree specs: a .glb/.gltf path, or generated:PRESET[:LEAVES[:IMAGES[:MATERIALS[:FOLD]]]] (TreeGenerator:
-// leaf count, leaf images in an atlas, leaf materials, leaf fold in degrees). Without --trees: the bundled trees, the
-// generated oak with a 2x2 leaf atlas under six leaf materials, and every .glb in
+// leaf count, leaf images in an atlas, leaf materials, leaf fold in degrees). Without --trees: the
+// bundled trees, the generated oak with a 2x2 leaf atlas under six leaf materials, the generated
+// oak with leaves folded 45 degrees (one mesh of two quads each), and every .glb in
 // media/third-party/ (docs/measurements.md says how to make them).
 //
 // Needs an X server: xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" treelod_corpus_study [options]
@@ -304,7 +305,8 @@ namespace TreeLod
         {
             if (args.trees.empty())
             {
-                args.trees = {"media/oak.glb", "media/conifer.glb", "media/birch.glb", "generated:oak:3000:4:6"};
+                args.trees = {"media/oak.glb", "media/conifer.glb", "media/birch.glb", "generated:oak:3000:4:6",
+                              "generated:oak:3000:1:1:45"};
                 std::vector<std::string> thirdParty;
                 if (std::filesystem::is_directory("media/third-party"))
                     for (const auto& entry : std::filesystem::directory_iterator("media/third-party"))
@@ -438,7 +440,7 @@ int main(int argc, char** argv)
                  "RMSE near, mid and far. Needs an X server (xvfb-run)."};
     app.add_option("--trees", args.trees,
                    "trees: .glb/.gltf paths or generated:PRESET[:LEAVES[:IMAGES[:MATERIALS[:FOLD]]]] (default: the bundled "
-                   "trees, generated:oak:3000:4:6 and media/third-party/*.glb)");
+                   "trees, generated:oak:3000:4:6, generated:oak:3000:1:1:45 and media/third-party/*.glb)");
     app.add_option("--techniques", args.techniques, "techniques to bake and compare")->capture_default_str();
     app.add_option("--option", args.options, "a baker's option, TECHNIQUE.NAME=VALUE (as treelod bake --option)");
     app.add_option("--param", args.params,

@@ -1373,7 +1373,10 @@ namespace TreeLod
                                                   const std::string& label, const ProgressCallback& progress,
                                                   BillboardCloudStats* stats)
     {
-        BakeContext ctx(model, options, label, progress);
+        // Deviation (docs/billboard-cloud.md): a leaf in several planes is clustered, tiled and
+        // listed plane by plane, each plane a leaf showing its part of the leaf image.
+        const std::optional<TreeModel> planes = leafPlanesAsLeaves(model);
+        BakeContext ctx(planes ? *planes : model, options, label, progress);
         Result<void> ready = prepare(ctx);
         if (!ready)
             return ready.error();
@@ -1385,7 +1388,8 @@ namespace TreeLod
                                                          const std::string& label, const ProgressCallback& progress,
                                                          BillboardCloudStats* stats)
     {
-        BakeContext ctx(model, options.cloud, label, progress);
+        const std::optional<TreeModel> planes = leafPlanesAsLeaves(model); // as bakeBillboardCloud
+        BakeContext ctx(planes ? *planes : model, options.cloud, label, progress);
         Result<void> ready = prepare(ctx);
         if (!ready)
             return ready.error();

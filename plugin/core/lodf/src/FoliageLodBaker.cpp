@@ -115,97 +115,41 @@ namespace TreeLod
             std::vector<std::uint32_t> indices; ///< its triangles (leaf vertex ids)
         };
 
-        /// Leaf `leaf`, one mesh in several planes, as one quad per plane: its triangles grouped by
-        /// normal (each with the plane of the most parallel seed within CROSSED_PARALLEL, the
-        /// largest triangles seeding), planes under PART_AREA of the leaf's area joined to the
-        /// most parallel larger one. Each part's UV rectangle is its own vertices' extent. Empty
-        /// when fewer than two planes remain.
-        std::vector<PlanePart> planeParts(const TreeModel& m, const Leaf& leaf)
+        /// Leaf `i`, one mesh in several planes (TreeModel::leafPlanes), as one quad per plane,
+        /// each on its own vertices nearest the corners of their UV extent. Empty for a flat leaf.
+        std::vector<PlanePart> planeParts(const TreeModel& m, std::size_t i)
         {
-            struct Plane
-            {
-                glm::vec3 seed{0.0f}, normalSum{0.0f}, weighted{0.0f};
-                float area = 0.0f;
-                std::vector<std::uint32_t> vertices, indices;
-            };
-            std::vector<std::uint32_t> triangles(leaf.indexCount / 3);
-            std::iota(triangles.begin(), triangles.end(), 0u);
-            const auto corner = [&](std::uint32_t t, int k) {
-                return m.leafIndices[leaf.firstIndex + 3 * t + std::uint32_t(k)];
-            };
-            const auto cross = [&](std::uint32_t t) {
-                const glm::vec3 a = m.leafVertices[corner(t, 0)].position, b = m.leafVertices[corner(t, 1)].position,
-                                c = m.leafVertices[corner(t, 2)].position;
-                return glm::cross(b - a, c - a);
-            };
-            std::stable_sort(triangles.begin(), triangles.end(),
-                             [&](std::uint32_t x, std::uint32_t y) { return glm::length(cross(x)) > glm::length(cross(y)); });
-            std::vector<Plane> planes;
-            const auto add = [](Plane& p, const glm::vec3& n, float area, const glm::vec3& centre,
-                                const std::vector<std::uint32_t>& indices) {
-                p.normalSum += (glm::dot(n, p.seed) < 0.0f ? -n : n) * area;
-                p.weighted += centre * area;
-                p.area += area;
-                p.indices.insert(p.indices.end(), indices.begin(), indices.end());
-                for (std::uint32_t v : indices)
-                    if (std::find(p.vertices.begin(), p.vertices.end(), v) == p.vertices.end())
-                        p.vertices.push_back(v);
-            };
-            for (std::uint32_t t : triangles)
-            {
-                const glm::vec3 c = cross(t);
-                const float twice = glm::length(c);
-                if (!(twice > 0.0f) || !std::isfinite(twice))
-                    continue;
-                const glm::vec3 n = c / twice;
-                std::size_t best = planes.size();
-                float bestDot = CROSSED_PARALLEL;
-                for (std::size_t p = 0; p < planes.size(); ++p)
-                    if (const float d = std::abs(glm::dot(planes[p].seed, n)); d >= bestDot)
-                    {
-                        bestDot = d;
-                        best = p;
-                    }
-                if (best == planes.size())
-                {
-                    planes.emplace_back();
-                    planes.back().seed = n;
-                }
-                const glm::vec3 centre = (m.leafVertices[corner(t, 0)].position + m.leafVertices[corner(t, 1)].position +
-                                          m.leafVertices[corner(t, 2)].position) / 3.0f;
-                add(planes[best], n, 0.5f * twice, centre, {corner(t, 0), corner(t, 1), corner(t, 2)});
-            }
-            std::stable_sort(planes.begin(), planes.end(), [](const Plane& x, const Plane& y) { return x.area > y.area; });
-            std::size_t keep = planes.size();
-            while (keep > 1 && planes[keep - 1].area < PART_AREA * leaf.area)
-                --keep;
-            if (keep < 2)
+            std::vector<std::vector<std::uint32_t>> planes = m.leafPlanes(i, CROSSED_PARALLEL, PART_AREA);
+            if (planes.size() < 2)
                 return {};
-            for (std::size_t p = keep; p < planes.size(); ++p)
+            std::vector<PlanePart> parts(planes.size());
+            for (std::size_t p = 0; p < planes.size(); ++p)
             {
-                std::size_t into = 0;
-                for (std::size_t q = 1; q < keep; ++q)
-                    if (std::abs(glm::dot(planes[q].seed, planes[p].seed)) > std::abs(glm::dot(planes[into].seed, planes[p].seed)))
-                        into = q;
-                const glm::vec3 n = glm::length(planes[p].normalSum) > 0.0f ? glm::normalize(planes[p].normalSum) : planes[p].seed;
-                add(planes[into], n, planes[p].area, planes[p].weighted / planes[p].area, planes[p].indices);
-            }
-            std::vector<PlanePart> parts(keep);
-            for (std::size_t p = 0; p < keep; ++p)
-            {
-                parts[p].indices = std::move(planes[p].indices);
                 Node& part = parts[p].node;
-                part.centre = planes[p].weighted / planes[p].area;
-                part.normal = glm::length(planes[p].normalSum) > 0.0f ? glm::normalize(planes[p].normalSum) : planes[p].seed;
-                part.area = planes[p].area;
+                glm::vec3 normalSum(0.0f), weighted(0.0f);
+                std::vector<std::uint32_t> vertices;
                 part.uvMin = glm::vec2(std::numeric_limits<float>::max());
                 part.uvMax = -part.uvMin;
-                for (std::uint32_t v : planes[p].vertices)
+                for (std::size_t t = 0; t + 3 <= planes[p].size(); t += 3)
                 {
-                    part.uvMin = glm::min(part.uvMin, m.leafVertices[v].uv);
-                    part.uvMax = glm::max(part.uvMax, m.leafVertices[v].uv);
+                    const glm::vec3 a = m.leafVertices[planes[p][t]].position, b = m.leafVertices[planes[p][t + 1]].position,
+                                    c = m.leafVertices[planes[p][t + 2]].position;
+                    const glm::vec3 n = glm::cross(b - a, c - a);
+                    normalSum += glm::dot(n, normalSum) < 0.0f ? -n : n; // length-weighted = area-weighted
+                    weighted += 0.5f * glm::length(n) * (a + b + c) / 3.0f;
+                    part.area += 0.5f * glm::length(n);
                 }
-                setCorners(m, planes[p].vertices, part);
+                for (std::uint32_t v : planes[p])
+                    if (std::find(vertices.begin(), vertices.end(), v) == vertices.end())
+                    {
+                        vertices.push_back(v);
+                        part.uvMin = glm::min(part.uvMin, m.leafVertices[v].uv);
+                        part.uvMax = glm::max(part.uvMax, m.leafVertices[v].uv);
+                    }
+                part.centre = part.area > 0.0f ? weighted / part.area : m.leafVertices[vertices[0]].position;
+                part.normal = glm::length(normalSum) > 0.0f ? glm::normalize(normalSum) : m.leaves[i].normal;
+                setCorners(m, vertices, part);
+                parts[p].indices = std::move(planes[p]);
             }
             return parts;
         }
@@ -651,7 +595,7 @@ namespace TreeLod
             const Leaf& leaf = model.leaves[i];
             std::vector<PlanePart> parts;
             if (options.crossedLeaves)
-                parts = planeParts(model, leaf);
+                parts = planeParts(model, i);
             if (parts.empty())
             {
                 Unit u{i, std::uint32_t(unitIndices.size()), leaf.indexCount, originalNode(model, i)};

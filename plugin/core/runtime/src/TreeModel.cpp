@@ -1,13 +1,127 @@
 #include "TreeLod/TreeModel.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 namespace TreeLod
 {
     namespace
     {
         bool isFinite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+    }
+
+    std::vector<std::vector<std::uint32_t>> TreeModel::leafPlanes(std::size_t i, float parallel, float minShare) const
+    {
+        const Leaf& leaf = leaves[i];
+        struct Plane
+        {
+            glm::vec3 seed{0.0f};
+            float area = 0.0f;
+            std::vector<std::uint32_t> indices;
+        };
+        const auto at = [&](std::uint32_t t, std::uint32_t k) { return leafIndices[leaf.firstIndex + 3 * t + k]; };
+        const auto cross = [&](std::uint32_t t) {
+            const glm::vec3 a = leafVertices[at(t, 0)].position;
+            return glm::cross(leafVertices[at(t, 1)].position - a, leafVertices[at(t, 2)].position - a);
+        };
+        std::vector<std::uint32_t> triangles(leaf.indexCount / 3);
+        std::iota(triangles.begin(), triangles.end(), 0u);
+        std::vector<float> twice(triangles.size());
+        for (std::uint32_t t : triangles)
+            twice[t] = glm::length(cross(t));
+        std::stable_sort(triangles.begin(), triangles.end(), [&](std::uint32_t x, std::uint32_t y) {
+            return twice[x] > twice[y];
+        });
+        std::vector<Plane> planes;
+        std::vector<std::uint32_t> degenerate;
+        for (std::uint32_t t : triangles)
+        {
+            if (!(twice[t] > 0.0f) || !std::isfinite(twice[t]))
+            {
+                degenerate.insert(degenerate.end(), {at(t, 0), at(t, 1), at(t, 2)});
+                continue;
+            }
+            const glm::vec3 n = cross(t) / twice[t];
+            std::size_t best = planes.size();
+            float bestDot = parallel;
+            for (std::size_t p = 0; p < planes.size(); ++p)
+                if (const float d = std::abs(glm::dot(planes[p].seed, n)); d >= bestDot)
+                {
+                    bestDot = d;
+                    best = p;
+                }
+            if (best == planes.size())
+            {
+                planes.emplace_back();
+                planes.back().seed = n;
+            }
+            planes[best].area += 0.5f * twice[t];
+            planes[best].indices.insert(planes[best].indices.end(), {at(t, 0), at(t, 1), at(t, 2)});
+        }
+        std::stable_sort(planes.begin(), planes.end(), [](const Plane& x, const Plane& y) { return x.area > y.area; });
+        std::size_t keep = std::max<std::size_t>(planes.size(), 1);
+        while (keep > 1 && planes[keep - 1].area < minShare * leaf.area)
+            --keep;
+        std::vector<std::vector<std::uint32_t>> out(keep);
+        for (std::size_t p = 0; p < planes.size(); ++p)
+        {
+            std::size_t into = p;
+            if (p >= keep)
+            {
+                into = 0;
+                for (std::size_t q = 1; q < keep; ++q)
+                    if (std::abs(glm::dot(planes[q].seed, planes[p].seed)) >
+                        std::abs(glm::dot(planes[into].seed, planes[p].seed)))
+                        into = q;
+            }
+            out[into].insert(out[into].end(), planes[p].indices.begin(), planes[p].indices.end());
+        }
+        out[0].insert(out[0].end(), degenerate.begin(), degenerate.end());
+        return out;
+    }
+
+    std::optional<TreeModel> leafPlanesAsLeaves(const TreeModel& model)
+    {
+        std::vector<std::vector<std::vector<std::uint32_t>>> planes(model.leaves.size());
+        bool several = false;
+        for (std::size_t i = 0; i < model.leaves.size(); ++i)
+        {
+            planes[i] = model.leafPlanes(i);
+            several = several || planes[i].size() > 1;
+        }
+        if (!several)
+            return std::nullopt;
+        TreeModel out = model;
+        out.leafVertices.clear();
+        out.leafIndices.clear();
+        out.leaves.clear();
+        std::vector<std::uint32_t> remap(model.leafVertices.size(), ~0u);
+        for (std::size_t i = 0; i < model.leaves.size(); ++i)
+        {
+            const Leaf& leaf = model.leaves[i];
+            for (const std::vector<std::uint32_t>& plane : planes[i])
+            {
+                Leaf part = leaf;
+                part.firstVertex = std::uint32_t(out.leafVertices.size());
+                part.firstIndex = std::uint32_t(out.leafIndices.size());
+                for (std::uint32_t v : plane)
+                {
+                    if (remap[v] == ~0u || remap[v] < part.firstVertex)
+                    {
+                        remap[v] = std::uint32_t(out.leafVertices.size());
+                        out.leafVertices.push_back(model.leafVertices[v]);
+                    }
+                    out.leafIndices.push_back(remap[v]);
+                }
+                part.vertexCount = std::uint32_t(out.leafVertices.size()) - part.firstVertex;
+                part.indexCount = std::uint32_t(plane.size());
+                out.leaves.push_back(part);
+                out.updateLeafRecord(out.leaves.size() - 1);
+            }
+        }
+        return out;
     }
 
     void TreeModel::updateBounds()

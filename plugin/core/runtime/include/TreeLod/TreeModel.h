@@ -13,6 +13,7 @@
 #include <glm/glm.hpp>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -95,8 +96,20 @@ namespace TreeLod
         /// Recompute centre, normal, area and UV rectangle of leaf `i` from its triangles.
         void updateLeafRecord(std::size_t i);
 
+        /// The triangles of leaf `i` by plane, as index triples into leafVertices, the largest
+        /// plane first: the largest triangles seed planes, a triangle joins the most parallel
+        /// seed within `parallel` (|n_a . n_b|), planes under `minShare` of the leaf's area join
+        /// the most parallel larger one, degenerate triangles the first. One plane for a flat
+        /// leaf; several for one mesh in several planes (a folded leaf, a sprig in one piece).
+        std::vector<std::vector<std::uint32_t>> leafPlanes(std::size_t i, float parallel = 0.9f,
+                                                           float minShare = 0.1f) const;
+
         /// Check internal consistency: ranges, indices, materials, finite values.
         /// `file` only labels the error.
         Result<void> validate(const std::string& file = "") const;
     };
+
+    /// `model` with each leaf in several planes (TreeModel::leafPlanes) made one leaf per plane,
+    /// on its own copies of the vertices, in the leaf's place; nullopt when every leaf is flat.
+    std::optional<TreeModel> leafPlanesAsLeaves(const TreeModel& model);
 }
