@@ -960,11 +960,11 @@ namespace TreeLod
         EXPECT_GE(coarsest, 0.45);
     }
 
-    /// Share of the leaf area of `m` in crossed leaves: leaves with another leaf whose centre lies
-    /// within half a leaf size and whose plane differs (|n_a . n_b| < 0.7).
-    double crossedShare(const TreeModel& m)
+    /// Share of the leaf area of `m` in leaves with another leaf in a different plane beside
+    /// them: |n_a . n_b| < `parallel`, centres within `reach` leaf sizes.
+    double shareBesideAnotherPlane(const TreeModel& m, float parallel, float reach)
     {
-        double crossed = 0.0, all = 0.0;
+        double beside = 0.0, all = 0.0;
         for (std::size_t i = 0; i < m.leaves.size(); ++i)
         {
             const Leaf& a = m.leaves[i];
@@ -972,16 +972,19 @@ namespace TreeLod
             for (std::size_t j = 0; j < m.leaves.size(); ++j)
             {
                 const Leaf& b = m.leaves[j];
-                if (j != i && std::abs(glm::dot(a.normal, b.normal)) < 0.7f &&
-                    glm::length(a.centre - b.centre) < 0.5f * std::sqrt(std::min(a.area, b.area)))
+                if (j != i && std::abs(glm::dot(a.normal, b.normal)) < parallel &&
+                    glm::length(a.centre - b.centre) < reach * std::sqrt(std::min(a.area, b.area)))
                 {
-                    crossed += a.area;
+                    beside += a.area;
                     break;
                 }
             }
         }
-        return all > 0.0 ? crossed / all : 0.0;
+        return all > 0.0 ? beside / all : 0.0;
     }
+
+    /// Crossed leaves: another plane within half a leaf size (|n_a . n_b| < 0.7).
+    double crossedShare(const TreeModel& m) { return shareBesideAnotherPlane(m, 0.7f, 0.5f); }
 
     TEST(LodfBuild, crossedLeavesCollapseIntoCrossedLeaves)
     {
@@ -1097,28 +1100,8 @@ namespace TreeLod
         m.updateLeafRecord(m.leaves.size() - 1);
     }
 
-    /// The share of the leaf area in quads with another quad in a different plane beside them
-    /// (|n_a . n_b| < 0.8, centres within one quad size): the wings of a folded leaf.
-    double foldedShare(const TreeModel& m)
-    {
-        double folded = 0.0, all = 0.0;
-        for (std::size_t i = 0; i < m.leaves.size(); ++i)
-        {
-            const Leaf& a = m.leaves[i];
-            all += a.area;
-            for (std::size_t j = 0; j < m.leaves.size(); ++j)
-            {
-                const Leaf& b = m.leaves[j];
-                if (j != i && std::abs(glm::dot(a.normal, b.normal)) < 0.8f &&
-                    glm::length(a.centre - b.centre) < std::sqrt(std::min(a.area, b.area)))
-                {
-                    folded += a.area;
-                    break;
-                }
-            }
-        }
-        return all > 0.0 ? folded / all : 0.0;
-    }
+    /// The wings of folded leaves: another plane within one leaf size (|n_a . n_b| < 0.8).
+    double foldedShare(const TreeModel& m) { return shareBesideAnotherPlane(m, 0.8f, 1.0f); }
 
     TEST(LodfBuild, foldedLeavesCollapseIntoFoldedLeaves)
     {
