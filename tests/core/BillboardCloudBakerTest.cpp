@@ -356,6 +356,30 @@ namespace TreeLod
 
     // ---- extremes ------------------------------------------------------------------------------
 
+    TEST(BillboardCloudBaker, aLeafInSeveralPlanesIsALeafPerPlane)
+    {
+        // Leaves folded along the midrib (one mesh of two quads each): each wing is a leaf of the
+        // cloud, with its half of the leaf image as an image of its own. The same tree with flat
+        // leaves keeps one leaf and one image per leaf.
+        GeneratorOptions g;
+        g.leafCount = 200;
+        g.textureSize = 32;
+        g.leafFold = 45.0f;
+        Result<TreeModel> folded = generateTree(g);
+        ASSERT_TRUE(folded.ok()) << folded.error().message();
+        BillboardCloudStats stats;
+        const BillboardCloudData data = bakeOrFail(*folded, fastOptions(), &stats);
+        EXPECT_EQ(stats.leaves, 400u);
+        ASSERT_EQ(data.leafImages.size(), 2u);
+        g.leafFold = 0.0f;
+        Result<TreeModel> flat = generateTree(g);
+        ASSERT_TRUE(flat.ok());
+        BillboardCloudStats flatStats;
+        const BillboardCloudData flatData = bakeOrFail(*flat, fastOptions(), &flatStats);
+        EXPECT_EQ(flatStats.leaves, 200u);
+        EXPECT_EQ(flatData.leafImages.size(), 1u);
+    }
+
     TEST(BillboardCloudBaker, oneLeafGivesOneBillboardPerLevel)
     {
         const TreeModel m = quadLeaves({{{0.0f, 2.0f, 0.3f}, {0.2f, 0.3f, 1.0f}, 0.2f}}, true);
