@@ -1,5 +1,8 @@
 // BillboardCloudBaker: TreeModel -> BillboardCloudData (BillboardCloudData.h), García et al. 2007.
 //
+//   0. Leaves: a leaf that is one mesh in several planes (a folded leaf, a sprig in one piece)
+//      is a leaf per plane, each showing its part of the leaf image (leafPlanesAsLeaves).
+//      Deviation (docs/billboard-cloud.md): as one flat leaf it lost to the classic cloud.
 //   1. Clustering (§4.1): leaves grouped into planes, k-means-like on leaf planes with an
 //      error bound ([BCF*05], [GSSK05]); each billboard's quad bounds its leaves' projection.
 //      Deviation (docs/billboard-cloud.md): each cloud is clustered with several weight pairs
