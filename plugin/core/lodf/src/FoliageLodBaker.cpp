@@ -347,46 +347,34 @@ namespace TreeLod
             return groups;
         }
 
-        /// Which parts collapse with which: each of the side with fewer parts (u on a tie), in
-        /// order, with the most parallel free part of the other. Pairs of (u index, v index).
-        std::vector<std::pair<std::size_t, std::size_t>> matchByNormal(const std::vector<glm::vec3>& u,
-                                                                        const std::vector<glm::vec3>& v)
+        /// The parts of `u` and `v` collapsed with each other: each part of the one with fewer
+        /// parts (u on a tie) with the most parallel free part of the other, in order.
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> matchParts(const std::vector<Node>& nodes,
+                                                                        const std::vector<std::uint32_t>& u,
+                                                                        const std::vector<std::uint32_t>& v)
         {
             const bool swap = v.size() < u.size();
-            const std::vector<glm::vec3>& few = swap ? v : u;
-            const std::vector<glm::vec3>& many = swap ? u : v;
+            const std::vector<std::uint32_t>& few = swap ? v : u;
+            const std::vector<std::uint32_t>& many = swap ? u : v;
             std::vector<char> used(many.size(), 0);
-            std::vector<std::pair<std::size_t, std::size_t>> pairs;
-            for (std::size_t a = 0; a < few.size(); ++a)
+            std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+            for (std::uint32_t a : few)
             {
                 std::size_t best = 0;
                 float bestDot = -1.0f;
                 for (std::size_t k = 0; k < many.size(); ++k)
                     if (!used[k])
-                        if (const float d = std::abs(glm::dot(few[a], many[k])); d > bestDot)
+                    {
+                        const float d = std::abs(glm::dot(nodes[a].normal, nodes[many[k]].normal));
+                        if (d > bestDot)
                         {
                             bestDot = d;
                             best = k;
                         }
+                    }
                 used[best] = 1;
-                pairs.push_back(swap ? std::make_pair(best, a) : std::make_pair(a, best));
+                pairs.push_back(swap ? std::make_pair(many[best], a) : std::make_pair(a, many[best]));
             }
-            return pairs;
-        }
-
-        /// The parts of `u` and `v` (node ids) collapsed with each other (matchByNormal).
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> matchParts(const std::vector<Node>& nodes,
-                                                                        const std::vector<std::uint32_t>& u,
-                                                                        const std::vector<std::uint32_t>& v)
-        {
-            std::vector<glm::vec3> nu, nv;
-            for (std::uint32_t a : u)
-                nu.push_back(nodes[a].normal);
-            for (std::uint32_t b : v)
-                nv.push_back(nodes[b].normal);
-            std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-            for (const auto& [i, j] : matchByNormal(nu, nv))
-                pairs.emplace_back(u[i], v[j]);
             return pairs;
         }
 
