@@ -1434,9 +1434,10 @@ namespace TreeLod
             std::printf("%5.0f px: mesh %.4f, lodf (all leaves) %.4f, impostor %.4f\n", double(curves->heightsPx[h]),
                         double(m), double(curves->levels[std::size_t(fullLodf)].flip[h]),
                         double(curves->levels[std::size_t(quad)].flip[h]));
-            // The GPU's mesh against the CPU's: the same tree, one sample a pixel against four.
+            // The GPU's mesh against the CPU's: the same tree, one sample a pixel against four, over
+            // the tree's own pixels (0.23 at 16 px, where most of them are edges; 0.15 at 192 px).
             EXPECT_GT(m, 0.0f);
-            EXPECT_LT(m, 0.12f);
+            EXPECT_LT(m, 0.3f);
             // LoDF with every leaf draws what the mesh draws.
             EXPECT_NEAR(curves->levels[std::size_t(fullLodf)].flip[h], m, 0.01f);
         }
@@ -1742,8 +1743,8 @@ namespace TreeLod
         compareWithGolden(coarseCasters, "forest-shadow-budget", 0.005);
 
         // A frame budget on a Forest whose error budget is off the ladder (never set: the default
-        // is on it; 0.04 is not): the controller's first choice is taken.
-        for (const float start : {-1.0f, 0.04f})
+        // is on it; 0.045 is not): the controller's first choice is taken.
+        for (const float start : {-1.0f, 0.045f})
         {
             Forest* other = placeForest();
             if (start >= 0.0f)

@@ -67,10 +67,27 @@ namespace TreeLod
             std::vector<RgbaImage> levels;
         };
 
+        /// The mean of a FLIP error map over the pixels that are tree in `reference` or in `test`:
+        /// the error per pixel of the tree, whatever share of the crop the background is. A forest
+        /// that fills the frame with trees shows that error on every pixel.
+        double meanOverTree(const FlipResult& result, const Image& reference, const Image& test)
+        {
+            double sum = 0.0;
+            std::size_t count = 0;
+            for (std::size_t i = 0; i < result.errorMap.size(); ++i)
+                if (isTreePixel(reference.pixels[i]) || isTreePixel(test.pixels[i]))
+                {
+                    sum += result.errorMap[i];
+                    ++count;
+                }
+            return count > 0 ? sum / double(count) : result.mean;
+        }
+
         /// Every level's scores against the reference over one square crop around the tree: the
         /// union of the reference's and every level's tree pixels, so the levels of a view are
-        /// judged over the same pixels and the reference is filtered for FLIP once. A level drawn
-        /// byte for byte as an earlier one gets its scores. Errors name the level.
+        /// compared on the same pixels and the reference is filtered for FLIP once. FLIP is the
+        /// mean over the tree's own pixels (meanOverTree), multi-scale RMSE the crop's. A level
+        /// drawn byte for byte as an earlier one gets its scores. Errors name the level.
         Result<std::vector<Scores>> scoreView(const ViewShots& shots, const std::vector<ForestLevel>& levels)
         {
             Extent extent = treeExtent(shots.reference);
@@ -93,13 +110,13 @@ namespace TreeLod
                 }
                 const std::string element = "level " + Forest::describeLevel(levels[l]);
                 const Image test = cropImage(toImage(shots.levels[l]), crop);
-                Result<FlipResult> f = flip(*prepared, test);
+                Result<FlipResult> f = flip(*prepared, test, true);
                 if (!f)
                     return fail("", element, "FLIP: " + f.error().message());
                 Result<MultiScaleRmseResult> m = multiScaleRmse(reference, test);
                 if (!m)
                     return fail("", element, "multi-scale RMSE: " + m.error().message());
-                scores[l] = Scores{f->mean, m->combined};
+                scores[l] = Scores{meanOverTree(*f, reference, test), m->combined};
             }
             return scores;
         }

@@ -26,7 +26,7 @@ namespace TreeLod
     {
         /// Bump when a baker's output changes without a chunk format version change, so that
         /// caches made by older builds are not reused.
-        constexpr int BAKE_CACHE_KEY_VERSION = 10;
+        constexpr int BAKE_CACHE_KEY_VERSION = 11;
 
         std::string hex16(std::uint64_t value)
         {

@@ -217,8 +217,8 @@ namespace TreeLod
 
     const std::vector<float>& frameBudgetLadder()
     {
-        static const std::vector<float> ladder{0.0f, 0.005f, 0.01f, 0.02f, 0.03f, 0.05f,
-                                               0.08f, 0.12f, 0.2f, 0.35f, 1.0f};
+        static const std::vector<float> ladder{0.0f, 0.005f, 0.01f, 0.02f, 0.03f, 0.04f,
+                                               0.05f, 0.08f, 0.12f, 0.2f, 0.35f, 1.0f};
         return ladder;
     }
 

@@ -26,12 +26,18 @@ namespace TreeLod
         int heightPx() const { return any() ? maxY - minY + 1 : 0; }
     };
 
+    /// Whether a pixel differs from the background: a pixel of the tree.
+    inline bool isTreePixel(const glm::vec4& pixel, const glm::vec3& background = LightingSpec().background)
+    {
+        return glm::length(glm::vec3(pixel) - background) > 0.02f;
+    }
+
     inline Extent treeExtent(const Image& image, const glm::vec3& background = LightingSpec().background)
     {
         Extent e;
         for (int y = 0; y < image.height; ++y)
             for (int x = 0; x < image.width; ++x)
-                if (glm::length(glm::vec3(image.at(x, y)) - background) > 0.02f)
+                if (isTreePixel(image.at(x, y), background))
                 {
                     e.minX = std::min(e.minX, x);
                     e.maxX = std::max(e.maxX, x);
@@ -46,7 +52,7 @@ namespace TreeLod
     {
         std::size_t covered = 0;
         for (const glm::vec4& p : image.pixels)
-            covered += glm::length(glm::vec3(p) - background) > 0.02f;
+            covered += isTreePixel(p, background);
         return image.pixels.empty() ? 0.0 : double(covered) / double(image.pixels.size());
     }
 

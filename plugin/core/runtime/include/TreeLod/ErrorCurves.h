@@ -8,7 +8,9 @@
 // rendered from `views` directions and compared with the reference (the polygonal tree,
 // supersampled referenceSamples times per pixel): flip is the mean FLIP over the views (the
 // measurer averages those a camera near the ground sees), flipMax the worst view's (all views),
-// rmse the mean multi-scale RMSE (ImageMetrics.h) over the same views as flip.
+// rmse the mean multi-scale RMSE (ImageMetrics.h) over the same views as flip. A view's FLIP is
+// the mean over the tree's own pixels (tree in the reference or in the level), its RMSE over a
+// square crop around the tree.
 // A level is named as ForestLevel names it: (technique, techniqueLevel, lowRes).
 //
 // ---- Chunk layout, level 0, formatVersion 1 (ERROR_CURVES_FORMAT_VERSION) -----------------
