@@ -679,7 +679,7 @@ namespace TreeLod
                     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-' && c != '_')
                         c = '_';
                 if (Result<void> w = addPlot("curves-" + fileName, csv,
-                                             {{"title", entry.name + ": error curves (FLIP over the tree's box against the "
+                                             {{"title", entry.name + ": error curves (FLIP per tree pixel against the "
                                                                      "CPU reference, mean of " +
                                                             std::to_string(curves->views) + " views)"},
                                               {"x", "height_px"},

@@ -35,8 +35,9 @@ namespace TreeLod
     /// "Budgeted auto").
     constexpr float DEFAULT_ERROR_BUDGET = 0.04f;
     /// The shadow casters' error budget the Forest starts with (Forest::setShadowErrorBudget): coarser
-    /// than the view's, as a shadow shows a tree's outline blurred and from one side.
-    constexpr float DEFAULT_SHADOW_ERROR_BUDGET = 0.08f;
+    /// than the view's, as a shadow shows a tree's outline blurred and from one side (four times it,
+    /// as when both were measured over a square about half background).
+    constexpr float DEFAULT_SHADOW_ERROR_BUDGET = 0.16f;
 
     /// The heights the selection samples: 4 per octave from 8192 px (sample 0) down to 1 px.
     constexpr int SELECTION_SAMPLES_PER_OCTAVE = 4;
