@@ -1,5 +1,6 @@
 // Budgeted level selection (LevelSelection.h) and the cost calibration file (LevelCosts.h):
-// budget 0 draws the reference, budget 1 the cheapest level, bad budgets are refused, runs are
+// budget 0 draws the reference, budget 1 the cheapest level, a level's worst view bounds it too,
+// bad budgets are refused, runs are
 // merged to the Forest's level limit; costs interpolate in log-log and a calibration made on
 // another renderer is not reused.
 #include "TreeLod/AtomicFile.h"
@@ -98,6 +99,29 @@ namespace TreeLod
         ASSERT_TRUE(without);
         for (const LevelChoice& c : *without)
             EXPECT_NE(c.curveLevel, 1u);
+    }
+
+    TEST(LevelSelection, aLevelWhoseWorstViewFailsIsNotChosen)
+    {
+        // The impostor's mean is within 0.02 below 16 px; its worst view (the mesh's is 0.05) may
+        // add WORST_VIEW_BUDGET_FACTOR * 0.02 = 0.08.
+        for (const float worstAdded : {0.07f, 0.09f})
+        {
+            Fixture f;
+            f.curves.levels[2].flipMax = {0.05f + worstAdded, 0.6f, 0.7f};
+            Result<std::vector<LevelChoice>> runs = chooseLevels(f.curves, f.costs, 0.02f);
+            ASSERT_TRUE(runs) << runs.error().message();
+            const bool impostor = runs->back().curveLevel == 2u;
+            EXPECT_EQ(impostor, worstAdded < WORST_VIEW_BUDGET_FACTOR * 0.02f) << "worst view +" << worstAdded;
+            if (!impostor)
+                EXPECT_EQ(runs->size(), 1u) << "lodf at every height";
+        }
+        // Budget 1 still draws the cheapest, whatever its worst view.
+        Fixture f;
+        f.curves.levels[2].flipMax = {1.0f, 1.0f, 1.0f};
+        Result<std::vector<LevelChoice>> one = chooseLevels(f.curves, f.costs, 1.0f);
+        ASSERT_TRUE(one);
+        EXPECT_EQ(one->back().curveLevel, 2u);
     }
 
     TEST(LevelSelection, runsAreMergedToTheLimit)

@@ -213,27 +213,40 @@ namespace TreeLod
         return -1;
     }
 
+    namespace
+    {
+        /// `values` (one per height) at `heightPx`, as ErrorCurves::flipAt says.
+        float interpolateAt(const std::vector<float>& heightsPx, const std::vector<float>& values, float heightPx)
+        {
+            if (values.empty() || heightsPx.empty())
+                return 0.0f;
+            const std::size_t n = std::min(values.size(), heightsPx.size());
+            if (!std::isfinite(heightPx) || !(heightPx > 0.0f) || heightPx <= heightsPx[0])
+                return values[0];
+            if (heightPx >= heightsPx[n - 1])
+                return values[n - 1];
+            // heightsPx[i - 1] <= heightPx < heightsPx[i], 1 <= i <= n - 1.
+            const std::size_t i =
+                std::size_t(std::upper_bound(heightsPx.begin(), heightsPx.begin() + std::ptrdiff_t(n), heightPx) -
+                            heightsPx.begin());
+            const double a = std::log2(double(heightsPx[i - 1])), b = std::log2(double(heightsPx[i]));
+            const double t = (std::log2(double(heightPx)) - a) / (b - a);
+            if (!std::isfinite(t))
+                return values[i - 1];
+            const double lo = values[i - 1], hi = values[i];
+            const double v = lo + std::clamp(t, 0.0, 1.0) * (hi - lo);
+            return float(std::clamp(v, std::min(lo, hi), std::max(lo, hi)));
+        }
+    }
+
     float ErrorCurves::flipAt(std::size_t level, float heightPx) const
     {
-        if (level >= levels.size() || levels[level].flip.empty() || heightsPx.empty())
-            return 0.0f;
-        const std::vector<float>& flip = levels[level].flip;
-        const std::size_t n = std::min(flip.size(), heightsPx.size());
-        if (!std::isfinite(heightPx) || !(heightPx > 0.0f) || heightPx <= heightsPx[0])
-            return flip[0];
-        if (heightPx >= heightsPx[n - 1])
-            return flip[n - 1];
-        // heightsPx[i - 1] <= heightPx < heightsPx[i], 1 <= i <= n - 1.
-        const std::size_t i =
-            std::size_t(std::upper_bound(heightsPx.begin(), heightsPx.begin() + std::ptrdiff_t(n), heightPx) -
-                        heightsPx.begin());
-        const double a = std::log2(double(heightsPx[i - 1])), b = std::log2(double(heightsPx[i]));
-        const double t = (std::log2(double(heightPx)) - a) / (b - a);
-        if (!std::isfinite(t))
-            return flip[i - 1];
-        const double lo = flip[i - 1], hi = flip[i];
-        const double v = lo + std::clamp(t, 0.0, 1.0) * (hi - lo);
-        return float(std::clamp(v, std::min(lo, hi), std::max(lo, hi)));
+        return level < levels.size() ? interpolateAt(heightsPx, levels[level].flip, heightPx) : 0.0f;
+    }
+
+    float ErrorCurves::flipMaxAt(std::size_t level, float heightPx) const
+    {
+        return level < levels.size() ? interpolateAt(heightsPx, levels[level].flipMax, heightPx) : 0.0f;
     }
 
     Result<void> validateErrorCurves(const ErrorCurves& curves, const std::string& label)

@@ -73,6 +73,8 @@ namespace TreeLod
         {
             const float h = selectionHeight(k);
             const float allowed = curves.flipAt(std::size_t(*reference), h) + errorBudget;
+            const float allowedWorst =
+                curves.flipMaxAt(std::size_t(*reference), h) + WORST_VIEW_BUDGET_FACTOR * errorBudget;
             std::size_t best = std::size_t(*reference);
             float bestCost = costOf[best] ? costOf[best]->msAt(h) : std::numeric_limits<float>::infinity();
             float bestFlip = curves.flipAt(best, h);
@@ -83,7 +85,8 @@ namespace TreeLod
                         continue;
                     const float flip = curves.flipAt(l, h);
                     const float cost = costOf[l]->msAt(h);
-                    if (flip <= allowed && (cost < bestCost || (cost == bestCost && flip < bestFlip)))
+                    if (flip <= allowed && curves.flipMaxAt(l, h) <= allowedWorst &&
+                        (cost < bestCost || (cost == bestCost && flip < bestFlip)))
                     {
                         best = l;
                         bestCost = cost;

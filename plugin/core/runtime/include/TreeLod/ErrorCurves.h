@@ -68,6 +68,8 @@ namespace TreeLod
         /// heights give the first value. 0 when `level` is out of range or has no values; on
         /// validated curves the result is in [0, 1].
         float flipAt(std::size_t level, float heightPx) const;
+        /// The worst view's FLIP (flipMax) of `level` at `heightPx`, interpolated as flipAt.
+        float flipMaxAt(std::size_t level, float heightPx) const;
     };
 
     /// Serialise in the layout above. Deterministic; does not validate (decode does, and the

@@ -3,6 +3,7 @@
 // machine (LevelCosts.h, calibrated). For an error budget e, at each screen height h the
 // cheapest level whose error is within e of the polygonal reference's own error at h:
 //     allowed(L, h)  <=>  flip(L, h) <= flip(mesh, h) + e        (mesh always allowed)
+//                    and  flipMax(L, h) <= flipMax(mesh, h) + WORST_VIEW_BUDGET_FACTOR e
 // and the result, sampled at 4 heights per octave from 1 to 8192 px, is merged into runs of one
 // level: near to far, each with the smallest height it is drawn at. A budget of 0 draws the
 // reference itself; a budget of 1 the cheapest level everywhere. A level without a cost is not a
@@ -34,6 +35,11 @@ namespace TreeLod
     /// three benchmark scenes stay within the project's margin of 0.02 (docs/measurements.md,
     /// "Budgeted auto").
     constexpr float DEFAULT_ERROR_BUDGET = 0.04f;
+    /// A level's worst view (the view from above among them) may add at most this many times the
+    /// budget over the reference's worst view: the mean is over the side views, and a level that
+    /// fails from above (a camera-facing quad seen from 30-40 degrees up) loses in a scene seen
+    /// from above though its side views are within the budget.
+    constexpr float WORST_VIEW_BUDGET_FACTOR = 4.0f;
     /// The shadow casters' error budget the Forest starts with (Forest::setShadowErrorBudget): coarser
     /// than the view's, as a shadow shows a tree's outline blurred and from one side (four times it,
     /// as when both were measured over a square about half background).
