@@ -119,7 +119,7 @@ namespace TreeLod
         /// The camera at frame `frame` of `frameCount` (0 = the script's frame count).
         CameraSpec cameraAtFrame(std::uint32_t frame, std::uint32_t frameCount = 0) const;
 
-        /// Per auto species, how its levels are chosen now: "oak: budget 0.02: lodf 0 >= 301 px, ..."
+        /// Per auto species, how its levels are chosen now: "oak: budget 0.04: lodf 0 >= 301 px, ..."
         /// or why the fixed auto bands were used.
         std::vector<std::string> getLevelNotes() const;
         /// Re-plan the budgeted species for `budget` now (Forest::setErrorBudget; throws as it does);
