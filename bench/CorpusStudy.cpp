@@ -115,28 +115,50 @@ namespace TreeLod
             return tree;
         }
 
-        /// The package of every technique; `chunkBytes` gets each technique's chunk size (level 0).
-        std::vector<std::uint8_t> bakePackage(const StudyTree& tree, const StudyArgs& args,
-                                              std::map<std::string, std::uint64_t>& chunkBytes)
+        /// TECHNIQUE.NAME=VALUE assignments (`flag` --option or --param) by technique; each
+        /// technique among --techniques (or "mesh", for --param).
+        std::map<std::string, BakeOptions> assignmentsByTechnique(const std::vector<std::string>& texts,
+                                                                  const StudyArgs& args, const std::string& flag)
         {
-            std::map<std::string, BakeOptions> options;
-            for (const std::string& text : args.options)
+            std::map<std::string, BakeOptions> byTechnique;
+            for (const std::string& text : texts)
             {
                 Result<BakeOptionAssignment> parsed = parseBakeOptionAssignment(text);
                 if (!parsed)
-                    throw StudyError(parsed.error().message());
-                if (!std::count(args.techniques.begin(), args.techniques.end(), parsed->technique))
-                    throw StudyError("option '" + text + "': '" + parsed->technique + "' is not among --techniques");
-                options[parsed->technique][parsed->name] = parsed->value;
+                    throw StudyError(flag + " '" + text + "': " + parsed.error().reason);
+                if (!(flag == "--param" && parsed->technique == "mesh") &&
+                    !std::count(args.techniques.begin(), args.techniques.end(), parsed->technique))
+                    throw StudyError(flag + " '" + text + "': '" + parsed->technique + "' is not among --techniques");
+                byTechnique[parsed->technique][parsed->name] = parsed->value;
             }
-            PackageWriter writer;
+            return byTechnique;
+        }
+
+        /// Every --technique is a baker and every --option names one of its options; --param is
+        /// well formed. Before any work, so a typo costs nothing.
+        void checkArguments(const StudyArgs& args)
+        {
+            std::map<std::string, BakeOptions> options = assignmentsByTechnique(args.options, args, "--option");
+            assignmentsByTechnique(args.params, args, "--param");
             for (const std::string& name : args.techniques)
             {
                 const BakeTechnique* technique = findBakeTechnique(name);
                 if (!technique)
                     throw StudyError("technique '" + name + "': not a baker (" + knownBakeTechniques() + ")");
-                if (Result<void> checked = checkBakeOptions(*technique, options[name], tree.label); !checked)
+                if (Result<void> checked = checkBakeOptions(*technique, options[name], "--option"); !checked)
                     throw StudyError(checked.error().message());
+            }
+        }
+
+        /// The package of every technique; `chunkBytes` gets each technique's chunk size (level 0).
+        std::vector<std::uint8_t> bakePackage(const StudyTree& tree, const StudyArgs& args,
+                                              std::map<std::string, std::uint64_t>& chunkBytes)
+        {
+            std::map<std::string, BakeOptions> options = assignmentsByTechnique(args.options, args, "--option");
+            PackageWriter writer;
+            for (const std::string& name : args.techniques)
+            {
+                const BakeTechnique* technique = findBakeTechnique(name);
                 progressLine("baking " + name + " of " + tree.label);
                 Result<void> baked = technique->bake(writer, tree.model, options[name], tree.label,
                                                      [](const std::string& step, float) {
@@ -194,17 +216,9 @@ namespace TreeLod
                 Ogre::NameValuePairList params;
                 if (technique.find("billboard-cloud") != std::string::npos)
                     params["ambientOcclusion"] = "false";
-                for (const std::string& text : args.params)
-                {
-                    Result<BakeOptionAssignment> parsed = parseBakeOptionAssignment(text);
-                    if (!parsed)
-                        throw StudyError("--param: " + parsed.error().message());
-                    if (parsed->technique != "mesh" &&
-                        !std::count(args.techniques.begin(), args.techniques.end(), parsed->technique))
-                        throw StudyError("--param '" + text + "': '" + parsed->technique + "' is not among --techniques");
-                    if (parsed->technique == technique)
-                        params[parsed->name] = parsed->value;
-                }
+                std::map<std::string, BakeOptions> assigned = assignmentsByTechnique(args.params, args, "--param");
+                for (const auto& [name, value] : assigned[technique])
+                    params[name] = value;
                 Ogre::MovableObject* object = registry.createInstance(technique, renderer.getSceneManager(),
                                                                       "corpus-" + technique, *asset, params);
                 node->attachObject(object);
@@ -303,6 +317,7 @@ namespace TreeLod
 
         int run(StudyArgs args, const std::string& commandLine)
         {
+            checkArguments(args);
             if (args.trees.empty())
             {
                 args.trees = {"media/oak.glb", "media/conifer.glb", "media/birch.glb", "generated:oak:3000:4:6",

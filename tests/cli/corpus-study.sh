@@ -2,7 +2,7 @@
 # treelod_corpus_study end to end (run by ctest under xvfb-run): two small trees (one with a leaf
 # atlas under three leaf materials), two techniques, 128 px. Checks the outputs agree: one CSV row
 # per tree, technique and view, finite metrics in range, the Markdown table, a worst-case picture
-# per technique; a bad tree spec exits 2 naming it.
+# per technique; a bad tree spec, option or parameter exits 2 naming it, before any bake.
 set -euo pipefail
 study=$1; src=$2; out=$3
 rm -rf "$out"; mkdir -p "$out"
@@ -35,4 +35,14 @@ set +e
 set -e
 [ $rc = 2 ] || fail "a bad tree spec exited $rc"
 grep -q "tree 'generated:nosuchpreset'" "$out/bad.txt" || fail "the error does not name the tree: $(cat "$out/bad.txt")"
+# Bad --option / --param: refused before any tree is baked, naming the argument.
+for arg in "--option lodf.noSuchOption=1" "--param impostor.x=1" "--param garbage"; do
+  set +e
+  # shellcheck disable=SC2086
+  "$study" --trees generated:birch:300 --techniques lodf $arg --out "$out/badarg" > "$out/badarg.txt" 2>&1; rc=$?
+  set -e
+  [ $rc = 2 ] || fail "'$arg' exited $rc"
+  grep -q -- "${arg%% *}" "$out/badarg.txt" || fail "'$arg': the error does not name it: $(cat "$out/badarg.txt")"
+  ! grep -q "baking" "$out/badarg.txt" || fail "'$arg': baked before refusing it"
+done
 echo "corpus study test: ok"
