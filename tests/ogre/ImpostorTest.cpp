@@ -175,7 +175,7 @@ namespace TreeLod
             int first = image.width, last = -1;
             for (int y = 0; y < image.height; ++y)
                 for (int x = 0; x < image.width; ++x)
-                    if (glm::length(glm::vec3(image.at(x, y)) - background) > 0.02f)
+                    if (isTreePixel(image.at(x, y), background))
                     {
                         first = std::min(first, x);
                         last = std::max(last, x);

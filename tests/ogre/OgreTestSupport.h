@@ -206,8 +206,8 @@ namespace TreeLod
         std::size_t both = 0, either = 0;
         for (std::size_t i = 0; i < a.pixels.size() && i < b.pixels.size(); ++i)
         {
-            const bool inA = glm::length(glm::vec3(a.pixels[i]) - background) > 0.02f;
-            const bool inB = glm::length(glm::vec3(b.pixels[i]) - background) > 0.02f;
+            const bool inA = isTreePixel(a.pixels[i], background);
+            const bool inB = isTreePixel(b.pixels[i], background);
             both += inA && inB;
             either += inA || inB;
         }
