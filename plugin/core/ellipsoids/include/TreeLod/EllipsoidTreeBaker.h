@@ -1,0 +1,104 @@
+// EllipsoidTreeBaker: TreeModel -> EllipsoidTreeData (EllipsoidTreeData.h): the leaf half of
+// the ellipsoids-and-lines paper (001), §3.1 and Alg. 1, with §4's image error and §6's
+// per-level target size. Branches (the lines of §3.2), the noise textures and ambient occlusion
+// are not baked here.
+//
+//   1. Leaves -> one ellipsoid each (§3.1): the mean and covariance of points spread uniformly
+//      over the leaf's triangles, PCA (eigenvectors = axes, semi-axis = 2 sqrt(eigenvalue)); the
+//      smallest semi-axes are floored at 2 % of the largest, so a flat leaf is a thin disc.
+//   2. Levels (Alg. 1): K = floor(|L| / clustersDivisor), then / clustersDivisor per level while
+//      K >= 1. Per level, `tries` runs of EM/GMM (GaussianMixture.h) over the leaf centres,
+//      weighted by leaf area, from random starts in the box of the centres; each component's
+//      ellipsoid is the weighted PCA of its leaves' points with the fuzzy memberships w_ij as
+//      weights (Fig. 5): covariance = sum_i w_ij a_i (S_i + (c_i - m_j)(c_i - m_j)^T) / sum_i w_ij a_i,
+//      so a cluster covers its leaves' extent, not only the spread of their centres. Ellipsoids
+//      whose surface area is under minAreaShare of the level's largest are dropped. Each try is
+//      rendered and scored by image error against the leaves; the best is kept.
+//   3. Calibration (§3.1, as [CP10]): each level's scale factor is the one of 0.6, 0.8, ... 1.4
+//      (the grid extended by 0.2 while the best is at an end, within [0.2, 3]; then +-0.1 around
+//      the best) with the least image error.
+//   4. Image error (§4): multi-scale RMSE (ImageMetrics.h), mean over 4 orthographic views (three
+//      around at 15 degrees elevation, one from above) of viewResolution^2 pixels, 2x2 samples,
+//      rendered by the CPU ReferenceRenderer: the leaves in one flat colour (their textures' alpha
+//      kept, colour dropped), the ellipsoids as icospheres of 80 triangles whose surface area is
+//      the sphere's, in the same colour, so the error measures coverage only.
+//   5. Target size (§6): targetHeightPx = the tree's height in pixels at which the level's mean
+//      ellipsoid (the diameter of the disc with its mean projected area) is
+//      ELLIPSOID_TARGET_DIAMETER_PX pixels across.
+//
+// Deviations from the paper, and why:
+//   - The "uniform sampling" of a leaf is done in closed form: the exact mean and covariance of a
+//     uniform distribution over its triangles (the limit of infinitely many samples): no sampling
+//     noise, no seed needed, and O(triangles).
+//   - The EM input carries each leaf's covariance and is truncated to the 12 nearest components
+//     per point (GaussianMixture.h): the paper needs 0.9 s per leaf, a 24k-leaf tree must bake in
+//     about a minute here.
+//   - Every level clusters the leaves (as Alg. 1), but a last level of one ellipsoid is added when
+//     the division stops above one (fewer than clustersDivisor^2 leaves, e.g. 2 or 3 leaves).
+//   - Leaves of zero area are left out (they cannot be seen).
+//   - The image error compares flat-colour coverage images instead of shaded ones: shading is the
+//     renderer's (noise normals, AO, §5), which this chunk does not fix.
+// Every length is relative to the leaves' bounding box (a 0.5 m and a 500 m tree give the same
+// result up to rounding). Deterministic for a seed and any TBB thread count.
+#pragma once
+
+#include "TreeLod/EllipsoidTreeData.h"
+#include "TreeLod/PackageWriter.h"
+#include "TreeLod/Progress.h"
+#include "TreeLod/Result.h"
+#include "TreeLod/TreeModel.h"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <string>
+
+namespace TreeLod
+{
+    struct EllipsoidTreeOptions
+    {
+        std::uint32_t tries = 4;           ///< EM runs per level, 1 to 16 (the paper's t)
+        std::uint64_t seed = 1;            ///< of the EM starts
+        std::uint32_t clustersDivisor = 4; ///< 2 to 64: each level has 1 / this of the previous' target
+        float minAreaShare = 0.01f;        ///< in [0, 0.5]: smaller ellipsoids (surface area) dropped
+        int viewResolution = 128;          ///< pixels a side of each error view, 16 to 1024
+    };
+
+    /// The moments of leaf `leaf`'s triangles as a uniform area distribution (metres).
+    struct LeafShape
+    {
+        glm::dvec3 mean{0.0};
+        glm::dmat3 covariance{0.0};
+        double area = 0.0;
+    };
+    LeafShape leafShape(const TreeModel& model, std::size_t leaf);
+
+    /// The ellipsoid of a distribution (PCA): semi-axes 2 sqrt(eigenvalue), largest first along the
+    /// rotation's local x, the others at least `minAxisShare` of the largest (and > 0 always).
+    Ellipsoid ellipsoidFromCovariance(const glm::dvec3& mean, const glm::dmat3& covariance, float minAxisShare = 0.02f);
+
+    /// Approximate surface area of an ellipsoid with semi-axes `radii` (Knud Thomsen's formula,
+    /// within about 1 %).
+    double ellipsoidSurfaceArea(const glm::dvec3& radii);
+
+    /// The ellipsoids of level `level` of `data` (scaled by the level's scale times `extraScale`) as
+    /// opaque, double-sided bark of one white material: icospheres of 80 triangles with the
+    /// sphere's surface area. What the baker renders; tests measure coverage with it.
+    TreeModel ellipsoidLevelMesh(const EllipsoidTreeData& data, std::size_t level, float extraScale = 1.0f);
+
+    /// `model`'s leaves alone, every material white (base colour and texture colour; the
+    /// textures' alpha and the alpha cutoffs kept): the reference the baker measures against.
+    TreeModel flatColourLeaves(const TreeModel& model);
+
+    /// Bake the ellipsoid hierarchy. Errors name `label`: invalid options or model, a model without
+    /// leaves of nonzero area, or leaves with no extent. Progress steps: "ellipsoids: leaves",
+    /// "ellipsoids: level N of M".
+    Result<EllipsoidTreeData> bakeEllipsoidTree(const TreeModel& model, const EllipsoidTreeOptions& options,
+                                                const std::string& label, const ProgressCallback& progress = {});
+
+    /// Package glue for `treelod bake` (BakeTechniques): adds the reference chunk when missing and
+    /// the "ellipsoids" chunk.
+    Result<void> addEllipsoidTreeChunk(PackageWriter& writer, const TreeModel& model,
+                                       const EllipsoidTreeOptions& options, const std::string& label,
+                                       const ProgressCallback& progress = {});
+}
