@@ -154,8 +154,8 @@ namespace TreeLod
                         "LoD technique: " + techniques + " (mesh: the polygonal reference); a .glb is baked in memory");
         cmd->add_option("--leaves", args->leaves, "lodf: draw exactly this many leaves (default: from screen size)");
         cmd->add_option("--pixels-per-leaf", args->pixelsPerLeaf, "lodf: projected pixels per leaf (default 4)");
-        cmd->add_option("--level", args->level, "billboard clouds: draw this cloud (0 finest .. 2 low-res only) "
-                                               "instead of the LoD strategy's");
+        cmd->add_option("--level", args->level, "billboard clouds, ellipsoids: draw this level (0 finest; clouds: "
+                                               "2 low-res only) instead of the LoD strategy's");
         cmd->add_option("--list-factor", args->listFactor,
                         "billboard-cloud: shader LoD, list entries walked per pixel of projected hash-cell diagonal "
                         "(0 = low-res texture only; default from the package)");

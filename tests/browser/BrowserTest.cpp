@@ -153,7 +153,7 @@ namespace TreeLod
     // docs/browser.md, "Memory".
     TEST(BrowserHeadless, SoakKeepsMemory)
     {
-        constexpr unsigned SWITCHES = 480;
+        constexpr unsigned SWITCHES = 600;
         constexpr double SOAK_GROWTH_MIB = 48.0;
         std::string errors;
         ASSERT_EQ(runBrowser("--headless --soak " + std::to_string(SWITCHES) + " --scene " +

@@ -1,0 +1,196 @@
+// EllipsoidTree: the leaves as ray-cast ellipsoids of one level (the ellipsoids-and-lines paper
+// (001) §5, §6), the branches as the reference bark. See EllipsoidTree.h for the LoD rule.
+#include "TreeLod/EllipsoidTree.h"
+
+#include "TreeLod/ObjectParams.h"
+#include "TreePart.h"
+
+#include <OgreCamera.h>
+#include <OgreHardwareBufferManager.h>
+#include <OgreLodStrategy.h>
+#include <OgreMaterialManager.h>
+#include <OgreMesh.h>
+#include <OgreNode.h>
+#include <OgreRenderQueue.h>
+#include <OgreSceneManager.h>
+#include <OgreSubMesh.h>
+#include <OgreViewport.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace TreeLod
+{
+    /// One draw of an EllipsoidTree: the ellipsoids of the level drawn, or a bark submesh.
+    class EllipsoidTree::Part : public TreePart
+    {
+    public:
+        Part(EllipsoidTree& parent, const Ogre::String& group, Ogre::VertexData* vertexData,
+             const Ogre::String& material, const Ogre::String& shadowedMaterial)
+            : TreePart(parent, group, vertexData, material, shadowedMaterial, "EllipsoidTree"),
+              mParent(parent)
+        {
+        }
+
+    protected:
+        bool useShadowedMaterials() const override { return mParent.useShadowedMaterials(); }
+        unsigned short barkLodIndex() const override { return mParent.mBarkLodIndex; }
+
+    private:
+        EllipsoidTree& mParent;
+    };
+
+    const Ogre::String EllipsoidTreeFactory::FACTORY_TYPE_NAME = "EllipsoidTree";
+
+    namespace
+    {
+        constexpr const char* ELLIPSOID_MATERIAL = "TreeLod/Ellipsoid"; ///< materials/TreeLodEllipsoid.material
+    }
+
+    EllipsoidTree::EllipsoidTree(const Ogre::String& name, const TreeAssetPtr& asset, const Options& options)
+        : Ogre::MovableObject(name), mAsset(asset), mGpu(&EllipsoidTreeResources::of(*asset).getGpu()),
+          mOptions(options)
+    {
+        if (mOptions.level >= 0 && std::size_t(mOptions.level) >= mGpu->levels.size())
+            OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                        "parameter 'level': " + std::to_string(mOptions.level) + " is not a level of the ellipsoids (" +
+                            std::to_string(mGpu->levels.size()) + " levels)",
+                        "EllipsoidTree '" + name + "'");
+
+        // The asset's ellipsoids plus one instance at the origin (position 0, scale 1, no
+        // rotation) as constant per-vertex attributes uv4, uv5, as a Forest instance reads them.
+        mVertexData.reset(mGpu->vertexData->clone(false));
+        const unsigned short source = static_cast<unsigned short>(mVertexData->vertexDeclaration->getMaxSource() + 1);
+        mVertexData->vertexDeclaration->addElement(source, 0, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 4);
+        mVertexData->vertexDeclaration->addElement(source, 4 * sizeof(float), Ogre::VET_FLOAT2,
+                                                   Ogre::VES_TEXTURE_COORDINATES, 5);
+        const std::vector<float> instance = [&] {
+            std::vector<float> v(6 * mVertexData->vertexCount);
+            for (std::size_t i = 0; i < mVertexData->vertexCount; ++i)
+                std::copy_n(std::initializer_list<float>{0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 0.0f}.begin(), 6, &v[6 * i]);
+            return v;
+        }();
+        Ogre::HardwareVertexBufferSharedPtr buffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
+            6 * sizeof(float), mVertexData->vertexCount, Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+        buffer->writeData(0, buffer->getSizeInBytes(), instance.data(), true);
+        mVertexData->vertexBufferBinding->setBinding(source, buffer);
+        // TreeLod's own material, in whichever group holds TreeLod's materials/.
+        const Ogre::MaterialPtr material =
+            Ogre::MaterialManager::getSingleton().getByName(ELLIPSOID_MATERIAL, Ogre::RGN_AUTODETECT);
+        if (!material)
+            OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
+                        Ogre::String("material '") + ELLIPSOID_MATERIAL +
+                            "' not found: add TreeLod's materials/ to a resource group",
+                        "EllipsoidTree '" + name + "'");
+        mEllipsoids = std::make_unique<Part>(*this, material->getGroup(), mVertexData.get(), ELLIPSOID_MATERIAL, "");
+        mEllipsoids->mIndexData.indexBuffer = mGpu->indexBuffer;
+
+        const TreeModel& model = mAsset->getReference().model;
+        mTreeHeight = model.boundsMax.y - model.boundsMin.y;
+        mBounds = mGpu->bounds;
+        mBounds.merge(Ogre::AxisAlignedBox(model.boundsMin.x, model.boundsMin.y, model.boundsMin.z, model.boundsMax.x,
+                                           model.boundsMax.y, model.boundsMax.z));
+        if (!model.barkIndices.empty())
+        {
+            // The reference's bark, lit like the polygonal tree.
+            mBarkMesh = mAsset->getBarkMesh();
+            const std::vector<Ogre::String>& plain = mAsset->getMaterialNames();
+            const std::vector<Ogre::String>& shadowed = mAsset->getShadowedMaterialNames();
+            for (Ogre::SubMesh* sub : mBarkMesh->getSubMeshes())
+            {
+                const auto it = std::find(plain.begin(), plain.end(), sub->getMaterialName());
+                const Ogre::String receiver = it == plain.end() ? "" : shadowed[std::size_t(it - plain.begin())];
+                auto part =
+                    std::make_unique<Part>(*this, mAsset->getGroup(), sub->vertexData, sub->getMaterialName(), receiver);
+                part->mLevels.push_back(sub->indexData);
+                for (Ogre::IndexData* level : sub->mLodFaceList)
+                    part->mLevels.push_back(level);
+                mBarkParts.push_back(std::move(part));
+            }
+        }
+        mRadius = Ogre::Math::boundingRadiusFromAABB(mBounds);
+        mLevel = mOptions.level >= 0 ? std::size_t(mOptions.level) : 0;
+        mEllipsoids->mIndexData.indexStart = mGpu->levels[mLevel].indexStart;
+        mEllipsoids->mIndexData.indexCount = mGpu->levels[mLevel].indexCount;
+        // No caster material yet (EllipsoidTree.h).
+        setCastShadows(false);
+    }
+
+    EllipsoidTree::~EllipsoidTree() = default;
+
+    const Ogre::String& EllipsoidTree::getMovableType() const { return EllipsoidTreeFactory::FACTORY_TYPE_NAME; }
+
+    std::size_t EllipsoidTree::levelForHeight(const EllipsoidTreeGpu& gpu, float heightPx)
+    {
+        std::size_t level = 0;
+        for (std::size_t l = 0; l < gpu.levels.size(); ++l)
+            if (gpu.levels[l].targetHeightPx >= heightPx)
+                level = l;
+        return level;
+    }
+
+    void EllipsoidTree::_notifyCurrentCamera(Ogre::Camera* camera)
+    {
+        Ogre::MovableObject::_notifyCurrentCamera(camera);
+        if (!mParentNode)
+            return;
+        // The LoD camera (the viewer's, for shadow cameras) and its bias decide.
+        const Ogre::Camera* lod = camera->getLodCamera();
+        const Ogre::Viewport* viewport = lod->getViewport();
+        const Ogre::Real viewHeight = viewport ? Ogre::Real(viewport->getActualHeight()) : 0.0f;
+        const Ogre::Real treeHeight = mTreeHeight * mParentNode->_getDerivedScale().y;
+        Ogre::Real heightPx = std::numeric_limits<Ogre::Real>::max();
+        if (lod->getProjectionType() == Ogre::PT_PERSPECTIVE)
+        {
+            const Ogre::Real depth = std::sqrt(mParentNode->getSquaredViewDepth(lod));
+            if (depth > std::numeric_limits<Ogre::Real>::epsilon())
+                heightPx = treeHeight * lod->getProjectionMatrix()[1][1] * viewHeight / (2.0f * depth);
+        }
+        else if (lod->getOrthoWindowHeight() > 0.0f)
+            heightPx = treeHeight * viewHeight / lod->getOrthoWindowHeight();
+        if (heightPx != std::numeric_limits<Ogre::Real>::max())
+            heightPx *= lod->getLodBias() * mOptions.lodBias;
+        mLevel = mOptions.level >= 0 ? std::size_t(mOptions.level) : levelForHeight(*mGpu, float(heightPx));
+        mEllipsoids->mIndexData.indexStart = mGpu->levels[mLevel].indexStart;
+        mEllipsoids->mIndexData.indexCount = mGpu->levels[mLevel].indexCount;
+        if (mBarkMesh)
+            mBarkLodIndex = mBarkMesh->getLodIndex(mBarkMesh->getLodStrategy()->getValue(this, camera));
+    }
+
+    bool EllipsoidTree::useShadowedMaterials() const
+    {
+        return mManager && mManager->isShadowTechniqueTextureBased() && mManager->isShadowTechniqueIntegrated();
+    }
+
+    void EllipsoidTree::_updateRenderQueue(Ogre::RenderQueue* queue)
+    {
+        queue->addRenderable(mEllipsoids.get(), mRenderQueueID, mRenderQueuePriority);
+        for (const std::unique_ptr<Part>& part : mBarkParts)
+            queue->addRenderable(part.get(), mRenderQueueID, mRenderQueuePriority);
+    }
+
+    void EllipsoidTree::visitRenderables(Ogre::Renderable::Visitor* visitor, bool)
+    {
+        visitor->visit(mEllipsoids.get(), 0, false);
+        for (const std::unique_ptr<Part>& part : mBarkParts)
+            visitor->visit(part.get(), 0, false);
+    }
+
+    Ogre::MovableObject* EllipsoidTreeFactory::createInstanceImpl(const Ogre::String& name,
+                                                                  const Ogre::NameValuePairList* params)
+    {
+        const ObjectParams p(params, "EllipsoidTreeFactory::createInstanceImpl");
+        EllipsoidTree::Options options;
+        double value = 0.0;
+        if (p.number("level", 0.0, 1e6, value))
+        {
+            if (value != std::floor(value))
+                p.bad("level", *p.find("level"), "a whole number");
+            options.level = int(value);
+        }
+        if (p.number("lodBias", 1e-6, 1e6, value))
+            options.lodBias = float(value);
+        return new EllipsoidTree(name, p.loadAsset(name, "EllipsoidTree"), options);
+    }
+}
