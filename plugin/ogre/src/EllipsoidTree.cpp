@@ -3,10 +3,10 @@
 #include "TreeLod/EllipsoidTree.h"
 
 #include "TreeLod/ObjectParams.h"
+#include "TreeLod/TechniqueSupport.h"
 #include "TreePart.h"
 
 #include <OgreCamera.h>
-#include <OgreHardwareBufferManager.h>
 #include <OgreLodStrategy.h>
 #include <OgreMaterialManager.h>
 #include <OgreMesh.h>
@@ -58,23 +58,9 @@ namespace TreeLod
                             std::to_string(mGpu->levels.size()) + " levels)",
                         "EllipsoidTree '" + name + "'");
 
-        // The asset's ellipsoids plus one instance at the origin (position 0, scale 1, no
-        // rotation) as constant per-vertex attributes uv4, uv5, as a Forest instance reads them.
+        // The asset's ellipsoids plus one instance at the origin, as a Forest instance reads them.
         mVertexData.reset(mGpu->vertexData->clone(false));
-        const unsigned short source = static_cast<unsigned short>(mVertexData->vertexDeclaration->getMaxSource() + 1);
-        mVertexData->vertexDeclaration->addElement(source, 0, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 4);
-        mVertexData->vertexDeclaration->addElement(source, 4 * sizeof(float), Ogre::VET_FLOAT2,
-                                                   Ogre::VES_TEXTURE_COORDINATES, 5);
-        const std::vector<float> instance = [&] {
-            std::vector<float> v(6 * mVertexData->vertexCount);
-            for (std::size_t i = 0; i < mVertexData->vertexCount; ++i)
-                std::copy_n(std::initializer_list<float>{0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 0.0f}.begin(), 6, &v[6 * i]);
-            return v;
-        }();
-        Ogre::HardwareVertexBufferSharedPtr buffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
-            6 * sizeof(float), mVertexData->vertexCount, Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
-        buffer->writeData(0, buffer->getSizeInBytes(), instance.data(), true);
-        mVertexData->vertexBufferBinding->setBinding(source, buffer);
+        addOriginInstance(*mVertexData);
         // TreeLod's own material, in whichever group holds TreeLod's materials/.
         const Ogre::MaterialPtr material =
             Ogre::MaterialManager::getSingleton().getByName(ELLIPSOID_MATERIAL, Ogre::RGN_AUTODETECT);

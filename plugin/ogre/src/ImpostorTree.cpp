@@ -1,9 +1,9 @@
 #include "TreeLod/ImpostorTree.h"
 
 #include "TreeLod/ObjectParams.h"
+#include "TreeLod/TechniqueSupport.h"
 
 #include <OgreException.h>
-#include <OgreHardwareBufferManager.h>
 #include <OgreMaterialManager.h>
 #include <OgreNode.h>
 #include <OgreRenderQueue.h>
@@ -28,24 +28,10 @@ namespace TreeLod
         mMaterial->load();
         mShadowedMaterial->load();
 
-        // The asset's quad, plus one instance at the origin (position 0, scale 1, no rotation) as
-        // constant per-vertex attributes uv4, uv5 in a buffer of its own.
+        // The asset's quad, plus one instance at the origin.
         mVertexData.reset(quad.vertexData->clone(false));
-        const unsigned short source = static_cast<unsigned short>(mVertexData->vertexDeclaration->getMaxSource() + 1);
-        mVertexData->vertexDeclaration->addElement(source, 0, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 4);
-        mVertexData->vertexDeclaration->addElement(source, 4 * sizeof(float), Ogre::VET_FLOAT2,
-                                                   Ogre::VES_TEXTURE_COORDINATES, 5);
-        float instance[4][6];
-        for (float(&v)[6] : instance)
-        {
-            const float one[6] = {0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 0.0f};
-            std::copy(one, one + 6, v);
-        }
-        Ogre::HardwareVertexBufferSharedPtr buffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
-            sizeof(instance[0]), mVertexData->vertexCount, Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
         OgreAssert(mVertexData->vertexCount == 4, "the impostor is one quad");
-        buffer->writeData(0, sizeof(instance), instance, true);
-        mVertexData->vertexBufferBinding->setBinding(source, buffer);
+        addOriginInstance(*mVertexData);
         mIndexData.indexBuffer = quad.indexBuffer;
         mIndexData.indexStart = 0;
         mIndexData.indexCount = 6;

@@ -1,19 +1,22 @@
 // TechniqueSupport: what a technique's Ogre half (its TechniqueResources) uses to put its chunk's
 // textures and materials on the GPU: the Ogre format of a baked texture, its upload with every
-// baked mip, and a clone of one of TreeLod's base materials.
+// baked mip, a clone of one of TreeLod's base materials, and a single tree as one instance.
 #pragma once
 
 #include "TreeLod/ModelChunk.h"
 
 #include <OgreException.h>
+#include <OgreHardwareBufferManager.h>
 #include <OgreImage.h>
 #include <OgreMaterial.h>
 #include <OgreMaterialManager.h>
 #include <OgrePass.h>
 #include <OgreTechnique.h>
 #include <OgreTextureManager.h>
+#include <OgreVertexIndexData.h>
 
 #include <cstdint>
+#include <vector>
 
 namespace TreeLod
 {
@@ -86,5 +89,24 @@ namespace TreeLod
                 p->setNamedConstant("backColour", backColour);
                 p->setNamedConstant("alphaCutoff", alphaCutoff);
             }
+    }
+
+    /// A single tree drawn by a Forest level's instanced programs (TreeLodInstance.glsl): adds to
+    /// `vertexData` the instance attributes uv4 = (0, 0, 0, 1) and uv5 = (1, 0) (position 0, scale 1,
+    /// no rotation) as constant per-vertex attributes in a buffer of their own.
+    inline void addOriginInstance(Ogre::VertexData& vertexData)
+    {
+        const unsigned short source = static_cast<unsigned short>(vertexData.vertexDeclaration->getMaxSource() + 1);
+        vertexData.vertexDeclaration->addElement(source, 0, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 4);
+        vertexData.vertexDeclaration->addElement(source, 4 * sizeof(float), Ogre::VET_FLOAT2,
+                                                 Ogre::VES_TEXTURE_COORDINATES, 5);
+        const float origin[6] = {0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 0.0f};
+        std::vector<float> values(6 * vertexData.vertexCount);
+        for (std::size_t i = 0; i < vertexData.vertexCount; ++i)
+            std::copy(origin, origin + 6, &values[6 * i]);
+        Ogre::HardwareVertexBufferSharedPtr buffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
+            6 * sizeof(float), vertexData.vertexCount, Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+        buffer->writeData(0, buffer->getSizeInBytes(), values.data(), true);
+        vertexData.vertexBufferBinding->setBinding(source, buffer);
     }
 }
