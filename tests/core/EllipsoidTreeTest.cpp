@@ -104,7 +104,7 @@ namespace TreeLod
         // One square leaf of 0.2 m: one level of one ellipsoid, a disc on the leaf: the two large
         // semi-axes equal (2 sqrt(var) of a uniform square of half-side 0.1 = 0.2 / sqrt 3), the
         // third the 2 % floor, the normal along the leaf's.
-        TEST(EllipsoidTree, oneLeafIsOneFlatEllipsoid)
+        TEST(EllipsoidTreeBake, oneLeafIsOneFlatEllipsoid)
         {
             TreeModel m = emptyLeafModel();
             test::addQuadLeaf(m, glm::vec3(0.3f, 2.0f, -0.1f), glm::vec3(0.1f, 0, 0), glm::vec3(0, 0.1f, 0),
@@ -131,7 +131,7 @@ namespace TreeLod
 
         // 64 leaves in one horizontal plane: every covariance (leaf and cluster) is singular along
         // Y. No NaN; every ellipsoid is a thin disc whose thin axis is Y.
-        TEST(EllipsoidTree, coplanarLeavesGiveFlatEllipsoids)
+        TEST(EllipsoidTreeBake, coplanarLeavesGiveFlatEllipsoids)
         {
             TreeModel m = emptyLeafModel();
             for (int i = 0; i < 8; ++i)
@@ -157,7 +157,7 @@ namespace TreeLod
         }
 
         // Two leaves on the same vertices: two identical level-0 ellipsoids, then one on both.
-        TEST(EllipsoidTree, twoIdenticalLeaves)
+        TEST(EllipsoidTreeBake, twoIdenticalLeaves)
         {
             TreeModel m = emptyLeafModel();
             for (int k = 0; k < 2; ++k)
@@ -179,7 +179,7 @@ namespace TreeLod
 
         // EM with every start on one point, three separate blobs of 40 points: the duplicates are
         // re-seeded, it converges without NaN and puts one component on each blob.
-        TEST(EllipsoidTree, emFromOnePointConverges)
+        TEST(EllipsoidTreeBake, emFromOnePointConverges)
         {
             GaussianMixtureInput input;
             const glm::dvec3 blobs[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0.5}};
@@ -226,7 +226,7 @@ namespace TreeLod
 
         // 256 leaves, divisor 4: targets 64, 16, 4, 1 after the 256 leaves (dropping may only lower
         // them); divisor 8: 32, 4, 1 (the division stops at 4, one ellipsoid is added).
-        TEST(EllipsoidTree, levelCountsFollowTheDivisor)
+        TEST(EllipsoidTreeBake, levelCountsFollowTheDivisor)
         {
             const TreeModel& oak = generatedOak(256);
             const EllipsoidTreeData d = bakeOrFail(oak);
@@ -259,7 +259,7 @@ namespace TreeLod
 
         // Encode, decode: equal to the quantisation (centre half a step of 65535 over the box, radii
         // 0.025 %, rotation 1/32767 per component), 28 bytes per ellipsoid, re-encoding identical.
-        TEST(EllipsoidTree, roundTripIsExactToTheQuantisation)
+        TEST(EllipsoidTreeBake, roundTripIsExactToTheQuantisation)
         {
             const EllipsoidTreeData& d = oakBake();
             const std::vector<std::uint8_t> bytes = encodeEllipsoidTreeChunk(d);
@@ -326,7 +326,7 @@ namespace TreeLod
         void putU32(std::vector<std::uint8_t>& bytes, std::size_t at, std::uint32_t v) { std::memcpy(&bytes[at], &v, 4); }
 
         // Every kind of damage is an error that names the element (little-endian host assumed).
-        TEST(EllipsoidTree, corruptChunksAreNamed)
+        TEST(EllipsoidTreeBake, corruptChunksAreNamed)
         {
             const EllipsoidTreeData& d = oakBake();
             const std::vector<std::uint8_t> good = encodeEllipsoidTreeChunk(d);
@@ -385,7 +385,7 @@ namespace TreeLod
         }
 
         // The same seed gives the same bytes, with 1 and 2 TBB threads; another seed moves the starts.
-        TEST(EllipsoidTree, deterministicForSeedAndThreads)
+        TEST(EllipsoidTreeBake, deterministicForSeedAndThreads)
         {
             const TreeModel& oak = generatedOak(256);
             const std::vector<std::uint8_t> reference = encodeEllipsoidTreeChunk(oakBake());
@@ -409,7 +409,7 @@ namespace TreeLod
         // of the leaves' for one ellipsoid per leaf and within 50 % for the clusters (opaque
         // ellipsoids against sparse leaves: the calibration minimises image error, not coverage,
         // and measured 0.9 to 1.4 times the leaves' coverage on this oak).
-        TEST(EllipsoidTree, everyLevelCoversWhatTheLeavesCover)
+        TEST(EllipsoidTreeBake, everyLevelCoversWhatTheLeavesCover)
         {
             const TreeModel& oak = generatedOak(256);
             const EllipsoidTreeData& d = oakBake();
@@ -441,7 +441,7 @@ namespace TreeLod
 
         // A 0.5 m and a 500 m tree: the same levels, scales and errors, and the same ellipsoids
         // relative to the tree's size.
-        TEST(EllipsoidTree, scaleFree)
+        TEST(EllipsoidTreeBake, scaleFree)
         {
             const TreeModel small = scaled(generatedOak(128), 0.5f / generatedOak(128).boundsMax.y);
             const TreeModel large = scaled(small, 1000.0f);
@@ -466,7 +466,7 @@ namespace TreeLod
 
         // `treelod bake` finds the baker and its options; `treelod info` describes the chunk; bad
         // options and a leafless model are errors that name them.
-        TEST(EllipsoidTree, registeredAndErrorsNamed)
+        TEST(EllipsoidTreeBake, registeredAndErrorsNamed)
         {
             const BakeTechnique* baker = findBakeTechnique("ellipsoids");
             ASSERT_NE(baker, nullptr);
