@@ -4,6 +4,7 @@
 #include "SingleTreeView.h"
 #include "TechniqueSample.h"
 #include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/LevelSelection.h"
 #include "TreeLod/OgreBootstrap.h"
 #include "TreeLod/ProcessMemory.h"
 #include "TreeLod/TechniqueRegistry.h"
@@ -46,8 +47,9 @@ namespace TreeLod
             return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         }
 
-        /// The error budget slider's steps (FLIP over the reference's own; 0: the reference itself).
-        const std::array<float, 10> ERROR_BUDGETS{0.0f, 0.005f, 0.01f, 0.02f, 0.03f, 0.05f, 0.08f, 0.12f, 0.2f, 1.0f};
+        /// The error budget slider's steps: the Forest's budget ladder (FLIP per tree pixel over the
+        /// reference's own; 0: the reference itself).
+        const std::vector<float>& ERROR_BUDGETS = frameBudgetLadder();
 
         std::size_t nearestErrorBudget(float budget)
         {
