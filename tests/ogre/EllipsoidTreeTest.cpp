@@ -152,8 +152,18 @@ namespace TreeLod
         camera.farClip = 100.0f;
         const Image inside = render(false, camera, 64, {{"level", std::to_string(last)}});
         EXPECT_GT(treeCoverage(inside, BACKGROUND), 0.95);
+        glm::dvec3 mean(0.0);
         for (const glm::vec4& p : inside.pixels)
+        {
             ASSERT_TRUE(std::isfinite(p.r) && std::isfinite(p.g) && std::isfinite(p.b));
+            mean += glm::dvec3(p) / double(inside.pixels.size());
+        }
+        // Lit foliage, not black: the leaves' green (the ellipsoid's colour, lit by the ambient
+        // light at least).
+        std::printf("inside: mean colour %.3f %.3f %.3f\n", mean.r, mean.g, mean.b);
+        EXPECT_GT(mean.g, 0.05);
+        EXPECT_GT(mean.g, mean.r);
+        EXPECT_GT(mean.g, mean.b);
     }
 
     TEST(EllipsoidTree, badParametersAndAMissingChunkAreNamed)
