@@ -9,12 +9,16 @@
 #   device call (one `run`, carry [".gpu/bundle.tar.xz", ".gpu/on-device.sh", ".gpu/payload.tar.xz"]):
 #       bash .gpu/on-device.sh .gpu/bundle.tar.xz bash bench/gpu-run.sh device
 #                                there: renders and times every scene's runs (reference, the three
-#                                floors, auto) into $OUT/SCENE, plus an RSS-only run of flythrough-10k
+#                                floors, TECHNIQUES) into $OUT/SCENE, plus an RSS-only run of
+#                                flythrough-10k; packs them into $OUT/results.tar.xz (the device
+#                                returns at most 8 files)
 #   bench/gpu-run.sh finish DIR  here: DIR = the run's files_at; FLIP, RMSE, temporal noise, plots
 #                                and summary.json into out/gpu/SCENE (treelod bench --frames-from)
 #
 # Settings (environment; prepare writes them to .gpu/settings.env and the other steps read them):
-#   SCENES="flythrough-10k forest-100k" FRAMES=240 SIZE=1920x1080 SCALE=1 SAMPLES=6
+#   SCENES="flythrough-10k forest-100k" TECHNIQUES=auto FRAMES=240 SIZE=1920x1080 SCALE=1 SAMPLES=6
+#   DEVICE_SAMPLES=$SAMPLES: images saved on the device; 0 = timings only (1920x1080 PNGs are ~3 MB
+#   each and the device returns 64 MiB at most)
 #   REFERENCE_BUDGET=3e8 (triangles of a timed reference frame) SCENE_TIMEOUT=200 (s a scene, on the device)
 #   SHADOW_LOD_BIAS_TRY=0.25 (forest-100k's auto once more with coarser casters, timings only; "" skips)
 # Trying the device step here (llvmpipe), small:
@@ -32,8 +36,8 @@ fail() { echo "gpu-run: $*" >&2; exit 2; }
 
 case $step in
 prepare)
-  : "${SCENES:=flythrough-10k forest-100k}" "${FRAMES:=240}" "${SIZE:=1920x1080}" "${SCALE:=1}" "${SAMPLES:=6}"
-  : "${REFERENCE_BUDGET:=3e8}" "${SCENE_TIMEOUT:=200}" "${SHADOW_LOD_BIAS_TRY=0.25}"
+  : "${SCENES:=flythrough-10k forest-100k}" "${TECHNIQUES:=auto}" "${FRAMES:=240}" "${SIZE:=1920x1080}" "${SCALE:=1}" "${SAMPLES:=6}"
+  : "${DEVICE_SAMPLES:=$SAMPLES}" "${REFERENCE_BUDGET:=3e8}" "${SCENE_TIMEOUT:=200}" "${SHADOW_LOD_BIAS_TRY=0.25}"
   build=${TREELOD_BUILD_DIR:-$root/build}
   for b in treelod treelod_frames; do
     [ -x "$build/bin/$b" ] || fail "$build/bin/$b is missing: build first (tests/run.sh or cmake --build build)"
@@ -49,11 +53,11 @@ prepare)
     echo "gpu-run: baking $s"
     # The bench bakes into .gpu/cache and prints the treelod_frames command of this very run.
     "$build/bin/treelod" bench "samples/scenes/$s.json" -o "$gpu/runs/$s" --cache "$gpu/cache" --bake-only \
-      --techniques auto --lod-bias 1 --frames "$FRAMES" --size "$SIZE" --scale "$SCALE" --samples "$SAMPLES" \
+      --techniques "$TECHNIQUES" --lod-bias 1 --frames "$FRAMES" --size "$SIZE" --scale "$SCALE" --samples "$SAMPLES" \
       --reference-budget "$REFERENCE_BUDGET" >"$gpu/runs/$s/command.txt"
   done
   cat >"$gpu/settings.env" <<EOF
-SCENES="$SCENES" FRAMES=$FRAMES SIZE=$SIZE SCALE=$SCALE SAMPLES=$SAMPLES REFERENCE_BUDGET=$REFERENCE_BUDGET SCENE_TIMEOUT=$SCENE_TIMEOUT SHADOW_LOD_BIAS_TRY=$SHADOW_LOD_BIAS_TRY
+SCENES="$SCENES" TECHNIQUES=$TECHNIQUES FRAMES=$FRAMES SIZE=$SIZE SCALE=$SCALE SAMPLES=$SAMPLES DEVICE_SAMPLES=$DEVICE_SAMPLES REFERENCE_BUDGET=$REFERENCE_BUDGET SCENE_TIMEOUT=$SCENE_TIMEOUT SHADOW_LOD_BIAS_TRY=$SHADOW_LOD_BIAS_TRY
 EOF
   # Texture shadows need OGRE's ShadowVolume programs; the bundle holds no OGRE media.
   rm -rf "$gpu/ogre-media"; mkdir -p "$gpu/ogre-media"
@@ -65,6 +69,21 @@ EOF
   if [ ! -f "$gpu/bundle.tar.xz" ] || [ $stale = 1 ]; then
     echo "gpu-run: bundling treelod_frames (~2.5 min)"
     "$shared/gpu/bundle.sh" "$gpu" "$build/bin/treelod_frames" >/dev/null
+    # ICU's data (libicudata, 7.5 MB packed) is in the closure only through LLVM's libxml2 (Mesa's
+    # swrast for Xvfb's GLX) and is never read there: nothing converts text encodings. A stub
+    # with its one symbol keeps the device call under 64 MiB; ICU reports missing data if used.
+    stage=$(mktemp -d)
+    tar -C "$stage" -xJf "$gpu/bundle.tar.xz"
+    for icu in "$stage"/lib/libicudata.so.*; do
+      [ -f "$icu" ] || continue
+      sym=$(nm -D --defined-only "$icu" | awk '/_dat$/ {print $3}')
+      echo "const char $sym[16] = {0};" >"$stage/icu-stub.c"
+      cc -shared -o "$icu" "$stage/icu-stub.c" -Wl,-soname,"$(basename "$icu")"
+      rm "$stage/icu-stub.c"
+      echo "gpu-run: $(basename "$icu") replaced by a stub exporting $sym (~2.5 min to pack again)"
+      XZ_OPT=-9T0 tar -C "$stage" -cJf "$gpu/bundle.tar.xz" .
+    done
+    rm -rf "$stage"
   fi
   # What travels: the tracked tree, the bundle and one compressed payload (the package lists, the
   # packages they name, OGRE's media, the settings); the device takes 64 MiB in all.
@@ -117,6 +136,7 @@ device)
   }
   for s in $SCENES; do
     load_command "$s" "$s"
+    set_arg --samples "${DEVICE_SAMPLES:-$SAMPLES}"
     start=$(date +%s)
     echo "gpu-run: $s: ${args[*]:1}"
     code=0
@@ -143,6 +163,10 @@ device)
       code=$?
     echo "gpu-run: shadow-lod-bias-forest-100k ($SHADOW_LOD_BIAS_TRY): exit $code" | tee -a "$OUT/device.txt"
   fi
+  # One archive of everything but device.txt (the device returns at most 8 files).
+  (cd "$OUT" && find . -mindepth 1 -maxdepth 1 ! -name device.txt -printf '%P\n' | tar -cJf results.tar.xz -T - &&
+    find . -mindepth 1 -maxdepth 1 ! -name device.txt ! -name results.tar.xz -exec rm -rf {} +)
+  ls -l "$OUT"
   ;;
 
 finish)
@@ -152,11 +176,15 @@ finish)
   eval "$(cat "$gpu/settings.env")"
   build=${TREELOD_BUILD_DIR:-$root/build}
   cat "$from/device.txt" 2>/dev/null || true
+  if [ -f "$from/results.tar.xz" ]; then
+    mkdir -p out/gpu/device && tar -C out/gpu/device -xJf "$from/results.tar.xz"
+    from=out/gpu/device
+  fi
   for s in $SCENES; do
     [ -f "$from/$s/timings.json" ] || { echo "gpu-run: $s: no timings.json in $from/$s (see $from/$s.log)"; continue; }
     mkdir -p "out/gpu/$s"
     "$build/bin/treelod" bench "samples/scenes/$s.json" -o "out/gpu/$s" --cache "$gpu/cache" --frames-from "$from/$s" \
-      --techniques auto --lod-bias 1 --frames "$FRAMES" --size "$SIZE" --scale "$SCALE" --samples "$SAMPLES" \
+      --techniques "$TECHNIQUES" --lod-bias 1 --frames "$FRAMES" --size "$SIZE" --scale "$SCALE" --samples "$SAMPLES" \
       --reference-budget "$REFERENCE_BUDGET" -q
     echo "gpu-run: $s: out/gpu/$s/summary.json"
     python3 - "out/gpu/$s/summary.json" <<'EOF'

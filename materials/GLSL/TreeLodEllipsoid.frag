@@ -1,18 +1,29 @@
 #version 330 core
 // Ray-ellipsoid intersection in the ellipsoid's unit-sphere frame (Sigg et al. 2006; the
-// ellipsoids-and-lines paper (001) §5): the view ray t * dir from the eye (view space origin)
-// becomes o + t * k with o = toUnit * (-centre), k = toUnit * dir, and |o + t k| = 1 is a
-// quadratic in t. The nearest hit in front of the eye is drawn with its true depth; the normal
-// is the unit sphere's u brought back to view space by the inverse transpose, transpose(toUnit).
-// colour = albedo * (ambient * ao + sun * max(0, n.l)) in linear space, written as sRGB, as
-// TreeLodLit.frag lights the leaves (LightingSpec in TreeLod/Camera.h).
+// ellipsoids-and-lines paper (001) §5): the pixel's ray from + t dir (from on the near plane)
+// becomes o + t k with o = toUnit * (from - centre), k = toUnit * dir, and |o + t k| = 1 is a
+// quadratic in t. The nearest hit past the near plane is drawn with its true depth (the far side
+// when the near plane cuts the ellipsoid); the normal is the unit sphere's u brought back to view
+// space by the inverse transpose, transpose(toUnit).
+// colour = albedo * (ambient * ao + sun * max(0, n.l) * shadow) in linear space, written as sRGB,
+// as TreeLodLit.frag lights the leaves (LightingSpec in TreeLod/Camera.h).
+// CASTER: writes the shadow camera's window depth of the hit instead (as TreeLodCaster.frag).
+// SHADOW_RECEIVER: the sun's visibility at the hit (texViewProj * inverseView * hit).
 // Not yet here: the paper's noise cube maps (alpha test and normal noise, §3.1 and §5).
 uniform mat4 projection;
+#ifndef CASTER
 uniform vec4 sunDirection; // view space, towards the sun (w = 0 for a directional light)
 uniform vec4 sunColour;
 uniform vec4 ambientColour;
+#endif
+#ifdef SHADOW_RECEIVER
+#define SHADOW_POS_PER_FRAGMENT
+uniform mat4 inverseView;
+uniform mat4 texViewProj;
+#endif
 
-in vec3 vRay;
+in vec4 vNear;
+in vec4 vFar;
 flat in vec3 vCentre;
 flat in mat3 vToUnit;
 flat in vec4 vColour;
@@ -23,8 +34,9 @@ out vec4 fragColour;
 
 void main()
 {
-    vec3 dir = normalize(vRay);
-    vec3 o = vToUnit * -vCentre;
+    vec3 from = vNear.xyz / vNear.w;
+    vec3 dir = normalize(vFar.xyz / vFar.w - from);
+    vec3 o = vToUnit * (from - vCentre);
     vec3 k = vToUnit * dir;
     float a = dot(k, k), b = dot(o, k), c = dot(o, o) - 1.0;
     float disc = b * b - a * c;
@@ -32,22 +44,31 @@ void main()
         discard;
     float root = sqrt(disc);
     float t = (-b - root) / a;
-    if (t <= 0.0) // the eye is inside: the far side
+    if (t < 0.0) // the near plane is inside: the far side
         t = (-b + root) / a;
-    if (t <= 0.0)
+    if (t < 0.0)
         discard;
-    vec3 hit = t * dir;
+    vec3 hit = from + t * dir;
     vec4 clip = projection * vec4(hit, 1.0);
     float ndcDepth = clip.z / clip.w;
-    if (ndcDepth < -1.0)
-        discard; // before the near plane
-    gl_FragDepth = 0.5 * ndcDepth + 0.5;
-
+    if (ndcDepth > 1.0)
+        discard; // beyond the far plane
+    float depth = 0.5 * ndcDepth + 0.5;
+    gl_FragDepth = depth;
+#ifdef CASTER
+    fragColour = vec4(depth, depth, depth, 1.0);
+#else
     vec3 n = normalize(transpose(vToUnit) * (o + t * k));
     if (dot(n, dir) > 0.0) // seen from inside
         n = -n;
+#ifdef SHADOW_RECEIVER
+    float shadow = sunVisibilityAt(texViewProj * (inverseView * vec4(hit, 1.0)));
+#else
+    float shadow = 1.0;
+#endif
     vec3 albedo = toLinear(vColour.rgb);
-    float lambert = max(dot(n, normalize(sunDirection.xyz)), 0.0) * sunVisibility();
+    float lambert = max(dot(n, normalize(sunDirection.xyz)), 0.0) * shadow;
     vec3 lit = albedo * (ambientColour.rgb * vColour.a + sunColour.rgb * lambert);
     fragColour = vec4(toSrgb(lit), 1.0);
+#endif
 }

@@ -1,14 +1,18 @@
 #version 330 core
 // Ellipsoids of an EllipsoidTree (EllipsoidTreeData.h), ray cast per fragment (Sigg et al. 2006,
-// as the ellipsoids-and-lines paper (001) §5 renders them): one quad per ellipsoid that covers
-// its bounding sphere as the camera sees it; the fragment stage intersects the view ray with
-// the ellipsoid in the frame where it is the unit sphere.
+// as the ellipsoids-and-lines paper (001) §5 renders them): one quad per ellipsoid covering, in
+// normalised device coordinates, the projection of the ellipsoid's box (centre +- the three
+// semi-axes). That holds for any projection (the view's perspective, a directional light's
+// orthographic shadow camera, a LiSPSM warp); a box reaching behind the eye (w <= 0) gets the
+// whole viewport. The fragment stage casts the ray of its pixel, from the near plane, against
+// the ellipsoid in the frame where it is the unit sphere; the ray's two points are interpolated
+// here exactly (inverse projection is linear in x, y and the quad has w = 1).
 // Per vertex: vertex = the centre (tree space, metres), uv0 = the quad corner (+-1, +-1),
 // uv1..uv3 = the three semi-axes (rotation columns times radii times the level's scale),
 // colour = sRGB colour, alpha = ambient occlusion. Per instance (TreeLodInstance.glsl): uv4, uv5.
 uniform mat4 worldView;
 uniform mat4 projection;
-uniform float nearClip;
+uniform mat4 inverseProjection;
 
 in vec4 vertex;
 in vec2 uv0;
@@ -19,7 +23,8 @@ in vec4 colour;
 
 #include "TreeLodInstance.glsl"
 
-out vec3 vRay;         // the quad point in view space: the view ray's direction
+out vec4 vNear;        // view space, homogeneous: the pixel's point on the near plane
+out vec4 vFar;         // view space, homogeneous: a point further along the pixel's ray
 flat out vec3 vCentre; // view space
 flat out mat3 vToUnit; // view space -> the unit-sphere frame (about the centre)
 flat out vec4 vColour;
@@ -30,29 +35,23 @@ void main()
     mat3 toView = mat3(worldView);
     mat3 axes = mat3(toView * instanceDirection(uv4.w * uv1), toView * instanceDirection(uv4.w * uv2),
                      toView * instanceDirection(uv4.w * uv3));
-    float radius = max(length(axes[0]), max(length(axes[1]), length(axes[2])));
-    float d = length(centre);
-    vec3 forward, right, up;
-    float at, extent;
-    if (d > 1.001 * radius + nearClip)
+    vec2 lo = vec2(1e30), hi = vec2(-1e30);
+    bool behind = false;
+    for (int i = 0; i < 8; ++i)
     {
-        // The cone from the eye around the sphere, cut at its nearest point.
-        forward = centre / d;
-        at = d - radius;
-        extent = at * radius / sqrt(d * d - radius * radius);
+        vec3 s = vec3((i & 1) != 0 ? 1.0 : -1.0, (i & 2) != 0 ? 1.0 : -1.0, (i & 4) != 0 ? 1.0 : -1.0);
+        vec4 clip = projection * vec4(centre + axes * s, 1.0);
+        behind = behind || clip.w <= 0.0;
+        vec2 ndc = clip.xy / clip.w;
+        lo = min(lo, ndc);
+        hi = max(hi, ndc);
     }
-    else
-    {
-        // The eye is inside or at the bounding sphere: a quad just past the near plane covering the view.
-        forward = vec3(0.0, 0.0, -1.0);
-        at = 1.01 * nearClip;
-        extent = 1000.0 * at;
-    }
-    right = normalize(abs(forward.y) < 0.99 ? cross(forward, vec3(0.0, 1.0, 0.0)) : cross(forward, vec3(1.0, 0.0, 0.0)));
-    up = cross(right, forward);
-    vRay = at * forward + extent * (uv0.x * right + uv0.y * up);
+    vec2 corner = uv0 * 0.5 + 0.5;
+    vec2 ndc = behind ? uv0 : mix(clamp(lo, -1.0, 1.0), clamp(hi, -1.0, 1.0), corner);
+    vNear = inverseProjection * vec4(ndc, -1.0, 1.0);
+    vFar = inverseProjection * vec4(ndc, 0.0, 1.0); // finite also with an infinite far plane
     vCentre = centre;
     vToUnit = inverse(axes);
     vColour = colour;
-    gl_Position = projection * vec4(vRay, 1.0);
+    gl_Position = vec4(ndc, 0.0, 1.0); // inside the clip volume; the fragment writes the depth
 }

@@ -26,11 +26,11 @@ vec3 srgbScale(vec3 k)
 uniform sampler2D shadowMap;
 uniform vec4 shadowTexelSize;  // 1 / width, 1 / height
 uniform float shadowBias;
-in vec4 vShadowPos;
 
-float sunVisibility()
+// The sun's visibility at a point given in the shadow texture's clip space (texViewProj * world).
+float sunVisibilityAt(vec4 shadowPos)
 {
-    vec3 p = vShadowPos.xyz / vShadowPos.w;
+    vec3 p = shadowPos.xyz / shadowPos.w;
     float depth = 0.5 * p.z + 0.5 - shadowBias;
     if (p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0 || depth >= 1.0)
         return 1.0;
@@ -40,6 +40,11 @@ float sunVisibility()
             lit += depth <= texture(shadowMap, p.xy + vec2(x, y) * shadowTexelSize.xy).r ? 1.0 : 0.0;
     return lit / 9.0;
 }
+
+#ifndef SHADOW_POS_PER_FRAGMENT // the program computes the point itself (ray-cast surfaces)
+in vec4 vShadowPos;
+float sunVisibility() { return sunVisibilityAt(vShadowPos); }
+#endif
 #else
 float sunVisibility() { return 1.0; }
 #endif

@@ -1,8 +1,8 @@
 // The ellipsoid tree (chunk "ellipsoids", the ellipsoids-and-lines paper (001) §3.1, §5): one leaf,
 // coplanar leaves (a singular covariance), two identical leaves, EM from all starts on one point,
 // the level counts of Alg. 1, the chunk round trip and every corruption named, determinism over
-// seeds and thread counts, each level's coverage against the leaves', 0.5 m vs 500 m, and the
-// registered baker and descriptor.
+// seeds and thread counts, each level's coverage against the leaves', 0.5 m vs 500 m, the
+// ellipsoids' ambient occlusion (§5), and the registered baker and descriptor.
 #include "TreeLod/BakeTechniques.h"
 #include "TreeLod/EllipsoidTreeBaker.h"
 #include "TreeLod/EllipsoidTreeData.h"
@@ -462,6 +462,73 @@ namespace TreeLod
                 for (int k = 0; k < 3; ++k)
                     EXPECT_NEAR(1000.0f * a.ellipsoids[i].radii[k] / b.ellipsoids[i].radii[k], 1.0f, 1e-3f) << i;
             }
+        }
+
+        // §5's AO: none without rays (255); with rays the crown's inside is darker than its rim, the
+        // last level's single ellipsoid (only the bark inside it) is open, and the values do not
+        // depend on the thread count.
+        TEST(EllipsoidTreeBake, ambientOcclusionDarkensTheCrownsInside)
+        {
+            const TreeModel& oak = generatedOak(256);
+            for (const Ellipsoid& e : oakBake().ellipsoids)
+                ASSERT_EQ(e.colour[3], 255u);
+            EllipsoidTreeData one = oakBake(), two = oakBake();
+            {
+                tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 1);
+                addEllipsoidAmbientOcclusion(one, oak, 32, 1);
+            }
+            {
+                tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 2);
+                addEllipsoidAmbientOcclusion(two, oak, 32, 1);
+            }
+            for (std::size_t i = 0; i < one.ellipsoids.size(); ++i)
+                ASSERT_EQ(one.ellipsoids[i].colour[3], two.ellipsoids[i].colour[3]) << "ellipsoid " << i;
+            // Level 0: the quarter nearest the crown's centre against the farthest quarter.
+            const EllipsoidLevel& leaves = one.levels[0];
+            glm::vec3 centre(0.0f);
+            for (std::uint32_t e = leaves.first; e < leaves.first + leaves.count; ++e)
+                centre += one.ellipsoids[e].centre / float(leaves.count);
+            std::vector<std::pair<float, float>> byDistance; // distance, AO
+            for (std::uint32_t e = leaves.first; e < leaves.first + leaves.count; ++e)
+                byDistance.emplace_back(glm::distance(one.ellipsoids[e].centre, centre),
+                                        float(one.ellipsoids[e].colour[3]) / 255.0f);
+            std::sort(byDistance.begin(), byDistance.end());
+            const std::size_t quarter = byDistance.size() / 4;
+            double inner = 0.0, outer = 0.0;
+            for (std::size_t i = 0; i < quarter; ++i)
+            {
+                inner += byDistance[i].second / double(quarter);
+                outer += byDistance[byDistance.size() - 1 - i].second / double(quarter);
+            }
+            const Ellipsoid& last = one.ellipsoids[one.levels.back().first];
+            std::printf("AO: inner quarter %.3f, outer quarter %.3f, the last level's ellipsoid %.3f\n", inner, outer,
+                        double(last.colour[3]) / 255.0);
+            EXPECT_LT(inner, outer - 0.1);
+            EXPECT_GT(outer, 0.5);
+            EXPECT_GT(last.colour[3], 0.9 * 255);
+        }
+
+        // Points inside another ellipsoid are not counted (§5): two unit spheres overlapping by half
+        // see the open sky from every point outside the other, bar the rays near the seam.
+        TEST(EllipsoidTreeBake, ambientOcclusionSkipsPointsInsideOtherEllipsoids)
+        {
+            EllipsoidTreeData d;
+            d.levels.push_back(EllipsoidLevel{0, 2, 1.0f, 10.0f, 0.0f});
+            for (const float x : {-0.5f, 0.5f})
+            {
+                Ellipsoid e;
+                e.centre = glm::vec3(x, 0.0f, 0.0f);
+                e.radii = glm::vec3(1.0f);
+                e.leafWeight = 1.0f;
+                d.ellipsoids.push_back(e);
+            }
+            TreeModel empty = emptyLeafModel();
+            addEllipsoidAmbientOcclusion(d, empty, 64, 1);
+            const double a = d.ellipsoids[0].colour[3] / 255.0, b = d.ellipsoids[1].colour[3] / 255.0;
+            std::printf("AO of two overlapping spheres: %.3f, %.3f\n", a, b);
+            EXPECT_GT(a, 0.75);
+            EXPECT_GT(b, 0.75);
+            EXPECT_NEAR(a, b, 0.1);
         }
 
         // `treelod bake` finds the baker and its options; `treelod info` describes the chunk; bad

@@ -43,11 +43,6 @@ namespace TreeLod
 
     const Ogre::String EllipsoidTreeFactory::FACTORY_TYPE_NAME = "EllipsoidTree";
 
-    namespace
-    {
-        constexpr const char* ELLIPSOID_MATERIAL = "TreeLod/Ellipsoid"; ///< materials/TreeLodEllipsoid.material
-    }
-
     EllipsoidTree::EllipsoidTree(const Ogre::String& name, const TreeAssetPtr& asset, const Options& options)
         : Ogre::MovableObject(name), mAsset(asset), mGpu(&EllipsoidTreeResources::of(*asset).getGpu()),
           mOptions(options)
@@ -69,7 +64,8 @@ namespace TreeLod
                         Ogre::String("material '") + ELLIPSOID_MATERIAL +
                             "' not found: add TreeLod's materials/ to a resource group",
                         "EllipsoidTree '" + name + "'");
-        mEllipsoids = std::make_unique<Part>(*this, material->getGroup(), mVertexData.get(), ELLIPSOID_MATERIAL, "");
+        mEllipsoids = std::make_unique<Part>(*this, material->getGroup(), mVertexData.get(), ELLIPSOID_MATERIAL,
+                                             ELLIPSOID_SHADOWED_MATERIAL);
         mEllipsoids->mIndexData.indexBuffer = mGpu->indexBuffer;
 
         const TreeModel& model = mAsset->getReference().model;
@@ -77,7 +73,16 @@ namespace TreeLod
         mBounds = mGpu->bounds;
         mBounds.merge(Ogre::AxisAlignedBox(model.boundsMin.x, model.boundsMin.y, model.boundsMin.z, model.boundsMax.x,
                                            model.boundsMax.y, model.boundsMax.z));
-        if (!model.barkIndices.empty())
+        mLines = mOptions.lines ? EllipsoidTreeResources::of(*mAsset).getLineGpu() : nullptr;
+        if (mLines)
+        {
+            mLineVertexData.reset(mLines->vertexData->clone(false));
+            addOriginInstance(*mLineVertexData);
+            mLineParts = std::make_unique<Part>(*this, material->getGroup(), mLineVertexData.get(),
+                                                ELLIPSOID_LINE_MATERIAL, ELLIPSOID_LINE_SHADOWED_MATERIAL);
+            mLineParts->mIndexData.indexBuffer = mLines->indexBuffer;
+        }
+        else if (!model.barkIndices.empty())
         {
             // The reference's bark, lit like the polygonal tree.
             mBarkMesh = mAsset->getBarkMesh();
@@ -96,11 +101,23 @@ namespace TreeLod
             }
         }
         mRadius = Ogre::Math::boundingRadiusFromAABB(mBounds);
-        mLevel = mOptions.level >= 0 ? std::size_t(mOptions.level) : 0;
+        setLevels(mOptions.level >= 0 ? mGpu->levels[std::size_t(mOptions.level)].targetHeightPx
+                                      : std::numeric_limits<float>::max());
+    }
+
+    void EllipsoidTree::setLevels(float heightPx)
+    {
+        mLevel = mOptions.level >= 0 ? std::size_t(mOptions.level) : TreeLod::levelForHeight(mGpu->levels, heightPx);
         mEllipsoids->mIndexData.indexStart = mGpu->levels[mLevel].indexStart;
         mEllipsoids->mIndexData.indexCount = mGpu->levels[mLevel].indexCount;
-        // No caster material yet (EllipsoidTree.h).
-        setCastShadows(false);
+        if (mLines)
+        {
+            // A forced level: the lines made for its target height.
+            mLineLevel = TreeLod::levelForHeight(mLines->levels, mOptions.level >= 0 ? mGpu->levels[mLevel].targetHeightPx
+                                                                            : heightPx);
+            mLineParts->mIndexData.indexStart = mLines->levels[mLineLevel].indexStart;
+            mLineParts->mIndexData.indexCount = mLines->levels[mLineLevel].indexCount;
+        }
     }
 
     EllipsoidTree::~EllipsoidTree() = default;
@@ -109,11 +126,7 @@ namespace TreeLod
 
     std::size_t EllipsoidTree::levelForHeight(const EllipsoidTreeGpu& gpu, float heightPx)
     {
-        std::size_t level = 0;
-        for (std::size_t l = 0; l < gpu.levels.size(); ++l)
-            if (gpu.levels[l].targetHeightPx >= heightPx)
-                level = l;
-        return level;
+        return TreeLod::levelForHeight(gpu.levels, heightPx);
     }
 
     void EllipsoidTree::_notifyCurrentCamera(Ogre::Camera* camera)
@@ -137,9 +150,7 @@ namespace TreeLod
             heightPx = treeHeight * viewHeight / lod->getOrthoWindowHeight();
         if (heightPx != std::numeric_limits<Ogre::Real>::max())
             heightPx *= lod->getLodBias() * mOptions.lodBias;
-        mLevel = mOptions.level >= 0 ? std::size_t(mOptions.level) : levelForHeight(*mGpu, float(heightPx));
-        mEllipsoids->mIndexData.indexStart = mGpu->levels[mLevel].indexStart;
-        mEllipsoids->mIndexData.indexCount = mGpu->levels[mLevel].indexCount;
+        setLevels(float(heightPx));
         if (mBarkMesh)
             mBarkLodIndex = mBarkMesh->getLodIndex(mBarkMesh->getLodStrategy()->getValue(this, camera));
     }
@@ -152,6 +163,8 @@ namespace TreeLod
     void EllipsoidTree::_updateRenderQueue(Ogre::RenderQueue* queue)
     {
         queue->addRenderable(mEllipsoids.get(), mRenderQueueID, mRenderQueuePriority);
+        if (mLineParts)
+            queue->addRenderable(mLineParts.get(), mRenderQueueID, mRenderQueuePriority);
         for (const std::unique_ptr<Part>& part : mBarkParts)
             queue->addRenderable(part.get(), mRenderQueueID, mRenderQueuePriority);
     }
@@ -159,6 +172,8 @@ namespace TreeLod
     void EllipsoidTree::visitRenderables(Ogre::Renderable::Visitor* visitor, bool)
     {
         visitor->visit(mEllipsoids.get(), 0, false);
+        if (mLineParts)
+            visitor->visit(mLineParts.get(), 0, false);
         for (const std::unique_ptr<Part>& part : mBarkParts)
             visitor->visit(part.get(), 0, false);
     }
@@ -177,6 +192,7 @@ namespace TreeLod
         }
         if (p.number("lodBias", 1e-6, 1e6, value))
             options.lodBias = float(value);
+        p.flag("lines", options.lines);
         return new EllipsoidTree(name, p.loadAsset(name, "EllipsoidTree"), options);
     }
 }

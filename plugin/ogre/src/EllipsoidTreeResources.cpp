@@ -33,8 +33,62 @@ namespace TreeLod
         return *mData;
     }
 
+    Ogre::AxisAlignedBox ellipsoidBounds(const EllipsoidTreeData& data)
+    {
+        Ogre::AxisAlignedBox bounds;
+        for (const EllipsoidLevel& level : data.levels)
+            for (std::uint32_t e = level.first; e < level.first + level.count; ++e)
+            {
+                const Ellipsoid& ellipsoid = data.ellipsoids[e];
+                // The ellipsoid's own box: per axis, the length of that row of R * diag(scale * radii).
+                const glm::mat3 rotation = glm::mat3_cast(ellipsoid.rotation);
+                glm::vec3 reach(0.0f);
+                for (int a = 0; a < 3; ++a)
+                {
+                    const glm::vec3 axis = rotation[a] * (ellipsoid.radii[a] * level.scale);
+                    reach += axis * axis;
+                }
+                reach = glm::sqrt(reach);
+                const Ogre::Vector3 centre(ellipsoid.centre.x, ellipsoid.centre.y, ellipsoid.centre.z);
+                const Ogre::Vector3 half(reach.x, reach.y, reach.z);
+                bounds.merge(Ogre::AxisAlignedBox(centre - half, centre + half));
+            }
+        return bounds;
+    }
+
+    std::size_t levelForHeight(const std::vector<EllipsoidGpuLevel>& levels, float heightPx)
+    {
+        std::size_t level = 0;
+        for (std::size_t l = 0; l < levels.size(); ++l)
+            if (levels[l].targetHeightPx >= heightPx)
+                level = l;
+        return level;
+    }
+
     namespace
     {
+        /// Two triangles per quad of 4 vertices, `quads` quads; 16-bit indices while the vertices allow.
+        Ogre::HardwareIndexBufferSharedPtr quadIndices(std::size_t quads)
+        {
+            const bool narrow = 4 * quads <= std::numeric_limits<std::uint16_t>::max();
+            std::vector<std::uint32_t> indices;
+            indices.reserve(6 * quads);
+            for (std::uint32_t q = 0; q < quads; ++q)
+                for (const std::uint32_t corner : {0u, 1u, 2u, 0u, 2u, 3u})
+                    indices.push_back(4 * q + corner);
+            Ogre::HardwareIndexBufferSharedPtr buffer = Ogre::HardwareBufferManager::getSingleton().createIndexBuffer(
+                narrow ? Ogre::HardwareIndexBuffer::IT_16BIT : Ogre::HardwareIndexBuffer::IT_32BIT, indices.size(),
+                Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+            if (narrow)
+            {
+                const std::vector<std::uint16_t> small(indices.begin(), indices.end());
+                buffer->writeData(0, small.size() * 2, small.data(), true);
+            }
+            else
+                buffer->writeData(0, indices.size() * 4, indices.data(), true);
+            return buffer;
+        }
+
         /// One vertex of TreeLodEllipsoid.vert: centre, corner, three semi-axes, RGBA8.
         struct EllipsoidVertex
         {
@@ -62,12 +116,10 @@ namespace TreeLod
                 const glm::mat3 rotation = glm::mat3_cast(ellipsoid.rotation);
                 EllipsoidVertex v{};
                 std::memcpy(v.centre, &ellipsoid.centre[0], sizeof v.centre);
-                float reach = 0.0f;
                 for (int a = 0; a < 3; ++a)
                 {
                     const glm::vec3 axis = rotation[a] * (ellipsoid.radii[a] * level.scale);
                     std::memcpy(v.axes[a], &axis[0], sizeof v.axes[a]);
-                    reach = std::max(reach, glm::length(axis));
                 }
                 std::copy(ellipsoid.colour.begin(), ellipsoid.colour.end(), v.colour);
                 for (int c = 0; c < 4; ++c)
@@ -77,15 +129,10 @@ namespace TreeLod
                     out.corner[0] = corners[c][0];
                     out.corner[1] = corners[c][1];
                 }
-                const Ogre::Vector3 centre(ellipsoid.centre.x, ellipsoid.centre.y, ellipsoid.centre.z);
-                gpu->bounds.merge(Ogre::AxisAlignedBox(centre - reach, centre + reach));
             }
-        std::size_t index = 0;
+        gpu->bounds = ellipsoidBounds(data);
         for (const EllipsoidLevel& level : data.levels)
-        {
             gpu->levels.push_back({6 * std::size_t(level.first), 6 * std::size_t(level.count), level.targetHeightPx});
-            index += 6 * std::size_t(level.count);
-        }
 
         Ogre::HardwareBufferManager& buffers = Ogre::HardwareBufferManager::getSingleton();
         gpu->vertexData = std::make_unique<Ogre::VertexData>();
@@ -103,25 +150,85 @@ namespace TreeLod
         gpu->vertexData->vertexStart = 0;
         gpu->vertexData->vertexCount = vertices.size();
 
-        // Two triangles per quad, 16-bit indices while the vertices allow.
-        const bool narrow = vertices.size() <= std::numeric_limits<std::uint16_t>::max();
-        std::vector<std::uint32_t> indices;
-        indices.reserve(index);
-        for (std::uint32_t e = 0; e < count; ++e)
-            for (const std::uint32_t corner : {0u, 1u, 2u, 0u, 2u, 3u})
-                indices.push_back(4 * e + corner);
-        gpu->indexBuffer = buffers.createIndexBuffer(narrow ? Ogre::HardwareIndexBuffer::IT_16BIT
-                                                            : Ogre::HardwareIndexBuffer::IT_32BIT,
-                                                     indices.size(), Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
-        if (narrow)
-        {
-            const std::vector<std::uint16_t> small(indices.begin(), indices.end());
-            gpu->indexBuffer->writeData(0, small.size() * 2, small.data(), true);
-        }
-        else
-            gpu->indexBuffer->writeData(0, indices.size() * 4, indices.data(), true);
+        gpu->indexBuffer = quadIndices(count);
         gpu->gpuBytes = vertexBuffer->getSizeInBytes() + gpu->indexBuffer->getSizeInBytes();
         mGpu = std::move(gpu);
         return *mGpu;
+    }
+
+    const EllipsoidLineData* EllipsoidTreeResources::getLineData()
+    {
+        if (mLinesRead)
+            return mLineData.get();
+        if (mAsset.hasChunk(ELLIPSOID_LINES_CHUNK))
+        {
+            Result<EllipsoidLineData> decoded =
+                decodeEllipsoidLineChunk(mAsset.readChunk(ELLIPSOID_LINES_CHUNK), mAsset.getName());
+            if (!decoded)
+                mAsset.raise(decoded.error());
+            mLineData = std::make_unique<EllipsoidLineData>(std::move(decoded.value()));
+        }
+        mLinesRead = true;
+        return mLineData.get();
+    }
+
+    namespace
+    {
+        /// One vertex of TreeLodEllipsoidLine.vert: start, corner, end and radius, RGBA8.
+        struct LineVertex
+        {
+            float start[3];
+            float corner[2];
+            float endRadius[4];
+            std::uint8_t colour[4];
+        };
+        static_assert(sizeof(LineVertex) == 9 * sizeof(float) + 4, "tightly packed");
+    }
+
+    const EllipsoidLineGpu* EllipsoidTreeResources::getLineGpu()
+    {
+        if (mLineGpu || !getLineData())
+            return mLineGpu.get();
+        const EllipsoidLineData& data = *mLineData;
+        auto gpu = std::make_unique<EllipsoidLineGpu>();
+        std::vector<LineVertex> vertices;
+        vertices.reserve(4 * data.lines.size());
+        const float corners[4][2] = {{0.0f, -1.0f}, {1.0f, -1.0f}, {1.0f, 1.0f}, {0.0f, 1.0f}};
+        for (const EllipsoidLine& line : data.lines)
+        {
+            LineVertex v{};
+            std::memcpy(v.start, &line.start[0], sizeof v.start);
+            std::memcpy(v.endRadius, &line.end[0], 3 * sizeof(float));
+            v.endRadius[3] = line.radius;
+            const std::array<std::uint8_t, 4>& colour = data.palette[line.colour];
+            std::copy(colour.begin(), colour.begin() + 3, v.colour);
+            v.colour[3] = line.ambientOcclusion;
+            for (const auto& corner : corners)
+            {
+                v.corner[0] = corner[0];
+                v.corner[1] = corner[1];
+                vertices.push_back(v);
+            }
+        }
+        for (const EllipsoidLineLevel& level : data.levels)
+            gpu->levels.push_back({6 * std::size_t(level.first), 6 * std::size_t(level.count), level.targetHeightPx});
+
+        gpu->vertexData = std::make_unique<Ogre::VertexData>();
+        Ogre::VertexDeclaration* declaration = gpu->vertexData->vertexDeclaration;
+        std::size_t offset = 0;
+        offset += declaration->addElement(0, offset, Ogre::VET_FLOAT3, Ogre::VES_POSITION).getSize();
+        offset += declaration->addElement(0, offset, Ogre::VET_FLOAT2, Ogre::VES_TEXTURE_COORDINATES, 0).getSize();
+        offset += declaration->addElement(0, offset, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 1).getSize();
+        declaration->addElement(0, offset, Ogre::VET_UBYTE4_NORM, Ogre::VES_DIFFUSE);
+        Ogre::HardwareVertexBufferSharedPtr vertexBuffer = Ogre::HardwareBufferManager::getSingleton().createVertexBuffer(
+            sizeof(LineVertex), vertices.size(), Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
+        vertexBuffer->writeData(0, vertexBuffer->getSizeInBytes(), vertices.data(), true);
+        gpu->vertexData->vertexBufferBinding->setBinding(0, vertexBuffer);
+        gpu->vertexData->vertexStart = 0;
+        gpu->vertexData->vertexCount = vertices.size();
+        gpu->indexBuffer = quadIndices(data.lines.size());
+        gpu->gpuBytes = vertexBuffer->getSizeInBytes() + gpu->indexBuffer->getSizeInBytes();
+        mLineGpu = std::move(gpu);
+        return mLineGpu.get();
     }
 }

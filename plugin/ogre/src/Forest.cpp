@@ -635,7 +635,10 @@ namespace TreeLod
                 {
                     if (name->empty())
                         continue;
+                    // The asset's own (cloned per asset), else a shared one wherever it is.
                     *slot = Ogre::MaterialManager::getSingleton().getByName(*name, group);
+                    if (!*slot)
+                        *slot = Ogre::MaterialManager::getSingleton().getByName(*name, Ogre::RGN_AUTODETECT);
                     if (!*slot)
                         OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND, "material '" + *name + "' not found",
                                     "Forest '" + mForest.mName + "'");

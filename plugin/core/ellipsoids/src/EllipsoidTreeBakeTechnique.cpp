@@ -21,13 +21,15 @@ namespace TreeLod
             Result<double> share = bakeOptionNumber(given, chunk, "minAreaShare", options.minAreaShare, 0, 0.5, label);
             Result<double> resolution =
                 bakeOptionNumber(given, chunk, "viewResolution", options.viewResolution, 16, 1024, label);
-            for (const Result<double>* r : {&tries, &seed, &divisor, &share, &resolution})
+            Result<double> aoRays = bakeOptionNumber(given, chunk, "aoRays", options.aoRays, 0, 1024, label);
+            for (const Result<double>* r : {&tries, &seed, &divisor, &share, &resolution, &aoRays})
                 if (!*r)
                     return r->error();
             for (const auto& [name, value] : {std::pair<const char*, double>{"tries", tries.value()},
                                               {"seed", seed.value()},
                                               {"clustersDivisor", divisor.value()},
-                                              {"viewResolution", resolution.value()}})
+                                              {"viewResolution", resolution.value()},
+                                              {"aoRays", aoRays.value()}})
                 if (value != std::floor(value))
                     return fail(label, std::string("option '") + chunk + "." + name + "'",
                                 std::to_string(value) + " is not a whole number");
@@ -36,6 +38,7 @@ namespace TreeLod
             options.clustersDivisor = std::uint32_t(divisor.value());
             options.minAreaShare = float(share.value());
             options.viewResolution = int(resolution.value());
+            options.aoRays = std::uint32_t(aoRays.value());
             return addEllipsoidTreeChunk(writer, model, options, label, progress);
         }
 
@@ -49,6 +52,7 @@ namespace TreeLod
               {"clustersDivisor", "each level has 1 / this of the previous level's clusters, 2 to 64", "4"},
               {"minAreaShare", "ellipsoids under this share of the level's largest surface area are dropped, 0 to 0.5",
                "0.01"},
-              {"viewResolution", "pixels a side of the 4 views the image error is taken over, 16 to 1024", "128"}}});
+              {"viewResolution", "pixels a side of the 4 views the image error is taken over, 16 to 1024", "128"},
+              {"aoRays", "rays per surface point of the ellipsoids' ambient occlusion, 0 (none) to 1024", "0"}}});
     }
 }

@@ -2,6 +2,7 @@
 // ellipsoids-and-lines paper (001) in EllipsoidTreeBaker.h, format in EllipsoidTreeData.h).
 #include "TreeLod/EllipsoidTreeBaker.h"
 
+#include "TreeLod/EllipsoidLineBaker.h"
 #include "TreeLod/GaussianMixture.h"
 #include "TreeLod/Image.h"
 #include "TreeLod/ImageMetrics.h"
@@ -57,6 +58,8 @@ namespace TreeLod
             if (o.viewResolution < 16 || o.viewResolution > 1024)
                 return fail(label, "ellipsoids option viewResolution",
                             std::to_string(o.viewResolution) + " is outside [16, 1024]");
+            if (o.aoRays > 1024)
+                return fail(label, "ellipsoids option aoRays", std::to_string(o.aoRays) + " is outside [0, 1024]");
             return {};
         }
 
@@ -652,6 +655,8 @@ namespace TreeLod
         }
         data.boundsMin = boxLo;
         data.boundsMax = boxHi;
+        if (options.aoRays > 0)
+            addEllipsoidAmbientOcclusion(data, model, options.aoRays, options.seed, progress);
         if (Result<void> valid = data.validate(label); !valid)
             return valid.error();
         return data;
@@ -669,6 +674,9 @@ namespace TreeLod
                                              encodeEllipsoidTreeChunk(data.value()));
         if (!added)
             return fail(label, added.error().element, added.error().reason);
-        return {};
+        // The branches (§3.2): chunk "ellipsoid-lines" when the model has bark, default line options.
+        EllipsoidLineOptions lines;
+        lines.seed = options.seed;
+        return addEllipsoidLineChunk(writer, model, lines, label, progress);
     }
 }

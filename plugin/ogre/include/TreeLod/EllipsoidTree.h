@@ -9,13 +9,21 @@
 // camera's bias and the object's lodBias), the finest when the tree is taller than every target.
 // lodBias is the paper's target-resolution factor: 1/2 or 1/4 draw coarser levels.
 //
-// Deviations from the paper, for now: the branches are the reference bark mesh with its mesh LoD
-// levels (the paper's simplified lines, §3.2, are not built yet), the ellipsoids have no noise
-// cube maps (alpha test and normal noise, §3.1) and no AO (§5), and the tree neither casts nor
-// receives shadows.
+// Branches (§3.2): the lines of chunk "ellipsoid-lines" (capsules ray cast per fragment, at least a
+// pixel wide, TreeLodEllipsoidLine.vert) at the level the same rule gives for the lines' own
+// targets (a mean line 1 px wide, §6); without that chunk, or with lines=false, the reference bark
+// mesh with its mesh LoD.
+//
+// Shadows (§5 uses shadow mapping): the ellipsoids cast their ray-cast surfaces into the sun's
+// texture shadow and receive it at the hit point (integrated texture shadows).
+//
+// AO (§5): the ambient term is scaled by each primitive's baked AO (none unless baked with
+// ellipsoids.aoRays). Deviation from the paper, for now: the ellipsoids have no noise cube maps
+// (alpha test and normal noise, §3.1).
 //
 // Parameters (createMovableObject params, or the registry): asset (required), group, level
-// (force a level: 0 finest), lodBias (> 0, multiplies the LoD camera's bias).
+// (force an ellipsoid level: 0 finest; the lines follow its target height), lodBias (> 0,
+// multiplies the LoD camera's bias), lines (true: the baked lines when the package has them).
 #pragma once
 
 #include "TreeLod/EllipsoidTreeResources.h"
@@ -35,6 +43,7 @@ namespace TreeLod
         {
             int level = -1;       ///< >= 0: always this level
             float lodBias = 1.0f; ///< > 0
+            bool lines = true;    ///< the baked lines when the package has them, else the bark mesh
         };
 
         EllipsoidTree(const Ogre::String& name, const TreeAssetPtr& asset, const Options& options);
@@ -46,6 +55,11 @@ namespace TreeLod
         std::size_t getLevel() const { return mLevel; }
         /// Ellipsoids of the level drawn.
         std::size_t getEllipsoidCount() const { return mGpu->levels[mLevel].indexCount / 6; }
+        /// Whether the branches are lines (else the bark mesh).
+        bool drawsLines() const { return mLines != nullptr; }
+        /// The line level drawn for the last camera, and its line count (0 without lines).
+        std::size_t getLineLevel() const { return mLineLevel; }
+        std::size_t getLineCount() const { return mLines ? mLines->levels[mLineLevel].indexCount / 6 : 0; }
         /// The level for a tree `heightPx` tall on screen (bias applied), as §6 above.
         static std::size_t levelForHeight(const EllipsoidTreeGpu& gpu, float heightPx);
 
@@ -60,12 +74,18 @@ namespace TreeLod
     private:
         class Part;
         bool useShadowedMaterials() const;
+        /// The ellipsoid and line levels for a tree `heightPx` tall on screen (or the forced level).
+        void setLevels(float heightPx);
 
         TreeAssetPtr mAsset;
         const EllipsoidTreeGpu* mGpu;
         Options mOptions;
         std::unique_ptr<Ogre::VertexData> mVertexData; ///< the asset's ellipsoids + one instance at the origin
         std::unique_ptr<Part> mEllipsoids;
+        const EllipsoidLineGpu* mLines = nullptr;
+        std::unique_ptr<Ogre::VertexData> mLineVertexData; ///< the asset's lines + one instance at the origin
+        std::unique_ptr<Part> mLineParts;
+        std::size_t mLineLevel = 0;
         std::vector<std::unique_ptr<Part>> mBarkParts;
         Ogre::MeshPtr mBarkMesh;
         unsigned short mBarkLodIndex = 0;

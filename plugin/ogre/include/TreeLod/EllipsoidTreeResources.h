@@ -1,8 +1,10 @@
 // EllipsoidTreeResources: the ellipsoids of one TreeAsset (chunk "ellipsoids", EllipsoidTreeData.h)
-// on the GPU, shared by every EllipsoidTree drawing it: one quad per ellipsoid, every level in one
-// vertex buffer, a level one index range (the paper's sequential array, §5).
+// and its lines when it has them (chunk "ellipsoid-lines", EllipsoidLineData.h) on the GPU, shared by
+// every EllipsoidTree and Forest drawing it: one quad per primitive, every level in one vertex
+// buffer, a level one index range (the paper's sequential array, §5).
 #pragma once
 
+#include "TreeLod/EllipsoidLineData.h"
 #include "TreeLod/EllipsoidTreeData.h"
 #include "TreeLod/TechniqueResources.h"
 
@@ -17,20 +19,49 @@ namespace TreeLod
 {
     class TreeAsset;
 
+    /// The ellipsoids' materials (materials/TreeLodEllipsoid.material), shared by every asset: the
+    /// programs read everything per vertex and per instance.
+    constexpr const char* ELLIPSOID_MATERIAL = "TreeLod/Ellipsoid";
+    /// The same receiving the sun's integrated texture shadow.
+    constexpr const char* ELLIPSOID_SHADOWED_MATERIAL = "TreeLod/EllipsoidShadowed";
+    /// The lines' (materials/TreeLodEllipsoid.material), plain and receiving.
+    constexpr const char* ELLIPSOID_LINE_MATERIAL = "TreeLod/EllipsoidLine";
+    constexpr const char* ELLIPSOID_LINE_SHADOWED_MATERIAL = "TreeLod/EllipsoidLineShadowed";
+
+    /// One level of primitives on the GPU: an index range and the tree height on screen it is for.
+    struct EllipsoidGpuLevel
+    {
+        std::size_t indexStart = 0, indexCount = 0;
+        float targetHeightPx = 0.0f;
+    };
+
+    /// The level for a tree `heightPx` tall on screen (§6): the coarsest whose target height is at
+    /// least `heightPx`, the finest when the tree is taller than every target. `levels` finest first.
+    std::size_t levelForHeight(const std::vector<EllipsoidGpuLevel>& levels, float heightPx);
+
+    /// The box (tree space, metres) every level of `data` draws: centres +- the scaled semi-axes' reach.
+    Ogre::AxisAlignedBox ellipsoidBounds(const EllipsoidTreeData& data);
+
     /// Vertices: 4 per ellipsoid, POSITION = centre, uv0 = corner (+-1, +-1), uv1..uv3 = the
     /// semi-axes with the level's scale applied, DIFFUSE = sRGB colour and AO (TreeLodEllipsoid.vert).
     struct EllipsoidTreeGpu
     {
-        struct Level
-        {
-            std::size_t indexStart = 0, indexCount = 0;
-            float targetHeightPx = 0.0f;
-        };
+        using Level = EllipsoidGpuLevel;
         std::unique_ptr<Ogre::VertexData> vertexData;
         Ogre::HardwareIndexBufferSharedPtr indexBuffer;
         std::vector<Level> levels;   ///< finest first
         Ogre::AxisAlignedBox bounds; ///< local: every level's ellipsoids
         std::uint64_t gpuBytes = 0;  ///< vertices + indices
+    };
+
+    /// Vertices: 4 per line, POSITION = start, uv0 = the corner (x: 0 start, 1 end; y: -1, +1
+    /// across), uv1 = end xyz and radius, DIFFUSE = sRGB colour and AO (TreeLodEllipsoidLine.vert).
+    struct EllipsoidLineGpu
+    {
+        std::unique_ptr<Ogre::VertexData> vertexData;
+        Ogre::HardwareIndexBufferSharedPtr indexBuffer;
+        std::vector<EllipsoidGpuLevel> levels; ///< finest first
+        std::uint64_t gpuBytes = 0;            ///< vertices + indices
     };
 
     class EllipsoidTreeResources : public TechniqueResources
@@ -47,12 +78,23 @@ namespace TreeLod
         const EllipsoidTreeData& getData();
         /// The ellipsoids on the GPU, built on first call.
         const EllipsoidTreeGpu& getGpu();
+        /// The decoded lines, or null when the package has no "ellipsoid-lines" chunk (the branches
+        /// are then the reference bark mesh); throws naming the asset for a broken chunk.
+        const EllipsoidLineData* getLineData();
+        /// The lines on the GPU (built on first call), or null as getLineData.
+        const EllipsoidLineGpu* getLineGpu();
 
-        std::uint64_t getGpuBytes() const override { return mGpu ? mGpu->gpuBytes : 0; }
+        std::uint64_t getGpuBytes() const override
+        {
+            return (mGpu ? mGpu->gpuBytes : 0) + (mLineGpu ? mLineGpu->gpuBytes : 0);
+        }
 
     private:
         TreeAsset& mAsset;
         std::unique_ptr<EllipsoidTreeData> mData;
         std::unique_ptr<EllipsoidTreeGpu> mGpu;
+        bool mLinesRead = false;
+        std::unique_ptr<EllipsoidLineData> mLineData;
+        std::unique_ptr<EllipsoidLineGpu> mLineGpu;
     };
 }

@@ -62,6 +62,9 @@ namespace TreeLod
         std::uint32_t clustersDivisor = 4; ///< 2 to 64: each level has 1 / this of the previous' target
         float minAreaShare = 0.01f;        ///< in [0, 0.5]: smaller ellipsoids (surface area) dropped
         int viewResolution = 128;          ///< pixels a side of each error view, 16 to 1024
+        /// Rays per point of the ellipsoids' ambient occlusion (§5), 0 to 1024; 0: none (the
+        /// polygonal reference's leaves have none, docs/ellipsoids.md "Ambient occlusion").
+        std::uint32_t aoRays = 0;
     };
 
     /// The moments of leaf `leaf`'s triangles as a uniform area distribution (metres).
@@ -95,6 +98,13 @@ namespace TreeLod
     /// "ellipsoids: level N of M".
     Result<EllipsoidTreeData> bakeEllipsoidTree(const TreeModel& model, const EllipsoidTreeOptions& options,
                                                 const std::string& label, const ProgressCallback& progress = {});
+
+    /// Ambient occlusion (paper 001 §5) into every ellipsoid's colour alpha (255 = unoccluded):
+    /// the mean, over points on its surface outside the other ellipsoids of its level, of the
+    /// cosine-weighted visibility (AmbientOcclusion.h, `rays` rays a point) past the level's
+    /// ellipsoids and `model`'s bark. Deterministic for a seed and any thread count.
+    void addEllipsoidAmbientOcclusion(EllipsoidTreeData& data, const TreeModel& model, std::uint32_t rays,
+                                      std::uint64_t seed, const ProgressCallback& progress = {});
 
     /// Package glue for `treelod bake` (BakeTechniques): adds the reference chunk when missing and
     /// the "ellipsoids" chunk.

@@ -1,0 +1,118 @@
+#version 330 core
+// Ray-capsule intersection for the lines of an EllipsoidTree (TreeLodEllipsoidLine.vert): the
+// pixel's ray against the cylinder of radius r around start..end, then the sphere at the nearer
+// end when the hit falls outside the segment. A line thinner than the pixel that the ray misses is
+// drawn at the axis point nearest the ray, its normal across the axis towards the viewer (a
+// one-pixel line). True depth out; lit as TreeLodEllipsoid.frag lights the ellipsoids.
+// CASTER: writes the shadow camera's window depth instead. SHADOW_RECEIVER: the sun's visibility at
+// the hit.
+uniform mat4 projection;
+uniform mat4 inverseProjection;
+#ifndef CASTER
+uniform vec4 sunDirection; // view space, towards the sun (w = 0 for a directional light)
+uniform vec4 sunColour;
+uniform vec4 ambientColour;
+#endif
+#ifdef SHADOW_RECEIVER
+#define SHADOW_POS_PER_FRAGMENT
+uniform mat4 inverseView;
+uniform mat4 texViewProj;
+#endif
+
+in vec3 vPosition;
+flat in vec3 vStart;
+flat in vec3 vEnd;
+flat in float vRadius;
+flat in float vPixel;
+flat in vec4 vColour;
+
+out vec4 fragColour;
+
+#include "TreeLodShading.glsl"
+
+// Distance along rd from ro to the capsule (pa, pb, r), or -1 (Quilez's capsule intersection).
+float capsule(vec3 ro, vec3 rd, vec3 pa, vec3 pb, float r)
+{
+    vec3 ba = pb - pa, oa = ro - pa;
+    float baba = dot(ba, ba), bard = dot(ba, rd), baoa = dot(ba, oa), rdoa = dot(rd, oa), oaoa = dot(oa, oa);
+    float a = baba - bard * bard, b = baba * rdoa - baoa * bard, c = baba * oaoa - baoa * baoa - r * r * baba;
+    float h = b * b - a * c;
+    if (baba > 0.0 && a > 1e-12 * baba && h >= 0.0)
+    {
+        float t = (-b - sqrt(h)) / a;
+        float y = baoa + t * bard;
+        if (y > 0.0 && y < baba)
+            return t;
+    }
+    // The end caps (or the whole capsule, for a segment along the ray or of no length).
+    float best = -1.0;
+    for (int e = 0; e < 2; ++e)
+    {
+        vec3 oc = ro - (e == 0 ? pa : pb);
+        float bb = dot(rd, oc), cc = dot(oc, oc) - r * r, hh = bb * bb - cc;
+        if (hh >= 0.0)
+        {
+            float t = -bb - sqrt(hh);
+            if (t >= 0.0 && (best < 0.0 || t < best))
+                best = t;
+        }
+    }
+    return best;
+}
+
+void main()
+{
+    vec4 c = inverseProjection * vec4(0.0, 0.0, 1.0, 0.0);
+    bool perspective = abs(c.w) > 1e-9 * length(c.xyz);
+    // From the eye through the pixel, or along a parallel projection's depth axis (into the scene).
+    vec3 rd = normalize(perspective ? vPosition - c.xyz / c.w : c.xyz);
+    // Start the ray behind the quad by the capsule's reach, so hits in front of it count.
+    float back = 2.0 * max(vRadius, vPixel) + length(vEnd - vStart);
+    vec3 ro = vPosition - rd * back;
+    float t = capsule(ro, rd, vStart, vEnd, vRadius);
+    vec3 hit, n;
+    vec3 ba = vEnd - vStart;
+    float baba = max(dot(ba, ba), 1e-30);
+    if (t >= 0.0)
+    {
+        hit = ro + t * rd;
+        vec3 onAxis = vStart + clamp(dot(hit - vStart, ba) / baba, 0.0, 1.0) * ba;
+        n = normalize(hit - onAxis);
+    }
+    else
+    {
+        if (vRadius >= vPixel)
+            discard;
+        // Thinner than a pixel: the axis point nearest the ray, within half a pixel of it.
+        vec3 w0 = ro - vStart;
+        float bd = dot(ba, rd), denom = baba - bd * bd;
+        float s = denom > 1e-12 * baba ? clamp((dot(ba, w0) - bd * dot(rd, w0)) / denom, 0.0, 1.0) : 0.0;
+        vec3 onAxis = vStart + s * ba;
+        float along = dot(onAxis - ro, rd);
+        if (length(ro + along * rd - onAxis) > 0.5 * vPixel)
+            discard;
+        hit = ro + along * rd;
+        vec3 axis = ba / sqrt(baba);
+        n = -rd + dot(rd, axis) * axis;
+        n = dot(n, n) > 1e-12 ? normalize(n) : -rd;
+    }
+    vec4 clip = projection * vec4(hit, 1.0);
+    float ndcDepth = clip.z / clip.w;
+    if (ndcDepth < -1.0 || ndcDepth > 1.0)
+        discard;
+    float depth = 0.5 * ndcDepth + 0.5;
+    gl_FragDepth = depth;
+#ifdef CASTER
+    fragColour = vec4(depth, depth, depth, 1.0);
+#else
+#ifdef SHADOW_RECEIVER
+    float shadow = sunVisibilityAt(texViewProj * (inverseView * vec4(hit, 1.0)));
+#else
+    float shadow = 1.0;
+#endif
+    vec3 albedo = toLinear(vColour.rgb);
+    float lambert = max(dot(n, normalize(sunDirection.xyz)), 0.0) * shadow;
+    vec3 lit = albedo * (ambientColour.rgb * vColour.a + sunColour.rgb * lambert);
+    fragColour = vec4(toSrgb(lit), 1.0);
+#endif
+}

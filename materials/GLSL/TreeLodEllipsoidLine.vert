@@ -1,0 +1,67 @@
+#version 330 core
+// Lines of an EllipsoidTree (EllipsoidLineData.h: capsules, a segment swept by a sphere), ray cast
+// per fragment like the ellipsoids (TreeLodEllipsoid.frag). The paper (001, §5) draws its lines as
+// screen-aligned strips ([MSE*06]); here the strip is a quad along the segment, turned to face the
+// projection's centre (the eye, or the view direction of an orthographic shadow camera), its ends
+// pushed out and its sides out by the radius, and never narrower than one pixel: §6 draws levels
+// whose mean line is 1 px wide, so twigs are thinner than a pixel and the fragment program gives
+// them the pixel's width as a line rasteriser would.
+// Per vertex: vertex = start (tree space, metres), uv0 = corner (x: 0 start, 1 end; y: -1, +1
+// across), uv1 = end xyz and radius, colour = sRGB colour, alpha = ambient occlusion. Per instance
+// (TreeLodInstance.glsl): uv4, uv5.
+uniform mat4 worldView;
+uniform mat4 projection;
+uniform mat4 inverseProjection;
+uniform vec4 viewportSize; // width, height, 1 / width, 1 / height
+
+in vec4 vertex;
+in vec2 uv0;
+in vec4 uv1;
+in vec4 colour;
+
+#include "TreeLodInstance.glsl"
+
+out vec3 vPosition;     // view space: the quad's point, on the pixel's ray
+flat out vec3 vStart;   // view space
+flat out vec3 vEnd;
+flat out float vRadius;
+flat out float vPixel;  // view-space size of a pixel at the line (perspective: at its nearer end)
+flat out vec4 vColour;
+
+// The projection's centre (w = 1) or, for a parallel projection, its direction (w = 0).
+vec4 projectionCentre()
+{
+    vec4 c = inverseProjection * vec4(0.0, 0.0, 1.0, 0.0);
+    return abs(c.w) > 1e-9 * length(c.xyz) ? vec4(c.xyz / c.w, 1.0) : vec4(normalize(c.xyz), 0.0);
+}
+
+void main()
+{
+    vec3 a = (worldView * instancePosition(vec4(vertex.xyz, 1.0))).xyz;
+    vec3 b = (worldView * instancePosition(vec4(uv1.xyz, 1.0))).xyz;
+    float radius = uv1.w * uv4.w;
+    vec4 centre = projectionCentre();
+    vec3 p = mix(a, b, uv0.x);
+    vec3 sight = centre.w > 0.0 ? p - centre.xyz : centre.xyz;
+    // A pixel's size at p: the projection's scale on y at p's distance along the sight line.
+    float distance = centre.w > 0.0 ? max(length(sight), 1e-6) : 1.0;
+    vPixel = 2.0 * distance * viewportSize.w / max(abs(projection[1][1]), 1e-9);
+    sight = normalize(sight);
+    vec3 axis = b - a;
+    float len = length(axis);
+    axis = len > 1e-9 ? axis / len : vec3(0.0, 1.0, 0.0);
+    vec3 across = cross(axis, sight);
+    if (length(across) < 1e-3) // seen end on: any two directions across the sight line
+    {
+        across = cross(abs(sight.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0), sight);
+        axis = cross(sight, normalize(across));
+    }
+    across = normalize(across);
+    float reach = max(1.05 * radius, vPixel);
+    vPosition = p + across * (reach * uv0.y) + axis * (reach * (2.0 * uv0.x - 1.0));
+    vStart = a;
+    vEnd = b;
+    vRadius = radius;
+    vColour = colour;
+    gl_Position = projection * vec4(vPosition, 1.0);
+}
