@@ -1,4 +1,5 @@
 #version 330 core
+#extension GL_ARB_conservative_depth : enable
 // Ray-ellipsoid intersection in the ellipsoid's unit-sphere frame (Sigg et al. 2006; the
 // ellipsoids-and-lines paper (001) §5): the pixel's ray from + t dir (from on the near plane)
 // becomes o + t k with o = toUnit * (from - centre), k = toUnit * dir, and |o + t k| = 1 is a
@@ -29,6 +30,11 @@ flat in mat3 vToUnit;
 flat in vec4 vColour;
 
 out vec4 fragColour;
+#ifdef GL_ARB_conservative_depth
+// The quad lies at the ellipsoid box's nearest depth (TreeLodEllipsoid.vert): the hit is never
+// nearer, so the depth test may run before the program.
+layout(depth_greater) out float gl_FragDepth;
+#endif
 
 #include "TreeLodShading.glsl"
 

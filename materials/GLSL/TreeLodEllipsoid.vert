@@ -3,10 +3,10 @@
 // as the ellipsoids-and-lines paper (001) §5 renders them): one quad per ellipsoid covering, in
 // normalised device coordinates, the projection of the ellipsoid's box (centre +- the three
 // semi-axes). That holds for any projection (the view's perspective, a directional light's
-// orthographic shadow camera, a LiSPSM warp); a box reaching behind the eye (w <= 0) gets the
-// whole viewport. The fragment stage casts the ray of its pixel, from the near plane, against
-// the ellipsoid in the frame where it is the unit sphere; the ray's two points are interpolated
-// here exactly (inverse projection is linear in x, y and the quad has w = 1).
+// orthographic shadow camera, a LiSPSM warp), the box clipped at the near plane first. The
+// fragment stage casts the ray of its pixel, from the near plane, against the ellipsoid in the
+// frame where it is the unit sphere; the ray's two points are interpolated here exactly (inverse
+// projection is linear in x, y and the quad has w = 1).
 // Per vertex: vertex = the centre (tree space, metres), uv0 = the quad corner (+-1, +-1),
 // uv1..uv3 = the three semi-axes (rotation columns times radii times the level's scale),
 // colour = sRGB colour, alpha = ambient occlusion. Per instance (TreeLodInstance.glsl): uv4, uv5.
@@ -35,23 +35,52 @@ void main()
     mat3 toView = mat3(worldView);
     mat3 axes = mat3(toView * instanceDirection(uv4.w * uv1), toView * instanceDirection(uv4.w * uv2),
                      toView * instanceDirection(uv4.w * uv3));
-    vec2 lo = vec2(1e30), hi = vec2(-1e30);
-    bool behind = false;
+    // The box's part in front of the near plane (clip z + w >= 0): its corners there and the
+    // points where its 12 edges cross the plane; their NDC rectangle.
+    vec4 clip[8];
+    float front[8];
     for (int i = 0; i < 8; ++i)
     {
         vec3 s = vec3((i & 1) != 0 ? 1.0 : -1.0, (i & 2) != 0 ? 1.0 : -1.0, (i & 4) != 0 ? 1.0 : -1.0);
-        vec4 clip = projection * vec4(centre + axes * s, 1.0);
-        behind = behind || clip.w <= 0.0;
-        vec2 ndc = clip.xy / clip.w;
-        lo = min(lo, ndc);
-        hi = max(hi, ndc);
+        clip[i] = projection * vec4(centre + axes * s, 1.0);
+        front[i] = clip[i].z + clip[i].w;
+    }
+    vec2 lo = vec2(1e30), hi = vec2(-1e30);
+    float nearest = 1.0; // NDC depth of the box's nearest point (TreeLodEllipsoid.frag: depth_greater)
+    bool whole = false; // a point on the plane at w <= 0: no finite rectangle, the whole viewport
+    for (int i = 0; i < 8; ++i)
+    {
+        if (front[i] >= 0.0)
+        {
+            whole = whole || clip[i].w <= 0.0;
+            vec2 ndc = clip[i].xy / max(clip[i].w, 1e-30);
+            lo = min(lo, ndc);
+            hi = max(hi, ndc);
+            nearest = min(nearest, clip[i].z / max(clip[i].w, 1e-30));
+        }
+        for (int bit = 1; bit <= 4; bit *= 2)
+        {
+            int j = i | bit;
+            if ((i & bit) != 0 || front[i] * front[j] >= 0.0)
+                continue;
+            vec4 onPlane = mix(clip[i], clip[j], front[i] / (front[i] - front[j]));
+            whole = whole || onPlane.w <= 0.0;
+            vec2 ndc = onPlane.xy / max(onPlane.w, 1e-30);
+            lo = min(lo, ndc);
+            hi = max(hi, ndc);
+            nearest = -1.0;
+        }
     }
     vec2 corner = uv0 * 0.5 + 0.5;
-    vec2 ndc = behind ? uv0 : mix(clamp(lo, -1.0, 1.0), clamp(hi, -1.0, 1.0), corner);
+    vec2 ndc = whole ? uv0 : mix(clamp(lo, -1.0, 1.0), clamp(hi, -1.0, 1.0), corner);
+    if (!whole && lo.x > hi.x)
+        ndc = vec2(2.0); // wholly behind the near plane: a point outside the view
     vNear = inverseProjection * vec4(ndc, -1.0, 1.0);
     vFar = inverseProjection * vec4(ndc, 0.0, 1.0); // finite also with an infinite far plane
     vCentre = centre;
     vToUnit = inverse(axes);
     vColour = colour;
-    gl_Position = vec4(ndc, 0.0, 1.0); // inside the clip volume; the fragment writes the depth
+    // At the box's nearest depth (inside the clip volume): the fragment writes a depth at least
+    // this, so the depth test can reject hidden fragments before they are shaded.
+    gl_Position = vec4(ndc, whole ? -1.0 : clamp(nearest, -1.0, 1.0), 1.0);
 }
