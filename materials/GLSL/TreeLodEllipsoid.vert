@@ -3,7 +3,7 @@
 // as the ellipsoids-and-lines paper (001) §5 renders them): one quad per ellipsoid covering, in
 // normalised device coordinates, the projection of the ellipsoid's box (centre +- the three
 // semi-axes). That holds for any projection (the view's perspective, a directional light's
-// orthographic shadow camera, a LiSPSM warp), the box clipped at the near plane first. The
+// orthographic shadow camera, a LiSPSM warp), the box clipped at w = 0 first. The
 // fragment stage casts the ray of its pixel, from the near plane, against the ellipsoid in the
 // frame where it is the unit sphere; the ray's two points are interpolated here exactly (inverse
 // projection is linear in x, y and the quad has w = 1).
@@ -35,46 +35,47 @@ void main()
     mat3 toView = mat3(worldView);
     mat3 axes = mat3(toView * instanceDirection(uv4.w * uv1), toView * instanceDirection(uv4.w * uv2),
                      toView * instanceDirection(uv4.w * uv3));
-    // The box's part in front of the near plane (clip z + w >= 0): its corners there and the
-    // points where its 12 edges cross the plane; their NDC rectangle.
+    // The box's part where w > 0 (everything the clip volume can hold: -w <= x, y, z <= w): its
+    // corners there and the points where its 12 edges cross w = eps; their NDC rectangle. Under a
+    // LiSPSM warp casters can straddle w = 0; a box wholly before the near plane is dropped.
     vec4 clip[8];
-    float front[8];
+    float reach = 0.0;
+    bool beforeNear = true;
     for (int i = 0; i < 8; ++i)
     {
         vec3 s = vec3((i & 1) != 0 ? 1.0 : -1.0, (i & 2) != 0 ? 1.0 : -1.0, (i & 4) != 0 ? 1.0 : -1.0);
         clip[i] = projection * vec4(centre + axes * s, 1.0);
-        front[i] = clip[i].z + clip[i].w;
+        reach = max(reach, abs(clip[i].w));
+        beforeNear = beforeNear && clip[i].z + clip[i].w < 0.0;
     }
+    float eps = 1e-6 * reach + 1e-30;
     vec2 lo = vec2(1e30), hi = vec2(-1e30);
     float nearest = 1.0; // NDC depth of the box's nearest point (TreeLodEllipsoid.frag: depth_greater)
-    bool whole = false; // a point on the plane at w <= 0: no finite rectangle, the whole viewport
     for (int i = 0; i < 8; ++i)
     {
-        if (front[i] >= 0.0)
+        if (clip[i].w >= eps)
         {
-            whole = whole || clip[i].w <= 0.0;
-            vec2 ndc = clip[i].xy / max(clip[i].w, 1e-30);
-            lo = min(lo, ndc);
-            hi = max(hi, ndc);
-            nearest = min(nearest, clip[i].z / max(clip[i].w, 1e-30));
+            vec3 ndc = clip[i].xyz / clip[i].w;
+            lo = min(lo, ndc.xy);
+            hi = max(hi, ndc.xy);
+            nearest = min(nearest, ndc.z);
         }
         for (int bit = 1; bit <= 4; bit *= 2)
         {
             int j = i | bit;
-            if ((i & bit) != 0 || front[i] * front[j] >= 0.0)
+            if ((i & bit) != 0 || (clip[i].w - eps) * (clip[j].w - eps) >= 0.0)
                 continue;
-            vec4 onPlane = mix(clip[i], clip[j], front[i] / (front[i] - front[j]));
-            whole = whole || onPlane.w <= 0.0;
-            vec2 ndc = onPlane.xy / max(onPlane.w, 1e-30);
-            lo = min(lo, ndc);
-            hi = max(hi, ndc);
-            nearest = -1.0;
+            vec4 onPlane = mix(clip[i], clip[j], (clip[i].w - eps) / (clip[i].w - clip[j].w));
+            vec3 ndc = onPlane.xyz / eps;
+            lo = min(lo, ndc.xy);
+            hi = max(hi, ndc.xy);
+            nearest = min(nearest, ndc.z);
         }
     }
     vec2 corner = uv0 * 0.5 + 0.5;
-    vec2 ndc = whole ? uv0 : mix(clamp(lo, -1.0, 1.0), clamp(hi, -1.0, 1.0), corner);
-    if (!whole && lo.x > hi.x)
-        ndc = vec2(2.0); // wholly behind the near plane: a point outside the view
+    vec2 ndc = mix(clamp(lo, -1.0, 1.0), clamp(hi, -1.0, 1.0), corner);
+    if (beforeNear || lo.x > hi.x)
+        ndc = vec2(2.0); // nothing of it can be seen: a point outside the view
     vNear = inverseProjection * vec4(ndc, -1.0, 1.0);
     vFar = inverseProjection * vec4(ndc, 0.0, 1.0); // finite also with an infinite far plane
     vCentre = centre;
@@ -82,5 +83,5 @@ void main()
     vColour = colour;
     // At the box's nearest depth (inside the clip volume): the fragment writes a depth at least
     // this, so the depth test can reject hidden fragments before they are shaded.
-    gl_Position = vec4(ndc, whole ? -1.0 : clamp(nearest, -1.0, 1.0), 1.0);
+    gl_Position = vec4(ndc, clamp(nearest, -1.0, 1.0), 1.0);
 }
