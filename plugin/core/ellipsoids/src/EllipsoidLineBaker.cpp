@@ -2,6 +2,8 @@
 // ellipsoids-and-lines paper (001) in EllipsoidLineBaker.h, format in EllipsoidLineData.h).
 #include "TreeLod/EllipsoidLineBaker.h"
 
+#include "EllipsoidErrorViews.h"
+
 #include "TreeLod/Image.h"
 #include "TreeLod/ImageMetrics.h"
 #include "TreeLod/ReferenceRenderer.h"
@@ -28,7 +30,7 @@ namespace TreeLod
         constexpr double MIN_RADIUS = 1e-5;
         constexpr double SAME_NODE = 1e-7;
         /// Samples per pixel side of the error views (2 x 2, as the ellipsoid baker's).
-        constexpr int SAMPLES = 2;
+        constexpr int SAMPLES = EllipsoidErrorViews::SAMPLES;
         constexpr std::int32_t NO_PARENT = -1;
         constexpr int CAPSULE_SIDES = 8;
 
@@ -146,47 +148,7 @@ namespace TreeLod
 
         /// The ellipsoid baker's four orthographic views of the bark box in the baker's units
         /// (centre 0, diagonal 1).
-        std::vector<CameraSpec> errorCameras()
-        {
-            std::vector<CameraSpec> cameras;
-            const float radius = 0.5f, elevation = glm::radians(15.0f);
-            for (int v = 0; v < 4; ++v)
-            {
-                CameraSpec c;
-                c.orthographic = true;
-                c.target = glm::vec3(0.0f);
-                glm::vec3 towards;
-                if (v < 3)
-                {
-                    const float azimuth = glm::radians(120.0f * float(v));
-                    towards = glm::vec3(std::sin(azimuth) * std::cos(elevation), std::sin(elevation),
-                                        std::cos(azimuth) * std::cos(elevation));
-                    c.up = glm::vec3(0, 1, 0);
-                }
-                else
-                {
-                    towards = glm::vec3(0, 1, 0);
-                    c.up = glm::vec3(0, 0, -1);
-                }
-                c.position = 3.0f * radius * towards;
-                c.orthoHeight = 2.1f * radius;
-                c.nearClip = 0.5f * radius;
-                c.farClip = 6.0f * radius;
-                cameras.push_back(c);
-            }
-            return cameras;
-        }
-
-        RenderOptions errorRenderOptions(int resolution)
-        {
-            RenderOptions o;
-            o.width = o.height = resolution;
-            o.samplesPerPixel = SAMPLES * SAMPLES;
-            o.lighting.ambientColour = glm::vec3(1.0f);
-            o.lighting.sunColour = glm::vec3(0.0f);
-            o.lighting.background = glm::vec3(0.0f);
-            return o;
-        }
+        std::vector<CameraSpec> errorCameras() { return EllipsoidErrorViews::cameras(glm::vec3(0.0f), 0.5f); }
 
         /// A capsule in one view's sample space (sample (i, j) is centred at (i + 0.5, j + 0.5)): the
         /// projected segment, the radius and the samples its bounding rectangle holds (x0 > x1: none).
@@ -1106,7 +1068,7 @@ namespace TreeLod
                 v.position = glm::vec3((glm::dvec3(v.position) - origin) / diagonal);
             bark.updateBounds();
             const std::vector<CameraSpec> cameras = errorCameras();
-            const RenderOptions renderOptions = errorRenderOptions(options.viewResolution);
+            const RenderOptions renderOptions = EllipsoidErrorViews::renderOptions(options.viewResolution);
             std::vector<Image> reference;
             {
                 const ReferenceRenderer renderer(bark);

@@ -1,6 +1,8 @@
 // EllipsoidLineData: the "ellipsoid-lines" chunk (layout and meaning in EllipsoidLineData.h).
 #include "TreeLod/EllipsoidLineData.h"
 
+#include "EllipsoidQuantisation.h"
+
 #include "TreeLod/ByteReader.h"
 #include "TreeLod/ByteWriter.h"
 #include "TreeLod/Package.h"
@@ -17,28 +19,24 @@ namespace TreeLod
         constexpr std::size_t HEADER_BYTES = 4 + 24 + 4 + 4 + 4 + 4 + 4;
         constexpr std::size_t PALETTE_ENTRY_BYTES = 4;
 
-        bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+        using EllipsoidQuantisation::finite;
+        using EllipsoidQuantisation::text;
 
-        std::string text(float v) { return std::to_string(v); }
-
-        std::string text(const glm::vec3& v) { return "(" + text(v.x) + ", " + text(v.y) + ", " + text(v.z) + ")"; }
-
-        std::uint16_t quantiseUnit(float t)
-        {
-            return std::uint16_t(std::lround(std::clamp(std::isfinite(t) ? t : 0.0f, 0.0f, 1.0f) * 65535.0f));
-        }
+        std::uint16_t quantiseUnit(float t) { return EllipsoidQuantisation::unit(t); }
 
         std::uint16_t quantiseRadius(float radius, float unit)
         {
-            const float l = std::log2(std::max(std::isfinite(radius) ? radius : 0.0f, 1e-30f) / unit);
-            return quantiseUnit((l - ELLIPSOID_LINE_RADIUS_LOG2_MIN) / ELLIPSOID_LINE_RADIUS_LOG2_SPAN);
+            return EllipsoidQuantisation::logLength(radius, unit, ELLIPSOID_LINE_RADIUS_LOG2_MIN,
+                                                    ELLIPSOID_LINE_RADIUS_LOG2_SPAN);
         }
 
         float radiusFromCode(std::uint16_t q, float unit)
         {
-            return unit *
-                   std::exp2(ELLIPSOID_LINE_RADIUS_LOG2_SPAN * float(q) / 65535.0f + ELLIPSOID_LINE_RADIUS_LOG2_MIN);
+            return EllipsoidQuantisation::lengthFromCode(q, unit, ELLIPSOID_LINE_RADIUS_LOG2_MIN,
+                                                         ELLIPSOID_LINE_RADIUS_LOG2_SPAN);
         }
+
+        std::string text(const glm::vec3& v) { return "(" + text(v.x) + ", " + text(v.y) + ", " + text(v.z) + ")"; }
     }
 
     std::size_t EllipsoidLineData::encodedBytes() const

@@ -2,6 +2,8 @@
 // ellipsoids-and-lines paper (001) in EllipsoidTreeBaker.h, format in EllipsoidTreeData.h).
 #include "TreeLod/EllipsoidTreeBaker.h"
 
+#include "EllipsoidErrorViews.h"
+
 #include "TreeLod/EllipsoidLineBaker.h"
 #include "TreeLod/GaussianMixture.h"
 #include "TreeLod/Image.h"
@@ -148,39 +150,9 @@ namespace TreeLod
         {
         public:
             ErrorViews(const glm::vec3& lo, const glm::vec3& hi, int resolution)
+                : mCameras(EllipsoidErrorViews::cameras(0.5f * (lo + hi), std::max(0.5f * glm::length(hi - lo), 1e-30f))),
+                  mOptions(EllipsoidErrorViews::renderOptions(resolution))
             {
-                const glm::vec3 centre = 0.5f * (lo + hi);
-                const float radius = std::max(0.5f * glm::length(hi - lo), 1e-30f);
-                const float elevation = glm::radians(15.0f);
-                for (int v = 0; v < 4; ++v)
-                {
-                    CameraSpec c;
-                    c.orthographic = true;
-                    c.target = centre;
-                    glm::vec3 towards;
-                    if (v < 3)
-                    {
-                        const float azimuth = glm::radians(120.0f * float(v));
-                        towards = glm::vec3(std::sin(azimuth) * std::cos(elevation), std::sin(elevation),
-                                            std::cos(azimuth) * std::cos(elevation));
-                        c.up = glm::vec3(0, 1, 0);
-                    }
-                    else
-                    {
-                        towards = glm::vec3(0, 1, 0);
-                        c.up = glm::vec3(0, 0, -1);
-                    }
-                    c.position = centre + 3.0f * radius * towards;
-                    c.orthoHeight = 2.1f * radius;
-                    c.nearClip = 0.5f * radius;
-                    c.farClip = 6.0f * radius;
-                    mCameras.push_back(c);
-                }
-                mOptions.width = mOptions.height = resolution;
-                mOptions.samplesPerPixel = 4;
-                mOptions.lighting.ambientColour = glm::vec3(1.0f);
-                mOptions.lighting.sunColour = glm::vec3(0.0f);
-                mOptions.lighting.background = glm::vec3(0.0f);
             }
 
             /// Throws std::runtime_error (Embree) like the renderer.

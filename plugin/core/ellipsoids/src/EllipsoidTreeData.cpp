@@ -1,6 +1,8 @@
 // EllipsoidTreeData: the "ellipsoids" chunk (layout and meaning in EllipsoidTreeData.h).
 #include "TreeLod/EllipsoidTreeData.h"
 
+#include "EllipsoidQuantisation.h"
+
 #include "TreeLod/ByteReader.h"
 #include "TreeLod/ByteWriter.h"
 #include "TreeLod/Package.h"
@@ -15,24 +17,21 @@ namespace TreeLod
         constexpr std::uint32_t KNOWN_FLAGS = 0;
         constexpr std::size_t HEADER_BYTES = 4 + 24 + 4 + 4 + 4; // flags, box, unit, both counts
 
-        bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+        using EllipsoidQuantisation::finite;
+        using EllipsoidQuantisation::text;
 
-        std::string text(float v) { return std::to_string(v); }
-
-        std::uint16_t quantiseUnit(float t)
-        {
-            return std::uint16_t(std::lround(std::clamp(std::isfinite(t) ? t : 0.0f, 0.0f, 1.0f) * 65535.0f));
-        }
+        std::uint16_t quantiseUnit(float t) { return EllipsoidQuantisation::unit(t); }
 
         std::uint16_t quantiseRadius(float radius, float unit)
         {
-            const float l = std::log2(std::max(radius, 1e-30f) / unit);
-            return quantiseUnit((l - ELLIPSOID_RADIUS_LOG2_MIN) / ELLIPSOID_RADIUS_LOG2_SPAN);
+            return EllipsoidQuantisation::logLength(radius, unit, ELLIPSOID_RADIUS_LOG2_MIN,
+                                                    ELLIPSOID_RADIUS_LOG2_SPAN);
         }
 
         float radiusFromCode(std::uint16_t q, float unit)
         {
-            return unit * std::exp2(ELLIPSOID_RADIUS_LOG2_SPAN * float(q) / 65535.0f + ELLIPSOID_RADIUS_LOG2_MIN);
+            return EllipsoidQuantisation::lengthFromCode(q, unit, ELLIPSOID_RADIUS_LOG2_MIN,
+                                                         ELLIPSOID_RADIUS_LOG2_SPAN);
         }
 
         std::int16_t quantiseSigned(float v)
