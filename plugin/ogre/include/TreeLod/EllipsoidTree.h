@@ -14,8 +14,9 @@
 // targets (a mean line 1 px wide, §6); without that chunk, or with lines=false, the reference bark
 // mesh with its mesh LoD.
 //
-// Shadows (§5 uses shadow mapping): the ellipsoids cast their ray-cast surfaces into the sun's
-// texture shadow and receive it at the hit point (integrated texture shadows).
+// Shadows (§5 uses shadow mapping): the ellipsoids and lines cast their ray-cast surfaces into
+// the sun's texture shadow and receive it at the hit point (integrated texture shadows; any shadow
+// camera projection: focused, LiSPSM).
 //
 // AO (§5): the ambient term is scaled by each primitive's baked AO (none unless baked with
 // ellipsoids.aoRays). Deviation from the paper, for now: the ellipsoids have no noise cube maps
