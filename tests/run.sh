@@ -71,7 +71,7 @@ CXX=clang++ cmake -S "$root" -B "$asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMA
 # hysteresis code they drive runs under ASan in the core tests and the package fuzzer. And two of
 # the four EllipsoidTree Ogre tests (each bakes its oak again, 25 s under ASan): the bake runs
 # under ASan in test_ellipsoids, drawing and the error paths in the other two.
-asan_skip='^(install|cli|bench)\.|^BillboardCloudBaker\.twoHundredThousandLeaves|^BillboardCloudTree\.goldenFiftyThousandLeaves$|^BakeCacheProcesses\.HitsWhilePackagesAreReplacedAreNotDiscarded$|^Forest\.(errorCurvesRankTheLevelsAgainstTheCpuReference|calibrationTimesEveryLevelAndIsCachedPerRenderer|anErrorBudgetChoosesTheCheapestLevelWithinIt|budgetedSpeciesReplanInPlaceForAnErrorAFrameAndAShadowBudget)$|^EllipsoidTree\.(theLevelFollowsTheHeightOnScreenAndTheBias|aCameraInsideAnEllipsoidSeesItsInside)$'
+asan_skip='^(install|cli|bench)\.|^BillboardCloudBaker\.twoHundredThousandLeaves|^BillboardCloudTree\.goldenFiftyThousandLeaves$|^BakeCacheProcesses\.HitsWhilePackagesAreReplacedAreNotDiscarded$|^Forest\.(errorCurvesRankTheLevelsAgainstTheCpuReference|calibrationTimesEveryLevelAndIsCachedPerRenderer|anErrorBudgetChoosesTheCheapestLevelWithinIt|budgetedSpeciesReplanInPlaceForAnErrorAFrameAndAShadowBudget)$|^EllipsoidTree\.(theLevelFollowsTheHeightOnScreenAndTheBias|aCameraInsideAnEllipsoidSeesItsInside)$|^EllipsoidLineBake\.(scaleFree|deterministicForSeedAndThreads|levelCountsWeightsAndTargets|registeredAndErrorsNamed|extractedSkeletonFollowsTheGenerator)$'
 if [ "${TREELOD_ASAN_OGRE:-1}" = 1 ]; then
   cmake --build "$asan" -j"$jobs" --target treelod_tests treelod_fuzzers
   run_ctest "$asan" -E "$asan_skip"
