@@ -26,6 +26,7 @@ namespace TreeLod
     namespace
     {
         using test::generatedOak;
+        using test::scaled;
         constexpr float PI = 3.14159265358979f;
 
         EllipsoidLineData bakeOrFail(const TreeModel& m, const EllipsoidLineOptions& options = {},
@@ -153,24 +154,6 @@ namespace TreeLod
             for (float a : images.alpha)
                 sum += a;
             return sum / double(images.alpha.size());
-        }
-
-        TreeModel scaled(const TreeModel& m, float s)
-        {
-            TreeModel out = m;
-            for (Vertex& v : out.barkVertices)
-                v.position *= s;
-            for (Vertex& v : out.leafVertices)
-                v.position *= s;
-            for (SkeletonNode& n : out.skeleton)
-            {
-                n.position *= s;
-                n.radius *= s;
-            }
-            for (std::size_t i = 0; i < out.leaves.size(); ++i)
-                out.updateLeafRecord(i);
-            out.updateBounds();
-            return out;
         }
 
         bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }

@@ -23,6 +23,7 @@ namespace TreeLod
     namespace
     {
         using test::generatedOak;
+        using test::scaled;
 
         EllipsoidTreeOptions fastOptions()
         {
@@ -68,25 +69,6 @@ namespace TreeLod
 
         /// The world direction of axis `k` of `e`.
         glm::vec3 axis(const Ellipsoid& e, int k) { return glm::mat3_cast(e.rotation)[k]; }
-
-        /// `m` with every vertex multiplied by `s` (and its bounds and leaf records).
-        TreeModel scaled(const TreeModel& m, float s)
-        {
-            TreeModel out = m;
-            for (Vertex& v : out.barkVertices)
-                v.position *= s;
-            for (Vertex& v : out.leafVertices)
-                v.position *= s;
-            for (SkeletonNode& n : out.skeleton)
-            {
-                n.position *= s;
-                n.radius *= s;
-            }
-            for (std::size_t i = 0; i < out.leaves.size(); ++i)
-                out.updateLeafRecord(i);
-            out.updateBounds();
-            return out;
-        }
 
         /// Fraction of pixels covered (alpha) in a side view of `m` framing the box [lo, hi].
         double coverage(const TreeModel& m, const glm::vec3& lo, const glm::vec3& hi, float azimuth)

@@ -79,5 +79,24 @@ namespace TreeLod
             m.leaves.push_back(l);
             m.updateLeafRecord(m.leaves.size() - 1);
         }
+
+        /// `m` with every vertex and skeleton node multiplied by `s` (and its bounds and leaf records).
+        inline TreeModel scaled(const TreeModel& m, float s)
+        {
+            TreeModel out = m;
+            for (Vertex& v : out.barkVertices)
+                v.position *= s;
+            for (Vertex& v : out.leafVertices)
+                v.position *= s;
+            for (SkeletonNode& n : out.skeleton)
+            {
+                n.position *= s;
+                n.radius *= s;
+            }
+            for (std::size_t i = 0; i < out.leaves.size(); ++i)
+                out.updateLeafRecord(i);
+            out.updateBounds();
+            return out;
+        }
     }
 }
