@@ -7,7 +7,6 @@
 // CASTER: writes the shadow camera's window depth instead. SHADOW_RECEIVER: the sun's visibility at
 // the hit.
 uniform mat4 projection;
-uniform mat4 inverseProjection;
 #ifndef CASTER
 uniform vec4 sunDirection; // view space, towards the sun (w = 0 for a directional light)
 uniform vec4 sunColour;
@@ -25,6 +24,7 @@ flat in vec3 vEnd;
 flat in float vRadius;
 flat in float vPixel;
 flat in vec4 vColour;
+flat in vec4 vProjectionCentre; // the eye (w = 1) or a parallel projection's depth direction (w = 0)
 
 out vec4 fragColour;
 
@@ -62,10 +62,8 @@ float capsule(vec3 ro, vec3 rd, vec3 pa, vec3 pb, float r)
 
 void main()
 {
-    vec4 c = inverseProjection * vec4(0.0, 0.0, 1.0, 0.0);
-    bool perspective = abs(c.w) > 1e-9 * length(c.xyz);
     // From the eye through the pixel, or along a parallel projection's depth axis (into the scene).
-    vec3 rd = normalize(perspective ? vPosition - c.xyz / c.w : c.xyz);
+    vec3 rd = normalize(vProjectionCentre.w > 0.0 ? vPosition - vProjectionCentre.xyz : vProjectionCentre.xyz);
     // Start the ray behind the quad by the capsule's reach, so hits in front of it count.
     float back = 2.0 * max(vRadius, vPixel) + length(vEnd - vStart);
     vec3 ro = vPosition - rd * back;

@@ -27,6 +27,7 @@ flat out vec3 vEnd;
 flat out float vRadius;
 flat out float vPixel;  // view-space size of a pixel at the line (perspective: at its nearer end)
 flat out vec4 vColour;
+flat out vec4 vProjectionCentre; // projectionCentre(), for the fragment's ray
 
 // The projection's centre (w = 1) or, for a parallel projection, its direction (w = 0).
 vec4 projectionCentre()
@@ -63,5 +64,6 @@ void main()
     vEnd = b;
     vRadius = radius;
     vColour = colour;
+    vProjectionCentre = centre;
     gl_Position = projection * vec4(vPosition, 1.0);
 }

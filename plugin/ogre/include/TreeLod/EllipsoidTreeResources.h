@@ -46,10 +46,9 @@ namespace TreeLod
     /// semi-axes with the level's scale applied, DIFFUSE = sRGB colour and AO (TreeLodEllipsoid.vert).
     struct EllipsoidTreeGpu
     {
-        using Level = EllipsoidGpuLevel;
         std::unique_ptr<Ogre::VertexData> vertexData;
         Ogre::HardwareIndexBufferSharedPtr indexBuffer;
-        std::vector<Level> levels;   ///< finest first
+        std::vector<EllipsoidGpuLevel> levels; ///< finest first
         Ogre::AxisAlignedBox bounds; ///< local: every level's ellipsoids
         std::uint64_t gpuBytes = 0;  ///< vertices + indices
     };
