@@ -3,16 +3,23 @@
 // Ray-ellipsoid intersection in the ellipsoid's unit-sphere frame (Sigg et al. 2006; the
 // ellipsoids-and-lines paper (001) §5): the pixel's ray from + t dir (from on the near plane)
 // becomes o + t k with o = toUnit * (from - centre), k = toUnit * dir, and |o + t k| = 1 is a
-// quadratic in t. The nearest hit past the near plane is drawn with its true depth (the far side
-// when the near plane cuts the ellipsoid); the normal is the unit sphere's u brought back to view
-// space by the inverse transpose, transpose(toUnit).
+// quadratic in t, solved about the ray's point nearest the centre (no cancellation for small
+// ellipsoids far away). The nearest hit past the near plane is drawn with its true depth (the
+// far side when the near plane cuts the ellipsoid); the normal is the unit sphere's u brought
+// back to view space by the inverse transpose, transpose(toUnit).
+// Noise (§3.1, Fig. 6; EllipsoidNoise.h): the unit-sphere point u indexes the noise cube maps;
+// where the alpha noise is below the level's threshold the surface has a hole and the far side
+// is tested instead; the normal in the unit frame is blended towards the normal noise (§5: "add
+// the normal noise to the normal vector before transforming it to eye space"). renderEllipsoids
+// (EllipsoidTreeBaker.h) is the CPU twin the baker calibrates the noise with.
 // colour = albedo * (ambient * ao + sun * max(0, n.l) * shadow) in linear space, written as sRGB,
 // as TreeLodLit.frag lights the leaves (LightingSpec in TreeLod/Camera.h).
 // CASTER: writes the shadow camera's window depth of the hit instead (as TreeLodCaster.frag).
 // SHADOW_RECEIVER: the sun's visibility at the hit (texViewProj * inverseView * hit).
-// Not yet here: the paper's noise cube maps (alpha test and normal noise, §3.1 and §5).
 uniform mat4 projection;
+uniform samplerCube noiseAlpha;
 #ifndef CASTER
+uniform samplerCube noiseNormal;
 uniform vec4 sunDirection; // view space, towards the sun (w = 0 for a directional light)
 uniform vec4 sunColour;
 uniform vec4 ambientColour;
@@ -28,6 +35,7 @@ in vec4 vFar;
 flat in vec3 vCentre;
 flat in mat3 vToUnit;
 flat in vec4 vColour;
+flat in vec3 vNoise; // lod, alpha threshold, normal blend
 
 out vec4 fragColour;
 #ifdef GL_ARB_conservative_depth
@@ -42,18 +50,25 @@ void main()
 {
     vec3 from = vNear.xyz / vNear.w;
     vec3 dir = normalize(vFar.xyz / vFar.w - from);
-    vec3 o = vToUnit * (from - vCentre);
     vec3 k = vToUnit * dir;
-    float a = dot(k, k), b = dot(o, k), c = dot(o, o) - 1.0;
-    float disc = b * b - a * c;
-    if (disc < 0.0)
+    float a = dot(k, k);
+    vec3 start = vToUnit * (from - vCentre);
+    float mid = -dot(start, k) / a;
+    vec3 o = start + mid * k;
+    float c = dot(o, o) - 1.0;
+    if (c > 0.0)
         discard;
-    float root = sqrt(disc);
-    float t = (-b - root) / a;
-    if (t < 0.0) // the near plane is inside: the far side
-        t = (-b + root) / a;
-    if (t < 0.0)
-        discard;
+    float halfChord = sqrt(-c / a);
+    // The near side; where the near plane cuts it or the noise opens a hole there, the far side.
+    float t = mid - halfChord;
+    vec3 u = o - halfChord * k;
+    if (t < 0.0 || (vNoise.y > 0.0 && textureLod(noiseAlpha, u, vNoise.x).r < vNoise.y))
+    {
+        t = mid + halfChord;
+        u = o + halfChord * k;
+        if (t < 0.0 || (vNoise.y > 0.0 && textureLod(noiseAlpha, u, vNoise.x).r < vNoise.y))
+            discard;
+    }
     vec3 hit = from + t * dir;
     vec4 clip = projection * vec4(hit, 1.0);
     float ndcDepth = clip.z / clip.w;
@@ -64,7 +79,10 @@ void main()
 #ifdef CASTER
     fragColour = vec4(depth, depth, depth, 1.0);
 #else
-    vec3 n = normalize(transpose(vToUnit) * (o + t * k));
+    vec3 unitNormal = u;
+    if (vNoise.z > 0.0)
+        unitNormal = mix(u, textureLod(noiseNormal, u, vNoise.x).rgb * 2.0 - 1.0, vNoise.z);
+    vec3 n = normalize(transpose(vToUnit) * unitNormal);
     if (dot(n, dir) > 0.0) // seen from inside
         n = -n;
 #ifdef SHADOW_RECEIVER

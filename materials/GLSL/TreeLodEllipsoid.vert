@@ -7,16 +7,20 @@
 // fragment stage casts the ray of its pixel, from the near plane, against the ellipsoid in the
 // frame where it is the unit sphere; the ray's two points are interpolated here exactly (inverse
 // projection is linear in x, y and the quad has w = 1).
-// Per vertex: vertex = the centre (tree space, metres), uv0 = the quad corner (+-1, +-1),
-// uv1..uv3 = the three semi-axes (rotation columns times radii times the level's scale),
-// colour = sRGB colour, alpha = ambient occlusion. Per instance (TreeLodInstance.glsl): uv4, uv5.
+// Per vertex: vertex = the centre (tree space, metres), uv0 = the quad corner (+-1, +-1), the
+// cluster's noise lod and the level's noise threshold, uv1..uv3 = the three semi-axes (rotation
+// columns times radii times the level's scale), uv1.w = the level's normal blend, colour = sRGB
+// colour, alpha = ambient occlusion. Per instance (TreeLodInstance.glsl): uv4, uv5.
+// The noise lod is raised to the pixel footprint's at the centre (EllipsoidNoise.h: the paper
+// (001) §5 limits the noise frequency by the screen-space derivatives; here once per ellipsoid).
 uniform mat4 worldView;
 uniform mat4 projection;
 uniform mat4 inverseProjection;
+uniform vec4 viewportSize; // pixels: width, height, 1 / width, 1 / height
 
 in vec4 vertex;
-in vec2 uv0;
-in vec3 uv1;
+in vec4 uv0;
+in vec4 uv1;
 in vec3 uv2;
 in vec3 uv3;
 in vec4 colour;
@@ -28,12 +32,16 @@ out vec4 vFar;         // view space, homogeneous: a point further along the pix
 flat out vec3 vCentre; // view space
 flat out mat3 vToUnit; // view space -> the unit-sphere frame (about the centre)
 flat out vec4 vColour;
+flat out vec3 vNoise;  // lod, alpha threshold, normal blend
+
+const float NOISE_SIZE = 256.0; // EllipsoidNoise.h: ELLIPSOID_NOISE_SIZE
+const float NOISE_MAX_LOD = 8.0;
 
 void main()
 {
     vec3 centre = (worldView * instancePosition(vec4(vertex.xyz, 1.0))).xyz;
     mat3 toView = mat3(worldView);
-    mat3 axes = mat3(toView * instanceDirection(uv4.w * uv1), toView * instanceDirection(uv4.w * uv2),
+    mat3 axes = mat3(toView * instanceDirection(uv4.w * uv1.xyz), toView * instanceDirection(uv4.w * uv2),
                      toView * instanceDirection(uv4.w * uv3));
     // The box's part where w > 0 (everything the clip volume can hold: -w <= x, y, z <= w): its
     // corners there and the points where its 12 edges cross w = eps; their NDC rectangle. Under a
@@ -72,7 +80,7 @@ void main()
             nearest = min(nearest, ndc.z);
         }
     }
-    vec2 corner = uv0 * 0.5 + 0.5;
+    vec2 corner = uv0.xy * 0.5 + 0.5;
     vec2 ndc = mix(clamp(lo, -1.0, 1.0), clamp(hi, -1.0, 1.0), corner);
     if (beforeNear || lo.x > hi.x)
         ndc = vec2(2.0); // nothing of it can be seen: a point outside the view
@@ -81,6 +89,13 @@ void main()
     vCentre = centre;
     vToUnit = inverse(axes);
     vColour = colour;
+    // A pixel's size at the centre over the noise radius (the geometric mean of the two largest
+    // semi-axes), in texels of the finest level: log2 of it is the footprint's lod.
+    vec3 r = vec3(length(axes[0]), length(axes[1]), length(axes[2]));
+    float radius = sqrt(r.x * r.y * r.z / max(min(r.x, min(r.y, r.z)), 1e-30));
+    float pixel = 2.0 * abs((projection * vec4(centre, 1.0)).w) / max(abs(projection[1][1]) * viewportSize.y, 1e-30);
+    float footprint = log2(max(pixel * NOISE_SIZE / (2.0 * radius), 1e-30));
+    vNoise = vec3(clamp(max(uv0.z, footprint), 0.0, NOISE_MAX_LOD), uv0.w, uv1.w);
     // At the box's nearest depth (inside the clip volume): the fragment writes a depth at least
     // this, so the depth test can reject hidden fragments before they are shaded.
     gl_Position = vec4(ndc, clamp(nearest, -1.0, 1.0), 1.0);

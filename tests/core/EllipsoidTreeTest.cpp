@@ -4,6 +4,7 @@
 // seeds and thread counts, each level's coverage against the leaves', 0.5 m vs 500 m, the
 // ellipsoids' ambient occlusion (§5), and the registered baker and descriptor.
 #include "TreeLod/BakeTechniques.h"
+#include "TreeLod/EllipsoidNoise.h"
 #include "TreeLod/EllipsoidTreeBaker.h"
 #include "TreeLod/EllipsoidTreeData.h"
 #include "TreeLod/GaussianMixture.h"
@@ -239,6 +240,153 @@ namespace TreeLod
             return d;
         }
 
+        /// Mean white over an image (flat white on black: the covered share).
+        double meanWhite(const Image& image)
+        {
+            double sum = 0.0;
+            for (const glm::vec4& p : image.pixels)
+                sum += srgbToLinear(p.r);
+            return sum / double(std::max<std::size_t>(image.pixels.size(), 1));
+        }
+
+        /// A side view of the oak's ellipsoids, flat white on black (the baker's coverage images).
+        RenderOptions coverageOptions(int size)
+        {
+            RenderOptions o = albedoRenderOptions(size, size, 4);
+            o.transparentBackground = false;
+            o.lighting.background = glm::vec3(0.0f);
+            return o;
+        }
+
+        // Without noise, the CPU ray caster the noise is calibrated with covers what the
+        // ellipsoids' icosphere meshes cover (which the scale calibration renders), level by level
+        // and in a perspective view too.
+        TEST(EllipsoidTreeBake, rayCastEllipsoidsCoverWhatTheirMeshesCover)
+        {
+            const EllipsoidTreeData& d = oakBake();
+            const TreeModel& oak = generatedOak(256);
+            for (std::size_t level = 0; level < d.levels.size(); ++level)
+            {
+                const EllipsoidLevel& l = d.levels[level];
+                const std::vector<Ellipsoid> ellipsoids(d.ellipsoids.begin() + l.first,
+                                                        d.ellipsoids.begin() + l.first + l.count);
+                for (bool orthographic : {true, false})
+                {
+                    CameraSpec camera = CameraSpec::framing(oak.boundsMin, oak.boundsMax, 30.0f, 10.0f);
+                    if (orthographic)
+                    {
+                        camera.orthographic = true;
+                        camera.orthoHeight = 1.2f * glm::length(oak.boundsMax - oak.boundsMin);
+                    }
+                    const RenderOptions options = coverageOptions(96);
+                    const TreeModel mesh = ellipsoidLevelMesh(d, level);
+                    const double meshCover = meanWhite(ReferenceRenderer(mesh).render(camera, options).colour);
+                    const double rayCover = meanWhite(renderEllipsoids(ellipsoids, l.scale, {}, camera, options));
+                    EXPECT_GT(meshCover, 0.01) << "level " << level;
+                    EXPECT_NEAR(rayCover, meshCover, 0.04 * meshCover + 0.002)
+                        << "level " << level << (orthographic ? " orthographic" : " perspective");
+                }
+            }
+        }
+
+        // The noise (§3.1, Fig. 6): at the finest lod the texels are uniform and symmetric about
+        // 0.5, so t = 0.5 opens half of the surface (the paper's "half of the texels are
+        // discarded"); seen through, the far side fills part of each hole, so the covered share of
+        // one large sphere lies between 1/2 and 3/4. Bilinear filtering concentrates the values
+        // near 0.5, so t = 0.25 opens less than a quarter, but some. Coarser lods average the noise
+        // towards 0.5: t = 0.25 then opens almost nothing. The normal blend changes the
+        // shading but not the coverage. The maps are the same bytes on every call.
+        TEST(EllipsoidTreeBake, noiseOpensHolesByThresholdAndLod)
+        {
+            const EllipsoidNoiseMaps& maps = ellipsoidNoiseMaps();
+            ASSERT_EQ(&maps, &ellipsoidNoiseMaps());
+            double mean = 0.0;
+            for (std::uint8_t a : maps.alpha[0][0])
+                mean += a / 255.0;
+            EXPECT_NEAR(mean / double(maps.alpha[0][0].size()), 0.5, 0.01);
+            EXPECT_EQ(maps.alpha[ELLIPSOID_NOISE_LEVELS - 1][0].size(), 1u);
+            EXPECT_NEAR(ellipsoidNoiseBaseLod(1.0f), 7.5f, 1e-5f);    // l_j = 0.5
+            EXPECT_NEAR(ellipsoidNoiseBaseLod(512.0f), 3.0f, 1e-5f);  // l_j = 5
+            EXPECT_NEAR(ellipsoidNoiseBaseLod(0.0f), 8.0f, 1e-5f);    // clamped
+            EXPECT_NEAR(ellipsoidNoiseFootprintLod(2.0f / 256.0f, 1.0f), 0.0f, 1e-5f);
+
+            Ellipsoid sphere;
+            sphere.radii = glm::vec3(1.0f);
+            sphere.leafWeight = 1e6f; // the finest lod
+            CameraSpec camera;
+            camera.orthographic = true;
+            camera.position = glm::vec3(0, 0, 5);
+            camera.target = glm::vec3(0.0f);
+            camera.orthoHeight = 1.0f; // the middle of the sphere, where the texels are about a pixel
+            const RenderOptions options = coverageOptions(128);
+            const double full = meanWhite(renderEllipsoids({sphere}, 1.0f, {}, camera, options));
+            double covered[2];
+            for (int k = 0; k < 2; ++k)
+            {
+                EllipsoidNoiseSetting noise;
+                noise.threshold = k == 0 ? 0.25f : 0.5f;
+                covered[k] = meanWhite(renderEllipsoids({sphere}, 1.0f, noise, camera, options)) / full;
+            }
+            EXPECT_GT(covered[1], 0.5 - 0.03);
+            EXPECT_LT(covered[1], 0.75 + 0.03);
+            EXPECT_LT(covered[0], 0.995);
+            EXPECT_GT(covered[0], covered[1] + 0.1);
+            sphere.leafWeight = 4.0f; // l_j = 1.5: 6.5 levels coarser, the noise near 0.5 everywhere
+            EllipsoidNoiseSetting quarter;
+            quarter.threshold = 0.25f;
+            EXPECT_GT(meanWhite(renderEllipsoids({sphere}, 1.0f, quarter, camera, options)) / full, 0.97);
+            // The footprint: pixels as large as the sphere average the noise as much.
+            sphere.leafWeight = 1e6f;
+            quarter.pixelSize = 0.5f;
+            EXPECT_GT(meanWhite(renderEllipsoids({sphere}, 1.0f, quarter, camera, options)) / full, 0.97);
+
+            RenderOptions shaded = options;
+            shaded.lighting = LightingSpec{};
+            shaded.lighting.background = glm::vec3(0.0f);
+            EllipsoidNoiseSetting blend;
+            blend.normalBlend = 0.7f;
+            const Image smooth = renderEllipsoids({sphere}, 1.0f, {}, camera, shaded);
+            const Image rough = renderEllipsoids({sphere}, 1.0f, blend, camera, shaded);
+            double difference = 0.0;
+            for (std::size_t i = 0; i < smooth.pixels.size(); ++i)
+                difference += std::abs(smooth.pixels[i].r - rough.pixels[i].r);
+            EXPECT_GT(difference / double(smooth.pixels.size()), 0.02);
+            EXPECT_NEAR(meanWhite(renderEllipsoids({sphere}, 1.0f, blend, camera, options)), full, 1e-6);
+        }
+
+        // Each level's noise is calibrated (the chosen threshold, compensation and blend from the
+        // candidates, stored and round-tripped) and, with the noise on, no level's coverage error is
+        // worse than without it by more than the two renderers differ; "noise=0" bakes none.
+        TEST(EllipsoidTreeBake, calibratedNoiseIsStoredAndNeverWorse)
+        {
+            const EllipsoidTreeData& withNoise = oakBake();
+            EllipsoidTreeOptions off = fastOptions();
+            off.noise = false;
+            const EllipsoidTreeData without = bakeOrFail(generatedOak(256), off);
+            ASSERT_EQ(withNoise.levels.size(), without.levels.size());
+            int noisy = 0;
+            for (std::size_t k = 0; k < without.levels.size(); ++k)
+            {
+                const EllipsoidLevel& a = withNoise.levels[k];
+                const EllipsoidLevel& b = without.levels[k];
+                EXPECT_EQ(b.noiseThreshold, 0.0f);
+                EXPECT_EQ(b.normalBlend, 0.0f);
+                EXPECT_GE(a.noiseThreshold, 0.0f);
+                EXPECT_LT(a.noiseThreshold, 1.0f);
+                EXPECT_GE(a.scale, b.scale * 0.999f) << "the compensation only grows the ellipsoids";
+                EXPECT_LE(a.imageError, b.imageError + 0.01f) << "level " << k;
+                noisy += a.noiseThreshold > 0.0f ? 1 : 0;
+            }
+            EXPECT_GT(noisy, 0) << "no level of the oak takes holes";
+            Result<EllipsoidTreeData> decoded = decodeEllipsoidTreeChunk(encodeEllipsoidTreeChunk(withNoise), "oak");
+            ASSERT_TRUE(decoded.ok()) << decoded.error().message();
+            for (std::size_t k = 0; k < withNoise.levels.size(); ++k)
+            {
+                EXPECT_EQ(decoded->levels[k].noiseThreshold, withNoise.levels[k].noiseThreshold);
+                EXPECT_EQ(decoded->levels[k].normalBlend, withNoise.levels[k].normalBlend);
+            }
+        }
+
         // Encode, decode: equal to the quantisation (centre half a step of 65535 over the box, radii
         // 0.025 %, rotation 1/32767 per component), 28 bytes per ellipsoid, re-encoding identical.
         TEST(EllipsoidTreeBake, roundTripIsExactToTheQuantisation)
@@ -248,7 +396,8 @@ namespace TreeLod
             EXPECT_EQ(bytes.size(), d.encodedBytes());
             const std::size_t header = bytes.size() - d.ellipsoids.size() * ELLIPSOID_RECORD_BYTES;
             EXPECT_LE(ELLIPSOID_RECORD_BYTES, 32u);
-            EXPECT_EQ(header, 40u + 20u * d.levels.size());
+            EXPECT_EQ(header, 40u + ELLIPSOID_LEVEL_BYTES * d.levels.size());
+            EXPECT_EQ(ELLIPSOID_LEVEL_BYTES, 28u);
             Result<EllipsoidTreeData> back = decodeEllipsoidTreeChunk(bytes, "round trip");
             ASSERT_TRUE(back.ok()) << back.error().message();
             ASSERT_EQ(back->ellipsoids.size(), d.ellipsoids.size());
@@ -260,6 +409,8 @@ namespace TreeLod
                 EXPECT_EQ(back->levels[k].scale, d.levels[k].scale);
                 EXPECT_EQ(back->levels[k].targetHeightPx, d.levels[k].targetHeightPx);
                 EXPECT_EQ(back->levels[k].imageError, d.levels[k].imageError);
+                EXPECT_EQ(back->levels[k].noiseThreshold, d.levels[k].noiseThreshold);
+                EXPECT_EQ(back->levels[k].normalBlend, d.levels[k].normalBlend);
             }
             for (std::size_t i = 0; i < d.ellipsoids.size(); ++i)
             {
@@ -312,8 +463,8 @@ namespace TreeLod
         {
             const EllipsoidTreeData& d = oakBake();
             const std::vector<std::uint8_t> good = encodeEllipsoidTreeChunk(d);
-            const std::size_t levels = 36, records = 40 + 20 * d.levels.size();
-            const std::size_t level1 = levels + 20, record3 = records + 3 * ELLIPSOID_RECORD_BYTES;
+            const std::size_t levels = 36, records = 40 + ELLIPSOID_LEVEL_BYTES * d.levels.size();
+            const std::size_t level1 = levels + ELLIPSOID_LEVEL_BYTES, record3 = records + 3 * ELLIPSOID_RECORD_BYTES;
 
             for (std::size_t cut : {std::size_t(0), std::size_t(10), levels + 2, level1 + 6, records - 2, record3 + 5,
                                     good.size() - 1})
@@ -344,13 +495,19 @@ namespace TreeLod
             putF32(b, level1 + 16, std::numeric_limits<float>::infinity());
             expectFailure(b, "level 1", "image error");
             b = good;
+            putF32(b, level1 + 20, 1.0f);
+            expectFailure(b, "level 1", "noise threshold");
+            b = good;
+            putF32(b, level1 + 24, std::nanf(""));
+            expectFailure(b, "level 1", "normal blend");
+            b = good;
             putU32(b, level1, d.levels[1].first + 1);
             expectFailure(b, "level 1", "contiguous");
             b = good;
             putU32(b, level1 + 4, 0);
             expectFailure(b, "level 1", "no ellipsoids");
             b = good;
-            putU32(b, levels + 20 * (d.levels.size() - 1) + 4, d.levels.back().count + 1);
+            putU32(b, levels + ELLIPSOID_LEVEL_BYTES * (d.levels.size() - 1) + 4, d.levels.back().count + 1);
             expectFailure(b, "level " + std::to_string(d.levels.size() - 1), "run past");
             b = good;
             putU32(b, records - 4, std::uint32_t(d.ellipsoids.size() + 1));

@@ -1,9 +1,16 @@
-// EllipsoidTreeResources: the ellipsoids (chunk "ellipsoids", EllipsoidTreeData.h) on the GPU.
+// EllipsoidTreeResources: the ellipsoids (chunk "ellipsoids", EllipsoidTreeData.h) on the GPU, and
+// the noise cube maps every tree shares (EllipsoidNoise.h).
 #include "TreeLod/EllipsoidTreeResources.h"
 
+#include "TreeLod/EllipsoidNoise.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreHardwareBufferManager.h>
+#include <OgreHardwarePixelBuffer.h>
+#include <OgreMaterialManager.h>
+#include <OgrePass.h>
+#include <OgreTechnique.h>
+#include <OgreTextureManager.h>
 
 #include <glm/gtc/quaternion.hpp>
 
@@ -67,6 +74,40 @@ namespace TreeLod
 
     namespace
     {
+        /// Fills the noise cube maps (EllipsoidNoise.h) every mip level as the core defines it, on
+        /// creation and whenever Ogre reloads them.
+        class NoiseLoader : public Ogre::ManualResourceLoader
+        {
+        public:
+            void loadResource(Ogre::Resource* resource) override
+            {
+                auto* texture = static_cast<Ogre::Texture*>(resource);
+                const bool alpha = texture->getName() == ELLIPSOID_NOISE_ALPHA_TEXTURE;
+                const Ogre::PixelFormat format = alpha ? Ogre::PF_L8 : Ogre::PF_BYTE_RGBA;
+                texture->setTextureType(Ogre::TEX_TYPE_CUBE_MAP);
+                texture->setWidth(ELLIPSOID_NOISE_SIZE);
+                texture->setHeight(ELLIPSOID_NOISE_SIZE);
+                texture->setNumMipmaps(ELLIPSOID_NOISE_LEVELS - 1);
+                texture->setFormat(format);
+                texture->createInternalResources();
+                const EllipsoidNoiseMaps& maps = ellipsoidNoiseMaps();
+                for (std::size_t level = 0; level < std::size_t(ELLIPSOID_NOISE_LEVELS); ++level)
+                    for (std::size_t face = 0; face < 6; ++face)
+                    {
+                        const std::vector<std::uint8_t>& texels = alpha ? maps.alpha[level][face] : maps.normal[level][face];
+                        const Ogre::uint32 side = Ogre::uint32(ELLIPSOID_NOISE_SIZE >> level);
+                        const Ogre::PixelBox box(side, side, 1, format, const_cast<std::uint8_t*>(texels.data()));
+                        texture->getBuffer(face, level)->blitFromMemory(box);
+                    }
+            }
+        };
+
+        NoiseLoader& noiseLoader()
+        {
+            static NoiseLoader loader;
+            return loader;
+        }
+
         /// Two triangles per quad of 4 vertices, `quads` quads; 16-bit indices while the vertices allow.
         Ogre::HardwareIndexBufferSharedPtr quadIndices(std::size_t quads)
         {
@@ -89,21 +130,53 @@ namespace TreeLod
             return buffer;
         }
 
-        /// One vertex of TreeLodEllipsoid.vert: centre, corner, three semi-axes, RGBA8.
+        /// One vertex of TreeLodEllipsoid.vert: centre; corner, noise lod and threshold; the first
+        /// semi-axis and the normal blend; the other two semi-axes; RGBA8.
         struct EllipsoidVertex
         {
             float centre[3];
-            float corner[2];
-            float axes[3][3];
+            float corner[4];
+            float axis0[4];
+            float axes[2][3];
             std::uint8_t colour[4];
         };
-        static_assert(sizeof(EllipsoidVertex) == 14 * sizeof(float) + 4, "tightly packed");
+        static_assert(sizeof(EllipsoidVertex) == 17 * sizeof(float) + 4, "tightly packed");
+    }
+
+    void bindEllipsoidNoise()
+    {
+        Ogre::TextureManager& textures = Ogre::TextureManager::getSingleton();
+        Ogre::TexturePtr maps[2];
+        const char* names[2] = {ELLIPSOID_NOISE_ALPHA_TEXTURE, ELLIPSOID_NOISE_NORMAL_TEXTURE};
+        for (int i = 0; i < 2; ++i)
+        {
+            maps[i] = textures.getByName(names[i], Ogre::RGN_INTERNAL);
+            if (!maps[i])
+                maps[i] = textures.createManual(names[i], Ogre::RGN_INTERNAL, Ogre::TEX_TYPE_CUBE_MAP, ELLIPSOID_NOISE_SIZE,
+                                                ELLIPSOID_NOISE_SIZE, ELLIPSOID_NOISE_LEVELS - 1,
+                                                i == 0 ? Ogre::PF_L8 : Ogre::PF_BYTE_RGBA, Ogre::TU_DEFAULT, &noiseLoader());
+            maps[i]->load();
+        }
+        for (const char* name : {ELLIPSOID_MATERIAL, ELLIPSOID_SHADOWED_MATERIAL, ELLIPSOID_CASTER_MATERIAL})
+        {
+            const Ogre::MaterialPtr material = Ogre::MaterialManager::getSingleton().getByName(name, Ogre::RGN_AUTODETECT);
+            if (!material)
+                continue; // EllipsoidTree names the missing material
+            for (Ogre::Technique* technique : material->getTechniques())
+                for (Ogre::Pass* pass : technique->getPasses())
+                    for (Ogre::TextureUnitState* unit : pass->getTextureUnitStates())
+                        if (unit->getName() == "NoiseAlpha" && unit->_getTexturePtr() != maps[0])
+                            unit->setTexture(maps[0]);
+                        else if (unit->getName() == "NoiseNormal" && unit->_getTexturePtr() != maps[1])
+                            unit->setTexture(maps[1]);
+        }
     }
 
     const EllipsoidTreeGpu& EllipsoidTreeResources::getGpu()
     {
         if (mGpu)
             return *mGpu;
+        bindEllipsoidNoise();
         const EllipsoidTreeData& data = getData();
         auto gpu = std::make_unique<EllipsoidTreeGpu>();
         const std::size_t count = data.ellipsoids.size();
@@ -119,8 +192,11 @@ namespace TreeLod
                 for (int a = 0; a < 3; ++a)
                 {
                     const glm::vec3 axis = rotation[a] * (ellipsoid.radii[a] * level.scale);
-                    std::memcpy(v.axes[a], &axis[0], sizeof v.axes[a]);
+                    std::memcpy(a == 0 ? v.axis0 : v.axes[a - 1], &axis[0], 3 * sizeof(float));
                 }
+                v.corner[2] = ellipsoidNoiseBaseLod(ellipsoid.leafWeight);
+                v.corner[3] = level.noiseThreshold;
+                v.axis0[3] = level.normalBlend;
                 std::copy(ellipsoid.colour.begin(), ellipsoid.colour.end(), v.colour);
                 for (int c = 0; c < 4; ++c)
                 {
@@ -139,8 +215,9 @@ namespace TreeLod
         Ogre::VertexDeclaration* declaration = gpu->vertexData->vertexDeclaration;
         std::size_t offset = 0;
         offset += declaration->addElement(0, offset, Ogre::VET_FLOAT3, Ogre::VES_POSITION).getSize();
-        offset += declaration->addElement(0, offset, Ogre::VET_FLOAT2, Ogre::VES_TEXTURE_COORDINATES, 0).getSize();
-        for (unsigned short a = 1; a <= 3; ++a)
+        offset += declaration->addElement(0, offset, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 0).getSize();
+        offset += declaration->addElement(0, offset, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 1).getSize();
+        for (unsigned short a = 2; a <= 3; ++a)
             offset += declaration->addElement(0, offset, Ogre::VET_FLOAT3, Ogre::VES_TEXTURE_COORDINATES, a).getSize();
         declaration->addElement(0, offset, Ogre::VET_UBYTE4_NORM, Ogre::VES_DIFFUSE);
         Ogre::HardwareVertexBufferSharedPtr vertexBuffer =

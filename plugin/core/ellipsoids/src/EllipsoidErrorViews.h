@@ -1,7 +1,7 @@
 // The views both ellipsoid bakers measure image error in (the ellipsoids-and-lines paper (001)
 // §4; EllipsoidTreeBaker.h, EllipsoidLineBaker.h): four orthographic views of the sphere
 // (centre, radius), three around at 15 degrees elevation and one from above, rendered by the CPU
-// ReferenceRenderer in flat white on black (coverage only), 2 x 2 samples a pixel.
+// ReferenceRenderer in flat white on black (coverage only) or shaded, 2 x 2 samples a pixel.
 #pragma once
 
 #include "TreeLod/ReferenceRenderer.h"
@@ -46,6 +46,17 @@ namespace TreeLod
                 out.push_back(c);
             }
             return out;
+        }
+
+        /// Shaded: white surfaces under RenderOptions' default sun and sky light, on black (the
+        /// normal noise's calibration, EllipsoidTreeBaker.h).
+        inline RenderOptions shadedRenderOptions(int resolution)
+        {
+            RenderOptions o;
+            o.width = o.height = resolution;
+            o.samplesPerPixel = SAMPLES * SAMPLES;
+            o.lighting.background = glm::vec3(0.0f);
+            return o;
         }
 
         inline RenderOptions renderOptions(int resolution)

@@ -22,14 +22,16 @@ namespace TreeLod
             Result<double> resolution =
                 bakeOptionNumber(given, chunk, "viewResolution", options.viewResolution, 16, 1024, label);
             Result<double> aoRays = bakeOptionNumber(given, chunk, "aoRays", options.aoRays, 0, 1024, label);
-            for (const Result<double>* r : {&tries, &seed, &divisor, &share, &resolution, &aoRays})
+            Result<double> noise = bakeOptionNumber(given, chunk, "noise", options.noise ? 1 : 0, 0, 1, label);
+            for (const Result<double>* r : {&tries, &seed, &divisor, &share, &resolution, &aoRays, &noise})
                 if (!*r)
                     return r->error();
             for (const auto& [name, value] : {std::pair<const char*, double>{"tries", tries.value()},
                                               {"seed", seed.value()},
                                               {"clustersDivisor", divisor.value()},
                                               {"viewResolution", resolution.value()},
-                                              {"aoRays", aoRays.value()}})
+                                              {"aoRays", aoRays.value()},
+                                              {"noise", noise.value()}})
                 if (value != std::floor(value))
                     return fail(label, std::string("option '") + chunk + "." + name + "'",
                                 std::to_string(value) + " is not a whole number");
@@ -39,6 +41,7 @@ namespace TreeLod
             options.minAreaShare = float(share.value());
             options.viewResolution = int(resolution.value());
             options.aoRays = std::uint32_t(aoRays.value());
+            options.noise = noise.value() != 0.0;
             return addEllipsoidTreeChunk(writer, model, options, label, progress);
         }
 
@@ -53,6 +56,8 @@ namespace TreeLod
               {"minAreaShare", "ellipsoids under this share of the level's largest surface area are dropped, 0 to 0.5",
                "0.01"},
               {"viewResolution", "pixels a side of the 4 views the image error is taken over, 16 to 1024", "128"},
-              {"aoRays", "rays per surface point of the ellipsoids' ambient occlusion, 0 (none) to 1024", "0"}}});
+              {"aoRays", "rays per surface point of the ellipsoids' ambient occlusion, 0 (none) to 1024", "0"},
+              {"noise", "1: calibrate each level's noise (alpha holes, area, normal blend) by image error; 0: none",
+               "1"}}});
     }
 }

@@ -12,6 +12,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <glm/gtc/quaternion.hpp>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -36,6 +37,11 @@ namespace TreeLod
         /// an end (within [MIN_SCALE, MAX_SCALE]), then +-REFINE around the best.
         constexpr std::array<float, 5> COARSE_SCALES = {0.6f, 0.8f, 1.0f, 1.2f, 1.4f};
         constexpr float COARSE_STEP = 0.2f, REFINE = 0.1f, MIN_SCALE = 0.2f, MAX_SCALE = 3.0f;
+        /// Noise calibration (§3.1, Fig. 6): alpha thresholds (0: none), area compensations on
+        /// the calibrated scale for each, and normal blends.
+        constexpr std::array<float, 5> NOISE_THRESHOLDS = {0.0f, 0.25f, 0.4f, 0.5f, 0.6f};
+        constexpr std::array<float, 6> AREA_COMPENSATIONS = {1.0f, 1.1f, 1.2f, 1.35f, 1.5f, 1.7f};
+        constexpr std::array<float, 5> NORMAL_BLENDS = {0.0f, 0.15f, 0.3f, 0.5f, 0.7f};
 
         std::uint64_t splitMix(std::uint64_t& state)
         {
@@ -151,17 +157,28 @@ namespace TreeLod
         public:
             ErrorViews(const glm::vec3& lo, const glm::vec3& hi, int resolution)
                 : mCameras(EllipsoidErrorViews::cameras(0.5f * (lo + hi), std::max(0.5f * glm::length(hi - lo), 1e-30f))),
-                  mOptions(EllipsoidErrorViews::renderOptions(resolution))
+                  mOptions(EllipsoidErrorViews::renderOptions(resolution)),
+                  mShaded(EllipsoidErrorViews::shadedRenderOptions(resolution))
             {
             }
 
-            /// Throws std::runtime_error (Embree) like the renderer.
-            std::vector<Image> render(const TreeModel& model) const
+            /// Coverage (or shaded) images of a model. Throws std::runtime_error (Embree) like the renderer.
+            std::vector<Image> render(const TreeModel& model, bool shaded = false) const
             {
                 const ReferenceRenderer renderer(model);
                 std::vector<Image> images;
                 for (const CameraSpec& c : mCameras)
-                    images.push_back(renderer.render(c, mOptions).colour);
+                    images.push_back(renderer.render(c, shaded ? mShaded : mOptions).colour);
+                return images;
+            }
+
+            /// The ray-cast ellipsoids with their noise (renderEllipsoids), single-threaded.
+            std::vector<Image> renderRayCast(const std::vector<Ellipsoid>& metres, float scale,
+                                             const EllipsoidNoiseSetting& noise, bool shaded) const
+            {
+                std::vector<Image> images;
+                for (const CameraSpec& c : mCameras)
+                    images.push_back(renderEllipsoids(metres, scale, noise, c, shaded ? mShaded : mOptions));
                 return images;
             }
 
@@ -180,7 +197,7 @@ namespace TreeLod
 
         private:
             std::vector<CameraSpec> mCameras;
-            RenderOptions mOptions;
+            RenderOptions mOptions, mShaded;
         };
 
         /// Linear mean colour of a leaf: base colour times the mean of its texture's texels in its
@@ -349,6 +366,64 @@ namespace TreeLod
             tryScale(centre - REFINE);
             tryScale(centre + REFINE);
             return best;
+        }
+
+        struct NoiseCalibrated
+        {
+            EllipsoidNoiseSetting noise;
+            float compensation = 1.0f; ///< on the level's scale
+            double error = 0.0;        ///< coverage, at the chosen threshold and compensation
+        };
+
+        /// §3.1, Fig. 6: the alpha threshold and the area compensation with the least coverage
+        /// error, then the normal blend with the least shaded error; the ellipsoids ray cast with
+        /// their noise as the renderer draws them, the noise's footprint that of `pixelSize`
+        /// (the level's size on screen). Candidates run in parallel, the first best kept.
+        NoiseCalibrated calibrateNoise(const std::vector<Ellipsoid>& metres, float scale, float pixelSize,
+                                       const ErrorViews& views, const std::vector<Image>& reference,
+                                       const std::vector<Image>& shadedReference)
+        {
+            struct Candidate
+            {
+                EllipsoidNoiseSetting noise;
+                float compensation = 1.0f;
+                double error = 0.0;
+            };
+            auto evaluate = [&](std::vector<Candidate>& candidates, bool shaded) {
+                tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t i) {
+                    Candidate& c = candidates[i];
+                    c.error = views.error(shaded ? shadedReference : reference,
+                                          views.renderRayCast(metres, scale * c.compensation, c.noise, shaded));
+                });
+                return *std::min_element(candidates.begin(), candidates.end(),
+                                         [](const Candidate& a, const Candidate& b) { return a.error < b.error; });
+            };
+            std::vector<Candidate> holes;
+            for (float t : NOISE_THRESHOLDS)
+                for (float c : AREA_COMPENSATIONS)
+                    if (t > 0.0f || c == 1.0f)
+                    {
+                        Candidate candidate;
+                        candidate.noise.threshold = t;
+                        candidate.noise.pixelSize = pixelSize;
+                        candidate.compensation = c;
+                        holes.push_back(candidate);
+                    }
+            const Candidate bestHoles = evaluate(holes, false);
+            std::vector<Candidate> blends;
+            for (float b : NORMAL_BLENDS)
+            {
+                Candidate candidate = bestHoles;
+                candidate.noise.normalBlend = b;
+                blends.push_back(candidate);
+            }
+            const Candidate bestBlend = evaluate(blends, true);
+            NoiseCalibrated out;
+            out.noise = bestBlend.noise;
+            out.noise.pixelSize = 0.0f;
+            out.compensation = bestHoles.compensation;
+            out.error = bestHoles.error;
+            return out;
         }
 
         /// §6: the tree height on screen (pixels) at which the level's mean ellipsoid is
@@ -538,6 +613,7 @@ namespace TreeLod
             const TreeModel flatLeaves = flatColourLeaves(model);
             const ErrorViews views(glm::vec3(lo), glm::vec3(hi), options.viewResolution);
             const std::vector<Image> reference = views.render(flatLeaves);
+            const std::vector<Image> shadedReference = options.noise ? views.render(flatLeaves, true) : std::vector<Image>{};
             report(progress, "ellipsoids: leaves", 0.5f);
 
             auto addLevel = [&](WorkLevel level, const Calibrated& calibrated, const std::vector<Ellipsoid>& metres) {
@@ -547,6 +623,18 @@ namespace TreeLod
                 l.scale = calibrated.scale;
                 l.imageError = float(calibrated.error);
                 l.targetHeightPx = targetHeight(metres, calibrated.scale, treeHeight);
+                if (options.noise)
+                {
+                    // The noise at the finest the level is drawn: the tree targetHeightPx tall.
+                    const float pixelSize = float(treeHeight) / l.targetHeightPx;
+                    const NoiseCalibrated noise =
+                        calibrateNoise(metres, l.scale, pixelSize, views, reference, shadedReference);
+                    l.scale *= noise.compensation;
+                    l.noiseThreshold = noise.noise.threshold;
+                    l.normalBlend = noise.noise.normalBlend;
+                    l.imageError = float(noise.error);
+                    l.targetHeightPx = targetHeight(metres, l.scale, treeHeight);
+                }
                 data.levels.push_back(l);
                 for (std::size_t j = 0; j < metres.size(); ++j)
                 {

@@ -87,6 +87,10 @@ namespace TreeLod
                 return fail(label, element, "target height " + text(l.targetHeightPx) + " px is not finite and > 0");
             if (!std::isfinite(l.imageError) || l.imageError < 0.0f || l.imageError > 1.0f)
                 return fail(label, element, "image error " + text(l.imageError) + " is outside [0, 1]");
+            if (!(l.noiseThreshold >= 0.0f && l.noiseThreshold < 1.0f))
+                return fail(label, element, "noise threshold " + text(l.noiseThreshold) + " is outside [0, 1)");
+            if (!(l.normalBlend >= 0.0f && l.normalBlend <= 1.0f))
+                return fail(label, element, "normal blend " + text(l.normalBlend) + " is outside [0, 1]");
         }
         if (next != ellipsoids.size())
             return fail(label, name + ", levels",
@@ -133,6 +137,8 @@ namespace TreeLod
             w.f32(l.scale);
             w.f32(l.targetHeightPx);
             w.f32(l.imageError);
+            w.f32(l.noiseThreshold);
+            w.f32(l.normalBlend);
         }
         w.u32(std::uint32_t(data.ellipsoids.size()));
         const glm::vec3 extent = data.boundsMax - data.boundsMin;
@@ -185,6 +191,8 @@ namespace TreeLod
             l.scale = r.f32();
             l.targetHeightPx = r.f32();
             l.imageError = r.f32();
+            l.noiseThreshold = r.f32();
+            l.normalBlend = r.f32();
         }
         r.setElement(name + ", ellipsoids");
         const std::uint32_t count = r.count(ELLIPSOID_RECORD_BYTES);

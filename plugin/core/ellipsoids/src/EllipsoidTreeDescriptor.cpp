@@ -21,15 +21,18 @@ namespace TreeLod
             nlohmann::json levelsJson = nlohmann::json::array();
             for (const EllipsoidLevel& l : d.levels)
             {
-                char one[96];
-                std::snprintf(one, sizeof(one), "%s%u (x%.2f, %.0f px, error %.4f)", counts.empty() ? "" : ", ",
-                              l.count, l.scale, l.targetHeightPx, l.imageError);
+                char one[128];
+                std::snprintf(one, sizeof(one), "%s%u (x%.2f, %.0f px, error %.4f, noise %.2f/%.2f)",
+                              counts.empty() ? "" : ", ", l.count, l.scale, l.targetHeightPx, l.imageError,
+                              l.noiseThreshold, l.normalBlend);
                 counts += one;
                 levelsJson.push_back({{"first", l.first},
                                       {"count", l.count},
                                       {"scale", l.scale},
                                       {"targetHeightPx", l.targetHeightPx},
-                                      {"imageError", l.imageError}});
+                                      {"imageError", l.imageError},
+                                      {"noiseThreshold", l.noiseThreshold},
+                                      {"normalBlend", l.normalBlend}});
             }
             char text[160];
             std::snprintf(text, sizeof(text), "%zu ellipsoids in %zu levels, %zu bytes (%zu per ellipsoid): ",

@@ -18,9 +18,14 @@
 // the sun's texture shadow and receive it at the hit point (integrated texture shadows; any shadow
 // camera projection: focused, LiSPSM).
 //
+// Noise (§3.1, Fig. 6; §5): one pair of white-noise cube maps for every tree (EllipsoidNoise.h,
+// bound by EllipsoidTreeResources): the alpha test opens holes in each ellipsoid at its level's
+// calibrated threshold (the far side shows through, in shadows too), the normal is blended with
+// the normal noise; the lod is the cluster's (from its leaf weight) or the pixel footprint's at
+// its centre if coarser (the paper takes fwidth per fragment).
+//
 // AO (§5): the ambient term is scaled by each primitive's baked AO (none unless baked with
-// ellipsoids.aoRays). Deviation from the paper, for now: the ellipsoids have no noise cube maps
-// (alpha test and normal noise, §3.1).
+// ellipsoids.aoRays).
 //
 // Parameters (createMovableObject params, or the registry): asset (required), group, level
 // (force an ellipsoid level: 0 finest; the lines follow its target height), lodBias (> 0,

@@ -24,6 +24,16 @@ namespace TreeLod
     constexpr const char* ELLIPSOID_MATERIAL = "TreeLod/Ellipsoid";
     /// The same receiving the sun's integrated texture shadow.
     constexpr const char* ELLIPSOID_SHADOWED_MATERIAL = "TreeLod/EllipsoidShadowed";
+    /// Their shadow caster (ray-cast depth, the noise's holes).
+    constexpr const char* ELLIPSOID_CASTER_MATERIAL = "TreeLod/EllipsoidCaster";
+    /// The noise cube maps (EllipsoidNoise.h), group RGN_INTERNAL, one pair for every tree: the
+    /// materials' texture units "NoiseAlpha" and "NoiseNormal".
+    constexpr const char* ELLIPSOID_NOISE_ALPHA_TEXTURE = "TreeLod/EllipsoidNoiseAlpha";
+    constexpr const char* ELLIPSOID_NOISE_NORMAL_TEXTURE = "TreeLod/EllipsoidNoiseNormal";
+
+    /// Creates the noise cube maps when missing (filled from the core's bytes, reloadable) and
+    /// binds them to the ellipsoid materials' noise units. getGpu() calls it.
+    void bindEllipsoidNoise();
     /// The lines' (materials/TreeLodEllipsoid.material), plain and receiving.
     constexpr const char* ELLIPSOID_LINE_MATERIAL = "TreeLod/EllipsoidLine";
     constexpr const char* ELLIPSOID_LINE_SHADOWED_MATERIAL = "TreeLod/EllipsoidLineShadowed";
@@ -42,8 +52,10 @@ namespace TreeLod
     /// The box (tree space, metres) every level of `data` draws: centres +- the scaled semi-axes' reach.
     Ogre::AxisAlignedBox ellipsoidBounds(const EllipsoidTreeData& data);
 
-    /// Vertices: 4 per ellipsoid, POSITION = centre, uv0 = corner (+-1, +-1), uv1..uv3 = the
-    /// semi-axes with the level's scale applied, DIFFUSE = sRGB colour and AO (TreeLodEllipsoid.vert).
+    /// Vertices: 4 per ellipsoid, POSITION = centre, uv0 = corner (+-1, +-1), the cluster's noise lod
+    /// (ellipsoidNoiseBaseLod) and the level's noise threshold, uv1..uv3 = the semi-axes with the
+    /// level's scale applied (uv1.w = the level's normal blend), DIFFUSE = sRGB colour and AO
+    /// (TreeLodEllipsoid.vert).
     struct EllipsoidTreeGpu
     {
         std::unique_ptr<Ogre::VertexData> vertexData;

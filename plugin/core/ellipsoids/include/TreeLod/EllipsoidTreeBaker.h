@@ -1,7 +1,7 @@
 // EllipsoidTreeBaker: TreeModel -> EllipsoidTreeData (EllipsoidTreeData.h): the leaf half of
 // the ellipsoids-and-lines paper (001), §3.1 and Alg. 1, with §4's image error and §6's
-// per-level target size. Branches (the lines of §3.2), the noise textures and ambient occlusion
-// are not baked here.
+// per-level target size and the noise's calibration. Branches (the lines of §3.2) are
+// EllipsoidLineBaker.h; ambient occlusion is addEllipsoidAmbientOcclusion below.
 //
 //   1. Leaves -> one ellipsoid each (§3.1): the mean and covariance of points spread uniformly
 //      over the leaf's triangles, PCA (eigenvectors = axes, semi-axis = 2 sqrt(eigenvalue)); the
@@ -22,6 +22,13 @@
 //      rendered by the CPU ReferenceRenderer: the leaves in one flat colour (their textures' alpha
 //      kept, colour dropped), the ellipsoids as icospheres of 80 triangles whose surface area is
 //      the sphere's, in the same colour, so the error measures coverage only.
+//   4b. Noise (§3.1, Fig. 6; EllipsoidNoise.h), with `noise`: per level, the alpha threshold
+//      t of 0, 0.25, 0.4, 0.5, 0.6 and the area compensation on the calibrated scale (1 to 1.7;
+//      1 for t = 0) with the least coverage error, then the normal blend of 0 to 0.7 with the
+//      least error in shaded views (white surfaces under the default sun and sky). These are
+//      scored on the ellipsoids ray cast as the renderer draws them (renderEllipsoids: true
+//      ellipsoids, the holes and the far side through them, the noise's lod at the footprint of
+//      the level's target size), not on icospheres; the level's imageError is then this error.
 //   5. Target size (§6): targetHeightPx = the tree's height in pixels at which the level's mean
 //      ellipsoid (the diameter of the disc with its mean projected area) is
 //      ELLIPSOID_TARGET_DIAMETER_PX pixels across.
@@ -36,15 +43,22 @@
 //   - Every level clusters the leaves (as Alg. 1), but a last level of one ellipsoid is added when
 //     the division stops above one (fewer than clustersDivisor^2 leaves, e.g. 2 or 3 leaves).
 //   - Leaves of zero area are left out (they cannot be seen).
-//   - The image error compares flat-colour coverage images instead of shaded ones: shading is the
-//     renderer's (noise normals, AO, §5), which this chunk does not fix.
+//   - The image error compares flat-colour coverage images instead of shaded ones (the leaves'
+//     colours are the ellipsoids' means); only the normal blend is chosen on shaded images.
+//   - The noise's mip level l_j is the paper's, but its footprint limit is taken once per
+//     ellipsoid at its centre, not per fragment from fwidth: the CPU twin and the GPU then agree
+//     exactly, and the ray caster has no derivatives of its own to take.
+//   - Where the alpha test opens a hole in the near side, the far side is tested and drawn (the
+//     paper does not say): a hole in a closed surface shows its inside.
 // Every length is relative to the leaves' bounding box (a 0.5 m and a 500 m tree give the same
 // result up to rounding). Deterministic for a seed and any TBB thread count.
 #pragma once
 
 #include "TreeLod/EllipsoidTreeData.h"
+#include "TreeLod/Image.h"
 #include "TreeLod/PackageWriter.h"
 #include "TreeLod/Progress.h"
+#include "TreeLod/ReferenceRenderer.h"
 #include "TreeLod/Result.h"
 #include "TreeLod/TreeModel.h"
 
@@ -65,6 +79,9 @@ namespace TreeLod
         /// Rays per point of the ellipsoids' ambient occlusion (§5), 0 to 1024; 0: none (the
         /// polygonal reference's leaves have none, docs/ellipsoids.md "Ambient occlusion").
         std::uint32_t aoRays = 0;
+        /// Calibrate each level's noise (§3.1, Fig. 6; EllipsoidNoise.h); false: none (every
+        /// level's threshold and blend 0).
+        bool noise = true;
     };
 
     /// The moments of leaf `leaf`'s triangles as a uniform area distribution (metres).
@@ -88,6 +105,28 @@ namespace TreeLod
     /// opaque, double-sided bark of one white material: icospheres of 80 triangles with the
     /// sphere's surface area. What the baker renders; tests measure coverage with it.
     TreeModel ellipsoidLevelMesh(const EllipsoidTreeData& data, std::size_t level, float extraScale = 1.0f);
+
+    /// The noise an ellipsoid level is drawn with (EllipsoidLevel, EllipsoidNoise.h).
+    struct EllipsoidNoiseSetting
+    {
+        float threshold = 0.0f;   ///< alpha test: 0 = no holes
+        float normalBlend = 0.0f; ///< 0 = the ellipsoid's own normal
+        /// Size of a pixel (metres) at the ellipsoids for the footprint's lod; 0: the clusters'
+        /// own lod only.
+        float pixelSize = 0.0f;
+    };
+
+    /// The radius the noise's footprint lod uses: the geometric mean of the two largest semi-axes.
+    float ellipsoidNoiseRadius(const glm::vec3& scaledRadii);
+
+    /// `ellipsoids` (radii times `scale`) ray cast as TreeLodEllipsoid.frag draws them, in white:
+    /// the nearest surface point of any ellipsoid that passes the noise's alpha test (the near
+    /// side, else the far side seen through the hole), lit with RenderOptions::lighting (ambient +
+    /// sun * max(0, n.l), the normal blended with the noise and facing the camera), supersampled
+    /// and written as ReferenceRenderer's colour image (sRGB, background opaque). Orthographic or
+    /// perspective; deterministic; single-threaded (callers parallelise over views).
+    Image renderEllipsoids(const std::vector<Ellipsoid>& ellipsoids, float scale, const EllipsoidNoiseSetting& noise,
+                           const CameraSpec& camera, const RenderOptions& options);
 
     /// `model`'s leaves alone, every material white (base colour and texture colour; the
     /// textures' alpha and the alpha cutoffs kept): the reference the baker measures against.

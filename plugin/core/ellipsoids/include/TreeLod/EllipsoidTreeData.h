@@ -1,7 +1,8 @@
 // EllipsoidTreeData: the leaves of a tree as a hierarchy of ellipsoids, package chunk "ellipsoids",
 // after the ellipsoids-and-lines paper (001), §3.1 (the hierarchy) and §5 (storage as a sequential
-// point tree). The baker is EllipsoidTreeBaker.h. Lines (the branches, §3.2), the noise cube maps
-// and ambient occlusion are not part of this chunk.
+// point tree). The baker is EllipsoidTreeBaker.h. Lines (the branches, §3.2) are chunk
+// "ellipsoid-lines" (EllipsoidLineData.h); the noise cube maps are shared by every tree
+// (EllipsoidNoise.h), this chunk holds each level's noise parameters.
 //
 // ---- Meaning ----------------------------------------------------------------------------------
 // One array of ellipsoids ordered by level, finest first (paper 001 §5): level 0 has one
@@ -16,16 +17,22 @@
 // ELLIPSOID_TARGET_DIAMETER_PX pixels across; a renderer shows the level whose target is nearest
 // above the tree's height on screen. imageError: the level's multi-scale RMSE (§4) against the
 // leaves as the baker measured it (flat-colour coverage images, see EllipsoidTreeBaker.h).
+// Noise (§3.1, Fig. 6; EllipsoidNoise.h): a level's ellipsoids drop the surface points whose
+// alpha noise is below noiseThreshold (0: no holes), sampled at the lod of
+// ellipsoidNoiseBaseLod(leafWeight) or the pixel footprint's if coarser, and blend their normal
+// towards the normal noise by normalBlend (0: the ellipsoid's own normal). The level's scale
+// includes the area compensation for the holes.
 //
-// ---- Chunk layout, formatVersion 1 (ELLIPSOID_TREE_CHUNK_FORMAT_VERSION) ------------------------
+// ---- Chunk layout, formatVersion 2 (ELLIPSOID_TREE_CHUNK_FORMAT_VERSION) ------------------------
 // Little-endian:
 //   u32 flags (0; others are an error)
 //   f32 x 3 boundsMin, f32 x 3 boundsMax   the box of the centres (finite, max >= min)
 //   f32 radiusUnit                         metres (finite, > 0): the unit of the radii's log scale
-//   u32 levelCount in [1, 32], then per level (20 bytes):
+//   u32 levelCount in [1, 32], then per level (28 bytes):
 //     u32 first, u32 count (>= 1)          level 0 starts at 0, each level right after the previous,
 //                                          the last ends at ellipsoidCount
 //     f32 scale in (0, 16], f32 targetHeightPx (finite, > 0), f32 imageError in [0, 1]
+//     f32 noiseThreshold in [0, 1), f32 normalBlend in [0, 1]
 //   u32 ellipsoidCount, then per ellipsoid ELLIPSOID_RECORD_BYTES = 28 bytes:
 //     u16 x 3 centre      boundsMin + (boundsMax - boundsMin) * q / 65535
 //     u16 x 3 radii       radiusUnit * 2^(24 q / 65535 - 20)  (relative step 2^(24/65535), 0.025 %)
@@ -50,9 +57,9 @@
 namespace TreeLod
 {
     constexpr const char* ELLIPSOID_TREE_CHUNK = "ellipsoids";
-    constexpr std::uint32_t ELLIPSOID_TREE_CHUNK_FORMAT_VERSION = 1;
+    constexpr std::uint32_t ELLIPSOID_TREE_CHUNK_FORMAT_VERSION = 2;
     constexpr std::size_t ELLIPSOID_RECORD_BYTES = 28;
-    constexpr std::size_t ELLIPSOID_LEVEL_BYTES = 20;
+    constexpr std::size_t ELLIPSOID_LEVEL_BYTES = 28;
     constexpr std::uint32_t ELLIPSOID_MAX_LEVELS = 32;
     /// Mean ellipsoid diameter in pixels a level is made for (paper 001 §6's default of 5).
     constexpr float ELLIPSOID_TARGET_DIAMETER_PX = 5.0f;
@@ -75,6 +82,8 @@ namespace TreeLod
         float scale = 1.0f;                 ///< calibrated visible-area factor on every radius
         float targetHeightPx = 0.0f;        ///< tree height on screen this level is made for
         float imageError = 0.0f;            ///< multi-scale RMSE against the leaves when baked
+        float noiseThreshold = 0.0f;        ///< alpha test on the noise (§3.1): 0 = no holes
+        float normalBlend = 0.0f;           ///< towards the noise normal: 0 = the ellipsoid's
     };
 
     struct EllipsoidTreeData
