@@ -3,8 +3,10 @@
 // follows the tree's height on screen and the lodBias; a camera inside an ellipsoid sees its
 // inside; as Forest levels they draw what EllipsoidTrees draw, and both cast ellipsoid-shaped
 // shadows (focused and LiSPSM shadow cameras) and receive them; the noise's holes are where the
-// baker's CPU twin has them; bad parameters and a missing chunk are named; golden images.
+// baker's CPU twin has them; a 0.5 m and a 500 m tree look the same at the same size on screen;
+// bad parameters and a missing chunk are named; golden images.
 #include "OgreTestSupport.h"
+#include "../core/TestTrees.h"
 
 #include "TreeLod/EllipsoidTree.h"
 #include "TreeLod/EllipsoidTreeBaker.h"
@@ -172,6 +174,60 @@ namespace TreeLod
         EXPECT_GT(double(holesDrawn), 0.6 * double(holes)) << "drawn holes differ from the calibrated ones";
         EXPECT_GT(double(filledDrawn), 0.97 * double(filled));
         compareWithGolden(drawn, "oak-ellipsoids-noise", 0.02);
+    }
+
+    // A 300-leaf oak scaled to 0.5 m and to 500 m, each baked: the same picture at the same screen
+    // size near and far, and the same levels (targets are in pixels; bake and draw are scale-free).
+    TEST(EllipsoidTree, halfAMetreAndFiveHundredMetresLookTheSame)
+    {
+        const TreeModel& base = test::generatedOak(300);
+        const float height = base.boundsMax.y - base.boundsMin.y;
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        r.setShadows(false);
+        std::vector<Image> images[2];
+        std::vector<std::size_t> levels[2], lineLevels[2];
+        int size = 0;
+        for (const float target : {0.5f, 500.0f})
+        {
+            const TreeModel model = test::scaled(base, target / height);
+            EllipsoidTreeOptions options;
+            options.viewResolution = 64;
+            options.tries = 2;
+            PackageWriter writer;
+            Result<void> added = addEllipsoidTreeChunk(writer, model, options, "oak");
+            ASSERT_TRUE(added.ok()) << added.error().message();
+            const TreeAssetPtr asset = TreeAssetManager::getSingleton().loadFromBytes(
+                "oak-" + std::to_string(int(target * 10.0f)) + "dm.ellipsoid-test", Ogre::RGN_DEFAULT, writer.toBytes());
+            for (const float distance : {1.0f, 5.0f})
+            {
+                r.clearContent();
+                const Ogre::NameValuePairList params = {{"asset", asset->getName()}, {"group", asset->getGroup()}};
+                auto* tree = static_cast<EllipsoidTree*>(r.getSceneManager().createMovableObject(
+                    "ellipsoid-scaled", EllipsoidTreeFactory::FACTORY_TYPE_NAME, &params));
+                r.getContentNode().attachObject(tree);
+                const CameraSpec camera = CameraSpec::framing(model.boundsMin, model.boundsMax, 30.0f, 10.0f, distance);
+                images[size].push_back(toImage(r.render(camera, 128, 128, 2)));
+                levels[size].push_back(tree->getLevel());
+                lineLevels[size].push_back(tree->getLineLevel());
+                r.clearContent();
+            }
+            ++size;
+        }
+        for (std::size_t v = 0; v < images[0].size(); ++v)
+        {
+            const Crop crop = cropAround(unite(treeExtent(images[0][v]), treeExtent(images[1][v])), 128, 128);
+            const double error = flipMean(cropImage(images[0][v], crop), cropImage(images[1][v], crop));
+            std::printf("view %zu: level %zu / %zu, lines %zu / %zu, FLIP 0.5 m vs 500 m %.5f\n", v, levels[0][v],
+                        levels[1][v], lineLevels[0][v], lineLevels[1][v], error);
+            EXPECT_EQ(levels[0][v], levels[1][v]) << "view " << v;
+            EXPECT_EQ(lineLevels[0][v], lineLevels[1][v]) << "view " << v;
+            EXPECT_GT(treeCoverage(images[0][v], BACKGROUND), 0.001) << "view " << v;
+            EXPECT_LT(error, 0.01) << "view " << v;
+        }
+        EXPECT_NE(levels[0].front(), levels[0].back()) << "near and far draw one level";
+        std::vector<Image> row = images[0];
+        row.insert(row.end(), images[1].begin(), images[1].end());
+        writePng(OgreEnvironment::outDir() + "/ellipsoids-half-metre-and-500-m.png", sideBySide(row));
     }
 
     TEST(EllipsoidTree, theLevelFollowsTheHeightOnScreenAndTheBias)
