@@ -172,8 +172,8 @@ namespace TreeLod
             const auto packages = scenePackages(*script, {choice});
             ASSERT_EQ(packages.size(), 1u);
             EXPECT_EQ(packages.begin()->second,
-                      (std::vector<std::string>{"billboard-cloud", "classic-billboard-cloud", "impostor", "lodf",
-                                                "octahedral-impostor", "reference"}))
+                      (std::vector<std::string>{"billboard-cloud", "classic-billboard-cloud", "ellipsoids", "impostor",
+                                                "lodf", "octahedral-impostor", "reference"}))
                 << "choice '" << choice << "'";
         }
     }

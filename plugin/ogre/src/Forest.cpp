@@ -474,8 +474,8 @@ namespace TreeLod
 
     std::vector<Ogre::String> Forest::getAutoTechniques()
     {
-        return {REFERENCE_TECHNIQUE, "lodf", "billboard-cloud", "classic-billboard-cloud", "octahedral-impostor",
-                FLOOR_TECHNIQUE};
+        return {REFERENCE_TECHNIQUE, "lodf", "billboard-cloud", "classic-billboard-cloud", "ellipsoids",
+                "octahedral-impostor", FLOOR_TECHNIQUE};
     }
 
     std::vector<ForestLevel> Forest::levelsForErrorBudget(TreeAsset& asset, const std::vector<LevelCost>& costs,

@@ -64,6 +64,11 @@ namespace TreeLod
             ClassicBillboardCloudOptions options;
             if (Result<void> read = readOptions(given, CLASSIC_BILLBOARD_CLOUD_CHUNK, label, options.cloud); !read)
                 return read;
+            Result<double> memory = bakeOptionNumber(given, CLASSIC_BILLBOARD_CLOUD_CHUNK, "memoryBytes",
+                                                     double(options.memoryBytes), 0.0, 4294967295.0, label);
+            if (!memory)
+                return memory.error();
+            options.memoryBytes = std::uint64_t(memory.value());
             return addClassicBillboardCloudChunk(writer, model, options, label, progress);
         }
 
@@ -97,9 +102,19 @@ namespace TreeLod
             {BILLBOARD_CLOUD_CHUNK,
              "billboard cloud, multi-layered indirect texturing, García et al. 2007 (adds reference)", &bakeLayered,
              cloudOptions()});
+        std::vector<BakeOptionInfo> classicOptions()
+        {
+            std::vector<BakeOptionInfo> options = cloudOptions();
+            options.push_back({"memoryBytes",
+                               "GPU bytes of the billboard textures, 0 (those of the multi-layered cloud with the same "
+                               "options) to 4294967295",
+                               "0"});
+            return options;
+        }
+
         const BakeTechniqueRegistration classic(
             {CLASSIC_BILLBOARD_CLOUD_CHUNK,
              "classic billboard cloud at equal memory, García et al. 2007 Fig. 13 (adds reference)", &bakeClassic,
-             cloudOptions()});
+             classicOptions()});
     }
 }

@@ -158,7 +158,7 @@ namespace TreeLod
         static Ogre::Real pixelCountForHeight(TreeAsset& asset, Ogre::Real heightPixels);
 
         /// The techniques budgeted auto chooses among: the reference, lodf, both billboard clouds,
-        /// the octahedral impostor and the impostor (docs/octahedral-impostor.md, "On the front":
+        /// the ellipsoids (with their lines), the octahedral impostor and the impostor (docs/octahedral-impostor.md, "On the front":
         /// baked with AO it made auto worse; without, auto is faster and more accurate with it).
         static std::vector<Ogre::String> getAutoTechniques();
 
