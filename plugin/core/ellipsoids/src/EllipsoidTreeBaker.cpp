@@ -172,13 +172,15 @@ namespace TreeLod
                 return images;
             }
 
-            /// The ray-cast ellipsoids with their noise (renderEllipsoids), single-threaded.
+            /// The ellipsoids ray cast as the renderer draws them (renderEllipsoids), noise included;
+            /// the views in parallel.
             std::vector<Image> renderRayCast(const std::vector<Ellipsoid>& metres, float scale,
-                                             const EllipsoidNoiseSetting& noise, bool shaded) const
+                                             const EllipsoidNoiseSetting& noise = {}, bool shaded = false) const
             {
-                std::vector<Image> images;
-                for (const CameraSpec& c : mCameras)
-                    images.push_back(renderEllipsoids(metres, scale, noise, c, shaded ? mShaded : mOptions));
+                std::vector<Image> images(mCameras.size());
+                tbb::parallel_for(std::size_t(0), mCameras.size(), [&](std::size_t v) {
+                    images[v] = renderEllipsoids(metres, scale, noise, mCameras[v], shaded ? mShaded : mOptions);
+                });
                 return images;
             }
 
@@ -350,7 +352,7 @@ namespace TreeLod
         {
             Calibrated best{1.0f, std::numeric_limits<double>::infinity()};
             auto tryScale = [&](float s) {
-                const double e = views.error(reference, views.render(ellipsoidMesh(metres, s)));
+                const double e = views.error(reference, views.renderRayCast(metres, s));
                 if (e < best.error)
                     best = Calibrated{s, e};
             };
@@ -685,7 +687,7 @@ namespace TreeLod
                     if (candidate.ellipsoids.empty())
                         continue;
                     std::vector<Ellipsoid> metres = toMetres(candidate.ellipsoids, origin, diagonal);
-                    const double error = tries == 1 ? 0.0 : views.error(reference, views.render(ellipsoidMesh(metres, 1.0f)));
+                    const double error = tries == 1 ? 0.0 : views.error(reference, views.renderRayCast(metres, 1.0f));
                     if (error < bestError)
                     {
                         bestError = error;

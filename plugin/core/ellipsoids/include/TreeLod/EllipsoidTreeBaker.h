@@ -19,16 +19,15 @@
 //      the best) with the least image error.
 //   4. Image error (§4): multi-scale RMSE (ImageMetrics.h), mean over 4 orthographic views (three
 //      around at 15 degrees elevation, one from above) of viewResolution^2 pixels, 2x2 samples,
-//      rendered by the CPU ReferenceRenderer: the leaves in one flat colour (their textures' alpha
-//      kept, colour dropped), the ellipsoids as icospheres of 80 triangles whose surface area is
-//      the sphere's, in the same colour, so the error measures coverage only.
+//      the leaves rendered by the CPU ReferenceRenderer in one flat colour (their textures' alpha
+//      kept, colour dropped), the ellipsoids ray cast in the same colour as the renderer draws
+//      them (renderEllipsoids), so the error measures coverage only.
 //   4b. Noise (§3.1, Fig. 6; EllipsoidNoise.h), with `noise`: per level, the alpha threshold
 //      t of 0, 0.25, 0.4, 0.5, 0.6 and the area compensation on the calibrated scale (1 to 1.7;
 //      1 for t = 0) with the least coverage error, then the normal blend of 0 to 0.7 with the
-//      least error in shaded views (white surfaces under the default sun and sky). These are
-//      scored on the ellipsoids ray cast as the renderer draws them (renderEllipsoids: true
-//      ellipsoids, the holes and the far side through them, the noise's lod at the footprint of
-//      the level's target size), not on icospheres; the level's imageError is then this error.
+//      least error in shaded views (white surfaces under the default sun and sky), the holes, the
+//      far side through them and the noise's lod (at the footprint of the level's target size) as
+//      the renderer draws them; the level's imageError is then this error.
 //   5. Target size (§6): targetHeightPx = the tree's height in pixels at which the level's mean
 //      ellipsoid (the diameter of the disc with its mean projected area) is
 //      ELLIPSOID_TARGET_DIAMETER_PX pixels across.
@@ -103,7 +102,7 @@ namespace TreeLod
 
     /// The ellipsoids of level `level` of `data` (scaled by the level's scale times `extraScale`) as
     /// opaque, double-sided bark of one white material: icospheres of 80 triangles with the
-    /// sphere's surface area. What the baker renders; tests measure coverage with it.
+    /// sphere's surface area, for the CPU reference renderer (tests measure coverage with it).
     TreeModel ellipsoidLevelMesh(const EllipsoidTreeData& data, std::size_t level, float extraScale = 1.0f);
 
     /// The noise an ellipsoid level is drawn with (EllipsoidLevel, EllipsoidNoise.h).
