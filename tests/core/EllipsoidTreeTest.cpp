@@ -1,8 +1,9 @@
 // The ellipsoid tree (chunk "ellipsoids", the ellipsoids-and-lines paper (001) §3.1, §5): one leaf,
 // coplanar leaves (a singular covariance), two identical leaves, EM from all starts on one point,
-// the level counts of Alg. 1, the chunk round trip and every corruption named, determinism over
-// seeds and thread counts, each level's coverage against the leaves', 0.5 m vs 500 m, the
-// ellipsoids' ambient occlusion (§5), and the registered baker and descriptor.
+// 200,000 leaves, the level counts of Alg. 1, the CPU ray caster and the noise (§3.1, Fig. 6), the
+// chunk round trip and every corruption named, determinism over seeds and thread counts, each
+// level's coverage against the leaves', 0.5 m vs 500 m, the ellipsoids' ambient occlusion (§5),
+// and the registered baker and descriptor.
 #include "TreeLod/BakeTechniques.h"
 #include "TreeLod/EllipsoidNoise.h"
 #include "TreeLod/EllipsoidTreeBaker.h"
@@ -232,6 +233,41 @@ namespace TreeLod
             EXPECT_LE(e.levels[1].count, 32u);
             EXPECT_LE(e.levels[2].count, 4u);
             EXPECT_EQ(e.levels[3].count, 1u);
+        }
+
+        // 200,000 leaves (one try, 32-pixel views, a divisor of 64, so 200,000 / 3125 / 48 / 1): every
+        // leaf its ellipsoid, every level's leaf weights summing to the leaves its ellipsoids keep,
+        // nothing but finite values, 28 bytes an ellipsoid, and the chunk round-trips.
+        TEST(EllipsoidTreeBake, twoHundredThousandLeaves)
+        {
+            const TreeModel& oak = generatedOak(200000);
+            EllipsoidTreeOptions options;
+            options.tries = 1;
+            options.viewResolution = 32;
+            options.clustersDivisor = 64;
+            const EllipsoidTreeData d = bakeOrFail(oak, options);
+            ASSERT_EQ(d.levels.size(), 4u);
+            EXPECT_EQ(d.levels[0].count, 200000u);
+            EXPECT_LE(d.levels[1].count, 3125u);
+            EXPECT_GE(d.levels[1].count, 1500u);
+            EXPECT_LE(d.levels[2].count, 48u);
+            EXPECT_EQ(d.levels[3].count, 1u);
+            expectAllFinite(d);
+            for (std::size_t k = 0; k < d.levels.size(); ++k)
+            {
+                double weight = 0.0;
+                for (std::uint32_t i = d.levels[k].first; i < d.levels[k].first + d.levels[k].count; ++i)
+                    weight += d.ellipsoids[i].leafWeight;
+                // Ellipsoids under 1 % of the largest's area are dropped with their weight.
+                EXPECT_LE(weight, 200000.0 * 1.0001) << "level " << k;
+                EXPECT_GE(weight, 200000.0 * (k == 0 ? 0.9999 : 0.9)) << "level " << k;
+            }
+            const std::vector<std::uint8_t> bytes = encodeEllipsoidTreeChunk(d);
+            EXPECT_EQ(bytes.size(), d.encodedBytes());
+            EXPECT_LT(bytes.size(), 28u * d.ellipsoids.size() + 1024u);
+            Result<EllipsoidTreeData> back = decodeEllipsoidTreeChunk(bytes, "200k");
+            ASSERT_TRUE(back.ok()) << back.error().message();
+            EXPECT_EQ(back->ellipsoids.size(), d.ellipsoids.size());
         }
 
         const EllipsoidTreeData& oakBake()
