@@ -6,10 +6,10 @@
 
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/BakeCache.h"
-#include "TreeLod/BillboardCloudData.h"
 #include "TreeLod/Crc32.h"
 #include "TreeLod/FoliageLodData.h"
 #include "TreeLod/GltfExporter.h"
+#include "TreeLod/ImpostorData.h"
 #include "TreeLod/Package.h"
 #include "TreeLod/TreeGenerator.h"
 
@@ -605,15 +605,15 @@ TEST(BakeCacheProcesses, TwoProcessesAddDifferentTechniquesAtOnce)
     const std::string dir = testDir("different-techniques");
     const std::string glb = writeTinyGlb(dir);
     const Strings withLodf = {"reference", FOLIAGE_LOD_CHUNK};
-    const Strings withCloud = {"reference", BILLBOARD_CLOUD_CHUNK};
-    const Strings all = {"reference", FOLIAGE_LOD_CHUNK, BILLBOARD_CLOUD_CHUNK};
+    const Strings withImpostor = {"reference", IMPOSTOR_CHUNK};
+    const Strings all = {"reference", FOLIAGE_LOD_CHUNK, IMPOSTOR_CHUNK};
     // What either child, or one after the other, can leave (an incremental bake gives the bytes
     // of a bake in one request).
     const Bytes seed = fileBytes(requireOk(BakeCache(dir + "/seed"), glb, {"reference"}).path);
     const Bytes lodfPackage = fileBytes(requireOk(BakeCache(dir + "/lodf"), glb, withLodf).path);
-    const Bytes cloudPackage = fileBytes(requireOk(BakeCache(dir + "/cloud"), glb, withCloud).path);
+    const Bytes impostorPackage = fileBytes(requireOk(BakeCache(dir + "/impostor"), glb, withImpostor).path);
     const Bytes allPackage = fileBytes(requireOk(BakeCache(dir + "/all"), glb, all).path);
-    ASSERT_FALSE(seed.empty() || lodfPackage.empty() || cloudPackage.empty() || allPackage.empty());
+    ASSERT_FALSE(seed.empty() || lodfPackage.empty() || impostorPackage.empty() || allPackage.empty());
     const std::string cacheDir = dir + "/cache";
     const BakeCache cache(cacheDir);
     Result<std::string> path = cache.packagePath(glb, "{}");
@@ -628,25 +628,25 @@ TEST(BakeCacheProcesses, TwoProcessesAddDifferentTechniquesAtOnce)
         ASSERT_TRUE(writeFileAtomic(path.value(), seed).ok());
         const std::vector<ChildRun> children = runChildren(
             {{{"source", glb}, {"cache", cacheDir}, {"techniques", withLodf}, {"barrier", barrier}},
-             {{"source", glb}, {"cache", cacheDir}, {"techniques", withCloud}, {"barrier", barrier}}});
+             {{"source", glb}, {"cache", cacheDir}, {"techniques", withImpostor}, {"barrier", barrier}}});
         EXPECT_TRUE(children[0].atBarrier && children[1].atBarrier) << children[0].printed << children[1].printed;
         expectBaked(children[0], path.value(), {FOLIAGE_LOD_CHUNK}, {"reference"});
-        expectBaked(children[1], path.value(), {BILLBOARD_CLOUD_CHUNK}, {"reference"});
+        expectBaked(children[1], path.value(), {IMPOSTOR_CHUNK}, {"reference"});
 
         EXPECT_EQ(filesIn(cacheDir), Strings{fileName(path.value())}) << "no temporary file is left";
         EXPECT_EQ(verifyPackage(path.value()), "");
         const Bytes final = fileBytes(path.value());
         const bool lodfWon = final == lodfPackage;
-        const bool cloudWon = final == cloudPackage;
+        const bool impostorWon = final == impostorPackage;
         // Written together, each had read the seed; one after the other, the second adds to the first.
-        EXPECT_TRUE(lodfWon || cloudWon || (barrier == "start" && final == allPackage))
+        EXPECT_TRUE(lodfWon || impostorWon || (barrier == "start" && final == allPackage))
             << "the cache holds a package neither child wrote (" << final.size() << " bytes)";
 
         const BakeCacheEntry after = requireOk(cache, glb, all);
         EXPECT_TRUE(after.discardedReason.empty()) << after.discardedReason;
-        EXPECT_EQ(after.builtTechniques, lodfWon ? Strings{BILLBOARD_CLOUD_CHUNK}
-                                         : cloudWon ? Strings{FOLIAGE_LOD_CHUNK}
-                                                    : Strings{});
+        EXPECT_EQ(after.builtTechniques, lodfWon ? Strings{IMPOSTOR_CHUNK}
+                                         : impostorWon ? Strings{FOLIAGE_LOD_CHUNK}
+                                                       : Strings{});
         EXPECT_EQ(fileBytes(path.value()), allPackage);
     }
 }
@@ -659,10 +659,10 @@ TEST(BakeCacheProcesses, HitsWhilePackagesAreReplacedAreNotDiscarded)
     const std::string dir = testDir("replaced");
     const std::string glb = writeTinyGlb(dir);
     const std::string lodfPackage = requireOk(BakeCache(dir + "/lodf"), glb, {"reference", FOLIAGE_LOD_CHUNK}).path;
-    const std::string cloudPackage =
-        requireOk(BakeCache(dir + "/cloud"), glb, {"reference", BILLBOARD_CLOUD_CHUNK}).path;
+    const std::string impostorPackage =
+        requireOk(BakeCache(dir + "/impostor"), glb, {"reference", IMPOSTOR_CHUNK}).path;
     ASSERT_EQ(verifyPackage(lodfPackage), "");
-    ASSERT_EQ(verifyPackage(cloudPackage), "");
+    ASSERT_EQ(verifyPackage(impostorPackage), "");
     const std::string cacheDir = dir + "/cache";
     std::filesystem::create_directories(cacheDir);
     const BakeCache cache(cacheDir);
@@ -676,7 +676,7 @@ TEST(BakeCacheProcesses, HitsWhilePackagesAreReplacedAreNotDiscarded)
     std::thread writer([&] {
         const std::string linkPath = dir + "/link";
         for (int i = 0; !done; ++i)
-            if (::link(i % 2 ? lodfPackage.c_str() : cloudPackage.c_str(), linkPath.c_str()) != 0 ||
+            if (::link(i % 2 ? lodfPackage.c_str() : impostorPackage.c_str(), linkPath.c_str()) != 0 ||
                 ::rename(linkPath.c_str(), path->c_str()) != 0)
                 ++writeErrors;
     });

@@ -4,9 +4,9 @@
 
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/BakeCache.h"
-#include "TreeLod/BillboardCloudData.h"
 #include "TreeLod/FoliageLodData.h"
 #include "TreeLod/GltfExporter.h"
+#include "TreeLod/ImpostorData.h"
 #include "TreeLod/Package.h"
 #include "TreeLod/TreeGenerator.h"
 
@@ -321,12 +321,12 @@ TEST(BakeCache, HitVerifiesOnlyTheRequestedChunks)
     EXPECT_EQ(fileBytes(first.path), damaged);
 
     // A new technique rewrites the package: the damaged chunk is found and the request rebaked whole.
-    const BakeCacheEntry rewrite = requireOk(cache, glb, {"reference", BILLBOARD_CLOUD_CHUNK});
-    EXPECT_EQ(rewrite.builtTechniques, (Strings{"reference", BILLBOARD_CLOUD_CHUNK}));
+    const BakeCacheEntry rewrite = requireOk(cache, glb, {"reference", IMPOSTOR_CHUNK});
+    EXPECT_EQ(rewrite.builtTechniques, (Strings{"reference", IMPOSTOR_CHUNK}));
     EXPECT_TRUE(rewrite.reusedTechniques.empty());
     EXPECT_NE(rewrite.discardedReason.find("checksum"), std::string::npos) << rewrite.discardedReason;
     EXPECT_TRUE(chunkBytes(rewrite.path, FOLIAGE_LOD_CHUNK).empty()) << "the damaged chunk is not copied";
-    EXPECT_FALSE(chunkBytes(rewrite.path, BILLBOARD_CLOUD_CHUNK).empty());
+    EXPECT_FALSE(chunkBytes(rewrite.path, IMPOSTOR_CHUNK).empty());
 
     // Asking for the damaged technique itself verifies it.
     ASSERT_TRUE(writeFileAtomic(first.path, damaged).ok());
