@@ -385,12 +385,7 @@ namespace TreeLod
                                        const ErrorViews& views, const std::vector<Image>& reference,
                                        const std::vector<Image>& shadedReference)
         {
-            struct Candidate
-            {
-                EllipsoidNoiseSetting noise;
-                float compensation = 1.0f;
-                double error = 0.0;
-            };
+            using Candidate = NoiseCalibrated;
             auto evaluate = [&](std::vector<Candidate>& candidates, bool shaded) {
                 tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t i) {
                     Candidate& c = candidates[i];
@@ -419,12 +414,9 @@ namespace TreeLod
                 candidate.noise.normalBlend = b;
                 blends.push_back(candidate);
             }
-            const Candidate bestBlend = evaluate(blends, true);
-            NoiseCalibrated out;
-            out.noise = bestBlend.noise;
+            NoiseCalibrated out = evaluate(blends, true);
             out.noise.pixelSize = 0.0f;
-            out.compensation = bestHoles.compensation;
-            out.error = bestHoles.error;
+            out.error = bestHoles.error; // the level's error stays the coverage error
             return out;
         }
 
