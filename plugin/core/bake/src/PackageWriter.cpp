@@ -273,6 +273,24 @@ namespace TreeLod
         return out;
     }
 
+    GpuTexture decompressTexture(const GpuTexture& src)
+    {
+        if (!isBlockCompressed(src.format))
+            return src;
+        GpuTexture out;
+        out.name = src.name;
+        out.format = GpuTextureFormat::RGBA8;
+        out.width = src.width;
+        out.height = src.height;
+        out.mipCount = src.mipCount;
+        out.data.resize(gpuTextureBytes(GpuTextureFormat::RGBA8, src.width, src.height, src.mipCount));
+        const int flags = src.format == GpuTextureFormat::DXT5 ? squish::kDxt5 : squish::kDxt1;
+        for (std::uint32_t mip = 0; mip < src.mipCount; ++mip)
+            squish::DecompressImage(out.data.data() + out.mipOffset(mip), int(src.mipWidth(mip)),
+                                    int(src.mipHeight(mip)), src.data.data() + src.mipOffset(mip), flags);
+        return out;
+    }
+
     ReferenceChunk makeReferenceChunk(const TreeModel& model)
     {
         ReferenceChunk chunk;

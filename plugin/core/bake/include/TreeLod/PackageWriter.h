@@ -80,6 +80,8 @@ namespace TreeLod
     /// DXT5) with libsquish's cluster fit, level by level. Block rows run in parallel; each
     /// block depends on its own texels only, so the bytes do not depend on the thread count.
     GpuTexture compressTexture(const GpuTexture& rgba8, GpuTextureFormat format);
+    /// A DXT1 or DXT5 texture back to RGBA8 (every mip level, libsquish); RGBA8 is returned as it is.
+    GpuTexture decompressTexture(const GpuTexture& compressed);
 
     /// The reference chunk of `model`: the model without its decoded textures plus a mip chain
     /// per texture, alpha-coverage preserving (with that material's cutoff) for the textures
