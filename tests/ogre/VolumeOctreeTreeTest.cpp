@@ -1,0 +1,272 @@
+// The volumetric octree tree through Plugin_TreeLod: a VolumeOctreeTree made by its factory draws
+// what the CPU twin (renderVolumeOctree) draws, pixel for pixel within FLIP bounds, at a forced
+// level and at the level its distance planes choose; nearer trees get finer levels and the camera
+// LoD bias moves them; the view octant reorders the cells; bad parameters and a package without
+// the chunk are named; a golden image of the oak.
+#include "OgreTestSupport.h"
+
+#include "TreeLod/CaptureSet.h"
+#include "TreeLod/PackageWriter.h"
+#include "TreeLod/TreeAssetManager.h"
+#include "TreeLod/TreeGenerator.h"
+#include "TreeLod/TreeViews.h"
+#include "TreeLod/VolumeOctreeBaker.h"
+#include "TreeLod/VolumeOctreeTree.h"
+
+#include <OgreSceneManager.h>
+
+namespace TreeLod
+{
+    namespace
+    {
+        struct BakedOak
+        {
+            TreeModel model;
+            VolumeOctreeData data;
+            TreeAssetPtr asset;
+        };
+
+        /// A generated oak photographed by 16 cameras and reconstructed in 6 levels.
+        const BakedOak& oak()
+        {
+            return OgreEnvironment::keep<BakedOak>("volume-octree.oak", [] {
+                BakedOak t;
+                GeneratorOptions generator;
+                generator.leafCount = 1500;
+                generator.textureSize = 64;
+                Result<TreeModel> model = generateTree(generator);
+                EXPECT_TRUE(model.ok());
+                t.model = std::move(model.value());
+                const std::vector<std::uint8_t> bytes = cachedPackage("volume-octree", "oak", [&] {
+                    CaptureSynthesisOptions capture;
+                    capture.cameraCount = 16;
+                    capture.resolution = 128;
+                    capture.samplesPerPixel = 1;
+                    VolumeOctreeOptions options;
+                    options.levelCount = 6;
+                    options.quantisation.colourCodebookSize = 256;
+                    options.quantisation.alphaCodebookSize = 256;
+                    PackageWriter writer;
+                    Result<void> added = addVolumeOctreeChunk(writer, t.model, capture, options, "oak");
+                    EXPECT_TRUE(added.ok()) << (added.ok() ? "" : added.error().message());
+                    return added.ok() ? writer.toBytes() : std::vector<std::uint8_t>();
+                });
+                t.asset = TreeAssetManager::getSingleton().loadFromBytes("oak.volume-octree-test", Ogre::RGN_DEFAULT,
+                                                                         bytes);
+                t.data = VolumeOctreeResources::of(*t.asset).getData();
+                return t;
+            });
+        }
+
+        const glm::vec3 BACKGROUND = LightingSpec().background;
+
+        struct Drawn
+        {
+            Image image;
+            std::uint32_t activeLevel = 0;
+            std::size_t cells = 0;
+        };
+
+        Drawn renderTree(const CameraSpec& camera, int size, const Ogre::NameValuePairList& extra = {},
+                         float lodBias = 1.0f)
+        {
+            const BakedOak& t = oak();
+            OffscreenRenderer& r = OgreEnvironment::renderer();
+            r.clearContent();
+            r.setLodBias(lodBias);
+            Ogre::NameValuePairList params = {{"asset", t.asset->getName()}, {"group", t.asset->getGroup()}};
+            params.insert(extra.begin(), extra.end());
+            auto* tree = static_cast<VolumeOctreeTree*>(r.getSceneManager().createMovableObject(
+                "volume", VolumeOctreeTreeFactory::FACTORY_TYPE_NAME, &params));
+            r.getContentNode().attachObject(tree);
+            Drawn d;
+            d.image = toImage(r.render(camera, size, size, 1));
+            d.activeLevel = tree->getActiveLevel();
+            d.cells = tree->getDrawnCellCount();
+            r.clearContent();
+            r.setLodBias(1.0f);
+            return d;
+        }
+
+        Image twin(const CameraSpec& camera, int size, int level)
+        {
+            VolumeOctreeRenderOptions o;
+            o.width = o.height = size;
+            o.activeLevel = level;
+            o.background = BACKGROUND;
+            Image image = renderVolumeOctree(oak().data, volumeOctreeAtlasSource(oak().data), camera, o);
+            // 8 bits a channel, as the GPU's frame (float against 8-bit sky alone costs FLIP ~0.03).
+            for (glm::vec4& p : image.pixels)
+                p = glm::round(p * 255.0f) / 255.0f;
+            return image;
+        }
+
+        /// FLIP of `test` against `reference` over the square around the tree in either.
+        double boxFlip(const Image& reference, const Image& test)
+        {
+            const Crop crop = cropAround(unite(treeExtent(reference), treeExtent(test)), reference.width,
+                                         reference.height);
+            return flipMean(cropImage(reference, crop), cropImage(test, crop));
+        }
+
+        /// Pixels that differ from the background.
+        std::size_t covered(const Image& image)
+        {
+            std::size_t n = 0;
+            for (const glm::vec4& p : image.pixels)
+                n += glm::length(glm::vec3(p) - BACKGROUND) > 2.0f / 255.0f ? 1 : 0;
+            return n;
+        }
+    }
+
+    TEST(VolumeOctreeTree, drawsWhatTheCpuTwinDraws)
+    {
+        OgreEnvironment::renderer().setShadows(false);
+        const BakedOak& t = oak();
+        const CameraSpec camera = CameraSpec::framing(t.model.boundsMin, t.model.boundsMax, 30.0f, 15.0f, 1.0f);
+        std::vector<Image> strip;
+        for (int level : {2, 4, 5})
+        {
+            const Drawn gpu = renderTree(camera, 160, {{"level", std::to_string(level)}});
+            const Image cpu = twin(camera, 160, level);
+            EXPECT_EQ(gpu.activeLevel, std::uint32_t(level));
+            const double error = boxFlip(cpu, gpu.image);
+            EXPECT_LT(error, 0.03) << "level " << level;
+            // Not a blank frame: the tree covers a good part of it, on both.
+            EXPECT_GT(covered(gpu.image), std::size_t(160 * 160 / 8)) << "level " << level;
+            // The GPU rounds each blend to 8 bits: faint edges of the coarse levels differ a little.
+            EXPECT_NEAR(double(covered(gpu.image)) / double(covered(cpu)), 1.0, 0.1) << "level " << level;
+            std::printf("level %d: tree-box FLIP %.4f against the CPU twin\n", level, error);
+            strip.push_back(cpu);
+            strip.push_back(gpu.image);
+        }
+        writePng(OgreEnvironment::outDir() + "/volume-octree-twin.png", sideBySide(strip));
+    }
+
+    TEST(VolumeOctreeTree, distancePlanesPickTheLevel)
+    {
+        OgreEnvironment::renderer().setShadows(false);
+        const BakedOak& t = oak();
+        const CameraSpec near = CameraSpec::framing(t.model.boundsMin, t.model.boundsMax, 0.0f, 10.0f, 0.8f);
+        const CameraSpec far = CameraSpec::framing(t.model.boundsMin, t.model.boundsMax, 0.0f, 10.0f, 8.0f);
+        const Drawn n = renderTree(near, 160), f = renderTree(far, 160);
+        EXPECT_GT(n.activeLevel, f.activeLevel);
+        EXPECT_GT(n.cells, f.cells);
+        // The chosen level draws as the twin draws it, the near camera mixing two levels by its plane.
+        EXPECT_LT(boxFlip(twin(near, 160, -1), n.image), 0.03);
+        EXPECT_LT(boxFlip(twin(far, 160, -1), f.image), 0.03);
+        // A level off is a visibly different picture: the bound above can fail.
+        EXPECT_GT(boxFlip(twin(near, 160, int(n.activeLevel) - 1), n.image), 0.05);
+        // A lower LoD bias draws coarser.
+        const Drawn coarse = renderTree(near, 160, {}, 0.25f);
+        EXPECT_LT(coarse.activeLevel, n.activeLevel);
+        compareWithGolden(n.image, "oak-volume-octree", 0.02);
+        writePng(OgreEnvironment::outDir() + "/volume-octree-near-far.png", sideBySide({n.image, f.image, coarse.image}));
+    }
+
+    TEST(VolumeOctreeTree, everyViewOctantDrawsBackToFront)
+    {
+        // Eight cells of level 1, each an even colour at alpha 0.8. Looking along a diagonal of the
+        // cube, the corner cell nearest the camera and the opposite one cover the centre pixel:
+        // the near colour must lie over the far one, from every octant.
+        const glm::vec3 colours[8] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0},
+                                      {1, 0, 1}, {0, 1, 1}, {1, 1, 1}, {0.5f, 0.25f, 0}};
+        VolumeOctreeData d;
+        d.levelCount = 2;
+        d.origin = glm::vec3(-1.0f, 0.0f, -1.0f);
+        d.size = 2.0f;
+        d.cameraDirections = {glm::vec3(0.0f, 0.0f, 1.0f)};
+        d.levelCellCounts = {1, 8};
+        d.cells.push_back(volumeCellCode(0, 0, 0));
+        d.slots.push_back({}); // the root draws nothing
+        for (std::uint32_t k = 0; k < 8; ++k) // Morton order: x lowest
+        {
+            d.cells.push_back(volumeCellCode(k & 1, (k >> 1) & 1, k >> 2));
+            d.slots.push_back({std::uint16_t(k), 0});
+        }
+        d.colourCodewords = 8;
+        d.alphaCodewords = 1;
+        d.atlas.name = "eight colours";
+        d.atlas.width = 16;
+        d.atlas.height = 8;
+        d.atlas.mipCount = 1;
+        d.atlas.data.assign(16 * 8 * 4, 0);
+        for (std::uint32_t y = 0; y < 8; ++y)
+            for (std::uint32_t x = 0; x < 16; ++x)
+            {
+                std::uint8_t* t = &d.atlas.data[(y * 16 + x) * 4];
+                const glm::vec3& c = colours[(y / 4) * 4 + x / 4];
+                t[0] = unitToByte(c.r);
+                t[1] = unitToByte(c.g);
+                t[2] = unitToByte(c.b);
+                t[3] = 204;
+            }
+        ASSERT_TRUE(d.validate("eight cells"));
+        PackageWriter writer;
+        ASSERT_TRUE(addReferenceChunkIfMissing(writer, oak().model, "eight cells", {}).ok());
+        ASSERT_TRUE(writer.addChunk(VOLUME_OCTREE_CHUNK, 0, VOLUME_OCTREE_CHUNK_FORMAT_VERSION,
+                                    encodeVolumeOctreeChunk(d)).ok());
+        TreeAssetPtr asset =
+            TreeAssetManager::getSingleton().loadFromBytes("eight.volume-octree-test", Ogre::RGN_DEFAULT, writer.toBytes());
+
+        OgreEnvironment::renderer().setShadows(false);
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        for (std::uint32_t corner = 0; corner < 8; ++corner)
+        {
+            const glm::vec3 sign(corner & 1 ? 1.0f : -1.0f, (corner >> 1) & 1 ? 1.0f : -1.0f, corner >> 2 ? 1.0f : -1.0f);
+            CameraSpec camera;
+            camera.target = glm::vec3(0.0f, 1.0f, 0.0f);
+            camera.position = camera.target + 6.0f * glm::normalize(sign);
+            camera.up = std::abs(sign.y) > 0.0f ? glm::vec3(1.0f, 0.0f, 0.0f) : camera.up;
+            r.clearContent();
+            const Ogre::NameValuePairList params = {{"asset", asset->getName()}, {"group", asset->getGroup()},
+                                                    {"level", "1"}, {"lodPixels", "0.001"}};
+            r.getContentNode().attachObject(r.getSceneManager().createMovableObject(
+                "eight", VolumeOctreeTreeFactory::FACTORY_TYPE_NAME, &params));
+            const Image image = toImage(r.render(camera, 32, 32, 1));
+            r.clearContent();
+            const glm::vec3 near = colours[corner], far = colours[7 - corner];
+            const glm::vec3 expected = 0.8f * near + 0.2f * (0.8f * far + 0.2f * BACKGROUND);
+            const glm::vec3 centre(image.at(16, 16));
+            EXPECT_LT(glm::length(centre - expected), 0.03f)
+                << "corner " << corner << ": centre (" << centre.r << ", " << centre.g << ", " << centre.b
+                << "), expected (" << expected.r << ", " << expected.g << ", " << expected.b << ")";
+        }
+        TreeAssetManager::getSingleton().remove(asset);
+    }
+
+    TEST(VolumeOctreeTree, badParametersAndMissingChunkAreNamed)
+    {
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const BakedOak& t = oak();
+        const Ogre::NameValuePairList params = {{"asset", t.asset->getName()}, {"group", t.asset->getGroup()},
+                                                {"level", "6"}};
+        try
+        {
+            r.getSceneManager().createMovableObject("bad", VolumeOctreeTreeFactory::FACTORY_TYPE_NAME, &params);
+            FAIL() << "level 6 of 6 levels accepted";
+        }
+        catch (const Ogre::Exception& e)
+        {
+            EXPECT_NE(e.getFullDescription().find("not a level of the octree (6 levels)"), std::string::npos)
+                << e.getFullDescription();
+        }
+        PackageWriter writer;
+        ASSERT_TRUE(addReferenceChunkIfMissing(writer, t.model, "plain", {}).ok());
+        TreeAssetPtr plain =
+            TreeAssetManager::getSingleton().loadFromBytes("oak.plain-volume-test", Ogre::RGN_DEFAULT, writer.toBytes());
+        const Ogre::NameValuePairList plainParams = {{"asset", plain->getName()}, {"group", plain->getGroup()}};
+        try
+        {
+            r.getSceneManager().createMovableObject("missing", VolumeOctreeTreeFactory::FACTORY_TYPE_NAME, &plainParams);
+            FAIL() << "a package without the chunk accepted";
+        }
+        catch (const Ogre::Exception& e)
+        {
+            EXPECT_NE(e.getFullDescription().find("volume-octree"), std::string::npos) << e.getFullDescription();
+            EXPECT_NE(e.getFullDescription().find("oak.plain-volume-test"), std::string::npos)
+                << e.getFullDescription();
+        }
+        TreeAssetManager::getSingleton().remove(plain);
+    }
+}
