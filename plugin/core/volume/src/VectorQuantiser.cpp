@@ -3,17 +3,18 @@
 //
 // The nearest-codeword search is exact (nearest by the float squared distance, ties to the lowest
 // index) but prunes with three bounds: a per-vector lower bound of the distance to every codeword
-// but its own, kept across iterations by subtracting how far codewords moved (Hamerly 2010); the
-// codewords sorted by their projection on the data's principal axis, walked outward from the
-// vector's projection until the projection gap alone exceeds the second-best distance; and partial
-// distances abandoned once they pass the second-best. Every vector's search reads only shared
-// data, so results do not depend on the thread count.
+// but its own, carried across iterations by subtracting how far the codewords moved (Hamerly 2010);
+// a kd-tree over the codewords' features (coordinates on the 3 principal axes and the norm of the
+// rest), whose distances bound the true ones from below; and partial distances abandoned once they
+// pass the second-nearest. Each vector's search reads only shared data, so results do not depend
+// on the thread count.
 #include "TreeLod/VectorQuantiser.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -21,6 +22,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #if defined(__SSE2__) || defined(_M_X64)
 #include <emmintrin.h>
@@ -352,7 +354,8 @@ namespace TreeLod
                     const std::uint32_t mid = begin + (end - begin) / 2;
                     std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
                                      [&](std::uint32_t a, std::uint32_t b) {
-                                         return all[a][split] < all[b][split] || (all[a][split] == all[b][split] && a < b);
+                                         const double fa = all[a][split], fb = all[b][split];
+                                         return fa < fb || (fa == fb && a < b);
                                      });
                     node.left = build(all, begin, mid);
                     node.right = build(all, mid, end);
@@ -382,6 +385,16 @@ namespace TreeLod
                                       for (std::size_t i = r.begin(); i < r.end(); ++i)
                                           mFeatures[i] = features(data + i * std::size_t(dim), rest);
                                   });
+                // Features carry double rounding of about 1e-14 |x - mean|: an absolute margin for them.
+                double largest = 0.0;
+                for (const Features& f : mFeatures)
+                {
+                    double normSquared = 0.0;
+                    for (double v : f)
+                        normSquared += v * v;
+                    largest = std::max(largest, normSquared);
+                }
+                mFeatureSlack = 1e-11 * largest;
             }
 
             /// Assign every vector to its nearest codeword of `codebook`. `previous` is the codebook
@@ -486,7 +499,7 @@ namespace TreeLod
                 while (top > 0)
                 {
                     const auto [n, boxDistance] = stack[--top];
-                    const double limit = double(second) * (1.0 + mSlack);
+                    const double limit = double(second) * (1.0 + mSlack) + mFeatureSlack;
                     if (boxDistance > limit)
                         continue;
                     const CodewordTree::Node& node = tree.nodes[n];
@@ -502,7 +515,8 @@ namespace TreeLod
                     for (std::uint32_t s = node.begin; s < node.end; ++s)
                     {
                         const std::uint32_t j = tree.order[s];
-                        if (j == skip || featureDistance(fx, tree.features[s]) > double(second) * (1.0 + mSlack))
+                        if (j == skip ||
+                            featureDistance(fx, tree.features[s]) > double(second) * (1.0 + mSlack) + mFeatureSlack)
                             continue;
                         const float dj = squaredDistance(x, codebook + j * d, mDim, second);
                         if (dj < best || (dj == best && j < bestIndex))
@@ -527,6 +541,7 @@ namespace TreeLod
             std::vector<Features> mFeatures; ///< per vector
             std::vector<double> mLower; ///< per vector, lower bound of the distance to every other codeword
             double mSlack;              ///< relative margin on float distances
+            double mFeatureSlack = 0.0; ///< absolute margin on feature distances
         };
 
         /// Vectors grouped by codeword, each group in index order (a counting sort).
@@ -749,10 +764,24 @@ namespace TreeLod
         result.dimension = dimension;
         if (count == 0)
             return result;
+        // The training set: every vector, or an evenly strided subset of maxTrainingVectors.
+        std::vector<float> subset;
         const float* data = vectors.data();
+        std::size_t trainCount = count;
+        if (options.maxTrainingVectors > 0 && count > options.maxTrainingVectors)
+        {
+            trainCount = options.maxTrainingVectors;
+            subset.resize(trainCount * d);
+            for (std::size_t i = 0; i < trainCount; ++i)
+            {
+                const std::size_t from = std::size_t((unsigned __int128)i * count / trainCount);
+                std::copy(data + from * d, data + (from + 1) * d, &subset[i * d]);
+            }
+            data = subset.data();
+        }
 
         // Initial codewords: K distinct training vectors by a seeded partial Fisher-Yates draw.
-        std::vector<std::uint32_t> distinct = distinctVectors(data, count, dimension);
+        std::vector<std::uint32_t> distinct = distinctVectors(data, trainCount, dimension);
         const std::uint32_t k = std::uint32_t(std::min<std::size_t>(options.codebookSize, distinct.size()));
         std::mt19937_64 rng(options.seed);
         std::vector<float> codebook(k * d), previous;
@@ -764,7 +793,7 @@ namespace TreeLod
         distinct = {};
 
         // GLA iterations (Linz et al. 2006, §4.1): assign to the nearest codeword, move to the means.
-        NearestCodeword search(data, count, dimension);
+        NearestCodeword search(data, trainCount, dimension);
         search.assign(codebook, previous);
         double mse = search.meanSquaredError();
         for (int iteration = 1; iteration <= options.maxIterations; ++iteration)
@@ -786,9 +815,18 @@ namespace TreeLod
         if (options.nearestInput)
         {
             previous = codebook;
-            moveToNearestInputs(data, count, dimension, search, codebook);
+            moveToNearestInputs(data, trainCount, dimension, search, codebook);
             search.assign(codebook, previous);
             mse = search.meanSquaredError();
+        }
+
+        if (!subset.empty())
+        {
+            // Every vector to its nearest codeword of the subset's codebook.
+            NearestCodeword all(vectors.data(), count, dimension);
+            all.assign(codebook, {});
+            mse = all.meanSquaredError();
+            search.assignment = std::move(all.assignment);
         }
 
         result.codebook = std::move(codebook);
@@ -902,6 +940,7 @@ namespace TreeLod
         gla.maxIterations = options.maxIterations;
         gla.nearestInput = options.nearestInput;
         gla.seed = options.seed;
+        gla.maxTrainingVectors = options.maxTrainingVectors;
         gla.codebookSize = options.colourCodebookSize;
         GlaResult colourGla = runGla(colour, COLOUR_DIM, gla);
         colour = {};
