@@ -64,57 +64,6 @@ namespace TreeLod
 
         void progressLine(const std::string& line) { std::fprintf(stderr, "corpus-study: %s\n", line.c_str()); }
 
-        struct StudyTree
-        {
-            std::string label;
-            TreeModel model;
-        };
-
-        StudyTree loadTree(const std::string& spec)
-        {
-            StudyTree tree;
-            if (spec.rfind("generated:", 0) == 0)
-            {
-                std::vector<std::string> fields;
-                std::stringstream in(spec.substr(10));
-                for (std::string f; std::getline(in, f, ':');)
-                    fields.push_back(f);
-                GeneratorOptions options;
-                if (fields.empty() || !parsePreset(fields[0], options.preset))
-                    throw StudyError("tree '" + spec +
-                                     "': no preset (generated:PRESET[:LEAVES[:IMAGES[:MATERIALS[:FOLD]]]])");
-                try
-                {
-                    if (fields.size() > 1)
-                        options.leafCount = std::uint32_t(std::stoul(fields[1]));
-                    if (fields.size() > 2)
-                        options.leafImages = std::uint32_t(std::stoul(fields[2]));
-                    if (fields.size() > 3)
-                        options.leafMaterials = std::uint32_t(std::stoul(fields[3]));
-                    if (fields.size() > 4)
-                        options.leafFold = std::stof(fields[4]);
-                }
-                catch (const std::exception&)
-                {
-                    throw StudyError("tree '" + spec + "': LEAVES, IMAGES and MATERIALS are whole numbers, FOLD degrees");
-                }
-                Result<TreeModel> model = generateTree(options);
-                if (!model)
-                    throw StudyError("tree '" + spec + "': " + model.error().message());
-                tree.model = std::move(model.value());
-                tree.label = spec;
-            }
-            else
-            {
-                Result<TreeModel> model = importGltf(spec);
-                if (!model)
-                    throw StudyError(model.error().message());
-                tree.model = std::move(model.value());
-                tree.label = std::filesystem::path(spec).filename().string();
-            }
-            return tree;
-        }
-
         /// TECHNIQUE.NAME=VALUE assignments (`flag` --option or --param) by technique; each
         /// technique among --techniques (or "mesh", for --param).
         std::map<std::string, BakeOptions> assignmentsByTechnique(const std::vector<std::string>& texts,
@@ -340,7 +289,7 @@ namespace TreeLod
             std::vector<std::string> labels;
             for (std::size_t t = 0; t < args.trees.size(); ++t)
             {
-                const StudyTree tree = loadTree(args.trees[t]);
+                const StudyTree tree = loadStudyTree(args.trees[t]);
                 labels.push_back(tree.label);
                 std::map<std::string, std::uint64_t> chunkBytes;
                 TreeAssetPtr asset = TreeAssetManager::getSingleton().loadFromBytes(

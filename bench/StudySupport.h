@@ -4,6 +4,8 @@
 #pragma once
 
 #include "TreeLod/AtomicFile.h"
+#include "TreeLod/GltfImporter.h"
+#include "TreeLod/TreeGenerator.h"
 #include "TreeLod/Camera.h"
 #include "TreeLod/Image.h"
 #include "TreeLod/ImageMetrics.h"
@@ -20,7 +22,9 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -153,6 +157,59 @@ namespace TreeLod
         for (int i = 1; i < argc; ++i)
             line += std::string(" ") + argv[i];
         return line;
+    }
+
+    struct StudyTree
+    {
+        std::string label;
+        TreeModel model;
+    };
+
+    /// A tree spec: a .glb/.gltf path, or generated:PRESET[:LEAVES[:IMAGES[:MATERIALS[:FOLD]]]] (TreeGenerator).
+    /// Throws StudyError naming the spec.
+    inline StudyTree loadStudyTree(const std::string& spec)
+    {
+        StudyTree tree;
+        if (spec.rfind("generated:", 0) == 0)
+        {
+            std::vector<std::string> fields;
+            std::stringstream in(spec.substr(10));
+            for (std::string f; std::getline(in, f, ':');)
+                fields.push_back(f);
+            GeneratorOptions options;
+            if (fields.empty() || !parsePreset(fields[0], options.preset))
+                throw StudyError("tree '" + spec +
+                                 "': no preset (generated:PRESET[:LEAVES[:IMAGES[:MATERIALS[:FOLD]]]])");
+            try
+            {
+                if (fields.size() > 1)
+                    options.leafCount = std::uint32_t(std::stoul(fields[1]));
+                if (fields.size() > 2)
+                    options.leafImages = std::uint32_t(std::stoul(fields[2]));
+                if (fields.size() > 3)
+                    options.leafMaterials = std::uint32_t(std::stoul(fields[3]));
+                if (fields.size() > 4)
+                    options.leafFold = std::stof(fields[4]);
+            }
+            catch (const std::exception&)
+            {
+                throw StudyError("tree '" + spec + "': LEAVES, IMAGES and MATERIALS are whole numbers, FOLD degrees");
+            }
+            Result<TreeModel> model = generateTree(options);
+            if (!model)
+                throw StudyError("tree '" + spec + "': " + model.error().message());
+            tree.model = std::move(model.value());
+            tree.label = spec;
+        }
+        else
+        {
+            Result<TreeModel> model = importGltf(spec);
+            if (!model)
+                throw StudyError(model.error().message());
+            tree.model = std::move(model.value());
+            tree.label = std::filesystem::path(spec).filename().string();
+        }
+        return tree;
     }
 
     /// summary.md and summary.json (with "command") in `out`, and the Markdown on stdout.

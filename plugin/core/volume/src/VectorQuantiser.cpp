@@ -10,6 +10,8 @@
 // on the thread count.
 #include "TreeLod/VectorQuantiser.h"
 
+#include "TreeLod/Colour.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -687,16 +689,6 @@ namespace TreeLod
                                              {0.0556434, -0.2040259, 1.0572252}};
         constexpr double DELTA = 6.0 / 29.0;
 
-        double srgbToLinear(double c)
-        {
-            return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
-        }
-
-        double linearToSrgb(double c)
-        {
-            return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
-        }
-
         /// The CIE f() with its linear segment near black, and its inverse.
         double labF(double t)
         {
@@ -720,7 +712,7 @@ namespace TreeLod
             static const std::array<double, 256> table = [] {
                 std::array<double, 256> t{};
                 for (int i = 0; i < 256; ++i)
-                    t[std::size_t(i)] = srgbToLinear(i / 255.0);
+                    t[std::size_t(i)] = srgbByteToLinear(std::uint8_t(i));
                 return t;
             }();
             return table;
@@ -730,13 +722,6 @@ namespace TreeLod
         {
             const std::array<double, 256>& lin = byteToLinear();
             return labFromLinear(lin[texel[0]], lin[texel[1]], lin[texel[2]]);
-        }
-
-        /// [0, 1] to a byte, rounded; out of range and NaN clamp (NaN to 0).
-        std::uint8_t unitToByte(double v)
-        {
-            const double s = v * 255.0;
-            return s >= 255.0 ? std::uint8_t(255) : s > 0.0 ? std::uint8_t(s + 0.5) : std::uint8_t(0);
         }
     }
 
@@ -837,7 +822,7 @@ namespace TreeLod
 
     std::array<float, 3> srgbToLab(float r, float g, float b)
     {
-        const auto linear = [](float c) { return srgbToLinear(std::clamp(double(c), 0.0, 1.0)); };
+        const auto linear = [](float c) { return double(srgbToLinear(std::clamp(c, 0.0f, 1.0f))); };
         return labFromLinear(linear(r), linear(g), linear(b));
     }
 
@@ -849,7 +834,7 @@ namespace TreeLod
         for (int c = 0; c < 3; ++c)
         {
             const double linear = XYZ_TO_RGB[c][0] * x + XYZ_TO_RGB[c][1] * y + XYZ_TO_RGB[c][2] * z;
-            out[std::size_t(c)] = float(std::clamp(linearToSrgb(std::clamp(linear, 0.0, 1.0)), 0.0, 1.0));
+            out[std::size_t(c)] = std::clamp(linearToSrgb(float(std::clamp(linear, 0.0, 1.0))), 0.0f, 1.0f);
         }
         return out;
     }
@@ -913,7 +898,7 @@ namespace TreeLod
             }
             else
                 for (std::size_t c = 0; c < 3; ++c)
-                    texel[c] = unitToByte(v[c] / 100.0);
+                    texel[c] = unitToByte(float(v[c] / 100.0));
             texel[3] = 255;
         }
         return out;
@@ -955,7 +940,7 @@ namespace TreeLod
         {
             BillboardTexture texture; // colour 0
             for (std::size_t t = 0; t < std::size_t(BILLBOARD_TEXELS); ++t)
-                texture.texels[t][3] = unitToByte(alphaGla.codebook[j * std::size_t(BILLBOARD_TEXELS) + t] / 255.0);
+                texture.texels[t][3] = unitToByte(alphaGla.codebook[j * std::size_t(BILLBOARD_TEXELS) + t] / 255.0f);
             q.alphaCodebook.push_back(texture);
         }
         q.colourIndex = std::move(colourGla.assignment);

@@ -1,0 +1,200 @@
+// treelod_volume_study: the volumetric octree tree's bake measured as Linz et al. 2006 measure it,
+// on one tree (a .glb, or generated:PRESET:LEAVES), on the CPU (no X server needed):
+//   - bake time per step: photographs (the reference renderer), reconstruction, quantisation;
+//   - per level the cells, billboards and the share pruned (Fig. 4), hidden and empty apart;
+//   - texture memory (§6): the octree's raw 4x4 RGBA8 billboards unpruned and pruned, VQ (the
+//     codebook atlas in RGBA8 plus the slot table) and VQ + DXT5;
+//   - PSNR of the quantised billboards against the raw ones, colour and alpha, against the
+//     codebook size (Fig. 6);
+//   - at one codebook size, the colour RMS of RGB GLA, CIELab GLA and the modified GLA in CIELab
+//     (Fig. 5): over the billboards' covered texels, and over images of the tree drawn by the CPU
+//     twin from between the input cameras, against the same octree uncompressed.
+// Output in --out: summary.md and summary.json.
+#include "TreeLod/VolumeOctreeBaker.h"
+
+#include "StudySupport.h"
+
+#include <CLI/CLI.hpp>
+
+namespace TreeLod
+{
+    namespace
+    {
+        /// RMS of the colour channels (0..255, R, G, B averaged) over pixels either image covers.
+        double imageColourRms(const Image& reference, const Image& test)
+        {
+            double sum[3] = {0, 0, 0};
+            std::size_t n = 0;
+            for (std::size_t i = 0; i < reference.pixels.size(); ++i)
+            {
+                if (reference.pixels[i].a <= 0.0f && test.pixels[i].a <= 0.0f)
+                    continue;
+                ++n;
+                for (int c = 0; c < 3; ++c)
+                {
+                    const double d = 255.0 * (double(reference.pixels[i][c]) - double(test.pixels[i][c]));
+                    sum[c] += d * d;
+                }
+            }
+            if (n == 0)
+                return 0.0;
+            return (std::sqrt(sum[0] / n) + std::sqrt(sum[1] / n) + std::sqrt(sum[2] / n)) / 3.0;
+        }
+
+        int run(int argc, char** argv)
+        {
+            std::string tree = "generated:oak:20000", out = "out/volume-study";
+            CaptureSynthesisOptions capture;
+            VolumeOctreeOptions options;
+            std::vector<std::uint32_t> codebooks{16, 64, 256, 512, 1024, 2048};
+            std::uint32_t compareAt = 512;
+            CLI::App app{"The volumetric octree tree's bake, memory and compression (Linz et al. 2006)"};
+            app.add_option("--tree", tree, "a .glb or generated:PRESET:LEAVES");
+            app.add_option("--cameras", capture.cameraCount, "synthetic photographs")->check(CLI::Range(1, 64));
+            app.add_option("--resolution", capture.resolution, "pixels a side of each photograph");
+            app.add_option("--levels", options.levelCount, "octree levels")->check(CLI::Range(1, 10));
+            app.add_option("--codebooks", codebooks, "codebook sizes for the PSNR curve");
+            app.add_option("--compare-at", compareAt, "codebook size of the RGB / CIELab / modified comparison");
+            app.add_option("--out", out, "output folder");
+            CLI11_PARSE(app, argc, argv);
+            std::filesystem::create_directories(out);
+
+            const StudyTree loaded = loadStudyTree(tree);
+            const TreeModel& model = loaded.model;
+            const auto t0 = std::chrono::steady_clock::now();
+            Result<CaptureSet> set = synthesiseCaptureSet(model, capture, tree);
+            const double captureSeconds = secondsSince(t0);
+            if (!set)
+                throw StudyError(set.error().message());
+            const auto t1 = std::chrono::steady_clock::now();
+            Result<VolumeOctreeReconstruction> built = reconstructVolumeOctree(set.value(), options, tree);
+            const double reconstructSeconds = secondsSince(t1);
+            if (!built)
+                throw StudyError(built.error().message());
+            const VolumeOctreeReconstruction& r = built.value();
+            const auto t2 = std::chrono::steady_clock::now();
+            Result<VolumeOctreeData> baked = compressVolumeOctree(r, options, tree);
+            const double compressSeconds = secondsSince(t2);
+            if (!baked)
+                throw StudyError(baked.error().message());
+
+            std::string md = "# Volumetric octree tree: " + tree + "\n\n";
+            md += format("Command: `%s`\n\n", studyCommandLine("treelod_volume_study", argc, argv).c_str());
+            md += format("Bake: photographs %.1f s (%d cameras, %d px), reconstruction %.1f s, quantisation and DXT5 "
+                         "%.1f s.\n\n",
+                         captureSeconds, capture.cameraCount, capture.resolution, reconstructSeconds, compressSeconds);
+            nlohmann::json json = {{"tree", tree},
+                                   {"seconds", {{"capture", captureSeconds},
+                                                {"reconstruction", reconstructSeconds},
+                                                {"compression", compressSeconds}}}};
+
+            // Fig. 4: the share pruned per level.
+            md += "## Cells and pruning per level (Fig. 4)\n\n| level | candidates | cells | dropped | slots | "
+                  "billboards | hidden | empty | pruned |\n|---|---|---|---|---|---|---|---|---|\n";
+            std::uint64_t slots = 0, unprunedSlots = 0;
+            for (std::size_t l = 0; l < r.levels.size(); ++l)
+            {
+                const auto& s = r.levels[l];
+                md += format("| %zu | %llu | %llu | %llu | %llu | %llu | %llu | %llu | %.1f %% |\n", l,
+                             (unsigned long long)s.candidates, (unsigned long long)s.cells,
+                             (unsigned long long)s.dropped, (unsigned long long)s.slots,
+                             (unsigned long long)s.billboards, (unsigned long long)s.hidden,
+                             (unsigned long long)s.empty,
+                             100.0 * double(s.hidden + s.empty) / double(std::max<std::uint64_t>(s.slots, 1)));
+                json["levels"].push_back({{"candidates", s.candidates}, {"cells", s.cells}, {"dropped", s.dropped},
+                                          {"slots", s.slots}, {"billboards", s.billboards}, {"hidden", s.hidden},
+                                          {"empty", s.empty}});
+                slots += s.cells * set->cameras.size();
+                unprunedSlots += s.slots;
+            }
+
+            // §6: texture memory.
+            const double raw = double(unprunedSlots) * 64.0, pruned = double(r.billboards.size()) * 64.0;
+            const double slotTable = double(slots) * 4.0;
+            const std::uint32_t blocks = std::max(baked->colourCodewords, baked->alphaCodewords);
+            const double atlasRgba = double(baked->atlas.width) * baked->atlas.height * 4.0;
+            const double atlasDxt = baked->atlas.format == GpuTextureFormat::DXT5 ? double(baked->atlas.data.size())
+                                                                                 : atlasRgba / 4.0;
+            md += "\n## Texture memory (§6)\n\n| representation | bytes | against the raw pruned octree |\n|---|---|---|\n";
+            const auto row = [&](const char* name, double bytes) {
+                md += format("| %s | %.0f | %.1f : 1 |\n", name, bytes, pruned / bytes);
+                json["memory"][name] = bytes;
+            };
+            row("octree, 4x4 RGBA8 billboards, unpruned", raw);
+            row("octree, 4x4 RGBA8 billboards, pruned", pruned);
+            row("VQ: RGBA8 codebook atlas + slot table", atlasRgba + slotTable);
+            row("VQ + DXT5: DXT5 codebook atlas + slot table", atlasDxt + slotTable);
+            md += format("\nThe atlas holds %u blocks (%u colour, %u alpha codewords) in %ux%u texels; the slot table "
+                         "is 4 bytes (two 16-bit indices) for each of %llu slots.\n",
+                         blocks, baked->colourCodewords, baked->alphaCodewords, baked->atlas.width,
+                         baked->atlas.height, (unsigned long long)slots);
+
+            // Fig. 6: PSNR against the codebook size.
+            md += "\n## PSNR of the quantised billboards against the codebook size (Fig. 6)\n\n| codewords | colour + "
+                  "alpha PSNR (dB) | alpha PSNR (dB) | seconds |\n|---|---|---|---|\n";
+            for (std::uint32_t k : codebooks)
+            {
+                BillboardQuantisationOptions q = options.quantisation;
+                q.colourCodebookSize = q.alphaCodebookSize = k;
+                const auto start = std::chrono::steady_clock::now();
+                const QuantisedBillboards quantised = quantiseBillboards(r.billboards, q);
+                const double seconds = secondsSince(start);
+                std::fprintf(stderr, "volume-study: %u codewords quantised in %.1f s\n", k, seconds);
+                std::vector<BillboardTexture> decoded(r.billboards.size());
+                for (std::size_t i = 0; i < decoded.size(); ++i)
+                    decoded[i] = dequantise(quantised, i);
+                const double all = billboardPsnr(r.billboards, decoded), alpha = billboardPsnr(r.billboards, decoded, true);
+                md += format("| %u | %.2f | %.2f | %.1f |\n", k, all, alpha, seconds);
+                json["psnr"].push_back({{"codewords", k}, {"all", all}, {"alpha", alpha}, {"seconds", seconds}});
+            }
+
+            // Fig. 5: RGB GLA, CIELab GLA, modified GLA in CIELab.
+            std::vector<CameraSpec> views;
+            const glm::dvec3 lo = set->volumeMin, hi = set->volumeMax;
+            for (float azimuth : {15.0f, 105.0f, 195.0f, 285.0f})
+                views.push_back(CameraSpec::framing(glm::vec3(lo), glm::vec3(hi), azimuth, 10.0f, 1.0f, 30.0f));
+            VolumeOctreeRenderOptions render;
+            render.width = render.height = 256;
+            render.transparentBackground = true;
+            render.activeLevel = int(options.levelCount) - 1;
+            std::vector<Image> uncompressed;
+            for (const CameraSpec& view : views)
+                uncompressed.push_back(renderVolumeOctree(r.octree, volumeOctreeRawSource(r), view, render));
+            md += format("\n## Colour RMS at %u codewords (Fig. 5)\n\n| quantisation | billboard RMS | image RMS |\n"
+                         "|---|---|---|\n",
+                         compareAt);
+            for (int mode = 0; mode < 3; ++mode)
+            {
+                VolumeOctreeOptions o = options;
+                o.compress = false;
+                o.quantisation.colourCodebookSize = o.quantisation.alphaCodebookSize = compareAt;
+                o.quantisation.space = mode == 0 ? QuantisationSpace::Rgb : QuantisationSpace::Lab;
+                o.quantisation.nearestInput = mode == 2;
+                const QuantisedBillboards quantised = quantiseBillboards(r.billboards, o.quantisation);
+                std::vector<BillboardTexture> decoded(r.billboards.size());
+                for (std::size_t i = 0; i < decoded.size(); ++i)
+                    decoded[i] = dequantise(quantised, i);
+                Result<VolumeOctreeData> data = compressVolumeOctree(r, o, tree);
+                if (!data)
+                    throw StudyError(data.error().message());
+                double imageRms = 0.0;
+                for (std::size_t v = 0; v < views.size(); ++v)
+                    imageRms += imageColourRms(
+                        uncompressed[v],
+                        renderVolumeOctree(data.value(), volumeOctreeAtlasSource(data.value()), views[v], render));
+                imageRms /= double(views.size());
+                const char* name = mode == 0 ? "RGB, GLA" : mode == 1 ? "CIELab, GLA" : "CIELab, modified GLA";
+                const double billboardRms = billboardColourRms(r.billboards, decoded);
+                md += format("| %s | %.2f | %.2f |\n", name, billboardRms, imageRms);
+                json["fig5"].push_back({{"mode", name}, {"billboardRms", billboardRms}, {"imageRms", imageRms}});
+            }
+            writeSummary(out, md, json, studyCommandLine("treelod_volume_study", argc, argv));
+            return 0;
+        }
+    }
+}
+
+int main(int argc, char** argv)
+{
+    return TreeLod::runStudy("treelod_volume_study", [&] { return TreeLod::run(argc, argv); });
+}
