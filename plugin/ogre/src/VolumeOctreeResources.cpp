@@ -12,7 +12,6 @@
 #include <OgreTextureManager.h>
 
 #include <algorithm>
-#include <numeric>
 
 namespace TreeLod
 {
@@ -34,30 +33,6 @@ namespace TreeLod
             for (const Ogre::String& t : {gpu.codebookTexture, gpu.slotsTexture})
                 if (!t.empty())
                     Ogre::TextureManager::getSingleton().remove(t, group);
-        }
-
-        /// A level's cells back to front for each view octant: slices along z, rows along y, cells
-        /// along x, each axis run from the far side (a valid visibility order of a grid's cells for
-        /// any view direction in the octant).
-        std::array<std::vector<std::uint32_t>, 8> octantOrders(const VolumeOctreeData& d, std::uint32_t level)
-        {
-            const std::uint32_t first = d.firstCell(level), count = d.levelCellCounts[level], last = (1u << level) - 1;
-            std::array<std::vector<std::uint32_t>, 8> orders;
-            for (std::uint32_t octant = 0; octant < 8; ++octant)
-            {
-                // Bit a set: the view runs towards -a, so the far side is low a.
-                const auto key = [&](std::uint32_t i) {
-                    const glm::uvec3 c = volumeCellCoords(d.cells[first + i]);
-                    const std::uint32_t x = octant & 1 ? c.x : last - c.x, y = octant & 2 ? c.y : last - c.y,
-                                        z = octant & 4 ? c.z : last - c.z;
-                    return (std::uint64_t(z) << 40) | (std::uint64_t(y) << 20) | x;
-                };
-                std::vector<std::uint32_t>& order = orders[octant];
-                order.resize(count);
-                std::iota(order.begin(), order.end(), 0u);
-                std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
-            }
-            return orders;
         }
     }
 
@@ -138,7 +113,11 @@ namespace TreeLod
             uploadTexture(gpu->codebookTexture, group, d.atlas);
 
             for (std::uint32_t level = 0; level < d.levelCount; ++level)
-                gpu->cellOrders.push_back(octantOrders(d, level));
+            {
+                gpu->cellOrders.emplace_back();
+                for (std::uint32_t octant = 0; octant < 8; ++octant)
+                    gpu->cellOrders.back()[octant] = volumeOctreeOctantOrder(d, level, octant);
+            }
 
             const float grow = 0.5f * d.cellEdge(d.levelCount - 1) * 0.75f; // a turned square sticks out
             gpu->bounds = Ogre::AxisAlignedBox(d.origin.x - grow, d.origin.y - grow, d.origin.z - grow,

@@ -98,8 +98,7 @@ namespace TreeLod
             towards = -(toModel.linear() * camera->getDerivedDirection());
         towards.normalise();
         mPair = volumeOctreeCameraPair(mData->cameraDirections, glm::vec3(towards.x, towards.y, towards.z));
-        const std::uint32_t octant = (towards.x > 0.0f ? 1u : 0u) | (towards.y > 0.0f ? 2u : 0u) |
-                                     (towards.z > 0.0f ? 4u : 0u); // bit a: the view runs towards -a
+        const std::uint32_t octant = volumeOctreeOctant(glm::vec3(-towards.x, -towards.y, -towards.z));
 
         // The active level by the LoD camera (the viewer's for shadow cameras) and its bias.
         const Ogre::Camera* lod = camera->getLodCamera();

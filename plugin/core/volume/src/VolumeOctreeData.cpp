@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace TreeLod
 {
@@ -62,6 +63,23 @@ namespace TreeLod
             if (volumeOctreePlaneDepth(data.cellEdge(l), focalPixels, lodPixels) > nearestDepth)
                 return l;
         return 0;
+    }
+
+    std::vector<std::uint32_t> volumeOctreeOctantOrder(const VolumeOctreeData& data, std::uint32_t level,
+                                                       std::uint32_t octant)
+    {
+        const std::uint32_t first = data.firstCell(level), count = data.levelCellCounts[level];
+        const std::uint32_t last = (1u << level) - 1;
+        const auto key = [&](std::uint32_t i) {
+            const glm::uvec3 c = volumeCellCoords(data.cells[first + i]);
+            const std::uint32_t x = octant & 1 ? c.x : last - c.x, y = octant & 2 ? c.y : last - c.y,
+                                z = octant & 4 ? c.z : last - c.z;
+            return (std::uint64_t(z) << 40) | (std::uint64_t(y) << 20) | x;
+        };
+        std::vector<std::uint32_t> order(count);
+        std::iota(order.begin(), order.end(), 0u);
+        std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+        return order;
     }
 
     VolumeCameraPair volumeOctreeCameraPair(const std::vector<glm::vec3>& cameraDirections, const glm::vec3& towards)

@@ -114,11 +114,14 @@ namespace TreeLod
         const float plane = camera.orthographic ? std::numeric_limits<float>::max()
                                                 : volumeOctreePlaneDepth(octree.cellEdge(active), focal, options.lodPixels);
 
+        // Back to front as the GPU draws: the level above first (behind the plane), each level in
+        // its order for the view's octant.
         std::vector<DrawnCell> drawn;
+        const std::uint32_t octant = volumeOctreeOctant(-towards);
         for (std::uint32_t level = active == 0 ? 0 : active - 1; level <= active; ++level)
         {
             const std::uint32_t first = octree.firstCell(level);
-            for (std::uint32_t i = 0; i < octree.levelCellCounts[level]; ++i)
+            for (std::uint32_t i : volumeOctreeOctantOrder(octree, level, octant))
             {
                 const std::uint32_t code = octree.cells[first + i];
                 const float depth = viewDepth(octree.cellCentre(code, level));
@@ -129,8 +132,6 @@ namespace TreeLod
                     drawn.push_back({first + i, level, depth});
             }
         }
-        // Back to front.
-        std::stable_sort(drawn.begin(), drawn.end(), [](const DrawnCell& a, const DrawnCell& b) { return a.depth > b.depth; });
 
         const float w0 = pair.firstWeight, w1 = 1.0f - pair.firstWeight;
         BillboardTexture first, second;

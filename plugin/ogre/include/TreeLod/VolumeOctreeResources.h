@@ -31,8 +31,7 @@ namespace TreeLod
         Ogre::String material;       ///< clone of TreeLod/VolumeOctree with the textures and constants
         Ogre::String codebookTexture, slotsTexture;
         std::uint32_t slotsWidth = 0;
-        /// [level][octant]: first-cell-relative indices of the level's cells, back to front for a
-        /// view direction whose sign along axis a is bit a of the octant (set: negative).
+        /// [level][octant]: volumeOctreeOctantOrder of every level and octant.
         std::vector<std::array<std::vector<std::uint32_t>, 8>> cellOrders;
         Ogre::AxisAlignedBox bounds; ///< local: the root cube grown by half a finest cell (billboards turn)
         std::uint64_t gpuBytes = 0;

@@ -102,8 +102,9 @@ namespace TreeLod
     /// level by the distance planes (volumeOctreeDrawsCell), billboards facing the camera (the
     /// camera's right and up axes), texels bilinear within their block (sRGB colour and alpha
     /// apart, as the GPU filters the atlas; raw billboards get the black-pixel fill first), the
-    /// two cameras' premultiplied texels weighted, blended back to front (cell centres by view
-    /// depth) with the over operator on sRGB values, as the GPU's framebuffer does, over
+    /// two cameras' premultiplied texels weighted, blended back to front (the level above first,
+    /// each level in volumeOctreeOctantOrder for the view's octant, as VolumeOctreeTree draws) with
+    /// the over operator on sRGB values, as the GPU's framebuffer does, over
     /// `background` (sRGB, alpha 1) or over transparency. One sample per pixel centre.
     struct VolumeOctreeRenderOptions
     {

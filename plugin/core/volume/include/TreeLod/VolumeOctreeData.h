@@ -149,6 +149,18 @@ namespace TreeLod
         return level + 1 == activeLevel && centreDepth >= planeDepth;
     }
 
+    /// Level `level`'s cells (indices from its first cell) back to front for a view direction
+    /// (from the camera towards the tree) whose sign along axis a is negative where bit a of
+    /// `octant` is set: slices along z, rows along y, cells along x, each axis run from its far side,
+    /// a visibility order of a grid's cells for any view direction in the octant.
+    std::vector<std::uint32_t> volumeOctreeOctantOrder(const VolumeOctreeData& data, std::uint32_t level,
+                                                       std::uint32_t octant);
+    /// The octant of a view direction (from the camera towards the tree) for volumeOctreeOctantOrder.
+    inline std::uint32_t volumeOctreeOctant(const glm::vec3& view)
+    {
+        return (view.x < 0.0f ? 1u : 0u) | (view.y < 0.0f ? 2u : 0u) | (view.z < 0.0f ? 4u : 0u);
+    }
+
     /// Serialise in the layout above. Deterministic; does not validate (decode does).
     std::vector<std::uint8_t> encodeVolumeOctreeChunk(const VolumeOctreeData& data);
     /// Parse and validate(); errors name `label`, "chunk 'volume-octree' level 0" and the element.
