@@ -7,6 +7,8 @@
 // - Texture (§2.1): the two input cameras nearest the view (chosen per object on the CPU); each
 //   one's slot gives a colour and an alpha codeword (§4.1), a 4x4 block of the atlas; a pruned
 //   slot (§3.2) gives weight 0.
+// CASTER: the same billboards facing the shadow camera, the two input cameras nearest the light;
+//   passes clip z and w and the cell on.
 uniform mat4 worldViewProj;
 uniform mat4 worldView;
 uniform vec4 lodState;   // active level, plane depth (view metres), weight of camera 0, of camera 1
@@ -22,6 +24,10 @@ out vec2 vTexel;             // billboard texels, (0, 0) top-left, (4, 4) bottom
 flat out vec4 vColourBlocks; // atlas texel origins of camera 0's and camera 1's colour codewords
 flat out vec4 vAlphaBlocks;  // ... of their alpha codewords
 flat out vec2 vWeights;
+#ifdef CASTER
+out vec2 vClipZW;
+flat out float vCell;
+#endif
 
 // The codewords of the slot of `cell` for `camera`: (colour, alpha), -1 when pruned.
 ivec2 codewords(int cell, int camera)
@@ -58,6 +64,10 @@ void main()
         vTexel = vec2(0.0);
         vColourBlocks = vec4(0.0);
         vAlphaBlocks = vec4(0.0);
+#ifdef CASTER
+        vClipZW = vec2(0.0, 1.0);
+        vCell = 0.0;
+#endif
         return;
     }
     vColourBlocks = vec4(blockOrigin(max(first.x, 0)), blockOrigin(max(second.x, 0)));
@@ -67,4 +77,8 @@ void main()
     vec3 position = vertex.xyz + (uv0.x * right + uv0.y * up) * uv1.w;
     vTexel = vec2(uv0.x + 1.0, 1.0 - uv0.y) * 2.0;
     gl_Position = worldViewProj * vec4(position, 1.0);
+#ifdef CASTER
+    vClipZW = gl_Position.zw;
+    vCell = uv0.w;
+#endif
 }

@@ -13,6 +13,8 @@
 #include "TreeLod/VolumeOctreeBaker.h"
 #include "TreeLod/VolumeOctreeTree.h"
 
+#include <OgreEntity.h>
+#include <OgreMeshManager.h>
 #include <OgreSceneManager.h>
 
 namespace TreeLod
@@ -233,6 +235,54 @@ namespace TreeLod
                 << "), expected (" << expected.r << ", " << expected.g << ", " << expected.b << ")";
         }
         TreeAssetManager::getSingleton().remove(asset);
+    }
+
+    TEST(VolumeOctreeTree, castsItsShadowOnTheGround)
+    {
+        // The oak on a white ground under the sun, casting and not casting: the ground darkens
+        // where the crown's billboards (hashed alpha test) block the light.
+        const BakedOak& t = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = t.model.boundsMax.y - t.model.boundsMin.y;
+        CameraSpec camera;
+        camera.position = glm::vec3(0.0f, 1.5f * h, 3.0f * h);
+        camera.target = glm::vec3(0.0f, 0.4f * h, 0.0f);
+        camera.nearClip = 0.1f * h;
+        camera.farClip = 20.0f * h;
+        Ogre::MeshPtr plane = Ogre::MeshManager::getSingleton().getByName("volume-test-ground", Ogre::RGN_DEFAULT);
+        if (!plane)
+            plane = Ogre::MeshManager::getSingleton().createPlane(
+                "volume-test-ground", Ogre::RGN_DEFAULT, Ogre::Plane(Ogre::Vector3::UNIT_Y, 0.0f), 8.0f * h, 8.0f * h,
+                1, 1, true, 1, 1.0f, 1.0f, Ogre::Vector3::NEGATIVE_UNIT_Z);
+        const auto render = [&](bool casts) {
+            r.clearContent();
+            r.setShadows(true, 1024, ShadowCamera::Focused);
+            const Ogre::NameValuePairList params = {{"asset", t.asset->getName()}, {"group", t.asset->getGroup()}};
+            Ogre::MovableObject* tree =
+                r.getSceneManager().createMovableObject("volume", VolumeOctreeTreeFactory::FACTORY_TYPE_NAME, &params);
+            tree->setCastShadows(casts);
+            r.getContentNode().attachObject(tree);
+            Ogre::Entity* ground = r.getSceneManager().createEntity(plane);
+            ground->setMaterialName("TreeLod/BarkShadowed");
+            ground->setCastShadows(false);
+            r.getContentNode().createChildSceneNode()->attachObject(ground);
+            Image image = toImage(r.render(camera, 200, 160, 1));
+            r.clearContent();
+            r.setShadows(false);
+            return image;
+        };
+        const Image lit = render(false), shadowed = render(true);
+        auto luminance = [](const glm::vec4& p) { return 0.2126 * p.r + 0.7152 * p.g + 0.0722 * p.b; };
+        std::size_t groundShadow = 0, changed = 0;
+        for (std::size_t i = 0; i < lit.pixels.size(); ++i)
+        {
+            groundShadow += luminance(lit.pixels[i]) > 0.9 && luminance(shadowed.pixels[i]) < 0.8;
+            changed += glm::length(glm::vec3(lit.pixels[i]) - glm::vec3(shadowed.pixels[i])) > 0.02f;
+        }
+        std::printf("%zu ground pixels in the tree's shadow, %zu pixels changed\n", groundShadow, changed);
+        EXPECT_GT(groundShadow, 300u);
+        writePng(OgreEnvironment::outDir() + "/volume-octree-shadows.png", sideBySide({lit, shadowed}));
+        compareWithGolden(shadowed, "oak-volume-octree-shadows", 0.02);
     }
 
     TEST(VolumeOctreeTree, badParametersAndMissingChunkAreNamed)

@@ -28,8 +28,9 @@ namespace TreeLod
 
         void removeGpu(const VolumeOctreeGpu& gpu, const Ogre::String& group)
         {
-            if (!gpu.material.empty())
-                Ogre::MaterialManager::getSingleton().remove(gpu.material, group);
+            for (const Ogre::String& m : {gpu.material, gpu.casterMaterial})
+                if (!m.empty())
+                    Ogre::MaterialManager::getSingleton().remove(m, group);
             for (const Ogre::String& t : {gpu.codebookTexture, gpu.slotsTexture})
                 if (!t.empty())
                     Ogre::TextureManager::getSingleton().remove(t, group);
@@ -125,31 +126,42 @@ namespace TreeLod
                                                d.origin.z + d.size + grow);
             gpu->gpuBytes = d.atlas.data.size() + slots.size() + buffer->getSizeInBytes();
 
-            // The material and its constants (TreeLodVolumeOctree.vert/.frag).
+            // The materials and their constants (TreeLodVolumeOctree.vert/.frag): the caster's clone
+            // is the main clone's shadow caster.
             gpu->material = prefix;
-            Ogre::MaterialPtr material = cloneBaseMaterial(VOLUME_OCTREE_MATERIAL, gpu->material, group, mAsset.getName());
-            material->load();
-            for (Ogre::Technique* tech : material->getTechniques())
-                for (Ogre::Pass* pass : tech->getPasses())
-                {
-                    if (Ogre::TextureUnitState* unit = pass->getTextureUnitState("Codebook"))
-                        unit->setTextureName(gpu->codebookTexture);
-                    if (Ogre::TextureUnitState* unit = pass->getTextureUnitState("Slots"))
-                        unit->setTextureName(gpu->slotsTexture);
-                    for (bool vertex : {true, false})
+            gpu->casterMaterial = prefix + "/Caster";
+            const Ogre::MaterialPtr material =
+                cloneBaseMaterial(VOLUME_OCTREE_MATERIAL, gpu->material, group, mAsset.getName());
+            const Ogre::MaterialPtr caster =
+                cloneBaseMaterial(VOLUME_OCTREE_CASTER_MATERIAL, gpu->casterMaterial, group, mAsset.getName());
+            for (const Ogre::MaterialPtr& m : {material, caster})
+            {
+                m->load();
+                for (Ogre::Technique* tech : m->getTechniques())
+                    for (Ogre::Pass* pass : tech->getPasses())
                     {
-                        if (vertex ? !pass->hasVertexProgram() : !pass->hasFragmentProgram())
-                            continue;
-                        Ogre::GpuProgramParametersSharedPtr p =
-                            vertex ? pass->getVertexProgramParameters() : pass->getFragmentProgramParameters();
-                        p->setIgnoreMissingParams(true);
-                        // x: cameras, y: slot texture width, z: atlas blocks a row, w: atlas size (texels)
-                        p->setNamedConstant("octree", Ogre::Vector4(float(d.cameraCount()), float(gpu->slotsWidth),
-                                                                    float(d.atlas.width / VOLUME_BILLBOARD_TEXELS),
-                                                                    float(d.atlas.width)));
-                        p->setNamedConstant("atlasHeight", float(d.atlas.height));
+                        if (Ogre::TextureUnitState* unit = pass->getTextureUnitState("Codebook"))
+                            unit->setTextureName(gpu->codebookTexture);
+                        if (Ogre::TextureUnitState* unit = pass->getTextureUnitState("Slots"))
+                            unit->setTextureName(gpu->slotsTexture);
+                        for (bool vertex : {true, false})
+                        {
+                            if (vertex ? !pass->hasVertexProgram() : !pass->hasFragmentProgram())
+                                continue;
+                            Ogre::GpuProgramParametersSharedPtr p =
+                                vertex ? pass->getVertexProgramParameters() : pass->getFragmentProgramParameters();
+                            p->setIgnoreMissingParams(true);
+                            // x: cameras, y: slot texture width, z: atlas blocks a row, w: atlas width
+                            p->setNamedConstant("octree",
+                                                Ogre::Vector4(float(d.cameraCount()), float(gpu->slotsWidth),
+                                                              float(d.atlas.width / VOLUME_BILLBOARD_TEXELS),
+                                                              float(d.atlas.width)));
+                            p->setNamedConstant("atlasHeight", float(d.atlas.height));
+                        }
                     }
-                }
+            }
+            for (Ogre::Technique* tech : material->getTechniques())
+                tech->setShadowCasterMaterial(caster);
         }
         catch (...)
         {

@@ -9,6 +9,7 @@
 #include <OgreHardwareBufferManager.h>
 #include <OgreNode.h>
 #include <OgreRenderQueue.h>
+#include <OgreSceneManager.h>
 #include <OgreViewport.h>
 
 #include <algorithm>
@@ -51,8 +52,8 @@ namespace TreeLod
             Ogre::HardwareBuffer::HBU_DYNAMIC_WRITE_ONLY_DISCARDABLE);
         mPart->mIndexData.indexBuffer = mIndexBuffer;
         mRadius = Ogre::Math::boundingRadiusFromAABB(mGpu->bounds);
-        setCastShadows(false);
         order(0, mOptions.level >= 0 ? std::uint32_t(mOptions.level) : mData->levelCount - 1);
+        mActive = mOrderedActive;
     }
 
     VolumeOctreeTree::~VolumeOctreeTree() = default;
@@ -98,6 +99,15 @@ namespace TreeLod
             towards = -(toModel.linear() * camera->getDerivedDirection());
         towards.normalise();
         mPair = volumeOctreeCameraPair(mData->cameraDirections, glm::vec3(towards.x, towards.y, towards.z));
+        if (mManager && mManager->_getCurrentRenderStage() == Ogre::SceneManager::IRS_RENDER_TO_TEXTURE)
+        {
+            // A shadow camera: the cameras nearest the light; the viewer's levels and order stay (a
+            // depth caster needs no order), the active level everywhere (no plane).
+            mPart->setCustomParameter(0, Ogre::Vector4(float(mOrderedActive), std::numeric_limits<float>::max(),
+                                                       mPair.firstWeight, 1.0f - mPair.firstWeight));
+            mPart->setCustomParameter(1, Ogre::Vector4(float(mPair.first), float(mPair.second), 0.0f, 0.0f));
+            return;
+        }
         const std::uint32_t octant = volumeOctreeOctant(glm::vec3(-towards.x, -towards.y, -towards.z));
 
         // The active level by the LoD camera (the viewer's for shadow cameras) and its bias.

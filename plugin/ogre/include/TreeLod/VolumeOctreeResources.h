@@ -18,6 +18,8 @@ namespace TreeLod
 
     /// The material every volume octree clone comes from (materials/TreeLodVolumeOctree.material).
     constexpr const char* VOLUME_OCTREE_MATERIAL = "TreeLod/VolumeOctree";
+    /// Its shadow caster (a hashed alpha test of the same billboards).
+    constexpr const char* VOLUME_OCTREE_CASTER_MATERIAL = "TreeLod/VolumeOctreeCaster";
 
     /// The octree on the GPU (materials/GLSL/TreeLodVolumeOctree.vert):
     ///   - vertices, 4 a cell: position = the cell's centre; uv0 = (corner x, corner y in {-1, 1},
@@ -29,6 +31,7 @@ namespace TreeLod
     {
         std::unique_ptr<Ogre::VertexData> vertexData;
         Ogre::String material;       ///< clone of TreeLod/VolumeOctree with the textures and constants
+        Ogre::String casterMaterial; ///< clone of TreeLod/VolumeOctreeCaster, the clone's shadow caster
         Ogre::String codebookTexture, slotsTexture;
         std::uint32_t slotsWidth = 0;
         /// [level][octant]: volumeOctreeOctantOrder of every level and octant.

@@ -15,7 +15,10 @@
 // level above first (its cells lie behind the plane), then the active level.
 //
 // Camera pair: chosen on the CPU once per object and frame (as the paper does per frame).
-// Shadows: none; the object does not cast (the photographs carry their light).
+// Shadows (the paper has none): it receives none (the photographs carry their light) and casts the
+// same billboards facing the light, textured by the input cameras nearest the light, each texel
+// kept by a hashed alpha test, so a light ray is blocked with the probability the reconstruction
+// gives (materials/GLSL/TreeLodVolumeOctree.frag, CASTER). Shadow cameras keep the viewer's levels.
 //
 // Parameters (createMovableObject params, or the registry): asset (required), group, level (force
 // the active level), lodBias (> 0), lodPixels (> 0).
