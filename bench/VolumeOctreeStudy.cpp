@@ -12,7 +12,13 @@
 //     (Fig. 5): over the billboards' covered texels, and over images of the tree drawn by the CPU
 //     twin from between the input cameras, against the same octree uncompressed.
 // Output in --out: summary.md and summary.json.
+#include "TreeLod/PackageWriter.h"
+#include "TreeLod/TreeAssetManager.h"
 #include "TreeLod/VolumeOctreeBaker.h"
+#include "TreeLod/VolumeOctreeTree.h"
+
+#include <OgreEntity.h>
+#include <OgreSceneManager.h>
 
 #include "StudySupport.h"
 
@@ -52,6 +58,7 @@ namespace TreeLod
             VolumeOctreeOptions options;
             std::vector<std::uint32_t> codebooks{16, 64, 256, 512, 1024, 2048};
             std::uint32_t compareAt = 512; // 0: no Fig. 5
+            int frames = 0;                // 0: no frame times (no X server needed)
             CLI::App app{"The volumetric octree tree's bake, memory and compression (Linz et al. 2006)"};
             app.add_option("--tree", tree, "a .glb or generated:PRESET:LEAVES");
             app.add_option("--cameras", capture.cameraCount, "synthetic photographs")->check(CLI::Range(1, 64));
@@ -60,6 +67,8 @@ namespace TreeLod
             app.add_option("--codebooks", codebooks, "codebook sizes for the PSNR curve");
             app.add_option("--compare-at", compareAt,
                            "codebook size of the RGB / CIELab / modified comparison (0: none)");
+            app.add_option("--frames", frames,
+                           "frames timed per view for pruned against unpruned (needs an X server; 0: none)");
             app.add_option("--out", out, "output folder");
             CLI11_PARSE(app, argc, argv);
             std::filesystem::create_directories(out);
@@ -244,7 +253,67 @@ namespace TreeLod
                                  {"sortMilliseconds", 1e3 * sortSeconds}};
             }
 
-            // Fig. 6: PSNR against the codebook size.
+            // §6: frame time, pruned against unpruned (and the mesh), through the plugin.
+            if (frames > 0)
+            {
+                VolumeOctreeOptions unprunedOptions = options;
+                unprunedOptions.prune = false;
+                Result<VolumeOctreeData> unpruned = bakeVolumeOctree(set.value(), unprunedOptions, tree);
+                if (!unpruned)
+                    throw StudyError(unpruned.error().message());
+                OffscreenRenderer renderer;
+                renderer.setLighting(LightingSpec());
+                const auto package = [&](const VolumeOctreeData& data, const std::string& name) {
+                    PackageWriter writer;
+                    if (Result<void> ok = addReferenceChunkIfMissing(writer, model, name, {}); !ok)
+                        throw StudyError(ok.error().message());
+                    if (Result<void> ok = writer.addChunk(VOLUME_OCTREE_CHUNK, 0, VOLUME_OCTREE_CHUNK_FORMAT_VERSION,
+                                                          encodeVolumeOctreeChunk(data));
+                        !ok)
+                        throw StudyError(ok.error().message());
+                    return TreeAssetManager::getSingleton().loadFromBytes(name, Ogre::RGN_DEFAULT, writer.toBytes());
+                };
+                const TreeAssetPtr prunedAsset = package(baked.value(), "volume-study-pruned");
+                const TreeAssetPtr unprunedAsset = package(unpruned.value(), "volume-study-unpruned");
+                std::vector<CameraSpec> orbit;
+                for (float azimuth : {0.0f, 45.0f, 90.0f, 135.0f, 180.0f, 225.0f, 270.0f, 315.0f})
+                    orbit.push_back(CameraSpec::framing(model.boundsMin, model.boundsMax, azimuth, 10.0f, 1.2f));
+                const auto time = [&](const TreeAssetPtr& asset) {
+                    renderer.clearContent();
+                    Ogre::NameValuePairList params;
+                    if (asset)
+                        params = {{"asset", asset->getName()}, {"group", asset->getGroup()}};
+                    Ogre::MovableObject* object =
+                        asset ? renderer.getSceneManager().createMovableObject(
+                                    "volume-study", VolumeOctreeTreeFactory::FACTORY_TYPE_NAME, &params)
+                              : static_cast<Ogre::MovableObject*>(
+                                    renderer.getSceneManager().createEntity(prunedAsset->getReferenceMesh()));
+                    renderer.getContentNode().attachObject(object);
+                    std::vector<double> ms;
+                    for (const CameraSpec& view : orbit)
+                        ms.push_back(median(renderer.timeFrames(view, 1024, 768, frames)));
+                    renderer.clearContent();
+                    return median(ms);
+                };
+                const double meshMs = time(nullptr), prunedMs = time(prunedAsset), unprunedMs = time(unprunedAsset);
+                md += format("\n## Frame time, pruned against unpruned (§6)\n\n1024x768, the tree 1/1.2 of the view "
+                             "height, 8 views around it, the median of %d frames each, then of the views:\n\n"
+                             "| draw | billboards stored | ms per frame | against the mesh |\n|---|---|---|---|\n"
+                             "| mesh | | %.1f | 1.00 |\n| octree, pruned | %zu | %.1f | %.2f |\n"
+                             "| octree, unpruned | %zu | %.1f | %.2f |\n",
+                             frames, meshMs, r.billboards.size(), prunedMs, prunedMs / meshMs,
+                             std::size_t(std::count_if(unpruned->slots.begin(), unpruned->slots.end(),
+                                                       [](const VolumeOctreeSlot& slot) { return !slot.pruned(); })),
+                             unprunedMs, unprunedMs / meshMs);
+                json["frames"] = {{"meshMs", meshMs}, {"prunedMs", prunedMs}, {"unprunedMs", unprunedMs}};
+            }
+
+            // Fig. 6: PSNR against the codebook size, against the billboards as the codebooks are made
+            // from them (transparent texels filled by the black-pixel heuristic, VectorQuantiser.h):
+            // the colour of a transparent texel is never seen.
+            std::vector<BillboardTexture> filled = r.billboards;
+            for (BillboardTexture& b : filled)
+                fillTransparentTexels(b);
             md += "\n## PSNR of the quantised billboards against the codebook size (Fig. 6)\n\n| codewords | colour + "
                   "alpha PSNR (dB) | alpha PSNR (dB) | seconds |\n|---|---|---|---|\n";
             for (std::uint32_t k : codebooks)
@@ -258,7 +327,7 @@ namespace TreeLod
                 std::vector<BillboardTexture> decoded(r.billboards.size());
                 for (std::size_t i = 0; i < decoded.size(); ++i)
                     decoded[i] = dequantise(quantised, i);
-                const double all = billboardPsnr(r.billboards, decoded), alpha = billboardPsnr(r.billboards, decoded, true);
+                const double all = billboardPsnr(filled, decoded), alpha = billboardPsnr(filled, decoded, true);
                 md += format("| %u | %.2f | %.2f | %.1f |\n", k, all, alpha, seconds);
                 json["psnr"].push_back({{"codewords", k}, {"all", all}, {"alpha", alpha}, {"seconds", seconds}});
             }
@@ -277,11 +346,16 @@ namespace TreeLod
             render.width = render.height = 256;
             render.transparentBackground = true;
             render.activeLevel = int(options.levelCount) - 1;
-            std::vector<Image> uncompressed;
+            VolumeOctreeRenderOptions opaque = render;
+            opaque.transparentBackground = false;
+            std::vector<Image> uncompressed, uncompressedOpaque;
             for (const CameraSpec& view : views)
+            {
                 uncompressed.push_back(renderVolumeOctree(r.octree, volumeOctreeRawSource(r), view, render));
-            md += format("\n## Colour RMS at %u codewords (Fig. 5)\n\n| quantisation | billboard RMS | image RMS |\n"
-                         "|---|---|---|\n",
+                uncompressedOpaque.push_back(renderVolumeOctree(r.octree, volumeOctreeRawSource(r), view, opaque));
+            }
+            md += format("\n## Colour error at %u codewords (Fig. 5)\n\n| quantisation | billboard RMS | image RMS | "
+                         "image FLIP (tree box) |\n|---|---|---|---|\n",
                          compareAt);
             for (int mode = 0; mode < 3; ++mode)
             {
@@ -297,16 +371,22 @@ namespace TreeLod
                 Result<VolumeOctreeData> data = compressVolumeOctree(r, o, tree);
                 if (!data)
                     throw StudyError(data.error().message());
-                double imageRms = 0.0;
+                double imageRms = 0.0, imageFlip = 0.0;
+                const VolumeBillboardSource source = volumeOctreeAtlasSource(data.value());
                 for (std::size_t v = 0; v < views.size(); ++v)
-                    imageRms += imageColourRms(
-                        uncompressed[v],
-                        renderVolumeOctree(data.value(), volumeOctreeAtlasSource(data.value()), views[v], render));
+                {
+                    imageRms += imageColourRms(uncompressed[v], renderVolumeOctree(data.value(), source, views[v], render));
+                    const Image test = renderVolumeOctree(data.value(), source, views[v], opaque);
+                    const Crop crop = cropAround(treeExtent(uncompressedOpaque[v]), opaque.width, opaque.height);
+                    imageFlip += flipMean(cropImage(uncompressedOpaque[v], crop), cropImage(test, crop));
+                }
                 imageRms /= double(views.size());
+                imageFlip /= double(views.size());
                 const char* name = mode == 0 ? "RGB, GLA" : mode == 1 ? "CIELab, GLA" : "CIELab, modified GLA";
                 const double billboardRms = billboardColourRms(r.billboards, decoded);
-                md += format("| %s | %.2f | %.2f |\n", name, billboardRms, imageRms);
-                json["fig5"].push_back({{"mode", name}, {"billboardRms", billboardRms}, {"imageRms", imageRms}});
+                md += format("| %s | %.2f | %.2f | %.4f |\n", name, billboardRms, imageRms, imageFlip);
+                json["fig5"].push_back(
+                    {{"mode", name}, {"billboardRms", billboardRms}, {"imageRms", imageRms}, {"imageFlip", imageFlip}});
             }
             writeSummary(out, md, json, studyCommandLine("treelod_volume_study", argc, argv));
             return 0;
