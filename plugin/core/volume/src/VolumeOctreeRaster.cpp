@@ -151,8 +151,11 @@ namespace TreeLod
                 return glm::vec2((clip.x / clip.w + 1.0f) * 0.5f * float(w), (1.0f - clip.y / clip.w) * 0.5f * float(h));
             };
             const glm::vec2 lo = toPixel(c - half * right + half * up), hi = toPixel(c + half * right - half * up);
-            const int x0 = std::max(0, int(std::ceil(lo.x - 0.5f))), x1 = std::min(w - 1, int(std::ceil(hi.x - 0.5f)) - 1);
-            const int y0 = std::max(0, int(std::ceil(lo.y - 0.5f))), y1 = std::min(h - 1, int(std::ceil(hi.y - 0.5f)) - 1);
+            // Pixel bounds clamped before the conversion to int (a quad just past the near plane
+            // projects far outside the image).
+            const auto pixelIndex = [](float v) { return int(std::clamp(std::ceil(v - 0.5f), -1e6f, 1e6f)); };
+            const int x0 = std::max(0, pixelIndex(lo.x)), x1 = std::min(w - 1, pixelIndex(hi.x) - 1);
+            const int y0 = std::max(0, pixelIndex(lo.y)), y1 = std::min(h - 1, pixelIndex(hi.y) - 1);
             const float sx = float(VOLUME_BILLBOARD_TEXELS) / (hi.x - lo.x), sy = float(VOLUME_BILLBOARD_TEXELS) / (hi.y - lo.y);
             for (int y = y0; y <= y1; ++y)
                 for (int x = x0; x <= x1; ++x)
