@@ -25,9 +25,10 @@
 //      accumulate along the ray from c to its centre (1 - exp(-their summed depths)) exceeds
 //      options.pruneAlpha, or when all its texels are transparent. Applied recursively (§3.2): a
 //      cell pruned for every camera is dropped, and its children are never made.
-//   5. Vector quantisation (§4.1, VectorQuantiser.h): the modified GLA in CIELab over every kept
-//      billboard, colour and alpha apart, the black-pixel heuristic; then the codebook atlas and
-//      optionally DXT5 (§5).
+//   5. Vector quantisation (§4.1, VectorQuantiser.h): the modified GLA in CIELab, colour and alpha
+//      apart, the black-pixel heuristic, trained on at most 200,000 of the kept billboards
+//      (deviation: BillboardQuantisationOptions::maxTrainingVectors), every billboard then given
+//      its nearest codewords; then the codebook atlas and optionally DXT5 (§5).
 // Deterministic for the inputs and options, whatever the thread count.
 #pragma once
 
