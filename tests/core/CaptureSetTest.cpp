@@ -87,6 +87,15 @@ namespace
 
     void saveJson(const std::string& dir, const Json& j) { saveText(jsonPath(dir), j.dump(2)); }
 
+    /// The set in `dir` read back after `edit` changed its cameras.json (a copy of `good`).
+    Result<CaptureSet> readEdited(const std::string& dir, const Json& good, const std::function<void(Json&)>& edit)
+    {
+        Json j = good;
+        edit(j);
+        saveJson(dir, j);
+        return readCaptureSet(dir);
+    }
+
     /// A fresh folder holding tinySet().
     std::string writtenTinySet(const std::string& name)
     {
@@ -462,12 +471,7 @@ TEST(CaptureSet, readNamesBadCameras)
     const std::string dir = writtenTinySet("read-cameras");
     const std::string file = jsonPath(dir);
     const Json good = loadJson(dir);
-    auto readWith = [&](const std::function<void(Json&)>& edit) {
-        Json j = good;
-        edit(j);
-        saveJson(dir, j);
-        return readCaptureSet(dir);
-    };
+    auto readWith = [&](const std::function<void(Json&)>& edit) { return readEdited(dir, good, edit); };
     ASSERT_TRUE(readWith([](Json&) {}).ok());
 
     // NaN and infinity become null in JSON.
@@ -494,12 +498,7 @@ TEST(CaptureSet, readNamesBadJson)
     const std::string dir = writtenTinySet("read-json");
     const std::string file = jsonPath(dir);
     const Json good = loadJson(dir);
-    auto readWith = [&](const std::function<void(Json&)>& edit) {
-        Json j = good;
-        edit(j);
-        saveJson(dir, j);
-        return readCaptureSet(dir);
-    };
+    auto readWith = [&](const std::function<void(Json&)>& edit) { return readEdited(dir, good, edit); };
 
     expectError(readWith([](Json& j) { j["format"] = "treelod-package"; }), file, "format",
                 "not a TreeLod capture set");

@@ -449,9 +449,7 @@ namespace TreeLod
             // keeps that share of what its pixel saw (1 - (1 - a)^share), so the cells along the
             // ray give the image back.
             std::vector<float> share(hull.size() * cameraCount, 0.0f);
-            std::vector<float> density(hull.size(), 0.0f);
             tbb::parallel_for(std::size_t(0), hull.size(), [&](std::size_t i) {
-                density[i] = float(1.0 - std::exp(-tau[i]));
                 for (std::size_t c = 0; c < cameraCount; ++c)
                     if (observed[i * cameraCount + c] >= 0.0f && tau[i] > 0.0)
                         share[i * cameraCount + c] = float(tau[i] / std::max(rayDepth(i, c, &tau), tau[i]));
@@ -564,7 +562,6 @@ namespace TreeLod
                                     [](std::uint32_t local) { return local == std::numeric_limits<std::uint32_t>::max(); }))
                         continue;
                     stored.push_back(kept[i]);
-                    out.density.push_back(density[keptFrom[i]]);
                     for (std::size_t c = 0; c < cameraCount; ++c)
                         out.billboardOf.push_back(slots[std::ptrdiff_t(c)] == std::numeric_limits<std::uint32_t>::max()
                                                       ? std::numeric_limits<std::uint32_t>::max()

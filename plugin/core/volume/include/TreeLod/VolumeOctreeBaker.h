@@ -63,7 +63,6 @@ namespace TreeLod
         VolumeOctreeData octree;               ///< levels, cameras and cells; no slots, codebooks, atlas
         std::vector<std::uint32_t> billboardOf; ///< per slot: index into billboards or UINT32_MAX
         std::vector<BillboardTexture> billboards;
-        std::vector<float> density;            ///< per cell
         /// Per level: candidate cells (children of the level above), cells stored, cells dropped for
         /// having no billboard; over the slots of the cells that passed the hull (stored and
         /// dropped): slots, billboards kept, pruned because hidden, pruned because empty.
