@@ -11,6 +11,12 @@ vec3 instanceDirection(vec3 v)
     return vec3(uv5.x * v.x + uv5.y * v.z, v.y, -uv5.y * v.x + uv5.x * v.z);
 }
 
+/// The inverse of instanceDirection: a Forest-local direction in the tree's local frame.
+vec3 instanceLocalDirection(vec3 v)
+{
+    return vec3(uv5.x * v.x - uv5.y * v.z, v.y, uv5.y * v.x + uv5.x * v.z);
+}
+
 /// A point (w = 1) placed like the instance.
 vec4 instancePosition(vec4 p)
 {

@@ -2,10 +2,13 @@
 // what the CPU twin (renderVolumeOctree) draws, pixel for pixel within FLIP bounds, at a forced
 // level and at the level its distance planes choose; nearer trees get finer levels and the camera
 // LoD bias moves them; the view octant reorders the cells; bad parameters and a package without
-// the chunk are named; a golden image of the oak.
+// the chunk are named; a golden image of the oak. As a Forest level: each instance draws what a
+// VolumeOctreeTree placed like it draws, trees blend far to near, levels follow screen size, the
+// trees cast shadows.
 #include "OgreTestSupport.h"
 
 #include "TreeLod/CaptureSet.h"
+#include "TreeLod/Forest.h"
 #include "TreeLod/PackageWriter.h"
 #include "TreeLod/TreeAssetManager.h"
 #include "TreeLod/TreeGenerator.h"
@@ -109,6 +112,59 @@ namespace TreeLod
             const Crop crop = cropAround(unite(treeExtent(reference), treeExtent(test)), reference.width,
                                          reference.height);
             return flipMean(cropImage(reference, crop), cropImage(test, crop));
+        }
+
+        /// A tree placed in the content node: position, rotation about +Y (radians), uniform scale.
+        struct Placed
+        {
+            glm::vec3 position{0.0f};
+            float rotation = 0.0f;
+            float scale = 1.0f;
+        };
+
+        /// `trees` as VolumeOctreeTrees with `params`, each on its own node; tree `early` (if any) in
+        /// a render queue before the others'.
+        void placeObjects(const std::vector<Placed>& trees, const Ogre::NameValuePairList& extra = {},
+                          std::size_t early = std::size_t(-1))
+        {
+            OffscreenRenderer& r = OgreEnvironment::renderer();
+            Ogre::NameValuePairList params = {{"asset", oak().asset->getName()}, {"group", oak().asset->getGroup()}};
+            params.insert(extra.begin(), extra.end());
+            for (std::size_t i = 0; i < trees.size(); ++i)
+            {
+                Ogre::MovableObject* tree = r.getSceneManager().createMovableObject(
+                    "volume" + std::to_string(i), VolumeOctreeTreeFactory::FACTORY_TYPE_NAME, &params);
+                if (i == early)
+                    tree->setRenderQueueGroup(Ogre::RENDER_QUEUE_MAIN - 1);
+                Ogre::SceneNode* node = r.getContentNode().createChildSceneNode(
+                    Ogre::Vector3(trees[i].position.x, trees[i].position.y, trees[i].position.z),
+                    Ogre::Quaternion(Ogre::Radian(trees[i].rotation), Ogre::Vector3::UNIT_Y));
+                node->setScale(Ogre::Vector3(trees[i].scale));
+                node->attachObject(tree);
+            }
+        }
+
+        /// `trees` as one Forest species of `levels`.
+        Forest& placeForest(const std::vector<Placed>& trees, const std::vector<ForestLevel>& levels)
+        {
+            OffscreenRenderer& r = OgreEnvironment::renderer();
+            auto* forest = static_cast<Forest*>(r.getSceneManager().createMovableObject("volume-forest", "Forest"));
+            forest->setLodHysteresis(0.0f);
+            forest->addSpecies(oak().asset, levels);
+            std::vector<ForestInstance> instances;
+            for (const Placed& t : trees)
+                instances.push_back(ForestInstance{t.position, t.rotation, t.scale, 0});
+            forest->addInstances(instances);
+            r.getContentNode().attachObject(forest);
+            return *forest;
+        }
+
+        Image renderContent(const CameraSpec& camera, int width, int height)
+        {
+            OffscreenRenderer& r = OgreEnvironment::renderer();
+            Image image = toImage(r.render(camera, width, height, 1));
+            r.clearContent();
+            return image;
         }
 
         /// Pixels that differ from the background.
@@ -318,5 +374,175 @@ namespace TreeLod
                 << e.getFullDescription();
         }
         TreeAssetManager::getSingleton().remove(plain);
+    }
+
+    TEST(VolumeOctreeTree, forestLevelDrawsWhatTheObjectDraws)
+    {
+        // One instance per Forest, turned and scaled, at a fixed level: its own view octant, camera
+        // pair and distance plane, as a VolumeOctreeTree on a node placed alike.
+        OgreEnvironment::renderer().setShadows(false);
+        const BakedOak& t = oak();
+        struct Case
+        {
+            std::uint32_t level;
+            Placed tree;
+            float distance; ///< of the camera, in framing distances
+        };
+        std::vector<Image> strip;
+        for (const Case& c : {Case{4, Placed{}, 0.9f}, Case{5, Placed{glm::vec3(0.0f), 2.2f, 1.0f}, 1.6f},
+                              Case{3, Placed{glm::vec3(1.0f, 0.0f, -2.0f), -0.7f, 1.5f}, 0.9f}})
+        {
+            const glm::vec3 lo = c.tree.position + c.tree.scale * t.model.boundsMin;
+            const glm::vec3 hi = c.tree.position + c.tree.scale * t.model.boundsMax;
+            const CameraSpec camera = CameraSpec::framing(lo, hi, 30.0f, 15.0f, c.distance);
+            placeObjects({c.tree}, {{"level", std::to_string(c.level)}});
+            const Image object = renderContent(camera, 160, 160);
+            // Whether the level's distance plane cuts the crown here (level L - 1 behind it).
+            placeObjects({c.tree}, {{"level", std::to_string(c.level)}, {"lodPixels", "0.001"}});
+            const double planeShows = boxFlip(object, renderContent(camera, 160, 160));
+            placeForest({c.tree}, {ForestLevel{VOLUME_OCTREE_CHUNK, c.level, false, 0.0f}});
+            const Image forest = renderContent(camera, 160, 160);
+            const double error = boxFlip(object, forest);
+            std::printf("level %u: forest against object, tree-box FLIP %.4f (the plane changes %.4f)\n", c.level,
+                        error, planeShows);
+            EXPECT_LT(error, 0.003) << "level " << c.level;
+            if (c.distance > 1.0f)
+                EXPECT_GT(planeShows, 0.01) << "the plane of level " << c.level << " misses the crown";
+            EXPECT_GT(covered(forest), std::size_t(160 * 160 / 16)) << "level " << c.level;
+            strip.push_back(object);
+            strip.push_back(forest);
+        }
+        writePng(OgreEnvironment::outDir() + "/volume-octree-forest-vs-object.png", sideBySide(strip));
+    }
+
+    TEST(VolumeOctreeTree, forestBlendsItsTreesFarToNear)
+    {
+        // Two trees one behind the other, seen from either side. The objects are sorted by Ogre
+        // (one renderable each); the Forest draws both in one instanced draw, listed far to near,
+        // whatever order it stores them in.
+        OgreEnvironment::renderer().setShadows(false);
+        const BakedOak& t = oak();
+        const float h = t.model.boundsMax.y - t.model.boundsMin.y;
+        const std::vector<Placed> trees = {Placed{glm::vec3(0.0f), 0.3f, 1.0f},
+                                           Placed{glm::vec3(0.25f * h, 0.0f, -1.0f * h), 1.1f, 1.0f}};
+        const Ogre::NameValuePairList level = {{"level", "4"}};
+        std::vector<Image> strip;
+        for (int side : {1, -1})
+        {
+            CameraSpec camera;
+            camera.position = glm::vec3(0.3f * h, 0.5f * h, -0.5f * h + float(side) * 2.9f * h);
+            camera.target = glm::vec3(0.3f * h, 0.45f * h, -0.5f * h - float(side) * 0.1f * h);
+            camera.nearClip = 0.05f * h;
+            camera.farClip = 20.0f * h;
+            placeObjects(trees, level);
+            const Image sorted = renderContent(camera, 200, 160);
+            // The near tree in an earlier render queue: drawn first, the far one over it.
+            placeObjects(trees, level, side > 0 ? 0 : 1);
+            const Image wrong = renderContent(camera, 200, 160);
+            placeForest(trees, {ForestLevel{VOLUME_OCTREE_CHUNK, 4, false, 0.0f}});
+            const Image forest = renderContent(camera, 200, 160);
+            const double error = boxFlip(sorted, forest), wrongError = boxFlip(sorted, wrong);
+            std::printf("side %d: forest against sorted objects: FLIP %.4f; near tree drawn first: %.4f\n", side,
+                        error, wrongError);
+            EXPECT_LT(error, 0.003) << "side " << side;
+            EXPECT_GT(wrongError, 3.0 * 0.003) << "side " << side; // the order shows: the bound can fail
+            strip.insert(strip.end(), {sorted, forest, wrong});
+        }
+        writePng(OgreEnvironment::outDir() + "/volume-octree-forest-order.png", sideBySide(strip));
+    }
+
+    TEST(VolumeOctreeTree, forestLevelsFollowScreenSize)
+    {
+        // The technique's levels over all screen sizes: one per octree level, finest first, each
+        // while a cell of it covers 4 pixels at the tree's centre. A near tree draws a finer level
+        // than a far one, and never a finer one than a VolumeOctreeTree (nearest point) picks.
+        OgreEnvironment::renderer().setShadows(false);
+        const BakedOak& t = oak();
+        const std::vector<ForestLevel> levels =
+            Forest::levelsForBands(*t.asset, {ForestBand{VOLUME_OCTREE_CHUNK, 0.0f}});
+        ASSERT_EQ(levels.size(), std::size_t(t.data.levelCount));
+        for (std::size_t i = 0; i < levels.size(); ++i)
+            EXPECT_EQ(levels[i].techniqueLevel, t.data.levelCount - 1 - i);
+        const float h = t.model.boundsMax.y - t.model.boundsMin.y;
+        const float expectedHeight = 4.0f * h / t.data.cellEdge(3);
+        EXPECT_NEAR(Forest::heightForPixelCount(*t.asset, levels[t.data.levelCount - 1 - 3].minPixelCount),
+                    expectedHeight, 1e-3f * expectedHeight);
+
+        std::vector<std::uint32_t> drawn;
+        for (float distance : {0.8f, 3.0f, 12.0f})
+        {
+            const CameraSpec camera = CameraSpec::framing(t.model.boundsMin, t.model.boundsMax, 0.0f, 10.0f, distance);
+            placeObjects({Placed{}});
+            OffscreenRenderer& r = OgreEnvironment::renderer();
+            r.render(camera, 160, 160, 1);
+            const std::uint32_t objectLevel =
+                static_cast<VolumeOctreeTree*>(r.getSceneManager().getMovableObject("volume0", VolumeOctreeTreeFactory::FACTORY_TYPE_NAME))
+                    ->getActiveLevel();
+            r.clearContent();
+            Forest& forest = placeForest({Placed{}}, levels);
+            r.render(camera, 160, 160, 1);
+            const std::vector<std::uint32_t>& counts = forest.getStats().levelCounts[0];
+            const auto at = std::find(counts.begin(), counts.end(), 1u);
+            ASSERT_NE(at, counts.end()) << "distance " << distance;
+            const std::uint32_t level = levels[std::size_t(at - counts.begin())].techniqueLevel;
+            std::printf("distance %.1f: forest level %u, object level %u\n", distance, level, objectLevel);
+            EXPECT_LE(level, objectLevel);
+            EXPECT_GE(level + 1, objectLevel);
+            drawn.push_back(level);
+            r.clearContent();
+        }
+        EXPECT_GT(drawn.front(), drawn.back());
+    }
+
+    TEST(VolumeOctreeTree, forestOfOctreesGolden)
+    {
+        // Nine trees, turned and scaled, at the levels their screen sizes give, casting shadows on
+        // a white ground (and not casting, to find the shadows).
+        const BakedOak& t = oak();
+        const float h = t.model.boundsMax.y - t.model.boundsMin.y;
+        std::vector<Placed> trees;
+        for (int i = 0; i < 9; ++i)
+            trees.push_back(Placed{glm::vec3(float(i % 3 - 1) * 1.1f * h, 0.0f, float(i / 3 - 1) * 1.1f * h - 0.5f * h),
+                                   0.7f * float(i), 0.8f + 0.05f * float(i)});
+        CameraSpec camera;
+        camera.position = glm::vec3(0.3f * h, 1.2f * h, 3.2f * h);
+        camera.target = glm::vec3(0.0f, 0.3f * h, -0.5f * h);
+        camera.nearClip = 0.05f * h;
+        camera.farClip = 20.0f * h;
+        Ogre::MeshPtr plane = Ogre::MeshManager::getSingleton().createPlane(
+            "volume-forest-ground", Ogre::RGN_DEFAULT, Ogre::Plane(Ogre::Vector3::UNIT_Y, 0.0f), 8.0f * h, 8.0f * h, 1, 1,
+            true, 1, 1.0f, 1.0f, Ogre::Vector3::NEGATIVE_UNIT_Z);
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        std::uint32_t levelsDrawn = 0, visible = 0;
+        const auto render = [&](bool casts) {
+            r.setShadows(true, 1024, ShadowCamera::Focused);
+            Forest& forest =
+                placeForest(trees, Forest::levelsForBands(*t.asset, {ForestBand{VOLUME_OCTREE_CHUNK, 0.0f}}));
+            forest.setCastShadows(casts);
+            Ogre::Entity* ground = r.getSceneManager().createEntity(plane);
+            ground->setMaterialName("TreeLod/BarkShadowed");
+            ground->setCastShadows(false);
+            r.getContentNode().createChildSceneNode()->attachObject(ground);
+            Image image = toImage(r.render(camera, 240, 180, 1));
+            levelsDrawn = 0;
+            for (std::uint32_t n : forest.getStats().levelCounts[0])
+                levelsDrawn += n > 0 ? 1 : 0;
+            visible = forest.getStats().visibleInstances;
+            r.clearContent();
+            r.setShadows(false);
+            return image;
+        };
+        const Image lit = render(false), shadowed = render(true);
+        Ogre::MeshManager::getSingleton().remove(plane);
+        EXPECT_EQ(visible, 9u);
+        EXPECT_GE(levelsDrawn, 2u); // near and far trees at different levels
+        std::size_t groundShadow = 0;
+        auto luminance = [](const glm::vec4& p) { return 0.2126 * p.r + 0.7152 * p.g + 0.0722 * p.b; };
+        for (std::size_t i = 0; i < lit.pixels.size(); ++i)
+            groundShadow += luminance(lit.pixels[i]) > 0.9 && luminance(shadowed.pixels[i]) < 0.8;
+        std::printf("%u levels drawn, %zu ground pixels in the trees' shadows\n", levelsDrawn, groundShadow);
+        EXPECT_GT(groundShadow, 1000u);
+        writePng(OgreEnvironment::outDir() + "/volume-octree-forest-shadows.png", sideBySide({lit, shadowed}));
+        compareWithGolden(shadowed, "forest-volume-octree", 0.02);
     }
 }

@@ -254,6 +254,8 @@ namespace TreeLod
         Ogre::MaterialPtr shadowedMaterial; ///< may be null
         unsigned short techniqueLod = 0;    ///< ForestPartOptions::techniqueLod
         float lengthFactor = 0.0f;          ///< ForestPartOptions::lengthFactor (custom parameter 0 when > 0)
+        std::map<std::size_t, Ogre::Vector4> customParameters; ///< ForestPartOptions::customParameters
+        bool backToFront = false;           ///< ForestPartOptions::backToFront
     };
 
     /// Where a level's drawables are (Forest.h, "Residency").
@@ -308,6 +310,8 @@ namespace TreeLod
             mSource = static_cast<unsigned short>(decl->getMaxSource() + 1);
             decl->addElement(mSource, 0, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 4);
             decl->addElement(mSource, 4 * sizeof(float), Ogre::VET_FLOAT2, Ogre::VES_TEXTURE_COORDINATES, 5);
+            for (const auto& [index, value] : part.customParameters)
+                setCustomParameter(index, value);
         }
         ~Batch() override { delete mVertexData; }
 
@@ -318,6 +322,8 @@ namespace TreeLod
         const Part& getPart() const { return mPart; }
 
         std::uint32_t mInstanceCount = 0;
+        /// Queued at this squared depth (world units) when >= 0, else at the Forest's node's.
+        Ogre::Real mSquaredViewDepth = -1.0f;
 
         const Ogre::MaterialPtr& getMaterial() const override
         {
@@ -342,6 +348,8 @@ namespace TreeLod
         }
         Ogre::Real getSquaredViewDepth(const Ogre::Camera* camera) const override
         {
+            if (mSquaredViewDepth >= 0.0f)
+                return mSquaredViewDepth;
             return mForest.getParentNode() ? mForest.getParentNode()->getSquaredViewDepth(camera) : 0.0f;
         }
         const Ogre::LightList& getLights() const override { return mForest.queryLights(); }
@@ -360,6 +368,9 @@ namespace TreeLod
         std::size_t capacity = 0; ///< instances
         std::uint32_t drawnLevel = NO_LEVEL; ///< the level whose parts `batches` draw
         std::vector<std::unique_ptr<Batch>> batches; ///< one per part of the drawn level
+        bool backToFront = false; ///< a part of the drawn level blends (ForestPartOptions::backToFront)
+        /// Squared distance (local) of the farthest instance of the last fill when backToFront.
+        float farthestSquared = 0.0f;
     };
 
     struct Forest::CameraState
@@ -369,6 +380,8 @@ namespace TreeLod
         float lodBias = 1.0f;
         bool hasLod = false;
         std::vector<std::unique_ptr<BucketState>> buckets; ///< by ForestInstances bucket index
+        glm::vec3 eye{0.0f};  ///< this camera's position in the Forest's local space
+        std::vector<std::pair<float, std::uint32_t>> depthOrder; ///< scratch of back-to-front fills
     };
 
     /// Clears the viewer's stats before each visibility pass of a viewport (not of shadow textures).
@@ -628,6 +641,8 @@ namespace TreeLod
             part->vertexData = vertices;
             part->techniqueLod = options.techniqueLod;
             part->lengthFactor = options.lengthFactor;
+            part->customParameters = options.customParameters;
+            part->backToFront = options.backToFront;
             if (options.instancedMaterial)
             {
                 for (auto [name, slot] : {std::make_pair(&material, &part->material),
@@ -1276,6 +1291,9 @@ namespace TreeLod
                     slot.batches.back()->setInstanceBuffer(slot.buffer);
             }
             slot.drawnLevel = drawn;
+            slot.backToFront = std::any_of(mSpecies[bucket.kind]->parts[drawn].begin(),
+                                           mSpecies[bucket.kind]->parts[drawn].end(),
+                                           [](const std::unique_ptr<Part>& part) { return part->backToFront; });
         }
         if (bucket.count > slot.capacity)
         {
@@ -1292,12 +1310,28 @@ namespace TreeLod
                 batch->setInstanceBuffer(slot.buffer);
         }
         // The cull's rows [R*s | t] (ForestInstances.h): t, s = m11, cos = m00 / s, sin = m02 / s.
-        const float* m = state.visibility.getBucketTransforms(b);
+        const float* transforms = state.visibility.getBucketTransforms(b);
+        constexpr std::size_t STRIDE = ForestVisibility::TRANSFORM_FLOATS;
+        if (slot.backToFront)
+        {
+            // Far to near: instances of one draw rasterise in order, so the blending is right
+            // between the bucket's trees.
+            state.depthOrder.clear();
+            for (std::uint32_t i = 0; i < bucket.count; ++i)
+            {
+                const float* m = transforms + i * STRIDE;
+                const glm::vec3 d = glm::vec3(m[3], m[7], m[11]) - state.eye;
+                state.depthOrder.emplace_back(glm::dot(d, d), i);
+            }
+            std::sort(state.depthOrder.begin(), state.depthOrder.end(),
+                      [](const auto& a, const auto& b) { return a.first > b.first; });
+            slot.farthestSquared = state.depthOrder.empty() ? 0.0f : state.depthOrder.front().first;
+        }
         float* out = static_cast<float*>(
             slot.buffer->lock(0, std::size_t(bucket.count) * INSTANCE_BYTES, Ogre::HardwareBuffer::HBL_DISCARD));
-        for (std::uint32_t i = 0; i < bucket.count;
-             ++i, m += ForestVisibility::TRANSFORM_FLOATS, out += INSTANCE_FLOATS)
+        for (std::uint32_t i = 0; i < bucket.count; ++i, out += INSTANCE_FLOATS)
         {
+            const float* m = transforms + (slot.backToFront ? state.depthOrder[i].second : i) * STRIDE;
             const float scale = m[5], inverse = 1.0f / scale;
             out[0] = m[3];
             out[1] = m[7];
@@ -1360,6 +1394,8 @@ namespace TreeLod
             state.lodBias = lod->getLodBias() * mLodBias * (shadowTexture ? mShadowLodBias : 1.0f);
             state.hasLod = true;
         }
+        const Ogre::Vector3 eye = world.inverse() * camera->getDerivedPosition();
+        state.eye = glm::vec3(eye.x, eye.y, eye.z);
 
         const auto start = std::chrono::steady_clock::now();
         const Result<void> culled = mInstances.cull(state.camera, state.lodBias, state.visibility, mLodHysteresis);
@@ -1417,6 +1453,13 @@ namespace TreeLod
                     params.x = batch->getPart().lengthFactor * std::sqrt(state.lodBias);
                     batch->setCustomParameter(0, params);
                 }
+                // Blending draws queue at their farthest tree's depth (world units: times the
+                // node's scale squared), so that Ogre sorts them back to front among transparents.
+                batch->mSquaredViewDepth =
+                    batch->getPart().backToFront
+                        ? state.buckets[b]->farthestSquared *
+                              (mParentNode ? mParentNode->_getDerivedScale().squaredLength() / 3.0f : 1.0f)
+                        : -1.0f;
                 queue->addRenderable(batch.get(), mRenderQueueID, mRenderQueuePriority);
                 ++batches;
                 triangles += std::uint64_t(batch->getPart().indexData->indexCount / 3) * bucket.count;

@@ -36,7 +36,8 @@ namespace TreeLod
 
     VolumeOctreeTree::VolumeOctreeTree(const Ogre::String& name, const TreeAssetPtr& asset, const Options& options)
         : Ogre::MovableObject(name), mAsset(asset), mData(&VolumeOctreeResources::of(*asset).getData()),
-          mGpu(&VolumeOctreeResources::of(*asset).getGpu()), mOptions(options)
+          mGpu(&VolumeOctreeResources::of(*asset).getGpu()),
+          mCellOrders(&VolumeOctreeResources::of(*asset).getCellOrders()), mOptions(options)
     {
         if (mOptions.level >= 0 && std::uint32_t(mOptions.level) >= mData->levelCount)
             OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
@@ -72,7 +73,7 @@ namespace TreeLod
         for (std::uint32_t level = active == 0 ? 0 : active - 1; level <= active; ++level)
         {
             const std::uint32_t first = mData->firstCell(level);
-            for (std::uint32_t i : mGpu->cellOrders[level][octant])
+            for (std::uint32_t i : (*mCellOrders)[level][octant])
             {
                 const std::uint32_t v = 4 * (first + i);
                 indices.insert(indices.end(), {v, v + 1, v + 2, v, v + 2, v + 3});

@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <vector>
 
 namespace Ogre
@@ -64,6 +65,12 @@ namespace TreeLod
         /// > 0: custom parameter 0 of the part is (lengthFactor * sqrt(camera LoD bias), 1, 0, 0),
         /// a screen-length factor that follows the LoD bias (billboard clouds' list factor).
         float lengthFactor = 0.0f;
+        /// Custom parameters set on every draw of the part (index -> value); index 0 is the length
+        /// factor's when lengthFactor > 0.
+        std::map<std::size_t, Ogre::Vector4> customParameters;
+        /// The part blends: each draw lists its trees far to near from the camera (instances are
+        /// drawn in order), and the Forest queues it at the depth of its farthest tree.
+        bool backToFront = false;
     };
 
     /// What a provider adds a level's parts through (implemented by the Forest).

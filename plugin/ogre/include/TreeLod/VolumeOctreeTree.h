@@ -10,7 +10,7 @@
 // cell between the active level and the level above.
 //
 // Order (§6: the paper traverses the octree on the CPU every frame, its stated bottleneck): each
-// level's cells are sorted once per view octant at load (VolumeOctreeGpu::cellOrders); the index
+// level's cells are sorted once per view octant at load (VolumeOctreeResources::getCellOrders); the index
 // buffer is rewritten only when the octant of the view direction or the active level changes, the
 // level above first (its cells lie behind the plane), then the active level.
 //
@@ -72,6 +72,7 @@ namespace TreeLod
         TreeAssetPtr mAsset;
         const VolumeOctreeData* mData;
         const VolumeOctreeGpu* mGpu;
+        const VolumeOctreeCellOrders* mCellOrders;
         Options mOptions;
         std::unique_ptr<Part> mPart;
         Ogre::HardwareIndexBufferSharedPtr mIndexBuffer;
