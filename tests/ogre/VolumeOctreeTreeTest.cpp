@@ -494,6 +494,46 @@ namespace TreeLod
         EXPECT_GT(drawn.front(), drawn.back());
     }
 
+    TEST(VolumeOctreeTree, forestInsideTheCrownAndKilometresAway)
+    {
+        // Inside the crown the finest level fills the view; 5 km away the root cell alone.
+        OgreEnvironment::renderer().setShadows(false);
+        const BakedOak& t = oak();
+        const std::vector<ForestLevel> levels =
+            Forest::levelsForBands(*t.asset, {ForestBand{VOLUME_OCTREE_CHUNK, 0.0f}});
+        const glm::vec3 centre = 0.5f * (t.model.boundsMin + t.model.boundsMax);
+        CameraSpec inside;
+        inside.position = centre + glm::vec3(0.0f, 0.1f, 0.5f);
+        inside.target = centre + glm::vec3(0.0f, 0.1f, -1.0f);
+        inside.nearClip = 0.01f;
+        CameraSpec far = inside;
+        far.position = centre + glm::vec3(0.0f, 0.0f, 5000.0f);
+        far.target = centre;
+        far.farClip = 10000.0f;
+        for (const bool isInside : {true, false})
+        {
+            const CameraSpec& camera = isInside ? inside : far;
+            Forest& forest = placeForest({Placed{}}, levels);
+            OffscreenRenderer& r = OgreEnvironment::renderer();
+            const Image image = toImage(r.render(camera, 96, 96, 1));
+            const std::vector<std::uint32_t>& counts = forest.getStats().levelCounts[0];
+            const auto at = std::find(counts.begin(), counts.end(), 1u);
+            ASSERT_NE(at, counts.end());
+            const std::uint32_t level = levels[std::size_t(at - counts.begin())].techniqueLevel;
+            r.clearContent();
+            if (isInside)
+            {
+                EXPECT_EQ(level, t.data.levelCount - 1);
+                EXPECT_GT(covered(image), std::size_t(96 * 96 / 2));
+            }
+            else
+            {
+                EXPECT_EQ(level, 0u);
+                EXPECT_LT(covered(image), std::size_t(4));
+            }
+        }
+    }
+
     TEST(VolumeOctreeTree, forestOfOctreesGolden)
     {
         // Nine trees, turned and scaled, at the levels their screen sizes give, casting shadows on
