@@ -253,7 +253,7 @@ namespace TreeLod
     void BillboardCloudResources::createMaterials(BillboardCloudGpu& gpu, const BillboardCloudData& data,
                                                   const Ogre::String& prefix)
     {
-        const std::pair<const char*, Ogre::String> units[] = {
+        const std::vector<std::pair<Ogre::String, Ogre::String>> units = {
             {"HashAtlas", prefix + "hash"},           {"ListsAtlas", prefix + "lists"},
             {"AoAtlas", prefix + "ao"},               {"LeavesColour", prefix + "leaves-colour"},
             {"LeavesNormal", prefix + "leaves-normal"}, {"LowRes", prefix + "low-res"}};
@@ -262,24 +262,18 @@ namespace TreeLod
         const int rows = std::max(1, int(data.leavesColour.height) / tileSize);
 
         auto configure = [&](const Ogre::MaterialPtr& material) {
-            material->load();
-            for (Ogre::Technique* tech : material->getTechniques())
-                for (Ogre::Pass* pass : tech->getPasses())
-                {
-                    for (const auto& unit : units)
-                        if (Ogre::TextureUnitState* state = pass->getTextureUnitState(unit.first))
-                            state->setTextureName(unit.second);
-                    if (!pass->hasFragmentProgram())
-                        continue;
-                    Ogre::GpuProgramParametersSharedPtr p = pass->getFragmentProgramParameters();
-                    p->setIgnoreMissingParams(true);
-                    p->setNamedConstant("listsAtlasWidth", int(std::max<std::uint32_t>(data.listsAtlasWidth, 1)));
-                    p->setNamedConstant("tileSize", float(tileSize));
-                    p->setNamedConstant("tileColumns", columns);
-                    p->setNamedConstant("tileRows", rows);
-                    p->setNamedConstant("orientationCount", int(std::max<std::uint32_t>(data.orientationCount(), 1)));
-                    p->setNamedConstant("leavesMaxLod", float(data.leavesMaxLod));
-                }
+            configurePasses(material, units, [&](Ogre::Pass& pass) {
+                if (!pass.hasFragmentProgram())
+                    return;
+                Ogre::GpuProgramParametersSharedPtr p = pass.getFragmentProgramParameters();
+                p->setIgnoreMissingParams(true);
+                p->setNamedConstant("listsAtlasWidth", int(std::max<std::uint32_t>(data.listsAtlasWidth, 1)));
+                p->setNamedConstant("tileSize", float(tileSize));
+                p->setNamedConstant("tileColumns", columns);
+                p->setNamedConstant("tileRows", rows);
+                p->setNamedConstant("orientationCount", int(std::max<std::uint32_t>(data.orientationCount(), 1)));
+                p->setNamedConstant("leavesMaxLod", float(data.leavesMaxLod));
+            });
         };
         auto clone = [&](const Ogre::String& base, const Ogre::String& name) {
             Ogre::MaterialPtr material = cloneBaseMaterial(base, name, mAsset.getGroup(), mAsset.getName());

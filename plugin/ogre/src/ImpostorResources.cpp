@@ -48,15 +48,7 @@ namespace TreeLod
     {
         auto clone = [&](const Ogre::String& from, const Ogre::String& name) {
             Ogre::MaterialPtr m = cloneBaseMaterial(from, name, asset.getGroup(), asset.getName());
-            m->load();
-            for (Ogre::Technique* tech : m->getTechniques())
-                for (Ogre::Pass* pass : tech->getPasses())
-                {
-                    for (const auto& [unitName, texture] : textures)
-                        if (Ogre::TextureUnitState* unit = pass->getTextureUnitState(unitName))
-                            unit->setTextureName(texture);
-                    configure(*pass);
-                }
+            configurePasses(m, textures, configure);
             return m;
         };
         Ogre::MaterialPtr caster;

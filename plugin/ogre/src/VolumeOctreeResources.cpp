@@ -13,7 +13,6 @@
 
 #include <algorithm>
 #include <functional>
-#include <map>
 
 namespace TreeLod
 {
@@ -64,34 +63,26 @@ namespace TreeLod
         }
 
         /// Clone `base` as `name` and `casterBase` as `name`/Caster, the clone's shadow caster; bind
-        /// the texture units named in `textures` (unit -> texture) and set `constants` on every program.
+        /// the texture units named in `textures` and set `constants` on every program.
         void cloneMaterials(const Ogre::String& base, const Ogre::String& casterBase, const Ogre::String& name,
                             const Ogre::String& group, const Ogre::String& assetName,
-                            const std::map<Ogre::String, Ogre::String>& textures,
+                            const std::vector<std::pair<Ogre::String, Ogre::String>>& textures,
                             const std::function<void(Ogre::GpuProgramParameters&)>& constants)
         {
             const Ogre::MaterialPtr material = cloneBaseMaterial(base, name, group, assetName);
             const Ogre::MaterialPtr caster = cloneBaseMaterial(casterBase, name + "/Caster", group, assetName);
             for (const Ogre::MaterialPtr& m : {material, caster})
-            {
-                m->load();
-                for (Ogre::Technique* tech : m->getTechniques())
-                    for (Ogre::Pass* pass : tech->getPasses())
+                configurePasses(m, textures, [&](Ogre::Pass& pass) {
+                    for (bool vertex : {true, false})
                     {
-                        for (const auto& [unitName, texture] : textures)
-                            if (Ogre::TextureUnitState* unit = pass->getTextureUnitState(unitName))
-                                unit->setTextureName(texture);
-                        for (bool vertex : {true, false})
-                        {
-                            if (vertex ? !pass->hasVertexProgram() : !pass->hasFragmentProgram())
-                                continue;
-                            Ogre::GpuProgramParametersSharedPtr p =
-                                vertex ? pass->getVertexProgramParameters() : pass->getFragmentProgramParameters();
-                            p->setIgnoreMissingParams(true);
-                            constants(*p);
-                        }
+                        if (vertex ? !pass.hasVertexProgram() : !pass.hasFragmentProgram())
+                            continue;
+                        Ogre::GpuProgramParametersSharedPtr p =
+                            vertex ? pass.getVertexProgramParameters() : pass.getFragmentProgramParameters();
+                        p->setIgnoreMissingParams(true);
+                        constants(*p);
                     }
-            }
+                });
             for (Ogre::Technique* tech : material->getTechniques())
                 tech->setShadowCasterMaterial(caster);
         }

@@ -46,6 +46,9 @@
 //   in code from the plain program: same source, defines + INSTANCED=1, shared by every
 //   Forest); the clones are the Forest's and go with it. Parts whose materials read the instance
 //   data already (ForestPartOptions::instancedMaterial, the impostor's) are used as they are.
+// - Blending parts (ForestPartOptions::backToFront, the volume octree's): each camera's bucket
+//   lists its trees far to near in the instance buffer, and the draw is queued at its farthest
+//   tree's depth, so Ogre's transparent queue sorts it among the others.
 // - Residency ("model only what a scene requires"; no stall when a level first shows):
 //   addSpecies plans every level from decoded chunks (ForestLevelProvider::checkLevel; the bark
 //   mesh that levelsForBands plans with is the one upload there) and builds

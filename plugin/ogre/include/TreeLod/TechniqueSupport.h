@@ -1,6 +1,7 @@
 // TechniqueSupport: what a technique's Ogre half (its TechniqueResources) uses to put its chunk's
 // textures and materials on the GPU: the Ogre format of a baked texture, its upload with every
-// baked mip, a clone of one of TreeLod's base materials, and a single tree as one instance.
+// baked mip, a clone of one of TreeLod's base materials and its passes' textures, and a single
+// tree as one instance.
 #pragma once
 
 #include "TreeLod/ModelChunk.h"
@@ -16,6 +17,8 @@
 #include <OgreVertexIndexData.h>
 
 #include <cstdint>
+#include <functional>
+#include <utility>
 #include <vector>
 
 namespace TreeLod
@@ -66,6 +69,24 @@ namespace TreeLod
                         "material '" + base + "' not found: add TreeLod's materials/ to a resource group",
                         "TreeAsset '" + assetName + "'");
         return parent->clone(name, true, group);
+    }
+
+    /// Load `material` and set up every pass: each texture unit named in `textures` (unit name,
+    /// texture) shows that texture, then `configure` (if any) runs on the pass.
+    inline void configurePasses(const Ogre::MaterialPtr& material,
+                                const std::vector<std::pair<Ogre::String, Ogre::String>>& textures,
+                                const std::function<void(Ogre::Pass&)>& configure = {})
+    {
+        material->load();
+        for (Ogre::Technique* tech : material->getTechniques())
+            for (Ogre::Pass* pass : tech->getPasses())
+            {
+                for (const auto& [unitName, texture] : textures)
+                    if (Ogre::TextureUnitState* unit = pass->getTextureUnitState(unitName))
+                        unit->setTextureName(texture);
+                if (configure)
+                    configure(*pass);
+            }
     }
 
     /// Set every pass of `material` (loaded first) as TreeLod's Bark/Leaf programs read it: texture
