@@ -1,17 +1,21 @@
 // treelod bake INPUT.glb -o OUT.treelod [--technique NAME]... [--leaf-material NAME]... [--error-curves] [-q]
+// treelod bake CAPTURE_FOLDER -o OUT.treelod [--technique volume-octree] [--option volume-octree.NAME=VALUE]... [-q]
 // Imports the tree, bakes one chunk set per technique plus the "meta" chunk (source file
 // name, its sourceHashOf() as the bake cache records it, options) and writes the package atomically:
-// on any error nothing is written and the exit code is 2.
+// on any error nothing is written and the exit code is 2. A capture folder (photographs,
+// CaptureSet.h) bakes volume-octree only, with a reference of bounds only (ModelChunk.h).
 #include "CliSupport.h"
 #include "Commands.h"
 
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/BakeCache.h"
 #include "TreeLod/BakeTechniques.h"
+#include "TreeLod/CaptureSet.h"
 #include "TreeLod/ErrorCurves.h"
 #include "TreeLod/GltfImporter.h"
 #include "TreeLod/Package.h"
 #include "TreeLod/PackageWriter.h"
+#include "TreeLod/VolumeOctreeBaker.h"
 
 #ifdef TREELOD_WITH_OGRE
 #include "TreeLod/ErrorCurveMeasurer.h"
@@ -41,8 +45,98 @@ namespace TreeLod
             bool quiet = false;
         };
 
+        /// The name of the folder at `path`: "photos" for "photos/", the working directory's for ".".
+        std::string folderName(const std::string& path)
+        {
+            std::error_code ec;
+            std::filesystem::path p = std::filesystem::absolute(path, ec).lexically_normal();
+            if (p.filename().empty())
+                p = p.parent_path();
+            return p.filename().string();
+        }
+
+        /// `treelod bake CAPTURE_FOLDER`: the photographs' volume octree and a reference of bounds only.
+        int runBakeCapture(const BakeArgs& args)
+        {
+            const std::string& folder = args.input;
+            for (const std::string& name : args.techniques)
+                if (name != VOLUME_OCTREE_CHUNK)
+                    return printError(fail(folder, "option --technique",
+                                           "'" + name + "': a capture folder (photographs) can only bake " +
+                                               VOLUME_OCTREE_CHUNK));
+            if (!args.leafMaterials.empty())
+                return printError(fail(folder, "option --leaf-material", "applies to glTF input, not to photographs"));
+            if (args.errorCurves)
+                return printError(fail(folder, "option --error-curves",
+                                       "error curves compare the levels with the polygonal tree, and photographs "
+                                       "have none"));
+            const BakeTechnique* technique = findBakeTechnique(VOLUME_OCTREE_CHUNK);
+            if (!technique)
+                return printError(fail(folder, "", std::string("this build has no ") + VOLUME_OCTREE_CHUNK + " baker"));
+            BakeOptions values;
+            nlohmann::json optionsJson = nlohmann::json::object();
+            for (const std::string& option : args.options)
+            {
+                Result<BakeOptionAssignment> parsed = parseBakeOptionAssignment(option);
+                if (!parsed)
+                    return printError(parsed.error());
+                const auto& [name, key, value] = parsed.value();
+                if (name != VOLUME_OCTREE_CHUNK)
+                    return printError(fail("", "option --option '" + option + "'",
+                                           "'" + name + "' is not a technique being baked"));
+                values[key] = value;
+                optionsJson[name][key] = value;
+            }
+            if (Result<void> checked = checkBakeOptions(*technique, values, args.output); !checked)
+                return printError(checked.error());
+            VolumeOctreeOptions options;
+            if (Result<void> parsed = parseVolumeOctreeBakeOptions(values, options, nullptr, args.output); !parsed)
+                return printError(parsed.error());
+
+            const std::filesystem::path outDir = std::filesystem::path(args.output).parent_path();
+            std::error_code ec;
+            if (!outDir.empty() && !std::filesystem::is_directory(outDir, ec))
+                return printError(fail(args.output, "", "directory '" + outDir.string() + "' does not exist"));
+
+            const ProgressCallback progress = makeProgress(args.quiet);
+            report(progress, "capture: read", 0.0f);
+            Result<CaptureSet> capture = readCaptureSet(folder);
+            if (!capture)
+                return printError(capture.error());
+            report(progress, "capture: read", 1.0f);
+            Result<std::string> hash = sourceHashOf(folder);
+            if (!hash)
+                return printError(hash.error());
+
+            PackageWriter writer;
+            PackageMeta meta;
+            meta.source = folderName(folder);
+            meta.sourceHash = hash.value();
+            meta.optionsJson = optionsJson.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+            meta.techniques = {REFERENCE_CHUNK, VOLUME_OCTREE_CHUNK};
+            if (Result<void> baked =
+                    addVolumeOctreeChunk(writer, capture.value(), meta.source, options, args.output, progress);
+                !baked)
+                return printError(baked.error());
+            if (Result<void> added = addMetaChunk(writer, meta); !added)
+                return printError(added.error());
+
+            const std::vector<std::uint8_t> bytes = writer.toBytes();
+            report(progress, "write", 0.0f);
+            if (Result<void> written = writeFileAtomic(args.output, bytes); !written)
+                return printError(written.error());
+            report(progress, "write", 1.0f);
+            std::printf("wrote %s: %zu chunks (%s, %s + meta), %zu bytes; %zu photographs, no polygons\n",
+                        args.output.c_str(), writer.chunkCount(), REFERENCE_CHUNK, VOLUME_OCTREE_CHUNK, bytes.size(),
+                        capture->cameras.size());
+            return EXIT_OK;
+        }
+
         int runBake(const BakeArgs& args)
         {
+            std::error_code isDirectoryError;
+            if (std::filesystem::is_directory(args.input, isDirectoryError))
+                return runBakeCapture(args);
             std::vector<const BakeTechnique*> techniques;
             for (const std::string& name : args.techniques.empty() ? std::vector<std::string>{REFERENCE_CHUNK}
                                                                    : args.techniques)
@@ -84,7 +178,9 @@ namespace TreeLod
 
             const std::string ext = lowerCaseExtension(args.input);
             if (ext != ".glb" && ext != ".gltf")
-                return printError(fail(args.input, "", "unknown tree format '" + ext + "' (expected .glb or .gltf)"));
+                return printError(fail(args.input, "",
+                                       "unknown tree format '" + ext +
+                                           "' (expected .glb, .gltf or a capture folder holding cameras.json)"));
             Result<std::string> hash = sourceHashOf(args.input);
             if (!hash)
                 return printError(hash.error());
@@ -167,8 +263,12 @@ namespace TreeLod
                 optionHelp += std::string("\n  ") + t.name + "." + o.name + " (default " + o.defaultValue + "): " +
                               o.description;
         }
-        CLI::App* cmd = app.add_subcommand("bake", "bake a .glb/.gltf tree into a .treelod package");
-        cmd->add_option("input", args->input, ".glb or .gltf file")->required();
+        CLI::App* cmd = app.add_subcommand(
+            "bake", "bake a .glb/.gltf tree, or a capture folder of photographs (volume-octree), into a .treelod package");
+        cmd->add_option("input", args->input,
+                        ".glb or .gltf file, or a capture folder (cameras.json and RGBA photographs: volume-octree "
+                        "only, without its synthesis options cameras, resolution, samplesPerPixel)")
+            ->required();
         cmd->add_option("-o,--output", args->output, ".treelod file to write (atomically)")->required();
         cmd->add_option("--technique", args->techniques, help)->allow_extra_args(false);
         cmd->add_option("--leaf-material", args->leafMaterials,

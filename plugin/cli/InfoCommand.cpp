@@ -55,6 +55,7 @@ namespace TreeLod
             j["leafVertices"] = m.leafVertices.size();
             j["materials"] = m.materials.size();
             j["skeletonNodes"] = m.skeleton.size();
+            j["polygons"] = hasPolygons(m); // false: baked from photographs, bounds only
             j["bounds"] = {{"min", vec3Json(m.boundsMin)}, {"max", vec3Json(m.boundsMax)}};
             json tex = json::array();
             for (const TextureRow& t : textures)
@@ -80,6 +81,9 @@ namespace TreeLod
             std::printf("  bounds (%.3f, %.3f, %.3f) .. (%.3f, %.3f, %.3f), %.3f x %.3f x %.3f m\n", m.boundsMin.x,
                         m.boundsMin.y, m.boundsMin.z, m.boundsMax.x, m.boundsMax.y, m.boundsMax.z, size.x, size.y,
                         size.z);
+            if (!hasPolygons(m))
+                std::printf("  no polygons: baked from photographs, the bounds are the capture's volume (only "
+                            "volume-octree draws it)\n");
             std::printf("  textures %zu\n", textures.size());
             for (std::size_t i = 0; i < textures.size(); ++i)
             {

@@ -7,6 +7,7 @@
 #include "TreeInput.h"
 
 #include "TreeLod/Image.h"
+#include "TreeLod/ModelChunk.h"
 #include "TreeLod/ReferenceRenderer.h"
 
 #include <chrono>
@@ -70,6 +71,8 @@ namespace TreeLod
                     return printError(fail("", "--camera", cameraError));
                 if (args.technique != "mesh")
                     return printError(fail("", "--technique", "the CPU renderer draws the polygonal reference only (mesh)"));
+                if (Result<void> polygons = requirePolygons(model, args.input, "the CPU renderer"); !polygons)
+                    return printError(polygons.error());
                 ReferenceRenderer renderer(model);
                 RenderOptions options;
                 options.width = width;

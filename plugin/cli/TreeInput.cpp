@@ -33,8 +33,11 @@ namespace TreeLod
             input.model = std::move(reference->model);
             for (const std::string& chunk : chunks)
                 if (package->findChunk(chunk, 0) < 0)
-                    return fail(path, chunkElement(chunk, 0),
-                                "missing: bake the package with --technique " + chunk);
+                {
+                    if (!hasPolygons(input.model)) // photographs bake volume-octree only
+                        return requirePolygons(input.model, path, "chunk '" + chunk + "'").error();
+                    return fail(path, chunkElement(chunk, 0), "missing: bake the package with --technique " + chunk);
+                }
             Result<std::vector<std::uint8_t>> bytes = readFile(path);
             if (!bytes)
                 return bytes.error();

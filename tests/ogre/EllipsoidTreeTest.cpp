@@ -306,7 +306,9 @@ namespace TreeLod
             if (lineLevels.empty() || lineLevels.back() != l)
                 lineLevels.push_back(l);
             if (i > 0)
+            {
                 EXPECT_LT(bands[i].minPixelCount, bands[i - 1].minPixelCount);
+            }
         }
         std::vector<std::uint32_t> all(t.data.levels.size()), allLines(lines->levels.size());
         std::iota(all.begin(), all.end(), 0u);

@@ -407,7 +407,9 @@ namespace TreeLod
                         error, planeShows);
             EXPECT_LT(error, 0.003) << "level " << c.level;
             if (c.distance > 1.0f)
+            {
                 EXPECT_GT(planeShows, 0.01) << "the plane of level " << c.level << " misses the crown";
+            }
             EXPECT_GT(covered(forest), std::size_t(160 * 160 / 16)) << "level " << c.level;
             strip.push_back(object);
             strip.push_back(forest);
@@ -584,5 +586,80 @@ namespace TreeLod
         EXPECT_GT(groundShadow, 1000u);
         writePng(OgreEnvironment::outDir() + "/volume-octree-forest-shadows.png", sideBySide({lit, shadowed}));
         compareWithGolden(shadowed, "forest-volume-octree", 0.02);
+    }
+}
+
+namespace TreeLod
+{
+    TEST(VolumeOctreeTree, photographedTreeDrawsAsVolumeOctreeOnly)
+    {
+        // A package baked from photographs (no polygons, the capture's volume as bounds) draws as a
+        // VolumeOctreeTree and as Forest levels; the mesh technique is refused naming the asset.
+        OgreEnvironment::renderer().setShadows(false);
+        GeneratorOptions generator;
+        generator.leafCount = 300;
+        generator.textureSize = 32;
+        Result<TreeModel> model = generateTree(generator);
+        ASSERT_TRUE(model.ok());
+        CaptureSynthesisOptions synthesis;
+        synthesis.cameraCount = 8;
+        synthesis.resolution = 64;
+        synthesis.samplesPerPixel = 1;
+        Result<CaptureSet> capture = synthesiseCaptureSet(model.value(), synthesis, "photos");
+        ASSERT_TRUE(capture.ok()) << capture.error().message();
+        VolumeOctreeOptions options;
+        options.levelCount = 4;
+        options.quantisation.colourCodebookSize = 32;
+        options.quantisation.alphaCodebookSize = 32;
+        PackageWriter writer;
+        Result<void> added = addVolumeOctreeChunk(writer, capture.value(), "photos", options, "photos");
+        ASSERT_TRUE(added.ok()) << added.error().message();
+        TreeAssetPtr asset =
+            TreeAssetManager::getSingleton().loadFromBytes("photos.volume-octree-test", Ogre::RGN_DEFAULT, writer.toBytes());
+
+        const std::vector<ForestLevel> candidates = Forest::getCandidateLevels(*asset);
+        ASSERT_EQ(candidates.size(), std::size_t(4));
+        for (const ForestLevel& level : candidates)
+            EXPECT_EQ(level.technique, VOLUME_OCTREE_CHUNK);
+        const auto refused = [&](const std::function<void()>& f, const std::vector<std::string>& needles) {
+            try
+            {
+                f();
+                ADD_FAILURE() << "accepted: " << needles.front();
+            }
+            catch (const Ogre::Exception& e)
+            {
+                for (const std::string& needle : needles)
+                    EXPECT_NE(e.getFullDescription().find(needle), std::string::npos) << e.getFullDescription();
+            }
+        };
+        refused([&] { Forest::levelsForBands(*asset, {ForestBand{"mesh", 0.0f}}); },
+                {"photos.volume-octree-test", "nothing this technique draws"});
+        refused([&] { asset->getReferenceMesh(); }, {"photos.volume-octree-test", "baked from photographs"});
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        auto* forest = static_cast<Forest*>(r.getSceneManager().createMovableObject("photo-forest", "Forest"));
+        refused([&] { forest->addSpecies(asset, {ForestLevel{"mesh", 0, false, 0.0f}}); },
+                {"photos.volume-octree-test", "baked from photographs", "technique 'mesh'"});
+        r.getSceneManager().destroyMovableObject(forest);
+
+        const glm::vec3 lo(capture->volumeMin), hi(capture->volumeMax);
+        CameraSpec camera;
+        camera.target = 0.5f * (lo + hi);
+        camera.position = camera.target + glm::vec3(0.3f, 0.2f, 1.0f) * 2.0f * glm::length(hi - lo);
+        const Ogre::NameValuePairList params = {{"asset", asset->getName()}, {"group", asset->getGroup()}};
+        r.getContentNode().attachObject(r.getSceneManager().createMovableObject(
+            "photo-tree", VolumeOctreeTreeFactory::FACTORY_TYPE_NAME, &params));
+        const Image single = renderContent(camera, 96, 96);
+        forest = static_cast<Forest*>(r.getSceneManager().createMovableObject("photo-forest", "Forest"));
+        forest->setLodHysteresis(0.0f);
+        forest->addSpecies(asset, Forest::levelsForBands(*asset, {ForestBand{VOLUME_OCTREE_CHUNK, 0.0f}}));
+        forest->addInstances({ForestInstance{glm::vec3(0.0f), 0.0f, 1.0f, 0}});
+        r.getContentNode().attachObject(forest);
+        const Image forestImage = renderContent(camera, 96, 96);
+        writePng(OgreEnvironment::outDir() + "/volume-octree-photographs.png", sideBySide({single, forestImage}));
+        EXPECT_GT(covered(single), std::size_t(96 * 96 / 50));
+        EXPECT_GT(covered(forestImage), std::size_t(96 * 96 / 50));
+        EXPECT_LT(boxFlip(single, forestImage), 0.01);
+        TreeAssetManager::getSingleton().remove(asset);
     }
 }

@@ -540,6 +540,10 @@ namespace TreeLod
             {
                 invalid(element + e.getDescription(), source);
             }
+            if (spans.empty())
+                invalid(element + "the asset has nothing this technique draws (a tree baked from photographs has "
+                                  "volume-octree levels only)",
+                        source);
             // The technique's levels clipped to the band's values [lower, upper).
             for (const Span& span : spans)
                 if (span.level.minPixelCount < upper && span.upper > lower)

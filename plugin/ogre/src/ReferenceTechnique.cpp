@@ -1,6 +1,7 @@
 // Technique "mesh": the polygonal reference (bark with MeshLodGenerator levels, every leaf) as an
 // Ogre Entity of TreeAsset::getReferenceMesh, and as a Forest level. Every comparison in this
 // project is made against it.
+#include "TreeLod/ModelChunk.h"
 #include "TreeLod/Package.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAsset.h"
@@ -18,7 +19,8 @@ namespace TreeLod
         public:
             std::vector<ForestLevelSpan> getSpans(TreeAsset& asset, const Ogre::String& technique) override
             {
-                asset.getReference();
+                if (!hasPolygons(asset.getReference().model))
+                    return {}; // baked from photographs: nothing to draw as a mesh
                 return {{ForestLevel{technique, 0, false, 0.0f}, ForestLevelSpan::NO_UPPER}};
             }
 
@@ -27,7 +29,9 @@ namespace TreeLod
                 if (level.lowRes)
                     OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, "lowRes is for billboard-cloud levels only",
                                 "ReferenceLevels::checkLevel");
-                asset.getReference();
+                if (Result<void> polygons = requirePolygons(asset.getReference().model, asset.getName(), "technique 'mesh'");
+                    !polygons)
+                    asset.raise(polygons.error());
             }
 
             void buildParts(TreeAsset& asset, const ForestLevel&, ForestPartBuilder& parts) override

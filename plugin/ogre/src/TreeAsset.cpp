@@ -246,6 +246,8 @@ namespace TreeLod
     {
         if (!mReferenceMesh)
         {
+            if (Result<void> polygons = requirePolygons(getReference().model, mName, "technique 'mesh'"); !polygons)
+                raise(polygons.error());
             const std::vector<Ogre::String>& materials = getMaterialNames();
             mReferenceMesh = buildTreeMesh(mName + "/reference", mGroup, getReference().model, materials);
         }

@@ -141,6 +141,8 @@ namespace TreeLod
             return fail(label, "error curves", "no technique can draw this asset as a Forest level");
 
         const TreeModel& model = asset.getReference().model;
+        if (Result<void> polygons = requirePolygons(model, label, "error curves (measured against it)"); !polygons)
+            return polygons.error();
         const ReferenceRenderer cpu(model);
         const glm::vec3 lo = model.boundsMin, hi = model.boundsMax;
 

@@ -108,6 +108,30 @@ namespace TreeLod
             return hashString(digest);
         }
 
+        /// Hash of a capture folder (CaptureSet.h): cameras.json's bytes and those of the image
+        /// each of its cameras names, in order. Images that cannot be read hash as missing;
+        /// readCaptureSet reports them.
+        Result<std::uint64_t> hashCaptureFolder(const std::string& folder)
+        {
+            const std::filesystem::path dir(folder);
+            Result<std::vector<std::uint8_t>> bytes = readFile((dir / "cameras.json").string());
+            if (!bytes)
+                return bytes.error();
+            std::string digest = "capture " + hex16(fnv1a64(bytes->data(), bytes->size()));
+            const nlohmann::json json = nlohmann::json::parse(bytes->begin(), bytes->end(), nullptr, false);
+            if (json.is_object() && json.contains("cameras") && json["cameras"].is_array())
+                for (const nlohmann::json& camera : json["cameras"])
+                {
+                    if (!camera.is_object() || !camera.contains("image") || !camera["image"].is_string())
+                        continue;
+                    const std::string image = camera["image"].get<std::string>();
+                    Result<std::vector<std::uint8_t>> file = readFile((dir / image).string());
+                    digest += "\n" + image + " " +
+                              (file ? hex16(fnv1a64(file->data(), file->size())) : std::string("missing"));
+                }
+            return hashString(digest);
+        }
+
         /// The options as compact JSON with sorted keys; "" is {}.
         Result<std::string> canonicalOptions(const std::string& source, const std::string& optionsJson)
         {
@@ -273,7 +297,9 @@ namespace TreeLod
 
     Result<std::string> sourceHashOf(const std::string& path)
     {
-        Result<std::uint64_t> hash = hashFileSource(path);
+        std::error_code ec;
+        Result<std::uint64_t> hash =
+            std::filesystem::is_directory(path, ec) ? hashCaptureFolder(path) : hashFileSource(path);
         if (!hash)
             return hash.error();
         return "fnv1a64:" + hex16(hash.value());

@@ -283,6 +283,17 @@ namespace TreeLod
         return w.take();
     }
 
+    bool hasPolygons(const TreeModel& model) { return !model.barkIndices.empty() || !model.leafIndices.empty(); }
+
+    Result<void> requirePolygons(const TreeModel& model, const std::string& label, const std::string& use)
+    {
+        if (hasPolygons(model))
+            return {};
+        return fail(label, chunkElement(REFERENCE_CHUNK, 0),
+                    "no polygons: the tree was baked from photographs (a capture folder) and only volume-octree "
+                    "draws it; " + use + " needs a polygonal tree");
+    }
+
     Result<ReferenceChunk> decodeReferenceChunk(const std::vector<std::uint8_t>& bytes, const std::string& label)
     {
         const std::string chunkName = chunkElement(REFERENCE_CHUNK, 0);

@@ -670,4 +670,28 @@ namespace TreeLod
             return fail(label, added.error().element, added.error().reason);
         return {};
     }
+
+    Result<void> addVolumeOctreeChunk(PackageWriter& writer, const CaptureSet& capture, const std::string& name,
+                                      const VolumeOctreeOptions& options, const std::string& label,
+                                      const ProgressCallback& progress)
+    {
+        if (writer.hasChunk(REFERENCE_CHUNK, 0))
+            return fail(label, chunkElement(REFERENCE_CHUNK, 0),
+                        "present already: a tree baked from photographs has a reference of bounds only");
+        Result<VolumeOctreeData> data = bakeVolumeOctree(capture, options, label, progress);
+        if (!data)
+            return data.error();
+        // No geometry: the bounds the Forest and the cameras frame the tree by.
+        TreeModel bounds;
+        bounds.name = name;
+        bounds.boundsMin = glm::vec3(capture.volumeMin);
+        bounds.boundsMax = glm::vec3(capture.volumeMax);
+        if (Result<void> reference = addReferenceChunk(writer, bounds, label, progress); !reference)
+            return reference;
+        Result<void> added = writer.addChunk(VOLUME_OCTREE_CHUNK, 0, VOLUME_OCTREE_CHUNK_FORMAT_VERSION,
+                                             encodeVolumeOctreeChunk(data.value()));
+        if (!added)
+            return fail(label, added.error().element, added.error().reason);
+        return {};
+    }
 }

@@ -95,7 +95,8 @@ namespace TreeLod
     public:
         virtual ~ForestLevelProvider() = default;
         /// Every level of `technique` (the registered name) for `asset` over all LoD values, near to
-        /// far, from decoded data (uploading at most the bark mesh). Throws
+        /// far, from decoded data (uploading at most the bark mesh); empty when the asset has the
+        /// technique's chunk but nothing it can draw (a reference without polygons). Throws
         /// Ogre::InvalidParametersException naming what the asset lacks.
         virtual std::vector<ForestLevelSpan> getSpans(TreeAsset& asset, const Ogre::String& technique) = 0;
         /// Whether the levels draw the asset's bark mesh (or a mesh with its LoD levels): the Forest

@@ -43,7 +43,8 @@ namespace TreeLod
         /// The decoded polygonal reference (decoded on first call).
         const ReferenceChunk& getReference();
         /// The polygonal reference as an Ogre mesh "<asset>/reference" with its materials
-        /// and textures (built on first call). See TreeMeshBuilder.
+        /// and textures (built on first call). See TreeMeshBuilder. Throws when the reference has no
+        /// polygons (a tree baked from photographs, ModelChunk.h hasPolygons).
         Ogre::MeshPtr getReferenceMesh();
 
         /// The bark alone as an Ogre mesh "<asset>/bark" with its MeshLodGenerator levels

@@ -63,8 +63,10 @@ namespace TreeLod
 
     /// "fnv1a64:" + 16 hex digits identifying a tree file's content: FNV-1a 64 over its bytes and,
     /// for a .gltf (JSON), the external buffers and images it references (missing ones hash as
-    /// missing; the import reports them). The meta chunk's "sourceHash" of `treelod bake` and of
-    /// the cache. Error when the file cannot be read.
+    /// missing; the import reports them). For a directory, a capture folder (CaptureSet.h): its
+    /// cameras.json and the image of each camera it lists, in its order (missing ones hash as
+    /// missing; readCaptureSet reports them). The meta chunk's "sourceHash" of `treelod bake` and
+    /// of the cache. Error when the file (cameras.json) cannot be read.
     Result<std::string> sourceHashOf(const std::string& path);
 
     /// Imports a tree file: .glb/.gltf with importGltf (`leafMaterials` as ImportOptions, `progress`

@@ -1,5 +1,7 @@
 // The "reference" chunk of a *.treelod package (Package.h): the polygonal tree, every
-// TreeModel field, with its textures stored GPU-ready (whole mip chains).
+// TreeModel field, with its textures stored GPU-ready (whole mip chains). A tree baked from
+// photographs has a reference with no geometry, materials or textures: its bounds only
+// (hasPolygons below).
 //
 // Layout, formatVersion 1 (REFERENCE_CHUNK_FORMAT_VERSION), little-endian. "string" is a
 // u32 byte length + UTF-8 bytes (at most MODEL_CHUNK_MAX_STRING); "align16" is zero bytes up to the next
@@ -107,6 +109,17 @@ namespace TreeLod
     /// Serialise `chunk` in the layout above. Deterministic: equal chunks give equal bytes.
     /// Does not check consistency; decodeReferenceChunk does.
     std::vector<std::uint8_t> encodeReferenceChunk(const ReferenceChunk& chunk);
+
+    /// Whether `model` holds a triangle. A reference without one holds only its bounds: the tree
+    /// was baked from photographs (`treelod bake CAPTURE_FOLDER`, VolumeOctreeBaker.h) and its
+    /// bounds are the capture's volume box. The glTF importer refuses a model without triangles,
+    /// so no polygonal tree reads as one.
+    bool hasPolygons(const TreeModel& model);
+
+    /// For consumers that need the polygons: an error naming `label` (the package) and the
+    /// reference chunk when `model` has none, saying that the tree was baked from photographs and
+    /// that `use` ("technique 'mesh'", "error curves", ...) needs a polygonal tree.
+    Result<void> requirePolygons(const TreeModel& model, const std::string& label, const std::string& use);
 
     /// Parse and check a reference chunk: every count and range against the chunk size,
     /// texture formats, sizes and mip counts, material texture indices, skeleton parents,

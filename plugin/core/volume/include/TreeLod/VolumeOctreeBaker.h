@@ -32,6 +32,7 @@
 // Deterministic for the inputs and options, whatever the thread count.
 #pragma once
 
+#include "TreeLod/BakeTechniques.h"
 #include "TreeLod/CaptureSet.h"
 #include "TreeLod/PackageWriter.h"
 #include "TreeLod/Progress.h"
@@ -94,6 +95,26 @@ namespace TreeLod
     Result<void> addVolumeOctreeChunk(PackageWriter& writer, const TreeModel& model,
                                       const CaptureSynthesisOptions& capture, const VolumeOctreeOptions& options,
                                       const std::string& label, const ProgressCallback& progress = {});
+
+    /// Package glue for `treelod bake CAPTURE_FOLDER`: the volume-octree chunk baked from `capture`,
+    /// and a reference chunk holding no geometry (hasPolygons, ModelChunk.h), only a model named
+    /// `name` whose bounds are the capture's volume box. Errors name `label`; an error when `writer`
+    /// holds a reference already.
+    Result<void> addVolumeOctreeChunk(PackageWriter& writer, const CaptureSet& capture, const std::string& name,
+                                      const VolumeOctreeOptions& options, const std::string& label,
+                                      const ProgressCallback& progress = {});
+
+    /// The names of the volume-octree bake options that only a synthesised capture reads
+    /// (cameras, resolution, samplesPerPixel): a capture folder's photographs fix them.
+    const std::vector<std::string>& volumeOctreeSynthesisOptions();
+
+    /// `--option volume-octree.NAME=VALUE` values (the names its BakeTechnique declares) into
+    /// `options` and, when not null, `synthesis`; absent names keep their value. With `synthesis`
+    /// null (a bake from photographs) a volumeOctreeSynthesisOptions() name is an error. Errors
+    /// name `label` and "option 'volume-octree.NAME'".
+    Result<void> parseVolumeOctreeBakeOptions(const BakeOptions& given,
+                                              VolumeOctreeOptions& options, CaptureSynthesisOptions* synthesis,
+                                              const std::string& label);
 
     // ---- the CPU twin of the renderer (VolumeOctreeRaster.cpp) -----------------------------
 
