@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // Billboard clouds with multi-layered indirect texturing (García et al. 2007 §5, Fig. 7), one pass.
 // Addressing: plugin/core/billboardcloud/include/TreeLod/BillboardCloudData.h (its
 // BillboardCloudSampler does the same steps on the CPU); all atlas addressing is integer.
@@ -17,7 +24,15 @@
 uniform sampler2D lowRes;
 #ifndef LOW_RES_ONLY
 uniform sampler2D hashAtlas;
+#ifdef OGRE_GLSLES
+// ES 3.00 has no 16-bit normalised textures: the list entries are RGBA16UI there
+// (BillboardCloudResources picks the format with the language).
+uniform highp usampler2D listsAtlas;
+#define LIST_ENTRY(at) texelFetch(listsAtlas, at, 0)
+#else
 uniform sampler2D listsAtlas;
+#define LIST_ENTRY(at) uvec4(texelFetch(listsAtlas, at, 0) * 65535.0 + 0.5)
+#endif
 uniform sampler2D aoAtlas;
 uniform sampler2D leavesColour;
 uniform sampler2D leavesNormal;
@@ -118,7 +133,7 @@ void main()
     {
         uint e = front ? start + k : start + count - 1u - k;
         ivec2 at = ivec2(int(e % width), int(e / width));
-        uvec4 w = uvec4(texelFetch(listsAtlas, at, 0) * 65535.0 + 0.5);
+        uvec4 w = LIST_ENTRY(at);
         vec2 q = q0 - (vec2(w.rg) / 65535.0 * 64.0 - 32.0);
         float psi = float(w.a >> 8u) * (TWO_PI / 256.0);
         float edge = exp2((float(w.a & 255u) - 128.0) / 32.0); // tile edge in cells

@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // Billboard cloud quads (García et al. 2007 §4.2, §6; vertex layout in TreeLod/TreeAsset.h,
 // BillboardCloudGpu): the billboard frame in world space, its (u, v), hash rectangle and
 // low-res rectangle to the fragment stage.

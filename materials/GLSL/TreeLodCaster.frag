@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // Shadow caster; ALPHA_TEST: leaves cast the shadow of their texture's shape.
 #ifdef ALPHA_TEST
 uniform sampler2D diffuseMap;

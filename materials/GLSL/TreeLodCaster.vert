@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // Shadow caster: passes clip-space z and w on; the fragment stage writes depth in 0..1.
 // INSTANCED: placed by the Forest's instance data first (TreeLodInstance.glsl).
 uniform mat4 worldViewProj;

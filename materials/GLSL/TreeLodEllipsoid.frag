@@ -1,5 +1,15 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+// Conservative depth is a desktop extension (ES 3.00 writes gl_FragDepth without the hint).
+#ifndef OGRE_GLSLES
 #extension GL_ARB_conservative_depth : enable
+#endif
+#include "TreeLodShaderSupport.glsl"
 // Ray-ellipsoid intersection in the ellipsoid's unit-sphere frame (Sigg et al. 2006; the
 // ellipsoids-and-lines paper (001) §5): the pixel's ray from + t dir (from on the near plane)
 // becomes o + t k with o = toUnit * (from - centre), k = toUnit * dir, and |o + t k| = 1 is a

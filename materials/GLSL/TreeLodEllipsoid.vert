@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // Ellipsoids of an EllipsoidTree (EllipsoidTreeData.h), ray cast per fragment (Sigg et al. 2006,
 // as the ellipsoids-and-lines paper (001) §5 renders them): one quad per ellipsoid covering, in
 // normalised device coordinates, the projection of the ellipsoid's box (centre +- the three

@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // Ray-capsule intersection for the lines of an EllipsoidTree (TreeLodEllipsoidLine.vert): the
 // pixel's ray against the cylinder of radius r around start..end, then the sphere at the nearer
 // end when the hit falls outside the segment. A line thinner than the pixel that the ray misses is

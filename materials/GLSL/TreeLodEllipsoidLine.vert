@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // Lines of an EllipsoidTree (EllipsoidLineData.h: capsules, a segment swept by a sphere), ray cast
 // per fragment like the ellipsoids (TreeLodEllipsoid.frag). The paper (001, §5) draws its lines as
 // screen-aligned strips ([MSE*06]); here the strip is a quad along the segment, turned to face the

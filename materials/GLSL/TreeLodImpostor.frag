@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // The one-quad impostor (ImpostorData.h): alpha test on the baked coverage, then lit as
 // TreeLodLit.frag lights leaves, colour = albedo * (ambient * ao + sun * max(0, n.l)) in linear
 // space written as sRGB, with the baked normal and ambient occlusion. It is the far level of every

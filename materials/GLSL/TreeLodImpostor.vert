@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // The one-quad impostor (ImpostorData.h), instanced by the Forest (Forest.h): per instance
 // uv4 = position (the Forest's local space) + uniform scale, uv5 = cos, sin of the rotation
 // about +Y, unused: the quad (vertex.xy, metres, facing +Z) turns about the instance's +Y axis

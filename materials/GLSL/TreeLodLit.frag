@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // colour = albedo * (ambient * ao + sun * max(0, n.l)) in linear space, written as sRGB
 // (LightingSpec in TreeLod/Camera.h; the CPU reference renderer uses the same formula).
 // LEAF: alpha test by discard; two-sided, the back side with backColour instead of baseColour.

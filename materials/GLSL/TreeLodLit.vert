@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // Lit tree surfaces (bark and leaves): world-space normal and UV to the fragment stage;
 // SHADOW_RECEIVER: also the position in the sun's shadow texture. AO: the vertex colour's red
 // channel (ambient occlusion) to the fragment stage. INSTANCED: placed by the Forest's

@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // The octahedral impostor (OctahedralImpostorData.h): the three frames TreeLodOctahedralImpostor.vert
 // chose, each read at its frame coordinates shifted by its stored depth (one parallax step), blended
 // by the barycentric weights with coverage as the weight of colour, normal and occlusion; alpha

@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // The octahedral impostor (OctahedralImpostorData.h), instanced by the Forest (Forest.h,
 // TreeLodInstance.glsl). Per instance, from the direction v towards the camera (CASTER: towards
 // the light) turned into the tree's own frame:

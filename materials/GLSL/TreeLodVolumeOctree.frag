@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // The volumetric octree tree's billboard (TreeLodVolumeOctree.vert): the two input cameras'
 // codewords sampled bilinearly inside their 4x4 blocks, premultiplied and weighted, for the over
 // operator (scene_blend one one_minus_src_alpha). Colour is sRGB as stored; the framebuffer holds

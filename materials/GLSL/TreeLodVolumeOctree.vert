@@ -1,4 +1,11 @@
+#if defined(OGRE_GLSLES)
+#version 300 es
+#elif OGRE_GLSL >= 330
 #version 330 core
+#else
+#version 150
+#endif
+#include "TreeLodShaderSupport.glsl"
 // The volumetric octree tree (VolumeOctreeData.h; Linz et al. 2006): one billboard a cell, facing
 // the viewer (the camera's right and up axes in the model's frame), its corners (+-1, +-1).
 // - Level of detail (§3.1, volumeOctreeDrawsCell): a cell of the active level L draws when its

@@ -100,10 +100,10 @@ namespace TreeLod
 
     bool TreeLodBrowser::oneTimeConfig()
     {
-        // No config dialog: GL3Plus, windowed, the requested size.
+        // No config dialog: the render system loadRenderPlugins chose, windowed, the requested size.
         const Ogre::RenderSystemList& systems = mRoot->getAvailableRenderers();
         if (systems.empty())
-            OGRE_EXCEPT(Ogre::Exception::ERR_RENDERINGAPI_ERROR, "RenderSystem_GL3Plus did not load",
+            OGRE_EXCEPT(Ogre::Exception::ERR_RENDERINGAPI_ERROR, renderSystemPlugin() + " did not load",
                         "TreeLodBrowser::oneTimeConfig");
         Ogre::RenderSystem* rs = systems.front();
         rs->setConfigOption("Full Screen", "No");

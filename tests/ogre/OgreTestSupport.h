@@ -70,9 +70,13 @@ namespace TreeLod
             s.renderer.reset();
         }
 
+        /// build/test-out/ogre, or ogre-<system> under another render system than GL3Plus
+        /// ($TREELOD_RENDER_SYSTEM, OgreBootstrap.h), so that runs side by side keep their pictures.
         static std::string outDir()
         {
-            std::string dir = std::string(TREELOD_BINARY_DIR) + "/test-out/ogre";
+            const char* system = std::getenv("TREELOD_RENDER_SYSTEM");
+            const std::string suffix = system && *system && std::string(system) != "GL3Plus" ? "-" + std::string(system) : "";
+            std::string dir = std::string(TREELOD_BINARY_DIR) + "/test-out/ogre" + suffix;
             std::filesystem::create_directories(dir);
             return dir;
         }

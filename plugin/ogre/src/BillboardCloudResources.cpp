@@ -176,9 +176,12 @@ namespace TreeLod
         };
         atlas("hash", data.hashAtlas.data(), data.hashAtlas.size(), data.hashAtlasWidth, data.hashAtlasHeight,
               Ogre::PF_BYTE_RGBA);
+        // Four u16 words a texel: normalised where the render system has 16-bit normalised
+        // textures, unsigned integers under GLSL ES (TreeLodBillboardCloud.frag reads either).
         static_assert(sizeof(BillboardListEntry) == 8, "a list entry is four u16 words");
         atlas("lists", reinterpret_cast<const std::uint8_t*>(data.entries.data()), data.entries.size() * 8,
-              data.listsAtlasWidth, data.listsAtlasHeight, Ogre::PF_SHORT_RGBA);
+              data.listsAtlasWidth, data.listsAtlasHeight,
+              programsAreGlslEs() ? Ogre::PF_R16G16B16A16_UINT : Ogre::PF_SHORT_RGBA);
         atlas("ao", data.entryAo.data(), data.entryAo.size(), data.listsAtlasWidth, data.listsAtlasHeight,
               Ogre::PF_BYTE_RGBA);
         // Leaves Texture and low-res texture: every mip level as baked (DXT or RGBA8).

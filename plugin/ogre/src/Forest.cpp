@@ -24,6 +24,7 @@
 #include <OgreSubMesh.h>
 #include <OgreTechnique.h>
 #include <OgreTextureManager.h>
+#include <OgreUnifiedHighLevelGpuProgram.h>
 #include <OgreViewport.h>
 
 #include <algorithm>
@@ -223,17 +224,26 @@ namespace TreeLod
         }
 
         /// The INSTANCED variant of vertex program `plain`: "<name>/Instanced", same source and
-        /// defines + INSTANCED=1, made once in the plain program's group.
+        /// defines + INSTANCED=1, made once in the plain program's group. A unified program
+        /// (materials/TreeLod.program) is varied through the delegate the render system chose.
         Ogre::String instancedProgram(const Ogre::GpuProgramPtr& plain)
         {
             const Ogre::String name = plain->getName() + "/Instanced";
             Ogre::HighLevelGpuProgramManager& programs = Ogre::HighLevelGpuProgramManager::getSingleton();
             if (programs.resourceExists(name, plain->getGroup()))
                 return name;
+            const Ogre::GpuProgram* source = plain.get();
+            if (const auto* unified = dynamic_cast<const Ogre::UnifiedHighLevelGpuProgram*>(source))
+                source = unified->_getDelegate().get();
+            if (!source)
+                OGRE_EXCEPT(Ogre::Exception::ERR_INVALID_STATE,
+                            "vertex program '" + plain->getName() + "' has no variant that " +
+                                Ogre::Root::getSingleton().getRenderSystem()->getName() + " supports",
+                            "Forest");
             Ogre::HighLevelGpuProgramPtr program =
-                programs.createProgram(name, plain->getGroup(), plain->getLanguage(), Ogre::GPT_VERTEX_PROGRAM);
-            program->setSourceFile(plain->getSourceFile());
-            const Ogre::String defines = plain->getParameter("preprocessor_defines");
+                programs.createProgram(name, plain->getGroup(), source->getLanguage(), Ogre::GPT_VERTEX_PROGRAM);
+            program->setSourceFile(source->getSourceFile());
+            const Ogre::String defines = source->getParameter("preprocessor_defines");
             program->setParameter("preprocessor_defines", defines.empty() ? "INSTANCED=1" : defines + ",INSTANCED=1");
             program->load();
             if (plain->hasDefaultParameters() && program->isSupported())

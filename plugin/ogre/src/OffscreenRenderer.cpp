@@ -103,7 +103,7 @@ namespace TreeLod
 
         const Ogre::RenderSystemList& systems = mRoot->getAvailableRenderers();
         if (systems.empty())
-            OGRE_EXCEPT(Ogre::Exception::ERR_RENDERINGAPI_ERROR, "RenderSystem_GL3Plus did not load from " + pluginDir,
+            OGRE_EXCEPT(Ogre::Exception::ERR_RENDERINGAPI_ERROR, renderSystemPlugin() + " did not load from " + pluginDir,
                         "OffscreenRenderer");
         mRoot->setRenderSystem(systems.front());
         mRoot->initialise(false);

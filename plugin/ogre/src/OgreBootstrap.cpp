@@ -1,5 +1,6 @@
 #include "TreeLod/OgreBootstrap.h"
 
+#include <OgreException.h>
 #include <OgreResourceGroupManager.h>
 
 #include <cstdlib>
@@ -37,10 +38,21 @@ namespace TreeLod
         return logManager;
     }
 
+    std::string renderSystemPlugin()
+    {
+        const std::string name = envOr("TREELOD_RENDER_SYSTEM", "GL3Plus");
+        for (const char* known : {"GL3Plus", "GL", "GLES2"})
+            if (name == known)
+                return "RenderSystem_" + name;
+        OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
+                    "TREELOD_RENDER_SYSTEM='" + name + "': not a render system TreeLod runs on (GL3Plus, GL or GLES2)",
+                    "TreeLod::renderSystemPlugin");
+    }
+
     std::string loadRenderPlugins(Ogre::Root& root)
     {
         const std::string pluginDir = ogrePluginDirectory();
-        root.loadPlugin(pluginDir + "/RenderSystem_GL3Plus.so");
+        root.loadPlugin(pluginDir + "/" + renderSystemPlugin() + ".so");
         root.loadPlugin(pluginDir + "/Codec_STBI.so");
         return pluginDir;
     }

@@ -7,6 +7,7 @@
 // beside the running executable (bin/../share/TreeLod: installed, and in the build tree, whose
 // share/TreeLod links to the sources):
 //   $OGRE_PLUGIN_DIR_OVERRIDE  OGRE's plugins (RenderSystem_GL3Plus.so, Codec_STBI.so)
+//   $TREELOD_RENDER_SYSTEM     GL3Plus (default), GL or GLES2: the render system loaded
 //   $TREELOD_OGRE_MEDIA_DIR    OGRE's media (ShadowVolume, RTShaderLib, packs/SdkTrays.zip)
 //   $TREELOD_MATERIALS_DIR     TreeLod's material scripts and shaders (share/TreeLod/media, and its GLSL/)
 // Part of TreeLodOffscreen, not of Plugin_TreeLod.
@@ -39,7 +40,11 @@ namespace TreeLod
     /// when `verbose`.
     std::unique_ptr<Ogre::LogManager> createLogManager(const std::string& logFile, bool verbose);
 
-    /// Load RenderSystem_GL3Plus and Codec_STBI from ogrePluginDirectory() into `root`; returns
+    /// The render system plugin to load: "RenderSystem_" + $TREELOD_RENDER_SYSTEM (GL3Plus, the
+    /// default, GL or GLES2); throws Ogre::InvalidParametersException naming any other value.
+    std::string renderSystemPlugin();
+
+    /// Load renderSystemPlugin() and Codec_STBI from ogrePluginDirectory() into `root`; returns
     /// that folder (for messages).
     std::string loadRenderPlugins(Ogre::Root& root);
 

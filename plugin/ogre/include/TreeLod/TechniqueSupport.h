@@ -8,6 +8,7 @@
 
 #include <OgreException.h>
 #include <OgreHardwareBufferManager.h>
+#include <OgreHighLevelGpuProgramManager.h>
 #include <OgreImage.h>
 #include <OgreMaterial.h>
 #include <OgreMaterialManager.h>
@@ -35,6 +36,15 @@ namespace TreeLod
         default:
             return Ogre::PF_BYTE_RGBA;
         }
+    }
+
+    /// Whether TreeLod's programs run as GLSL ES (materials/TreeLod.program: the render system
+    /// compiles GLSL ES and no GLSL, as RenderSystem_GLES2): textures that the shaders read must
+    /// then have formats ES 3.00 samples (no 16-bit normalised ones).
+    inline bool programsAreGlslEs()
+    {
+        const Ogre::HighLevelGpuProgramManager& programs = Ogre::HighLevelGpuProgramManager::getSingleton();
+        return programs.isLanguageSupported("glsles") && !programs.isLanguageSupported("glsl");
     }
 
     /// Upload `bytes` (level 0 then its mips, tightly packed; `mips` levels, 0 read as 1) as
