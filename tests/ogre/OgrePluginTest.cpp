@@ -1,15 +1,23 @@
 // Plugin_TreeLod loaded into a headless Root: install, the TreeAsset resource type,
-// packages found through resource groups, the reference mesh, bad packages.
+// packages found through resource groups, the reference mesh, bad packages, the LoD strategy.
 #include "OgreTestSupport.h"
 
 #include "TreeLod/PackageWriter.h"
+#include "TreeLod/ScreenSizeLodStrategy.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 #include "TreeLod/TreeGenerator.h"
 
+#include <OgreEntity.h>
+#include <OgreLodStrategyManager.h>
+#include <OgreMaterialManager.h>
+#include <OgreMeshManager.h>
+#include <OgrePixelCountLodStrategy.h>
 #include <OgrePlugin.h>
 #include <OgreSubMesh.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
 
 namespace TreeLod
@@ -193,5 +201,103 @@ namespace TreeLod
             EXPECT_NE(e.getDescription().find("nosuch"), std::string::npos);
             EXPECT_NE(e.getDescription().find("mesh"), std::string::npos);
         }
+    }
+}
+
+namespace TreeLod
+{
+    // ScreenSizeLodStrategy: registered by the plugin under its name, chosen by a material script
+    // and by a mesh; its value is 4 pi r_px^2 of the scaled bounding sphere with the LoD camera's
+    // bias in it (Ogre's pixel_count counts pi r_px^2 and leaves the bias out), perspective and
+    // orthographic alike; an Entity whose mesh names it switches its LoD levels by it.
+    TEST(ScreenSizeLodStrategy, namedByMaterialsAndMeshesAndHonoursTheCameraBias)
+    {
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        Ogre::LodStrategy* strategy = Ogre::LodStrategyManager::getSingleton().getStrategy("treelod_screen_size");
+        ASSERT_NE(strategy, nullptr);
+        EXPECT_EQ(strategy, ScreenSizeLodStrategy::getSingletonPtr());
+
+        const std::string script = "material TreeLodTest/ScreenSizeLod\n{\n    lod_strategy treelod_screen_size\n"
+                                   "    lod_values 40000 10000\n    technique\n    {\n        pass {}\n    }\n"
+                                   "    technique\n    {\n        lod_index 1\n        pass {}\n    }\n"
+                                   "    technique\n    {\n        lod_index 2\n        pass {}\n    }\n}\n";
+        Ogre::DataStreamPtr stream(new Ogre::MemoryDataStream("ScreenSizeLod.material",
+                                                              const_cast<char*>(script.data()), script.size()));
+        Ogre::MaterialManager::getSingleton().parseScript(stream, "TreeLod");
+        Ogre::MaterialPtr material = Ogre::MaterialManager::getSingleton().getByName("TreeLodTest/ScreenSizeLod", "TreeLod");
+        ASSERT_TRUE(material);
+        EXPECT_EQ(material->getLodStrategy(), strategy);
+        EXPECT_EQ(material->getLodIndex(50000.0f), 0u);
+        EXPECT_EQ(material->getLodIndex(20000.0f), 1u);
+        EXPECT_EQ(material->getLodIndex(100.0f), 2u);
+
+        std::filesystem::create_directories(OgreEnvironment::outDir() + "/packages");
+        bakeGenerated(OgreEnvironment::outDir() + "/packages", "birch-lod-strategy.treelod", 300);
+        Ogre::ResourceGroupManager::getSingleton().initialiseResourceGroup(packageGroup());
+        TreeAssetPtr asset = TreeAssetManager::getSingleton().load("birch-lod-strategy.treelod", packageGroup());
+        ASSERT_TRUE(asset);
+        // A copy of the reference mesh (its MeshLodGenerator levels: 250k, 62.5k, 15.6k) that names
+        // the strategy: its lod values are now TreeLod screen sizes.
+        Ogre::MeshPtr mesh = asset->getReferenceMesh()->clone("TreeLodTest/ScreenSizeLodMesh");
+        mesh->setLodStrategy(strategy);
+        ASSERT_GT(mesh->getNumLodLevels(), 2u);
+        Ogre::SceneManager& sm = r.getSceneManager();
+        Ogre::Entity* entity = sm.createEntity("screenSizeLodEntity", mesh);
+        Ogre::SceneNode* node = r.getContentNode().createChildSceneNode();
+        node->attachObject(entity);
+        node->setScale(2.0f, 2.0f, 2.0f);
+        Ogre::Camera* camera = sm.getCamera("TreeLodOffscreenCamera");
+        const TreeModel& model = asset->getReference().model;
+        auto spec = [&](const char* text) {
+            CameraSpec s;
+            std::string error;
+            EXPECT_TRUE(CameraSpec::parse(text, model.boundsMin * 2.0f, model.boundsMax * 2.0f, s, error)) << error;
+            return s;
+        };
+        const Ogre::LodStrategy& ogrePixels = Ogre::AbsolutePixelCountLodStrategy::getSingleton();
+        const std::vector<const char*> views{"orbit:30,10,0.5", "orbit:30,10,1", "orbit:30,10,2", "orbit:30,10,4",
+                                             "orbit:30,10,60"};
+        std::vector<Ogre::ushort> indices;
+        for (const char* view : views)
+        {
+            r.render(spec(view), 256, 256, 1);
+            const Ogre::Real value = strategy->getValue(entity, camera);
+            EXPECT_NEAR(value, 4.0f * ogrePixels.getValue(entity, camera), 1e-4f * value) << view;
+            EXPECT_EQ(entity->getCurrentLodIndex(), mesh->getLodIndex(value)) << view;
+            indices.push_back(entity->getCurrentLodIndex());
+        }
+        std::printf("mesh LoD index at 0.5, 1, 2, 4, 60 tree sizes: %u %u %u %u %u\n", indices[0], indices[1], indices[2],
+                    indices[3], indices[4]);
+        EXPECT_EQ(indices.front(), 0u);
+        EXPECT_EQ(indices.back(), mesh->getNumLodLevels() - 1u);
+        for (std::size_t i = 1; i < indices.size(); ++i)
+            EXPECT_GE(indices[i], indices[i - 1]);
+
+        // The camera's LoD bias multiplies the value (Ogre's pixel_count ignores it): where the
+        // mesh first leaves level 0, a bias of 16 brings a finer level back.
+        const std::size_t coarser = std::size_t(std::find_if(indices.begin(), indices.end(),
+                                                             [](Ogre::ushort i) { return i > 0; }) - indices.begin());
+        ASSERT_LT(coarser, views.size());
+        r.render(spec(views[coarser]), 256, 256, 1);
+        const Ogre::Real unbiased = strategy->getValue(entity, camera);
+        const Ogre::Real ogreUnbiased = ogrePixels.getValue(entity, camera);
+        r.setLodBias(16.0f);
+        r.render(spec(views[coarser]), 256, 256, 1);
+        EXPECT_NEAR(strategy->getValue(entity, camera), 16.0f * unbiased, 1e-4f * 16.0f * unbiased);
+        EXPECT_NEAR(ogrePixels.getValue(entity, camera), ogreUnbiased, 1e-4f * ogreUnbiased);
+        EXPECT_LT(entity->getCurrentLodIndex(), indices[coarser]) << views[coarser];
+        r.setLodBias(1.0f);
+
+        // Orthographic: the same units.
+        r.render(spec("ortho:30,10,2"), 256, 256, 1);
+        const Ogre::Real ortho = strategy->getValue(entity, camera);
+        EXPECT_GT(ortho, 0.0f);
+        EXPECT_NEAR(ortho, 4.0f * ogrePixels.getValue(entity, camera), 1e-4f * ortho);
+
+        node->detachAllObjects();
+        sm.destroyEntity(entity);
+        r.getContentNode().removeAndDestroyChild(node);
+        Ogre::MeshManager::getSingleton().remove(mesh);
+        Ogre::MaterialManager::getSingleton().remove(material);
     }
 }

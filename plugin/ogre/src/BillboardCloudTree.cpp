@@ -3,11 +3,13 @@
 #include "TreeLod/BillboardCloudTree.h"
 
 #include "TreeLod/ObjectParams.h"
+#include "TreeLod/ScreenSizeLodStrategy.h"
 #include "TreePart.h"
 
 #include "TreeLod/TreeAssetManager.h"
 
 #include <OgreCamera.h>
+#include <OgreDistanceLodStrategy.h>
 #include <OgreException.h>
 #include <OgreMaterialManager.h>
 #include <OgreNode.h>
@@ -15,7 +17,6 @@
 #include <OgreSceneManager.h>
 #include <OgreSubMesh.h>
 #include <OgreTechnique.h>
-#include <OgreViewport.h>
 
 #include <algorithm>
 #include <cmath>
@@ -196,43 +197,29 @@ namespace TreeLod
         Ogre::MovableObject::_notifyCurrentCamera(camera);
         if (!mParentNode)
             return;
-        // The LoD camera (the viewer's, for shadow cameras) and its bias decide.
+        // The LoD camera (the viewer's, for shadow cameras) and its bias decide, through Ogre's
+        // strategies: TreeLod's screen size, or the distance to the bounding box.
         const Ogre::Camera* lod = camera->getLodCamera();
         mBias = lod->getLodBias() * mOptions.lodBias;
-        const Ogre::Viewport* viewport = lod->getViewport();
-        const Ogre::Real area = viewport ? Ogre::Real(viewport->getActualWidth() * viewport->getActualHeight()) : 0.0f;
-        const Ogre::Real radius = getBoundingRadiusScaled();
-        const Ogre::Real circle = Ogre::Math::PI * radius * radius;
         const Ogre::Real maxValue = std::numeric_limits<Ogre::Real>::max();
-        Ogre::Real pixels = maxValue;
-        if (lod->getProjectionType() == Ogre::PT_PERSPECTIVE)
-        {
-            // AbsolutePixelCountLodStrategy, with the radius the node scales.
-            const Ogre::Matrix4& projection = lod->getProjectionMatrix();
-            mDistanceToPixels = circle * area * projection[0][0] * projection[1][1];
-            const Ogre::Real depth2 = mParentNode->getSquaredViewDepth(lod);
-            if (depth2 > std::numeric_limits<Ogre::Real>::epsilon())
-                pixels = mDistanceToPixels / depth2;
-        }
-        else
-        {
-            // The same units as a perspective camera's (4 pi r_px^2; Ogre's orthographic value is pi r_px^2).
-            const Ogre::Real window = lod->getOrthoWindowWidth() * lod->getOrthoWindowHeight();
-            mDistanceToPixels = 0.0f;
-            if (window > std::numeric_limits<Ogre::Real>::epsilon())
-                pixels = 4.0f * circle * area / window;
-        }
-        mPixelCountValue = pixels == maxValue ? maxValue : pixels * mBias;
+        mDistanceToPixels = ScreenSizeLodStrategy::depthFactor(getBoundingRadiusScaled(), *lod);
         if (mOptions.strategy == LodStrategy::Distance)
         {
-            // DistanceLodBoxStrategy's value; its pixel-count equivalent through this projection.
-            const Ogre::Real distance = getWorldBoundingBox(true).distance(lod->getDerivedPosition());
-            mLodValue = distance * distance / mBias;
-            if (mDistanceToPixels > 0.0f)
-                mPixelCountValue = mLodValue > 0.0f ? mDistanceToPixels / mLodValue : maxValue;
+            // DistanceLodBoxStrategy's value (the camera's bias in it), with the object's bias;
+            // its screen size through this projection.
+            mLodValue = Ogre::DistanceLodBoxStrategy::getSingleton().getValue(this, camera) / mOptions.lodBias;
+            mPixelCountValue = mDistanceToPixels <= 0.0f ? ScreenSizeLodStrategy::getSingleton().getValue(this, camera)
+                               : mLodValue > 0.0f        ? mDistanceToPixels / mLodValue
+                                                         : maxValue;
+            if (mDistanceToPixels <= 0.0f && mPixelCountValue != maxValue)
+                mPixelCountValue *= mOptions.lodBias;
         }
         else
+        {
+            const Ogre::Real value = ScreenSizeLodStrategy::getSingleton().getValue(this, camera);
+            mPixelCountValue = value == maxValue ? maxValue : value * mOptions.lodBias;
             mLodValue = mPixelCountValue;
+        }
 
         if (mOptions.level < 0)
             mLevel = levelForPixelCount(mPixelCountValue);

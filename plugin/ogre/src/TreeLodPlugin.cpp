@@ -1,10 +1,12 @@
 #include "TreeLod/TreeLodPlugin.h"
 
 #include "TreeLod/Forest.h"
+#include "TreeLod/ScreenSizeLodStrategy.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 
 #include <MeshLodGenerator/OgreMeshLodGenerator.h>
+#include <OgreLodStrategyManager.h>
 #include <OgreLogManager.h>
 #include <OgreRoot.h>
 
@@ -24,6 +26,9 @@ namespace TreeLod
     void TreeLodPlugin::install()
     {
         mAssetManager = std::make_unique<TreeAssetManager>();
+        // Before any script is parsed: materials and meshes may name it.
+        mScreenSizeStrategy = std::make_unique<ScreenSizeLodStrategy>();
+        Ogre::LodStrategyManager::getSingleton().addStrategy(mScreenSizeStrategy.get());
         // One MovableObject factory per technique (docs/architecture.md, "Factories"), some shared.
         for (const TechniqueInfo& technique : TechniqueRegistry::getSingleton().getTechniques())
         {
@@ -63,5 +68,8 @@ namespace TreeLod
         delete mLodGenerator;
         mLodGenerator = nullptr;
         mAssetManager.reset();
+        if (mScreenSizeStrategy)
+            Ogre::LodStrategyManager::getSingleton().removeStrategy(ScreenSizeLodStrategy::NAME);
+        mScreenSizeStrategy.reset();
     }
 }

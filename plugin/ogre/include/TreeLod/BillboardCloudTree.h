@@ -9,13 +9,12 @@
 // Bark: the reference bark with its MeshLodGenerator levels, lit with the chunk's bark AO
 // (§5.2, §6 [Hop96]).
 //
-// Level of detail. Geometric (§6): the clouds are switched by an LoD value, Ogre's
-// AbsolutePixelCountLodStrategy units (pi * r^2 * viewport area * P00 * P11 / d^2, r the
-// bounding radius scaled by the node, the LoD camera's bias and the `lodBias` parameter
-// multiplying it; Ogre's pixel-count strategies ignore the bias) or, with
-// lodStrategy=distance, the squared distance to the world bounding box divided by the bias
-// (DistanceLodBoxStrategy's units; its thresholds are the pixel-count ones seen through the LoD
-// camera's projection). Thresholds follow the shader LoD so that a switch changes little
+// Level of detail. Geometric (§6): the clouds are switched by an LoD value read through Ogre's
+// LodStrategy interface: ScreenSizeLodStrategy's ("treelod_screen_size": 4 pi r_px^2 of the
+// bounding sphere scaled by the node, the LoD camera's bias in it), times the `lodBias`
+// parameter, or, with lodStrategy=distance, DistanceLodBoxStrategy's (the squared distance to
+// the world bounding box over the camera's bias) divided by `lodBias`; its thresholds are the
+// screen-size ones seen through the LoD camera's projection. Thresholds follow the shader LoD so that a switch changes little
 // (§6: "consistent with the corresponding shader LoD at the time of the switch"):
 //   - a layered level gives way to the next layered level where its shader walks
 //     SWITCH_ENTRIES list entries (listFactor * projected cell diagonal = 4), the leaves the
@@ -52,7 +51,7 @@ namespace TreeLod
     public:
         enum class LodStrategy
         {
-            PixelCount, ///< AbsolutePixelCountLodStrategy's value, times the bias
+            PixelCount, ///< ScreenSizeLodStrategy's value, times the bias
             Distance    ///< squared distance to the bounding box, divided by the bias
         };
 

@@ -1,7 +1,8 @@
 // TreeLodPlugin: the Ogre::Plugin of TreeLod (Plugin_TreeLod.so).
 //
 // install: creates the TreeAsset resource manager (resource type "TreeAsset", files
-// *.treelod found through resource groups like meshes), and adds the MovableObject factory of
+// *.treelod found through resource groups like meshes), registers ScreenSizeLodStrategy
+// ("treelod_screen_size") with Ogre::LodStrategyManager, and adds the MovableObject factory of
 // every technique in the TechniqueRegistry and the Forest's to Ogre::Root.
 // initialise: creates the MeshLodGenerator singleton if the application has none.
 // shutdown/uninstall undo the same in reverse order.
@@ -21,6 +22,7 @@ namespace Ogre
 namespace TreeLod
 {
     class ForestFactory;
+    class ScreenSizeLodStrategy;
     class TreeAssetManager;
 
     class TreeLodPlugin : public Ogre::Plugin
@@ -37,6 +39,7 @@ namespace TreeLod
 
     private:
         std::unique_ptr<TreeAssetManager> mAssetManager;
+        std::unique_ptr<ScreenSizeLodStrategy> mScreenSizeStrategy; ///< registered by install()
         std::vector<Ogre::MovableObjectFactory*> mFactories; ///< added to Root by install(), owned by the registry
         std::unique_ptr<ForestFactory> mForestFactory;
         Ogre::MeshLodGenerator* mLodGenerator = nullptr; ///< owned only when we created it
