@@ -202,23 +202,17 @@ namespace TreeLod
         const Ogre::Camera* lod = camera->getLodCamera();
         mBias = lod->getLodBias() * mOptions.lodBias;
         const Ogre::Real maxValue = std::numeric_limits<Ogre::Real>::max();
+        const Ogre::Real screen = ScreenSizeLodStrategy::getSingleton().getValue(this, camera);
+        mPixelCountValue = screen == maxValue ? maxValue : screen * mOptions.lodBias;
+        mLodValue = mPixelCountValue;
         mDistanceToPixels = ScreenSizeLodStrategy::depthFactor(getBoundingRadiusScaled(), *lod);
         if (mOptions.strategy == LodStrategy::Distance)
         {
             // DistanceLodBoxStrategy's value (the camera's bias in it), with the object's bias;
-            // its screen size through this projection.
+            // under a perspective camera, its screen size through this projection.
             mLodValue = Ogre::DistanceLodBoxStrategy::getSingleton().getValue(this, camera) / mOptions.lodBias;
-            mPixelCountValue = mDistanceToPixels <= 0.0f ? ScreenSizeLodStrategy::getSingleton().getValue(this, camera)
-                               : mLodValue > 0.0f        ? mDistanceToPixels / mLodValue
-                                                         : maxValue;
-            if (mDistanceToPixels <= 0.0f && mPixelCountValue != maxValue)
-                mPixelCountValue *= mOptions.lodBias;
-        }
-        else
-        {
-            const Ogre::Real value = ScreenSizeLodStrategy::getSingleton().getValue(this, camera);
-            mPixelCountValue = value == maxValue ? maxValue : value * mOptions.lodBias;
-            mLodValue = mPixelCountValue;
+            if (mDistanceToPixels > 0.0f)
+                mPixelCountValue = mLodValue > 0.0f ? mDistanceToPixels / mLodValue : maxValue;
         }
 
         if (mOptions.level < 0)
