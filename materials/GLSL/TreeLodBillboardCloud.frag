@@ -6,6 +6,9 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#ifdef CASTER
+#include "TreeLodShadowCaster.glsl"
+#endif
 // Billboard clouds with multi-layered indirect texturing (García et al. 2007 §5, Fig. 7), one pass.
 // Addressing: plugin/core/billboardcloud/include/TreeLod/BillboardCloudData.h (its
 // BillboardCloudSampler does the same steps on the CPU); all atlas addressing is integer.
@@ -189,7 +192,7 @@ void main()
     }
 #ifdef CASTER
     float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5; // as TreeLodCaster.frag
-    fragColour = vec4(depth, depth, depth, 1.0);
+    fragColour = casterOutput(depth);
 #else
     float lambert = max(dot(n, normalize(sunDirection.xyz)), 0.0) * sunVisibility();
     vec3 colour = albedo * (ambientColour.rgb * mix(1.0, ao, lodParams.y) + sunColour.rgb * lambert);

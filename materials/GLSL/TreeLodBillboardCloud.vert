@@ -23,8 +23,7 @@ uniform mat4 normalMatrix;
 uniform vec4 cameraPosition;
 #endif
 #ifdef SHADOW_RECEIVER
-uniform mat4 texViewProj; // the sun's shadow camera, clip space to texture space
-out vec4 vShadowPos;
+#include "TreeLodShadowReceiver.glsl"
 #endif
 
 in vec4 vertex;
@@ -70,6 +69,6 @@ void main()
     vHash = uv1;
     vLowResUv = mix(uv2.xy, uv2.zw, uv0);
 #ifdef SHADOW_RECEIVER
-    vShadowPos = texViewProj * vec4(position, 1.0);
+    passShadowPositions(vec4(position, 1.0));
 #endif
 }

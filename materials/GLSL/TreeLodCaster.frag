@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodShadowCaster.glsl"
 // Shadow caster; ALPHA_TEST: leaves cast the shadow of their texture's shape.
 #ifdef ALPHA_TEST
 uniform sampler2D diffuseMap;
@@ -25,8 +26,8 @@ void main()
     if (leafAlpha(diffuseMap, vUv, alphaMaxLod) < alphaCutoff)
         discard;
 #endif
-    // Depth as the shadow camera's window depth, 0..1 (shadow textures clear to 1); the
-    // receiver computes the same from texture_viewproj_matrix.
+    // The shadow camera's window depth, 0..1 (shadow textures clear to 1); the receiver computes
+    // the same from texture_viewproj_matrix.
     float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5;
-    fragColour = vec4(depth, depth, depth, 1.0);
+    fragColour = casterOutput(depth);
 }

@@ -10,6 +10,9 @@
 #extension GL_ARB_conservative_depth : enable
 #endif
 #include "TreeLodShaderSupport.glsl"
+#ifdef CASTER
+#include "TreeLodShadowCaster.glsl"
+#endif
 // Ray-ellipsoid intersection in the ellipsoid's unit-sphere frame (Sigg et al. 2006; the
 // ellipsoids-and-lines paper (001) §5): the pixel's ray from + t dir (from on the near plane)
 // becomes o + t k with o = toUnit * (from - centre), k = toUnit * dir, and |o + t k| = 1 is a
@@ -25,7 +28,7 @@
 // colour = albedo * (ambient * ao + sun * max(0, n.l) * shadow) in linear space, written as sRGB,
 // as TreeLodLit.frag lights the leaves (LightingSpec in TreeLod/Camera.h).
 // CASTER: writes the shadow camera's window depth of the hit instead (as TreeLodCaster.frag).
-// SHADOW_RECEIVER: the sun's visibility at the hit (texViewProj * inverseView * hit).
+// SHADOW_RECEIVER: the sun's visibility at the hit (its world position, inverseView * hit).
 uniform mat4 projection;
 uniform samplerCube noiseAlpha;
 #ifndef CASTER
@@ -37,7 +40,6 @@ uniform vec4 ambientColour;
 #ifdef SHADOW_RECEIVER
 #define SHADOW_POS_PER_FRAGMENT
 uniform mat4 inverseView;
-uniform mat4 texViewProj;
 #endif
 
 in vec4 vNear;
@@ -87,7 +89,7 @@ void main()
     float depth = 0.5 * ndcDepth + 0.5;
     gl_FragDepth = depth;
 #ifdef CASTER
-    fragColour = vec4(depth, depth, depth, 1.0);
+    fragColour = casterOutput(depth);
 #else
     vec3 unitNormal = u;
     if (vNoise.z > 0.0)
@@ -96,7 +98,7 @@ void main()
     if (dot(n, dir) > 0.0) // seen from inside
         n = -n;
 #ifdef SHADOW_RECEIVER
-    float shadow = sunVisibilityAt(texViewProj * (inverseView * vec4(hit, 1.0)));
+    float shadow = sunVisibilityAtWorld(inverseView * vec4(hit, 1.0));
 #else
     float shadow = 1.0;
 #endif

@@ -6,6 +6,9 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#ifdef CASTER
+#include "TreeLodShadowCaster.glsl"
+#endif
 // Ray-capsule intersection for the lines of an EllipsoidTree (TreeLodEllipsoidLine.vert): the
 // pixel's ray against the cylinder of radius r around start..end, then the sphere at the nearer
 // end when the hit falls outside the segment. A line thinner than the pixel that the ray misses is
@@ -22,7 +25,6 @@ uniform vec4 ambientColour;
 #ifdef SHADOW_RECEIVER
 #define SHADOW_POS_PER_FRAGMENT
 uniform mat4 inverseView;
-uniform mat4 texViewProj;
 #endif
 
 in vec3 vPosition;
@@ -108,10 +110,10 @@ void main()
     float depth = 0.5 * ndcDepth + 0.5;
     gl_FragDepth = depth;
 #ifdef CASTER
-    fragColour = vec4(depth, depth, depth, 1.0);
+    fragColour = casterOutput(depth);
 #else
 #ifdef SHADOW_RECEIVER
-    float shadow = sunVisibilityAt(texViewProj * (inverseView * vec4(hit, 1.0)));
+    float shadow = sunVisibilityAtWorld(inverseView * vec4(hit, 1.0));
 #else
     float shadow = 1.0;
 #endif

@@ -6,6 +6,9 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#ifdef CASTER
+#include "TreeLodShadowCaster.glsl"
+#endif
 // The one-quad impostor (ImpostorData.h): alpha test on the baked coverage, then lit as
 // TreeLodLit.frag lights leaves, colour = albedo * (ambient * ao + sun * max(0, n.l)) in linear
 // space written as sRGB, with the baked normal and ambient occlusion. It is the far level of every
@@ -41,7 +44,7 @@ void main()
         discard;
 #ifdef CASTER
     float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5;
-    fragColour = vec4(depth, depth, depth, 1.0);
+    fragColour = casterOutput(depth);
 #else
     vec3 baked = texture(normalMap, vUv).xyz;
     vec2 xy = baked.xy * 2.0 - 1.0;

@@ -27,8 +27,7 @@ uniform vec4 sunDirection;   // world space, towards the sun (w = 0 for a direct
 out vec3 vSunInQuad;
 #endif
 #ifdef SHADOW_RECEIVER
-uniform mat4 texViewProj; // the sun's shadow camera, clip space to texture space
-out vec4 vShadowPos;
+#include "TreeLodShadowReceiver.glsl"
 #endif
 
 in vec4 vertex;
@@ -62,6 +61,6 @@ void main()
                       dot(sun, normalize(toWorld * towards)));
 #endif
 #ifdef SHADOW_RECEIVER
-    vShadowPos = texViewProj * (world * position);
+    passShadowPositions(world * position);
 #endif
 }

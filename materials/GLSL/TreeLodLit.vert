@@ -27,8 +27,7 @@ in vec4 colour;
 out float vAo;
 #endif
 #ifdef SHADOW_RECEIVER
-uniform mat4 texViewProj; // the sun's shadow camera, clip space to texture space
-out vec4 vShadowPos;
+#include "TreeLodShadowReceiver.glsl"
 #endif
 #ifdef INSTANCED
 #include "TreeLodInstance.glsl"
@@ -51,6 +50,6 @@ void main()
     vAo = colour.r;
 #endif
 #ifdef SHADOW_RECEIVER
-    vShadowPos = texViewProj * (world * position);
+    passShadowPositions(world * position);
 #endif
 }

@@ -6,6 +6,9 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#ifdef CASTER
+#include "TreeLodShadowCaster.glsl"
+#endif
 // The octahedral impostor (OctahedralImpostorData.h): the three frames TreeLodOctahedralImpostor.vert
 // chose, each read at its frame coordinates shifted by its stored depth (one parallax step), blended
 // by the barycentric weights with coverage as the weight of colour, normal and occlusion; alpha
@@ -85,7 +88,7 @@ void main()
     if (colourSum.a < alphaCutoff)
         discard;
     float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5;
-    fragColour = vec4(depth, depth, depth, 1.0);
+    fragColour = casterOutput(depth);
 #else
     addFrame(vWeights.x, vFrame01.xy, vUv01.xy, vParallax01.xy, vSun0);
     addFrame(vWeights.y, vFrame01.zw, vUv01.zw, vParallax01.zw, vSun1);

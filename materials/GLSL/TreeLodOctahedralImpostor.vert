@@ -38,8 +38,7 @@ out vec4 vParallax01; // frames 0 and 1: frame-coordinate shift per unit of (dep
 out vec2 vParallax2;
 #endif
 #ifdef SHADOW_RECEIVER
-uniform mat4 texViewProj;
-out vec4 vShadowPos;
+#include "TreeLodShadowReceiver.glsl"
 #endif
 
 in vec4 vertex;
@@ -157,6 +156,6 @@ void main()
     vSun2 = sun2;
 #endif
 #ifdef SHADOW_RECEIVER
-    vShadowPos = texViewProj * (world * position);
+    passShadowPositions(world * position);
 #endif
 }

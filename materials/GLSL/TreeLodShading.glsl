@@ -1,6 +1,6 @@
 // Shading helpers shared by the fragment programs (lit leaves and bark, billboard clouds, the
-// impostors): sRGB conversions, srgbScale and, with SHADOW_RECEIVER, the sun's visibility in the
-// integrated texture shadow.
+// impostors): sRGB conversions, srgbScale and, with SHADOW_RECEIVER, the sun's visibility in its
+// texture shadow.
 
 vec3 toLinear(vec3 c) { return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(0.04045, c)); }
 vec3 toSrgb(vec3 c)
@@ -20,30 +20,60 @@ vec3 srgbScale(vec3 k)
 }
 
 #ifdef SHADOW_RECEIVER
-// Integrated texture shadows (OGRE-NOTES.md "Shadows"): the casters wrote the shadow
-// camera's window depth (TreeLodCaster.frag, TreeLodBillboardCloud.frag with CASTER), the
-// receiver computes the same from texture_viewproj_matrix; 3x3 percentage-closer filtering.
-uniform sampler2D shadowMap;
-uniform vec4 shadowTexelSize;  // 1 / width, 1 / height
+// Depth shadows (integrated texture shadows; OGRE-NOTES.md "Shadows", TreeLod/ShadowSetup.h): the
+// casters wrote the shadow camera's window depth (TreeLodShadowCaster.glsl), the receiver computes
+// the same from texture_viewproj_matrix; 3x3 percentage-closer filtering. Up to three shadow
+// textures, one (focused, LiSPSM) or PSSM's three splits: a point is looked up in the first
+// texture that holds it, the finest (units past the scene's texture count hold Ogre's null shadow
+// texture, which is lit).
+uniform sampler2D shadowMap0;
+uniform sampler2D shadowMap1;
+uniform sampler2D shadowMap2;
+uniform vec4 shadowTexelSize;  // 1 / width, 1 / height (the sun's shadow textures share a size)
 uniform float shadowBias;
 
-// The sun's visibility at a point given in the shadow texture's clip space (texViewProj * world).
-float sunVisibilityAt(vec4 shadowPos)
+// The fraction of the 3x3 texels around p (texture coordinates, window depth) that p is not behind.
+float filteredVisibility(sampler2D map, vec3 p)
 {
-    vec3 p = shadowPos.xyz / shadowPos.w;
-    float depth = 0.5 * p.z + 0.5 - shadowBias;
-    if (p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0 || depth >= 1.0)
-        return 1.0;
     float lit = 0.0;
     for (int y = -1; y <= 1; ++y)
         for (int x = -1; x <= 1; ++x)
-            lit += depth <= texture(shadowMap, p.xy + vec2(x, y) * shadowTexelSize.xy).r ? 1.0 : 0.0;
+            lit += p.z <= texture(map, p.xy + vec2(x, y) * shadowTexelSize.xy).r ? 1.0 : 0.0;
     return lit / 9.0;
 }
 
-#ifndef SHADOW_POS_PER_FRAGMENT // the program computes the point itself (ray-cast surfaces)
-in vec4 vShadowPos;
-float sunVisibility() { return sunVisibilityAt(vShadowPos); }
+// The point in texture coordinates and biased window depth; outside the texture when z >= 1.
+vec3 shadowTexturePoint(vec4 shadowPos)
+{
+    vec3 p = shadowPos.xyz / shadowPos.w;
+    bool inside = p.x > 0.0 && p.x < 1.0 && p.y > 0.0 && p.y < 1.0;
+    return vec3(p.xy, inside ? 0.5 * p.z + 0.5 - shadowBias : 1.0);
+}
+
+// The sun's visibility at a point given in each shadow texture's clip space (texViewProj[i] * world).
+float sunVisibilityAt(vec4 shadowPos0, vec4 shadowPos1, vec4 shadowPos2)
+{
+    vec3 p = shadowTexturePoint(shadowPos0);
+    if (p.z < 1.0)
+        return filteredVisibility(shadowMap0, p);
+    p = shadowTexturePoint(shadowPos1);
+    if (p.z < 1.0)
+        return filteredVisibility(shadowMap1, p);
+    p = shadowTexturePoint(shadowPos2);
+    return p.z < 1.0 ? filteredVisibility(shadowMap2, p) : 1.0;
+}
+
+#ifdef SHADOW_POS_PER_FRAGMENT // the program computes the point itself (ray-cast surfaces)
+uniform mat4 texViewProj[3];   // the sun's shadow cameras, world to texture clip space
+float sunVisibilityAtWorld(vec4 world)
+{
+    return sunVisibilityAt(texViewProj[0] * world, texViewProj[1] * world, texViewProj[2] * world);
+}
+#else
+in vec4 vShadowPos0; // TreeLodShadowReceiver.glsl
+in vec4 vShadowPos1;
+in vec4 vShadowPos2;
+float sunVisibility() { return sunVisibilityAt(vShadowPos0, vShadowPos1, vShadowPos2); }
 #endif
 #else
 float sunVisibility() { return 1.0; }

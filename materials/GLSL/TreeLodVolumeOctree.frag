@@ -6,6 +6,9 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#ifdef CASTER
+#include "TreeLodShadowCaster.glsl"
+#endif
 // The volumetric octree tree's billboard (TreeLodVolumeOctree.vert): the two input cameras'
 // codewords sampled bilinearly inside their 4x4 blocks, premultiplied and weighted, for the over
 // operator (scene_blend one one_minus_src_alpha). Colour is sRGB as stored; the framebuffer holds
@@ -61,7 +64,7 @@ void main()
     if (colour.a <= hash01(uint(vCell + 0.5), uint(cell.y * 4 + cell.x)))
         discard;
     float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5;
-    fragColour = vec4(depth, depth, depth, 1.0);
+    fragColour = casterOutput(depth);
 #else
     if (colour.a < 0.5 / 255.0)
         discard;

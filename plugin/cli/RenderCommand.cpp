@@ -53,8 +53,9 @@ namespace TreeLod
                 return printError(fail("", "--supersample", "must be 1..8 samples per axis"));
             if (!(args.lodBias > 0.0f))
                 return printError(fail("", "--lod-bias", "must be a positive number"));
-            if (args.shadowCamera != "focused" && args.shadowCamera != "lispsm")
-                return printError(fail("", "--shadow-camera", "'" + args.shadowCamera + "' is not focused or lispsm"));
+            if (args.shadowCamera != "focused" && args.shadowCamera != "lispsm" && args.shadowCamera != "pssm")
+                return printError(
+                    fail("", "--shadow-camera", "'" + args.shadowCamera + "' is not focused, lispsm or pssm"));
             if (args.renderer != "cpu" && args.renderer != "ogre")
                 return printError(fail("", "--renderer", "'" + args.renderer + "' is not ogre or cpu"));
             ProgressCallback progress = makeProgress();
@@ -117,8 +118,7 @@ namespace TreeLod
                         params["level"] = std::to_string(args.level);
                     if (args.listFactor >= 0.0f)
                         params["listFactor"] = std::to_string(args.listFactor);
-                    renderer.setShadows(args.shadows, 2048,
-                                        args.shadowCamera == "lispsm" ? ShadowCamera::LiSPSM : ShadowCamera::Focused);
+                    renderer.setShadows(args.shadows, 2048, parseShadowCamera(args.shadowCamera, "--shadow-camera"));
                     renderer.setLodBias(args.lodBias);
                     Ogre::MovableObject* object = TechniqueRegistry::getSingleton().createInstance(
                         args.technique, renderer.getSceneManager(), "tree", *asset, params);
@@ -165,8 +165,8 @@ namespace TreeLod
         cmd->add_option("--lod-bias", args->lodBias, "camera LoD bias (> 1 = more detail)");
         cmd->add_flag("--shadows", args->shadows, "texture shadows from the sun (2048^2 float depth)");
         cmd->add_option("--shadow-camera", args->shadowCamera,
-                        "with --shadows: focused (orthographic, Ogre's FocusedShadowCameraSetup) or lispsm "
-                        "(LiSPSMShadowCameraSetup, García et al. 2007 §5.2)");
+                        "with --shadows: focused (orthographic, Ogre's FocusedShadowCameraSetup), lispsm "
+                        "(LiSPSMShadowCameraSetup, García et al. 2007 §5.2) or pssm (PSSMShadowCameraSetup, 3 splits)");
         cmd->add_option("--camera", args->camera,
                         "orbit:AZIMUTH,ELEVATION,DISTANCE (degrees; distance 1 = tree fills the view), "
                         "ortho:AZ,EL,DIST, or PX,PY,PZ,TX,TY,TZ[,FOV]");

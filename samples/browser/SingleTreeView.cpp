@@ -2,6 +2,7 @@
 
 #include "TreeLod/ImageMetrics.h"
 #include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/ShadowSetup.h"
 #include "TreeLod/RgbaImageConversion.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
@@ -466,7 +467,10 @@ namespace TreeLod
     void SingleTreeView::setShadows(bool enabled)
     {
         mShadows = enabled;
-        applyTextureShadows(*mSceneManager, *mSun, enabled, mShadowSize, ShadowCamera::Focused);
+        SunShadowSettings settings;
+        settings.technique = enabled ? Ogre::SHADOWTYPE_TEXTURE_ADDITIVE_INTEGRATED : Ogre::SHADOWTYPE_NONE;
+        settings.textureSize = mShadowSize;
+        setupSunShadows(*mSceneManager, *mSun, settings);
         useShadowedMaterials(*mReference, *mAsset, enabled);
         if (auto* mesh = dynamic_cast<Ogre::Entity*>(mTechniques[REFERENCE_TECHNIQUE]))
             useShadowedMaterials(*mesh, *mAsset, enabled);

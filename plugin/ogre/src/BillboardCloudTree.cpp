@@ -4,6 +4,7 @@
 
 #include "TreeLod/ObjectParams.h"
 #include "TreeLod/ScreenSizeLodStrategy.h"
+#include "TreeLod/ShadowSetup.h"
 #include "TreePart.h"
 
 #include "TreeLod/TreeAssetManager.h"
@@ -224,11 +225,13 @@ namespace TreeLod
 
     bool BillboardCloudTree::useShadowedMaterials() const
     {
-        return mManager && mManager->isShadowTechniqueTextureBased() && mManager->isShadowTechniqueIntegrated();
+        return receivesDepthShadows(mManager);
     }
 
     void BillboardCloudTree::_updateRenderQueue(Ogre::RenderQueue* queue)
     {
+        if (mManager)
+            notifyShadowTechnique(*mManager);
         for (const std::unique_ptr<Part>& part : mBarkParts)
             queue->addRenderable(part.get(), mRenderQueueID, mRenderQueuePriority);
         if (mLevel < mLevelParts.size() && mLevelParts[mLevel]->mIndexData.indexCount > 0)

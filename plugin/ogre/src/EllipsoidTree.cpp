@@ -3,6 +3,7 @@
 #include "TreeLod/EllipsoidTree.h"
 
 #include "TreeLod/ObjectParams.h"
+#include "TreeLod/ShadowSetup.h"
 #include "TreeLod/TechniqueSupport.h"
 #include "TreePart.h"
 
@@ -157,11 +158,13 @@ namespace TreeLod
 
     bool EllipsoidTree::useShadowedMaterials() const
     {
-        return mManager && mManager->isShadowTechniqueTextureBased() && mManager->isShadowTechniqueIntegrated();
+        return receivesDepthShadows(mManager);
     }
 
     void EllipsoidTree::_updateRenderQueue(Ogre::RenderQueue* queue)
     {
+        if (mManager)
+            notifyShadowTechnique(*mManager);
         queue->addRenderable(mEllipsoids.get(), mRenderQueueID, mRenderQueuePriority);
         if (mLineParts)
             queue->addRenderable(mLineParts.get(), mRenderQueueID, mRenderQueuePriority);

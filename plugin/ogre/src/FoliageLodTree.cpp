@@ -1,6 +1,7 @@
 #include "TreeLod/FoliageLodTree.h"
 
 #include "TreeLod/ObjectParams.h"
+#include "TreeLod/ShadowSetup.h"
 #include "TreePart.h"
 
 #include "TreeLod/FoliageLodResources.h"
@@ -243,12 +244,13 @@ namespace TreeLod
 
     bool FoliageLodTree::useShadowedMaterials()
     {
-        return mManager && mManager->isShadowTechniqueTextureBased() &&
-               mManager->isShadowTechniqueIntegrated();
+        return receivesDepthShadows(mManager);
     }
 
     void FoliageLodTree::_updateRenderQueue(Ogre::RenderQueue* queue)
     {
+        if (mManager)
+            notifyShadowTechnique(*mManager);
         for (auto* parts : {&mBarkParts, &mLeafParts})
             for (const std::unique_ptr<Part>& part : *parts)
                 queue->addRenderable(part.get(), mRenderQueueID, mRenderQueuePriority);

@@ -5,6 +5,7 @@
 #include "TreeLod/ErrorCurves.h"
 #include "TreeLod/LevelSelection.h"
 #include "TreeLod/ObjectParams.h"
+#include "TreeLod/ShadowSetup.h"
 
 #include "TreeLod/TechniqueRegistry.h"
 
@@ -1141,7 +1142,7 @@ namespace TreeLod
 
     bool Forest::useShadowedMaterials() const
     {
-        return mManager && mManager->isShadowTechniqueTextureBased() && mManager->isShadowTechniqueIntegrated();
+        return receivesDepthShadows(mManager);
     }
 
     std::uint64_t Forest::getGpuBytes() const { return drawableBytes() + mInstanceBufferBytes; }
@@ -1359,6 +1360,8 @@ namespace TreeLod
 
     void Forest::_updateRenderQueue(Ogre::RenderQueue* queue)
     {
+        if (mManager)
+            notifyShadowTechnique(*mManager);
         Ogre::Camera* camera = mCurrentCamera;
         if (!camera || mSpecies.empty())
             return;

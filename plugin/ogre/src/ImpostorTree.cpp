@@ -1,6 +1,7 @@
 #include "TreeLod/ImpostorTree.h"
 
 #include "TreeLod/ObjectParams.h"
+#include "TreeLod/ShadowSetup.h"
 #include "TreeLod/TechniqueSupport.h"
 
 #include <OgreException.h>
@@ -46,6 +47,8 @@ namespace TreeLod
 
     void ImpostorTree::_updateRenderQueue(Ogre::RenderQueue* queue)
     {
+        if (mManager)
+            notifyShadowTechnique(*mManager);
         queue->addRenderable(this, mRenderQueueID, mRenderQueuePriority);
     }
 
@@ -57,7 +60,7 @@ namespace TreeLod
     const Ogre::MaterialPtr& ImpostorTree::getMaterial() const
     {
         const bool shadowed =
-            mManager && mManager->isShadowTechniqueTextureBased() && mManager->isShadowTechniqueIntegrated();
+            receivesDepthShadows(mManager);
         return shadowed ? mShadowedMaterial : mMaterial;
     }
 

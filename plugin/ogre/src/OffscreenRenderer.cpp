@@ -5,8 +5,6 @@
 #include "TreeLod/OgreBootstrap.h"
 #include "TreeLod/TreeLodPlugin.h"
 
-#include <OgreShadowCameraSetupFocused.h>
-#include <OgreShadowCameraSetupLiSPSM.h>
 #include <OgreWorkQueue.h>
 
 #include <algorithm>
@@ -238,30 +236,21 @@ namespace TreeLod
         mCameraNode->setPosition(spec.position.x, spec.position.y, spec.position.z);
         mCameraNode->setFixedYawAxis(true, Ogre::Vector3(spec.up.x, spec.up.y, spec.up.z));
         mCameraNode->lookAt(Ogre::Vector3(spec.target.x, spec.target.y, spec.target.z), Ogre::Node::TS_WORLD);
+        updateShadowSplits(*mSceneManager, *mCamera);
     }
 
-    void applyTextureShadows(Ogre::SceneManager& sceneManager, Ogre::Light& sun, bool enabled, unsigned textureSize,
-                             ShadowCamera camera)
+    void OffscreenRenderer::setShadows(const SunShadowSettings& settings)
     {
-        if (!enabled)
-        {
-            sceneManager.setShadowTechnique(Ogre::SHADOWTYPE_NONE);
-            return;
-        }
-        sceneManager.setShadowTechnique(Ogre::SHADOWTYPE_TEXTURE_ADDITIVE_INTEGRATED);
-        sceneManager.setShadowTextureCount(1);
-        sceneManager.setShadowTextureSettings(textureSize, 1, Ogre::PF_FLOAT32_R);
-        sceneManager.setShadowTextureSelfShadow(true);
-        if (camera == ShadowCamera::LiSPSM)
-            sceneManager.setShadowCameraSetup(Ogre::ShadowCameraSetupPtr(new Ogre::LiSPSMShadowCameraSetup()));
-        else
-            sceneManager.setShadowCameraSetup(Ogre::ShadowCameraSetupPtr(new Ogre::FocusedShadowCameraSetup()));
-        sun.setCastShadows(true);
+        setupSunShadows(*mSceneManager, *mSun, settings, mCamera);
     }
 
     void OffscreenRenderer::setShadows(bool enabled, unsigned textureSize, ShadowCamera camera)
     {
-        applyTextureShadows(*mSceneManager, *mSun, enabled, textureSize, camera);
+        SunShadowSettings settings;
+        settings.technique = enabled ? Ogre::SHADOWTYPE_TEXTURE_ADDITIVE_INTEGRATED : Ogre::SHADOWTYPE_NONE;
+        settings.textureSize = textureSize;
+        settings.camera = camera;
+        setShadows(settings);
     }
 
     FrameTiming OffscreenRenderer::renderTimedFrame(const CameraSpec& spec, int width, int height)

@@ -2,18 +2,33 @@
 
 #include "TreeLod/Forest.h"
 #include "TreeLod/ScreenSizeLodStrategy.h"
+#include "TreeLod/ShadowSetup.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 
 #include <MeshLodGenerator/OgreMeshLodGenerator.h>
 #include <OgreLodStrategyManager.h>
+#include <OgreGpuProgramManager.h>
 #include <OgreLogManager.h>
+#include <OgreResourceGroupManager.h>
 #include <OgreRoot.h>
 
 #include <algorithm>
 
 namespace TreeLod
 {
+    /// Creates the casters' shared parameters before the first script that may reference them is
+    /// parsed (the render system, which owns the GpuProgramManager, exists by then).
+    class TreeLodPlugin::ShadowParamsListener : public Ogre::ResourceGroupListener
+    {
+    public:
+        void scriptParseStarted(const Ogre::String&, bool&) override
+        {
+            if (Ogre::GpuProgramManager::getSingletonPtr())
+                createShadowParams();
+        }
+    };
+
     TreeLodPlugin::TreeLodPlugin() = default;
     TreeLodPlugin::~TreeLodPlugin() = default;
 
@@ -29,6 +44,8 @@ namespace TreeLod
         // Before any script is parsed: materials and meshes may name it.
         mScreenSizeStrategy = std::make_unique<ScreenSizeLodStrategy>();
         Ogre::LodStrategyManager::getSingleton().addStrategy(mScreenSizeStrategy.get());
+        mShadowParamsListener = std::make_unique<ShadowParamsListener>();
+        Ogre::ResourceGroupManager::getSingleton().addResourceGroupListener(mShadowParamsListener.get());
         // One MovableObject factory per technique (docs/architecture.md, "Factories"), some shared.
         for (const TechniqueInfo& technique : TechniqueRegistry::getSingleton().getTechniques())
         {
@@ -71,5 +88,8 @@ namespace TreeLod
         if (mScreenSizeStrategy)
             Ogre::LodStrategyManager::getSingleton().removeStrategy(ScreenSizeLodStrategy::NAME);
         mScreenSizeStrategy.reset();
+        if (mShadowParamsListener)
+            Ogre::ResourceGroupManager::getSingleton().removeResourceGroupListener(mShadowParamsListener.get());
+        mShadowParamsListener.reset();
     }
 }

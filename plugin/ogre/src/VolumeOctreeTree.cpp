@@ -3,6 +3,7 @@
 #include "TreeLod/VolumeOctreeTree.h"
 
 #include "TreeLod/ObjectParams.h"
+#include "TreeLod/ShadowSetup.h"
 #include "TreePart.h"
 
 #include <OgreCamera.h>
@@ -143,6 +144,8 @@ namespace TreeLod
 
     void VolumeOctreeTree::_updateRenderQueue(Ogre::RenderQueue* queue)
     {
+        if (mManager)
+            notifyShadowTechnique(*mManager);
         if (mPart->mIndexData.indexCount > 0)
             queue->addRenderable(mPart.get(), mRenderQueueID, mRenderQueuePriority);
     }

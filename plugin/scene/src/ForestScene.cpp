@@ -3,6 +3,7 @@
 #include "TreeLod/ErrorCurves.h"
 #include "TreeLod/ImpostorData.h"
 #include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/ShadowSetup.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 
@@ -458,13 +459,16 @@ namespace TreeLod
 
     void ForestScene::setShadows(bool enabled)
     {
-        const ShadowCamera camera = mScript.shadows.camera == "lispsm" ? ShadowCamera::LiSPSM : ShadowCamera::Focused;
-        applyTextureShadows(mSceneManager, *mSun, enabled, unsigned(mScript.shadows.textureSize), camera);
+        SunShadowSettings settings;
+        settings.technique = enabled ? Ogre::SHADOWTYPE_TEXTURE_ADDITIVE_INTEGRATED : Ogre::SHADOWTYPE_NONE;
+        settings.camera = parseShadowCamera(mScript.shadows.camera, mScript.file + ": /shadows/camera");
+        settings.textureSize = unsigned(mScript.shadows.textureSize);
+        settings.farDistance = SHADOW_FAR_DISTANCE;
+        // PSSM splits the view of the scene manager's first camera (OffscreenRenderer's, the browser's).
+        const Ogre::SceneManager::CameraList& cameras = mSceneManager.getCameras();
+        setupSunShadows(mSceneManager, *mSun, settings, cameras.empty() ? nullptr : cameras.begin()->second);
         if (enabled)
-        {
-            mSceneManager.setShadowFarDistance(SHADOW_FAR_DISTANCE);
             mSceneManager.setShadowDirectionalLightExtrusionDistance(2.0f * SHADOW_FAR_DISTANCE + 50.0f);
-        }
         if (mGround)
             mGround->setMaterialName(0, enabled ? "TreeLod/GroundShadowed" : "TreeLod/Ground", mOptions.group);
     }

@@ -682,9 +682,9 @@ namespace TreeLod
             if (const Json* v = find(j, "camera"))
             {
                 s.camera = text(*v, child(pointer, "camera"));
-                if (s.camera != "focused" && s.camera != "lispsm")
+                if (s.camera != "focused" && s.camera != "lispsm" && s.camera != "pssm")
                     bad(child(pointer, "camera"),
-                        "unknown shadow camera '" + s.camera + "' (expected focused, lispsm)");
+                        "unknown shadow camera '" + s.camera + "' (expected focused, lispsm, pssm)");
             }
             if (const Json* v = find(j, "lodBias"))
                 s.lodBias = float(number(*v, child(pointer, "lodBias"), 0.0, 1e6, true));

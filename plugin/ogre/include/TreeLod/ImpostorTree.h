@@ -57,6 +57,7 @@ namespace TreeLod
         void getWorldTransforms(Ogre::Matrix4* xform) const override;
         Ogre::Real getSquaredViewDepth(const Ogre::Camera* camera) const override;
         const Ogre::LightList& getLights() const override;
+        bool getCastsShadows() const override { return getCastShadows(); }
 
     private:
         TreeAssetPtr mAsset;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "TreeLod/Camera.h"
+#include "TreeLod/ShadowSetup.h"
 
 #include <Ogre.h>
 
@@ -17,13 +18,6 @@
 namespace TreeLod
 {
     class TreeLodPlugin;
-
-    /// How the sun's shadow camera frames the view (OffscreenRenderer::setShadows).
-    enum class ShadowCamera
-    {
-        Focused, ///< Ogre::FocusedShadowCameraSetup: orthographic, fitted to the visible receivers
-        LiSPSM   ///< Ogre::LiSPSMShadowCameraSetup: light space perspective shadow maps [WSP04] (García et al. 2007 §5.2)
-    };
 
     struct OffscreenOptions
     {
@@ -44,11 +38,6 @@ namespace TreeLod
     /// Sun (a directional light) and ambient light as `lighting` says (its background is the
     /// viewport's business). Shared by OffscreenRenderer and the scene builder (ForestScene).
     void applyLighting(Ogre::SceneManager& sceneManager, Ogre::Light& sun, const LightingSpec& lighting);
-
-    /// Texture shadows from `sun`, or none: integrated additive technique, one float depth map of
-    /// `textureSize`^2 framed by `camera` (see OffscreenRenderer::setShadows).
-    void applyTextureShadows(Ogre::SceneManager& sceneManager, Ogre::Light& sun, bool enabled, unsigned textureSize,
-                             ShadowCamera camera);
 
     /// One timed frame (OffscreenRenderer::renderTimedFrame).
     struct FrameTiming
@@ -78,12 +67,12 @@ namespace TreeLod
         /// Sun (directional light) and ambient as LightingSpec says; background colour too.
         void setLighting(const LightingSpec& lighting);
 
-        /// Texture shadows from the sun: integrated additive technique, one float depth map of
-        /// `textureSize`^2 framed by `camera` (OGRE-NOTES.md "Shadows"); casters store the
-        /// shadow camera's window depth (materials/GLSL/TreeLodShading.glsl). The shadow far
-        /// distance reaches past the content from wherever the camera stands (render()): a
-        /// shorter one clipped the shadows of distant trees away, with either camera setup.
-        /// Objects choose receiving materials themselves (FoliageLodTree and BillboardCloudTree do).
+        /// The sun's shadows as `settings` say (setupSunShadows, ShadowSetup.h). Unless
+        /// setShadowFarDistance says otherwise, the shadow far distance reaches past the content
+        /// from wherever the camera stands (render()): a shorter one clipped the shadows of
+        /// distant trees away; PSSM's splits follow it.
+        void setShadows(const SunShadowSettings& settings);
+        /// Integrated additive texture shadows framed by `camera`, or none.
         void setShadows(bool enabled, unsigned textureSize = 2048, ShadowCamera camera = ShadowCamera::Focused);
 
         /// Shadow far distance in metres from the camera; 0 (default) = past the content's far

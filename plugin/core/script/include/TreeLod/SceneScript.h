@@ -137,7 +137,7 @@ namespace TreeLod
     {
         bool enabled = false;
         int textureSize = 2048;       ///< power of two, 256..16384
-        std::string camera = "focused"; ///< "focused" | "lispsm" (Ogre's shadow camera setups)
+        std::string camera = "focused"; ///< "focused" | "lispsm" | "pssm" (Ogre's shadow camera setups; pssm: 3 splits)
         float lodBias = 1.0f;           ///< Forest::setShadowLodBias: < 1 = coarser casters than the view
     };
 
