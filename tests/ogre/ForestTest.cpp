@@ -27,9 +27,11 @@
 #include "TreeLod/LevelCalibration.h"
 #include "TreeLod/PackageWriter.h"
 #include "TreeLod/QuadFloors.h"
+#include "TreeLod/ShadowSetup.h"
 #include "TreeLod/TreeAssetManager.h"
 
 #include <OgreEntity.h>
+#include <OgreLogManager.h>
 #include <OgreManualObject.h>
 #include <OgreMaterialManager.h>
 #include <OgreRenderQueue.h>
@@ -793,6 +795,202 @@ namespace TreeLod
         writePng(OgreEnvironment::outDir() + "/forest-shadows-strip.png",
                  sideBySide({plain, shadowed, separate, lispsm, cloudForest, cloudSeparate, casterMesh, casterQuad}));
         compareWithGolden(shadowed, "forest-shadows", 0.02);
+    }
+
+    /// Texture shadows for the tests below: Forest trees (mesh level) on a ground receiving the
+    /// sun's depth shadow (a clone of TreeLod/BarkShadowed), or no ground.
+    void placeShadowScene(const std::vector<ForestInstance>& trees, bool ground, float groundSize)
+    {
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        Ogre::SceneManager& sm = r.getSceneManager();
+        Ogre::MaterialManager& materials = Ogre::MaterialManager::getSingleton();
+        if (!materials.resourceExists("ForestTest/ShadowGround", "TreeLod"))
+        {
+            Ogre::MaterialPtr material = materials.getByName("TreeLod/BarkShadowed", "TreeLod")->clone("ForestTest/ShadowGround");
+            material->getTechnique(0)->getPass(0)->getFragmentProgramParameters()->setNamedConstant(
+                "baseColour", Ogre::ColourValue(0.45f, 0.5f, 0.3f, 1.0f));
+            material->load();
+        }
+        r.clearContent();
+        if (ground)
+        {
+            Ogre::ManualObject* quad = sm.createManualObject();
+            quad->setCastShadows(false);
+            quad->begin("ForestTest/ShadowGround", Ogre::RenderOperation::OT_TRIANGLE_LIST, "TreeLod");
+            const float s = groundSize;
+            for (const glm::vec2 c : {glm::vec2(-s, -s), glm::vec2(s, -s), glm::vec2(s, s), glm::vec2(-s, s)})
+            {
+                quad->position(c.x, 0.0f, c.y);
+                quad->normal(0.0f, 1.0f, 0.0f);
+                quad->textureCoord(0.0f, 0.0f);
+            }
+            quad->quad(0, 3, 2, 1);
+            quad->end();
+            r.getContentNode().createChildSceneNode()->attachObject(quad);
+        }
+        static int serial = 0;
+        auto* forest = static_cast<Forest*>(sm.createMovableObject("shadowSetup" + std::to_string(serial++), "Forest"));
+        forest->addSpecies(oak().asset, {ForestLevel{"mesh", 0, false, 0.0f}});
+        forest->addInstances(trees);
+        r.getContentNode().createChildSceneNode()->attachObject(forest);
+    }
+
+    /// Mean luminance of the rows [top, bottom) of `image` (fractions of its height).
+    double bandLuminance(const Image& image, double top, double bottom)
+    {
+        Image band;
+        band.width = image.width;
+        const int y0 = int(top * image.height), y1 = int(bottom * image.height);
+        band.height = y1 - y0;
+        band.pixels.assign(image.pixels.begin() + std::ptrdiff_t(y0) * image.width,
+                           image.pixels.begin() + std::ptrdiff_t(y1) * image.width);
+        return meanLuminance(band);
+    }
+
+    // PSSM (three splits, as OGRE's Terrain sample) through setupSunShadows: every split's texture
+    // holds casters, and the receivers read the far splits too, so the far trees' shadows are there.
+    TEST(Forest, pssmShadowsReachTheFarTrees)
+    {
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        Ogre::SceneManager& sm = r.getSceneManager();
+        const float h = treeHeight(tree.model);
+        // The first tree stands within the first split (about 0.5 h from a near clip of 0.05 h).
+        std::vector<ForestInstance> row;
+        for (int i = 0; i < 8; ++i)
+            row.push_back(instance((i % 2 ? 0.5f : -0.5f) * h, 0.0f, -1.6f * h * float(i), 0.7f * float(i)));
+        CameraSpec view = look(glm::vec3(0.1f * h, 0.6f * h, 0.5f * h), glm::vec3(0.0f, 0.3f * h, -6.0f * h), 60.0f);
+        view.nearClip = 0.05f * h;
+        const float far = 12.0f * h;
+        r.setShadowFarDistance(far);
+        auto render = [&](Ogre::ShadowTechnique technique, ShadowCamera camera) {
+            SunShadowSettings settings;
+            settings.technique = technique;
+            settings.camera = camera;
+            settings.textureSize = 1024;
+            placeShadowScene(row, true, 20.0f * h);
+            r.setShadows(settings);
+            r.render(view, 256, 160, 1); // Ogre frames shadow cameras with the previous frame's receivers
+            return toImage(r.render(view, 256, 160, 2));
+        };
+        const Image plain = render(Ogre::SHADOWTYPE_NONE, ShadowCamera::Focused);
+        const Image focused = render(Ogre::SHADOWTYPE_TEXTURE_ADDITIVE_INTEGRATED, ShadowCamera::Focused);
+        const Image pssm = render(Ogre::SHADOWTYPE_TEXTURE_ADDITIVE_INTEGRATED, ShadowCamera::PSSM);
+        ASSERT_EQ(sm.getShadowTextureCount(), std::size_t(PSSM_SPLITS));
+        std::vector<double> casterFraction;
+        for (std::size_t i = 0; i < sm.getShadowTextureCount(); ++i)
+        {
+            const Ogre::TexturePtr& texture = sm.getShadowTexture(i);
+            ASSERT_EQ(texture->getFormat(), Ogre::PF_FLOAT32_R);
+            std::vector<float> depth(texture->getWidth() * texture->getHeight());
+            texture->getBuffer()->blitToMemory(
+                Ogre::PixelBox(texture->getWidth(), texture->getHeight(), 1, Ogre::PF_FLOAT32_R, depth.data()));
+            casterFraction.push_back(double(std::count_if(depth.begin(), depth.end(), [](float d) { return d < 1.0f; })) /
+                                     double(depth.size()));
+        }
+        r.setShadows(false);
+        r.setShadowFarDistance(0.0f);
+        r.clearContent();
+        const double nearDrop = bandLuminance(plain, 0.6, 1.0) - bandLuminance(pssm, 0.6, 1.0);
+        const double farDrop = bandLuminance(plain, 0.3, 0.6) - bandLuminance(pssm, 0.3, 0.6);
+        const double focusedDrop = meanLuminance(plain) - meanLuminance(focused);
+        std::printf("PSSM: casters cover %.3f %.3f %.3f of the three textures; luminance drop near %.4f, far %.4f; "
+                    "focused drop %.4f, PSSM %.4f\n", casterFraction[0], casterFraction[1], casterFraction[2], nearDrop,
+                    farDrop, focusedDrop, meanLuminance(plain) - meanLuminance(pssm));
+        writePng(OgreEnvironment::outDir() + "/forest-shadows-pssm-strip.png", sideBySide({plain, focused, pssm}));
+        for (double f : casterFraction)
+            EXPECT_GT(f, 0.001) << "every split's texture holds casters";
+        EXPECT_GT(nearDrop, 0.014) << "the near trees' shadows (the first splits)";
+        EXPECT_GT(farDrop, 0.01) << "the far trees' shadows: the receivers read the far splits (0.006 with the first only)";
+        EXPECT_NEAR(meanLuminance(plain) - meanLuminance(pssm), focusedDrop, 0.5 * focusedDrop);
+        compareWithGolden(pssm, "forest-shadows-pssm", 0.02);
+    }
+
+    // Ogre's colour texture shadows: the casters write what Ogre's own caster pass would (the
+    // shadow colour, black), and the trees, casters that do not receive there, draw as unshadowed.
+    // Stencil shadows are refused by setupSunShadows and logged once by the objects.
+    TEST(Forest, castersFollowOgresShadowTechniqueAndStencilIsRefused)
+    {
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        Ogre::SceneManager& sm = r.getSceneManager();
+        const float h = treeHeight(tree.model);
+        const std::vector<ForestInstance> trees = {instance(-0.6f * h, 0, 0.3f * h, 0.5f, 0.9f),
+                                                   instance(0.5f * h, 0, -0.4f * h, 2.0f, 1.1f)};
+        const CameraSpec view = look(glm::vec3(0.5f * h, 1.3f * h, 2.3f * h), glm::vec3(0.0f, 0.25f * h, 0.0f), 45.0f);
+        placeShadowScene(trees, false, 0.0f);
+        r.setShadows(false);
+        const Image plain = toImage(r.render(view, 160, 128, 1));
+        /// The shadow texture's darkest and brightest red, 0..1.
+        auto textureRange = [&] {
+            const Ogre::TexturePtr& texture = sm.getShadowTexture(0);
+            std::vector<float> red(texture->getWidth() * texture->getHeight() * 4);
+            texture->getBuffer()->blitToMemory(
+                Ogre::PixelBox(texture->getWidth(), texture->getHeight(), 1, Ogre::PF_FLOAT32_RGBA, red.data()));
+            float lo = 1e9f, hi = -1e9f;
+            for (std::size_t i = 0; i < red.size(); i += 4)
+            {
+                lo = std::min(lo, red[i]);
+                hi = std::max(hi, red[i]);
+            }
+            return std::make_pair(lo, hi);
+        };
+        sm.setShadowColour(Ogre::ColourValue(0.25f, 0.25f, 0.25f));
+        for (Ogre::ShadowTechnique technique : {Ogre::SHADOWTYPE_TEXTURE_MODULATIVE, Ogre::SHADOWTYPE_TEXTURE_ADDITIVE,
+                                                Ogre::SHADOWTYPE_TEXTURE_ADDITIVE_INTEGRATED})
+        {
+            SunShadowSettings settings;
+            settings.technique = technique;
+            settings.textureSize = 512;
+            r.setShadows(settings);
+            const Image shadowed = toImage(r.render(view, 160, 128, 1));
+            const auto [lo, hi] = textureRange();
+            const bool integrated = technique & Ogre::SHADOWDETAILTYPE_INTEGRATED;
+            std::printf("shadow technique %d: shadow texture red %.3f..%.3f; FLIP against unshadowed %.5f\n",
+                        int(technique), lo, hi, flipMean(shadowed, plain));
+            EXPECT_FLOAT_EQ(hi, 1.0f) << "cleared where nothing casts";
+            if (technique == Ogre::SHADOWTYPE_TEXTURE_MODULATIVE)
+                EXPECT_NEAR(lo, 0.25f, 0.01f) << "modulative casters write the shadow colour";
+            else if (!integrated)
+                EXPECT_NEAR(lo, 0.0f, 0.01f) << "additive casters write black";
+            else
+            {
+                EXPECT_GT(lo, 0.0f) << "integrated casters write depth";
+                EXPECT_LT(lo, 1.0f);
+            }
+            if (!integrated)
+                EXPECT_LT(flipMean(shadowed, plain), 0.002) << "casters do not receive colour shadows";
+        }
+        // Stencil: refused by the set-up, logged once by the objects when set on Ogre directly.
+        SunShadowSettings stencil;
+        stencil.technique = Ogre::SHADOWTYPE_STENCIL_MODULATIVE;
+        try
+        {
+            r.setShadows(stencil);
+            ADD_FAILURE() << "stencil shadows must be refused";
+        }
+        catch (const Ogre::InvalidParametersException& e)
+        {
+            EXPECT_NE(e.getDescription().find("stencil"), std::string::npos) << e.getDescription();
+        }
+        struct Counter : Ogre::LogListener
+        {
+            int stencilLines = 0;
+            void messageLogged(const Ogre::String& message, Ogre::LogMessageLevel, bool, const Ogre::String&,
+                               bool&) override
+            {
+                stencilLines += message.find("do not support stencil shadows") != Ogre::String::npos;
+            }
+        } counter;
+        Ogre::LogManager::getSingleton().getDefaultLog()->addListener(&counter);
+        sm.setShadowTechnique(Ogre::SHADOWTYPE_STENCIL_MODULATIVE);
+        const Image stencilled = toImage(r.render(view, 160, 128, 1));
+        r.render(view, 160, 128, 1);
+        Ogre::LogManager::getSingleton().getDefaultLog()->removeListener(&counter);
+        r.setShadows(false);
+        r.clearContent();
+        EXPECT_EQ(counter.stencilLines, 1) << "one log line per scene manager";
+        EXPECT_LT(flipMean(stencilled, plain), 0.002) << "trees draw unshadowed under stencil shadows";
     }
 
     TEST(Forest, badInputIsRefusedAndNamed)

@@ -108,8 +108,9 @@ namespace TreeLod
         }
         if (technique & Ogre::SHADOWDETAILTYPE_STENCIL)
             OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
-                        Ogre::String("scene manager '") + sceneManager.getName() + "': " + techniqueName(technique) +
-                            " is not supported by TreeLod's trees (no edge lists); use a texture shadow technique",
+                        Ogre::String("scene manager '") + sceneManager.getName() + "': stencil shadows (" +
+                            techniqueName(technique) +
+                            ") are not supported by TreeLod's trees (no edge lists); use a texture shadow technique",
                         "setupSunShadows");
         if (sun.getType() != Ogre::Light::LT_DIRECTIONAL)
             OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
