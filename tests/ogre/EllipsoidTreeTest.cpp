@@ -453,3 +453,26 @@ namespace TreeLod
         TreeAssetManager::getSingleton().remove(bare);
     }
 }
+
+namespace TreeLod
+{
+    TEST(EllipsoidTree, meshLodBiasActsAsEntitysOnTheEllipsoidLevel)
+    {
+        const BakedOak& t = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        r.setShadows(false);
+        r.clearContent();
+        auto* tree = static_cast<EllipsoidTree*>(create({}, "ellipsoid-bias"));
+        r.getContentNode().attachObject(tree);
+        std::vector<CameraSpec> views;
+        for (const float distance : {1.0f, 2.0f, 4.0f, 8.0f, 16.0f, 32.0f, 64.0f})
+            views.push_back(CameraSpec::framing(t.model.boundsMin, t.model.boundsMax, 0.0f, 10.0f, distance));
+        MeshLodBiasProbe probe;
+        probe.setBias = [&](Ogre::Real f, unsigned short max, unsigned short min) { tree->setMeshLodBias(f, max, min); };
+        probe.index = [&] { return unsigned(tree->getLevel()); };
+        probe.render = [&](const CameraSpec& view) { r.render(view, 128, 128, 1); };
+        probe.indexCount = unsigned(tree->getLevelCount());
+        expectMeshLodBiasLikeEntity(probe, views);
+        r.clearContent();
+    }
+}
