@@ -652,3 +652,57 @@ namespace TreeLod
         writePng(OgreEnvironment::outDir() + "/bc-scales.png", sideBySide(images));
     }
 }
+
+namespace TreeLod
+{
+    TEST(BillboardCloudTree, meshLodBiasActsAsEntitysOnTheCloudLevel)
+    {
+        // The cloud level is the mesh LoD: the factor multiplies the screen size as the camera's
+        // LoD bias does, the detail indices clamp it; lodBias=4 is setMeshLodBias(4).
+        const BakedTree& oak = bundled("oak");
+        BillboardCloudTree* tree = placeCloud(oak.asset);
+        std::vector<CameraSpec> views;
+        for (const char* view : {"orbit:30,10,8", "orbit:30,10,16", "orbit:30,10,32", "orbit:30,10,64", "orbit:30,10,128"})
+            views.push_back(camera(oak.model, view));
+        MeshLodBiasProbe probe;
+        probe.setBias = [&](Ogre::Real f, unsigned short max, unsigned short min) { tree->setMeshLodBias(f, max, min); };
+        probe.index = [&] { return unsigned(tree->getLevel()); };
+        probe.render = [&](const CameraSpec& view) { OgreEnvironment::renderer().render(view, 128, 128, 1); };
+        probe.indexCount = tree->getLevelCount();
+        expectMeshLodBiasLikeEntity(probe, views);
+
+        tree = placeCloud(oak.asset, {{"lodBias", "4"}});
+        EXPECT_FLOAT_EQ(tree->getLodBias().meshFactor, 4.0f);
+        EXPECT_THROW(tree->setMeshLodBias(0.0f), Ogre::InvalidParametersException);
+        EXPECT_THROW(tree->setMaterialLodBias(std::nanf("")), Ogre::InvalidParametersException);
+    }
+
+    TEST(BillboardCloudTree, materialLodBiasMovesTheLowResSwitch)
+    {
+        // A layered level drawn far away (forced) takes its material LoD 1, the low-res texture
+        // alone: a large material factor brings the layers back, maxDetailIndex 1 keeps them off.
+        const BakedTree& oak = bundled("oak");
+        BillboardCloudTree* tree = placeCloud(oak.asset, {{"level", "1"}});
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const CameraSpec far = camera(oak.model, "orbit:30,10,512");
+        r.render(far, 128, 128, 1);
+        ASSERT_EQ(tree->getLevel(), 1u);
+        EXPECT_EQ(tree->getMaterialLodIndex(), 1u);
+        tree->setMaterialLodBias(1e6f);
+        r.render(far, 128, 128, 1);
+        EXPECT_EQ(tree->getMaterialLodIndex(), 0u);
+        tree->setMaterialLodBias(1e6f, 1, 99);
+        r.render(far, 128, 128, 1);
+        EXPECT_EQ(tree->getMaterialLodIndex(), 1u);
+        // The camera's bias moves it as the factor does; the mesh factor leaves it.
+        tree->setMaterialLodBias(1.0f);
+        tree->setMeshLodBias(1e6f);
+        r.render(far, 128, 128, 1);
+        EXPECT_EQ(tree->getMaterialLodIndex(), 1u);
+        tree->setMeshLodBias(1.0f);
+        r.setLodBias(1e6f);
+        r.render(far, 128, 128, 1);
+        r.setLodBias(1.0f);
+        EXPECT_EQ(tree->getMaterialLodIndex(), 0u);
+    }
+}

@@ -367,3 +367,44 @@ namespace TreeLod
         EXPECT_GT(treeCoverage(quantised, LightingSpec().background), 0.05);
     }
 }
+
+namespace TreeLod
+{
+    TEST(FoliageLodTree, meshLodBiasScalesTheCurveAndClampsTheBark)
+    {
+        // The factor multiplies the curve's pixels as the camera's bias does (both through
+        // treelod_screen_size); the detail indices clamp the bark mesh's LoD index.
+        const LodfTree& oak = bundledOak();
+        FoliageLodTree* tree = place(oak.asset);
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const CameraSpec view = camera(oak.model, "orbit:30,10,8");
+        r.render(view, 256, 256, 1);
+        const std::uint32_t base = tree->getLeafCount();
+        ASSERT_LT(2 * base, tree->getMaxLeafCount());
+        tree->setMeshLodBias(2.0f);
+        r.render(view, 256, 256, 1);
+        const std::uint32_t doubled = tree->getLeafCount();
+        EXPECT_NEAR(double(doubled), 2.0 * base, 2.0);
+        tree->setMeshLodBias(1.0f);
+        r.setLodBias(2.0f);
+        r.render(view, 256, 256, 1);
+        r.setLodBias(1.0f);
+        EXPECT_EQ(tree->getLeafCount(), doubled) << "the camera's bias 2 acts as factor 2";
+
+        Ogre::MeshPtr bark = oak.asset->getBarkMesh();
+        ASSERT_GT(bark->getNumLodLevels(), 2u);
+        const CameraSpec far = camera(oak.model, "orbit:30,10,30");
+        r.render(far, 256, 256, 1);
+        const unsigned short farBark = tree->getBarkLodIndex();
+        ASSERT_GT(farBark, 0u);
+        tree->setMeshLodBias(1.0f, farBark + 1, 99);
+        r.render(camera(oak.model, "orbit:30,10,1"), 256, 256, 1);
+        EXPECT_EQ(tree->getBarkLodIndex(), std::min<unsigned short>(farBark + 1, bark->getNumLodLevels() - 1));
+        tree->setMeshLodBias(1.0f, 0, 0);
+        r.render(far, 256, 256, 1);
+        EXPECT_EQ(tree->getBarkLodIndex(), 0u);
+        tree->setMeshLodBias(1e4f);
+        r.render(far, 256, 256, 1);
+        EXPECT_LT(tree->getBarkLodIndex(), farBark) << "a factor on the bark mesh's pixel_count values";
+    }
+}

@@ -1956,3 +1956,52 @@ namespace TreeLod
         }
     }
 }
+
+namespace TreeLod
+{
+    TEST(Forest, meshLodBiasActsAsEntitysOnEveryInstance)
+    {
+        // setMeshLodBias's factor is setLodBias (the Forest's factor, with the camera's); its
+        // detail indices clamp every instance's level.
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+        std::vector<ForestLevel> levels;
+        Forest* forest = autoBandsGrid(tree, levels);
+        ASSERT_GE(levels.size(), 3u);
+        const std::size_t last = levels.size() - 1;
+        const CameraSpec mid = look(glm::vec3(0.0f, 3.0f * h, 10.0f * h), glm::vec3(0.0f, 0.3f * h, 0.0f));
+        r.render(mid, 256, 192, 1);
+        const double plain = meanLevel(*forest);
+        forest->setMeshLodBias(4.0f);
+        EXPECT_FLOAT_EQ(forest->getLodBias(), 4.0f);
+        r.render(mid, 256, 192, 1);
+        const double finer = meanLevel(*forest);
+        forest->setMeshLodBias(1.0f);
+        r.setLodBias(4.0f);
+        r.render(mid, 256, 192, 1);
+        r.setLodBias(1.0f);
+        EXPECT_DOUBLE_EQ(meanLevel(*forest), finer) << "the camera's bias 4 acts as factor 4";
+        forest->setMeshLodBias(0.25f);
+        r.render(mid, 256, 192, 1);
+        const double coarser = meanLevel(*forest);
+        std::printf("mean level: factor 1 %.2f, 4 %.2f, 0.25 %.2f\n", plain, finer, coarser);
+        EXPECT_LT(finer, plain);
+        EXPECT_GT(coarser, plain);
+
+        // From 10 km every tree draws the last level; minDetailIndex 1 stops them at level 1,
+        // and maxDetailIndex 1 keeps them from level 0 close up.
+        const CameraSpec distant = look(glm::vec3(0.0f, 200.0f, 10000.0f), glm::vec3(0.0f));
+        forest->setMeshLodBias(1.0f, 0, 1);
+        r.render(distant, 96, 96, 1);
+        EXPECT_EQ(forest->getStats().levelCounts[0][1], forest->getStats().visibleInstances);
+        EXPECT_GT(forest->getStats().visibleInstances, 0u);
+        forest->setMeshLodBias(1e4f, 1, 99);
+        r.render(mid, 256, 192, 1);
+        EXPECT_EQ(forest->getStats().levelCounts[0][0], 0u);
+        EXPECT_EQ(forest->getStats().levelCounts[0][1], forest->getStats().visibleInstances);
+        forest->setMeshLodBias(1.0f);
+        r.render(distant, 96, 96, 1);
+        EXPECT_EQ(forest->getStats().levelCounts[0][last], forest->getStats().visibleInstances);
+    }
+}

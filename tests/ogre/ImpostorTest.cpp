@@ -484,3 +484,43 @@ namespace TreeLod
         compareWithGolden(shadowed, "oak-impostor-shadows", 0.02);
     }
 }
+
+namespace TreeLod
+{
+    TEST(Impostor, materialLodBiasActsAsEntitys)
+    {
+        // One quad, one mesh level. The material's own LoD strategy and values pick its technique,
+        // biased and clamped by setMaterialLodBias: here a second technique beyond 1 m.
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        r.clearContent();
+        r.setShadows(false);
+        const BakedOak& t = oak();
+        Ogre::NameValuePairList params{{"asset", t.asset->getName()}, {"group", t.asset->getGroup()}};
+        auto* tree = static_cast<ImpostorTree*>(r.getSceneManager().createMovableObject(
+            "impostor-lod-bias", ImpostorTreeFactory::FACTORY_TYPE_NAME, &params));
+        r.getContentNode().attachObject(tree);
+        const Ogre::MaterialPtr& material = tree->getMaterial();
+        Ogre::Technique* far = material->createTechnique();
+        *far = *material->getTechnique(0);
+        far->setLodIndex(1);
+        material->setLodLevels({1.0f});
+        material->compile();
+        const CameraSpec view = CameraSpec::framing(t.model.boundsMin, t.model.boundsMax, 30.0f, 10.0f, 4.0f);
+        r.render(view, 64, 64, 1);
+        EXPECT_EQ(tree->getMaterialLodIndex(), 1u);
+        EXPECT_EQ(tree->getTechnique(), far);
+        tree->setMaterialLodBias(1e6f);
+        r.render(view, 64, 64, 1);
+        EXPECT_EQ(tree->getMaterialLodIndex(), 0u);
+        tree->setMaterialLodBias(1.0f, 0, 0);
+        r.render(view, 64, 64, 1);
+        EXPECT_EQ(tree->getMaterialLodIndex(), 0u);
+        tree->setMeshLodBias(2.0f);
+        EXPECT_FLOAT_EQ(tree->getLodBias().meshFactor, 2.0f);
+        EXPECT_THROW(tree->setMeshLodBias(-1.0f), Ogre::InvalidParametersException);
+        material->removeTechnique(1);
+        material->setLodLevels({});
+        material->compile();
+        r.clearContent();
+    }
+}

@@ -249,4 +249,66 @@ namespace TreeLod
     {
         compareWithGoldenFile(actual, OgreEnvironment::sourcePath("tests/golden/" + name + ".png"), name, bound);
     }
+
+    /// A tree object's Entity-style mesh LoD bias, seen through callbacks: set it, read the
+    /// detail index it draws for the last camera (0 = finest), render a view.
+    struct MeshLodBiasProbe
+    {
+        std::function<void(Ogre::Real factor, unsigned short maxDetailIndex, unsigned short minDetailIndex)> setBias;
+        std::function<unsigned()> index;
+        std::function<void(const CameraSpec& view)> render;
+        unsigned indexCount = 0; ///< detail indices the object has
+    };
+
+    /// setMeshLodBias as Entity's: at the first of `views` whose index L lies strictly between
+    /// the finest and the coarsest, factor 4 draws a finer index and 0.25 a coarser one (at
+    /// least one of them strictly); a camera LoD bias of 4 (Camera::setLodBias, through the
+    /// strategy) draws what factor 4 draws; maxDetailIndex and minDetailIndex clamp.
+    inline void expectMeshLodBiasLikeEntity(const MeshLodBiasProbe& p, const std::vector<CameraSpec>& views)
+    {
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        ASSERT_GE(p.indexCount, 3u);
+        p.setBias(1.0f, 0, 99);
+        const CameraSpec* middle = nullptr;
+        unsigned level = 0;
+        for (const CameraSpec& view : views)
+        {
+            p.render(view);
+            level = p.index();
+            if (level > 0 && level + 1 < p.indexCount)
+            {
+                middle = &view;
+                break;
+            }
+        }
+        ASSERT_NE(middle, nullptr) << "no view draws a middle level";
+        p.setBias(4.0f, 0, 99);
+        p.render(*middle);
+        const unsigned finer = p.index();
+        p.setBias(0.25f, 0, 99);
+        p.render(*middle);
+        const unsigned coarser = p.index();
+        std::printf("detail index %u; with factor 4: %u, 0.25: %u\n", level, finer, coarser);
+        EXPECT_LE(finer, level);
+        EXPECT_GE(coarser, level);
+        EXPECT_LT(finer, coarser);
+
+        p.setBias(1.0f, 0, 99);
+        r.setLodBias(4.0f);
+        p.render(*middle);
+        r.setLodBias(1.0f);
+        EXPECT_EQ(p.index(), finer) << "the camera's LoD bias 4 acts as factor 4";
+
+        // Limits: a huge factor stops at maxDetailIndex, a tiny one at minDetailIndex.
+        p.setBias(1e4f, 1, 99);
+        p.render(*middle);
+        EXPECT_EQ(p.index(), 1u);
+        p.setBias(1e-4f, 0, 1);
+        p.render(*middle);
+        EXPECT_EQ(p.index(), 1u);
+        p.setBias(1e-4f, 0, 99);
+        p.render(*middle);
+        EXPECT_EQ(p.index(), p.indexCount - 1);
+        p.setBias(1.0f, 0, 99);
+    }
 }

@@ -663,3 +663,29 @@ namespace TreeLod
         TreeAssetManager::getSingleton().remove(asset);
     }
 }
+
+namespace TreeLod
+{
+    TEST(VolumeOctreeTree, meshLodBiasActsAsEntitysOnTheActiveLevel)
+    {
+        // Detail index = levels from the finest: levelCount - 1 - active level.
+        OgreEnvironment::renderer().setShadows(false);
+        const BakedOak& t = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        r.clearContent();
+        Ogre::NameValuePairList params = {{"asset", t.asset->getName()}, {"group", t.asset->getGroup()}};
+        auto* tree = static_cast<VolumeOctreeTree*>(r.getSceneManager().createMovableObject(
+            "volume-bias", VolumeOctreeTreeFactory::FACTORY_TYPE_NAME, &params));
+        r.getContentNode().attachObject(tree);
+        std::vector<CameraSpec> views;
+        for (const float distance : {0.5f, 1.0f, 2.0f, 4.0f, 8.0f, 16.0f})
+            views.push_back(CameraSpec::framing(t.model.boundsMin, t.model.boundsMax, 0.0f, 10.0f, distance));
+        MeshLodBiasProbe probe;
+        probe.setBias = [&](Ogre::Real f, unsigned short max, unsigned short min) { tree->setMeshLodBias(f, max, min); };
+        probe.index = [&] { return tree->getLevelCount() - 1 - tree->getActiveLevel(); };
+        probe.render = [&](const CameraSpec& view) { r.render(view, 96, 96, 1); };
+        probe.indexCount = tree->getLevelCount();
+        expectMeshLodBiasLikeEntity(probe, views);
+        r.clearContent();
+    }
+}

@@ -41,7 +41,7 @@ namespace TreeLod
         /// up, the low-res texture alone far away).
         Ogre::Technique* getTechnique() const override
         {
-            return getMaterial()->getBestTechnique(mCloud ? mParent.mMaterialLodIndex : 0, this);
+            return mCloud ? getMaterial()->getBestTechnique(mParent.mMaterialLodIndex, this) : TreePart::getTechnique();
         }
 
     protected:
@@ -65,6 +65,7 @@ namespace TreeLod
                         "parameter 'level': " + std::to_string(mOptions.level) +
                             " is not a level of the cloud (it has " + std::to_string(levels) + ")",
                         "BillboardCloudTree '" + name + "'");
+        mLodBias.setMesh(mOptions.lodBias, 0, 99, "BillboardCloudTree '" + name + "'");
         mListFactor = mOptions.listFactor >= 0.0f ? mOptions.listFactor : mGpu->listFactor;
         updateSwitchValues();
 
@@ -179,7 +180,19 @@ namespace TreeLod
         // moves with value * (listFactor / chunk's)^2.
         const float ratio = mGpu->listFactor > 0.0f ? mListFactor / mGpu->listFactor : 0.0f;
         const Ogre::MaterialPtr& material = mLevelParts[mLevel]->getMaterial();
-        return material->getLodIndex(value * ratio * ratio);
+        return mLodBias.clampMaterial(material->getLodIndex(value * ratio * ratio));
+    }
+
+    void BillboardCloudTree::setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex,
+                                            unsigned short minDetailIndex)
+    {
+        mLodBias.setMesh(factor, maxDetailIndex, minDetailIndex, "BillboardCloudTree '" + mName + "'");
+    }
+
+    void BillboardCloudTree::setMaterialLodBias(Ogre::Real factor, unsigned short maxDetailIndex,
+                                                unsigned short minDetailIndex)
+    {
+        mLodBias.setMaterial(factor, maxDetailIndex, minDetailIndex, "BillboardCloudTree '" + mName + "'");
     }
 
     void BillboardCloudTree::applyLevel()
@@ -190,7 +203,11 @@ namespace TreeLod
                                       0.0f);
         for (const std::unique_ptr<Part>& part : mLevelParts)
             part->setCustomParameter(0, lodParams);
-        mMaterialLodIndex = materialLodIndexForPixelCount(mPixelCountValue);
+        // Entity's material value: the unbiased one times the material factor.
+        const Ogre::Real maxValue = std::numeric_limits<Ogre::Real>::max();
+        mMaterialLodIndex = materialLodIndexForPixelCount(
+            mPixelCountValue == maxValue ? maxValue
+                                         : mPixelCountValue / mLodBias.meshFactor * mLodBias.materialFactor);
     }
 
     void BillboardCloudTree::_notifyCurrentCamera(Ogre::Camera* camera)
@@ -201,25 +218,27 @@ namespace TreeLod
         // The LoD camera (the viewer's, for shadow cameras) and its bias decide, through Ogre's
         // strategies: TreeLod's screen size, or the distance to the bounding box.
         const Ogre::Camera* lod = camera->getLodCamera();
-        mBias = lod->getLodBias() * mOptions.lodBias;
+        mBias = lod->getLodBias() * mLodBias.meshFactor;
         const Ogre::Real maxValue = std::numeric_limits<Ogre::Real>::max();
-        const Ogre::Real screen = ScreenSizeLodStrategy::getSingleton().getValue(this, camera);
-        mPixelCountValue = screen == maxValue ? maxValue : screen * mOptions.lodBias;
+        mPixelCountValue = mLodBias.screenSize(*this, camera);
         mLodValue = mPixelCountValue;
         mDistanceToPixels = ScreenSizeLodStrategy::depthFactor(getBoundingRadiusScaled(), *lod);
         if (mOptions.strategy == LodStrategy::Distance)
         {
-            // DistanceLodBoxStrategy's value (the camera's bias in it), with the object's bias;
+            // DistanceLodBoxStrategy's value (the camera's bias in it), with the mesh factor;
             // under a perspective camera, its screen size through this projection.
-            mLodValue = Ogre::DistanceLodBoxStrategy::getSingleton().getValue(this, camera) / mOptions.lodBias;
+            mLodValue = mLodBias.meshValue(Ogre::DistanceLodBoxStrategy::getSingleton(), *this, camera);
             if (mDistanceToPixels > 0.0f)
                 mPixelCountValue = mLodValue > 0.0f ? mDistanceToPixels / mLodValue : maxValue;
         }
 
         if (mOptions.level < 0)
-            mLevel = levelForPixelCount(mPixelCountValue);
+            mLevel = mLodBias.clampMesh(Ogre::ushort(std::min<std::uint32_t>(levelForPixelCount(mPixelCountValue), 0xffff)));
+        mLevel = std::min(mLevel, std::max<std::uint32_t>(getLevelCount(), 1) - 1);
         if (mBarkMesh)
-            mBarkLodIndex = mBarkMesh->getLodIndex(mPixelCountValue);
+            mBarkLodIndex = mLodBias.meshLodIndex(*mBarkMesh, *this, camera);
+        for (const std::unique_ptr<Part>& part : mBarkParts)
+            part->updateMaterialLod(mLodBias, camera);
         applyLevel();
     }
 

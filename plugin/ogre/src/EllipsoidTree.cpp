@@ -3,6 +3,7 @@
 #include "TreeLod/EllipsoidTree.h"
 
 #include "TreeLod/ObjectParams.h"
+#include "TreeLod/ScreenSizeLodStrategy.h"
 #include "TreeLod/ShadowSetup.h"
 #include "TreeLod/TechniqueSupport.h"
 #include "TreePart.h"
@@ -48,6 +49,7 @@ namespace TreeLod
         : Ogre::MovableObject(name), mAsset(asset), mGpu(&EllipsoidTreeResources::of(*asset).getGpu()),
           mOptions(options)
     {
+        mLodBias.setMesh(mOptions.lodBias, 0, 99, "EllipsoidTree '" + name + "'");
         if (mOptions.level >= 0 && std::size_t(mOptions.level) >= mGpu->levels.size())
             OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
                         "parameter 'level': " + std::to_string(mOptions.level) + " is not a level of the ellipsoids (" +
@@ -108,7 +110,17 @@ namespace TreeLod
 
     void EllipsoidTree::setLevels(float heightPx)
     {
-        mLevel = mOptions.level >= 0 ? std::size_t(mOptions.level) : TreeLod::levelForHeight(mGpu->levels, heightPx);
+        if (mOptions.level >= 0)
+            mLevel = std::size_t(mOptions.level);
+        else
+        {
+            mLevel = TreeLod::levelForHeight(mGpu->levels, heightPx);
+            const std::size_t clamped = std::min<std::size_t>(
+                mLodBias.clampMesh(Ogre::ushort(std::min<std::size_t>(mLevel, 0xffff))), mGpu->levels.size() - 1);
+            if (clamped != mLevel) // a clamped level: the lines made for its target height
+                heightPx = mGpu->levels[clamped].targetHeightPx;
+            mLevel = clamped;
+        }
         mEllipsoids->mIndexData.indexStart = mGpu->levels[mLevel].indexStart;
         mEllipsoids->mIndexData.indexCount = mGpu->levels[mLevel].indexCount;
         if (mLines)
@@ -135,25 +147,33 @@ namespace TreeLod
         Ogre::MovableObject::_notifyCurrentCamera(camera);
         if (!mParentNode)
             return;
-        // The LoD camera (the viewer's, for shadow cameras) and its bias decide.
-        const Ogre::Camera* lod = camera->getLodCamera();
-        const Ogre::Viewport* viewport = lod->getViewport();
-        const Ogre::Real viewHeight = viewport ? Ogre::Real(viewport->getActualHeight()) : 0.0f;
-        const Ogre::Real treeHeight = mTreeHeight * mParentNode->_getDerivedScale().y;
+        // The tree's height on screen from treelod_screen_size's value (the LoD camera's, the
+        // viewer's for shadow cameras, with its bias) and the mesh factor: r_px scaled by the
+        // tree's height over its bounding radius.
+        const Ogre::Real radiusPx = ScreenSizeLodStrategy::radiusInPixels(mLodBias.screenSize(*this, camera));
+        const Ogre::Real radius = getBoundingRadiusScaled();
         Ogre::Real heightPx = std::numeric_limits<Ogre::Real>::max();
-        if (lod->getProjectionType() == Ogre::PT_PERSPECTIVE)
-        {
-            const Ogre::Real depth = std::sqrt(mParentNode->getSquaredViewDepth(lod));
-            if (depth > std::numeric_limits<Ogre::Real>::epsilon())
-                heightPx = treeHeight * lod->getProjectionMatrix()[1][1] * viewHeight / (2.0f * depth);
-        }
-        else if (lod->getOrthoWindowHeight() > 0.0f)
-            heightPx = treeHeight * viewHeight / lod->getOrthoWindowHeight();
-        if (heightPx != std::numeric_limits<Ogre::Real>::max())
-            heightPx *= lod->getLodBias() * mOptions.lodBias;
+        if (radiusPx < heightPx && radius > 0.0f)
+            heightPx = mTreeHeight * std::abs(mParentNode->_getDerivedScale().y) * radiusPx / radius;
         setLevels(float(heightPx));
         if (mBarkMesh)
-            mBarkLodIndex = mBarkMesh->getLodIndex(mBarkMesh->getLodStrategy()->getValue(this, camera));
+            mBarkLodIndex = mLodBias.meshLodIndex(*mBarkMesh, *this, camera);
+        for (Part* part : {mEllipsoids.get(), mLineParts.get()})
+            if (part)
+                part->updateMaterialLod(mLodBias, camera);
+        for (const std::unique_ptr<Part>& part : mBarkParts)
+            part->updateMaterialLod(mLodBias, camera);
+    }
+
+    void EllipsoidTree::setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex, unsigned short minDetailIndex)
+    {
+        mLodBias.setMesh(factor, maxDetailIndex, minDetailIndex, "EllipsoidTree '" + mName + "'");
+    }
+
+    void EllipsoidTree::setMaterialLodBias(Ogre::Real factor, unsigned short maxDetailIndex,
+                                           unsigned short minDetailIndex)
+    {
+        mLodBias.setMaterial(factor, maxDetailIndex, minDetailIndex, "EllipsoidTree '" + mName + "'");
     }
 
     bool EllipsoidTree::useShadowedMaterials() const

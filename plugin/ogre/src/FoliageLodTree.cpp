@@ -1,6 +1,7 @@
 #include "TreeLod/FoliageLodTree.h"
 
 #include "TreeLod/ObjectParams.h"
+#include "TreeLod/ScreenSizeLodStrategy.h"
 #include "TreeLod/ShadowSetup.h"
 #include "TreePart.h"
 
@@ -12,7 +13,6 @@
 #include <OgreHardwareBufferManager.h>
 #include <OgreMaterialManager.h>
 #include <OgreNode.h>
-#include <OgrePixelCountLodStrategy.h>
 #include <OgreRenderQueue.h>
 #include <OgreSceneManager.h>
 #include <OgreStringConverter.h>
@@ -228,18 +228,28 @@ namespace TreeLod
         Ogre::MovableObject::_notifyCurrentCamera(camera);
         if (!mParentNode)
             return;
-        const Ogre::Camera* lodCamera = camera->getLodCamera();
-        const Ogre::Real pixels = Ogre::AbsolutePixelCountLodStrategy::getSingleton().getValue(this, camera);
+        // Through the strategies, as an Entity: the LoD camera (the viewer's for shadow cameras)
+        // and its bias are in the values.
         if (mBarkMesh)
-        {
-            const Ogre::LodStrategy* strategy = mBarkMesh->getLodStrategy();
-            mBarkLodIndex = mBarkMesh->getLodIndex(
-                strategy == Ogre::AbsolutePixelCountLodStrategy::getSingletonPtr() ? pixels
-                                                                                  : strategy->getValue(this, camera));
-        }
-        // The LoD camera (the viewer's camera for shadow cameras) and its bias drive the count.
-        updateLeafCount(mOptions.fixedLeafCount > 0 ? mOptions.fixedLeafCount
-                                                    : leafCountForPixels(pixels, lodCamera->getLodBias()));
+            mBarkLodIndex = mLodBias.meshLodIndex(*mBarkMesh, *this, camera);
+        for (auto* parts : {&mBarkParts, &mLeafParts})
+            for (const std::unique_ptr<Part>& part : *parts)
+                part->updateMaterialLod(mLodBias, camera);
+        if (mOptions.fixedLeafCount > 0)
+            updateLeafCount(mOptions.fixedLeafCount);
+        else
+            updateLeafCount(leafCountForPixels(ScreenSizeLodStrategy::pixelCountOf(mLodBias.screenSize(*this, camera))));
+    }
+
+    void FoliageLodTree::setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex, unsigned short minDetailIndex)
+    {
+        mLodBias.setMesh(factor, maxDetailIndex, minDetailIndex, "FoliageLodTree '" + mName + "'");
+    }
+
+    void FoliageLodTree::setMaterialLodBias(Ogre::Real factor, unsigned short maxDetailIndex,
+                                            unsigned short minDetailIndex)
+    {
+        mLodBias.setMaterial(factor, maxDetailIndex, minDetailIndex, "FoliageLodTree '" + mName + "'");
     }
 
     bool FoliageLodTree::useShadowedMaterials()

@@ -784,8 +784,7 @@ namespace TreeLod
         kind.name = asset->getName() + " species " + std::to_string(mSpecies.size());
         kind.boundsCentre = glm::vec3(centre.x, centre.y, centre.z);
         kind.boundsRadius = radius;
-        for (std::size_t l = 0; l + 1 < levels.size(); ++l)
-            kind.thresholds.push_back(species->kindValue(levels[l].minPixelCount));
+        kind.thresholds = kindThresholds(*species, levels);
         Result<std::uint32_t> added = mInstances.addKind(kind);
         if (!added)
             invalid(label + added.error().message(), source);
@@ -905,10 +904,7 @@ namespace TreeLod
         // old parts), the buckets of later species moved with their indices.
         const std::uint32_t first = mInstances.getBucketIndex(s, 0);
         const std::size_t oldCount = species.levels.size();
-        std::vector<float> thresholds;
-        for (std::size_t l = 0; l + 1 < count; ++l)
-            thresholds.push_back(species.kindValue(levels[l].minPixelCount));
-        if (Result<void> set = mInstances.setKindThresholds(s, thresholds); !set)
+        if (Result<void> set = mInstances.setKindThresholds(s, kindThresholds(species, levels)); !set)
             invalid(label + set.error().message(), source);
         for (auto& [camera, state] : mCameras)
         {
@@ -1114,12 +1110,33 @@ namespace TreeLod
             mParentNode->needUpdate();
     }
 
+    std::vector<float> Forest::kindThresholds(const Species& species, const std::vector<ForestLevel>& levels) const
+    {
+        // Level l is drawn while the value is at least thresholds[l]: setMeshLodBias's limits make
+        // the levels finer than maxDetailIndex unreachable and stop at minDetailIndex.
+        std::vector<float> thresholds;
+        for (std::size_t l = 0; l + 1 < levels.size(); ++l)
+            thresholds.push_back(l < mLodBias.maxMeshIndex    ? FLT_MAX
+                                 : l >= mLodBias.minMeshIndex ? 0.0f
+                                                              : species.kindValue(levels[l].minPixelCount));
+        return thresholds;
+    }
+
+    void Forest::setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex, unsigned short minDetailIndex)
+    {
+        const bool limits = maxDetailIndex != mLodBias.maxMeshIndex || minDetailIndex != mLodBias.minMeshIndex;
+        mLodBias.setMesh(factor, maxDetailIndex, minDetailIndex, "Forest '" + mName + "'");
+        if (!limits)
+            return;
+        for (std::uint32_t s = 0; s < mSpecies.size(); ++s)
+            if (Result<void> set = mInstances.setKindThresholds(s, kindThresholds(*mSpecies[s], mSpecies[s]->levels));
+                !set)
+                invalid("Forest '" + mName + "': " + set.error().message(), "Forest::setMeshLodBias");
+    }
+
     void Forest::setLodBias(Ogre::Real bias)
     {
-        if (!std::isfinite(bias) || !(bias > 0.0f))
-            invalid("Forest '" + mName + "': LoD bias " + std::to_string(bias) + " is not finite and > 0",
-                    "Forest::setLodBias");
-        mLodBias = bias;
+        setMeshLodBias(bias, mLodBias.maxMeshIndex, mLodBias.minMeshIndex);
     }
 
     void Forest::setLodHysteresis(Ogre::Real hysteresis)
@@ -1408,7 +1425,7 @@ namespace TreeLod
             state.camera.lodPosition = glm::vec3(eye.x, eye.y, eye.z);
             state.camera.lodPixelScale = area * std::abs(projection[0][0] * projection[1][1]);
             state.camera.lodOrthographic = lod->getProjectionType() == Ogre::PT_ORTHOGRAPHIC;
-            state.lodBias = lod->getLodBias() * mLodBias * (shadowTexture ? mShadowLodBias : 1.0f);
+            state.lodBias = lod->getLodBias() * mLodBias.meshFactor * (shadowTexture ? mShadowLodBias : 1.0f);
             state.hasLod = true;
         }
         const Ogre::Vector3 eye = world.inverse() * camera->getDerivedPosition();

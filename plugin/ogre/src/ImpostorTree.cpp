@@ -9,6 +9,7 @@
 #include <OgreNode.h>
 #include <OgreRenderQueue.h>
 #include <OgreSceneManager.h>
+#include <OgreTechnique.h>
 
 namespace TreeLod
 {
@@ -44,6 +45,29 @@ namespace TreeLod
     ImpostorTree::~ImpostorTree() = default;
 
     const Ogre::String& ImpostorTree::getMovableType() const { return mMovableType; }
+
+    void ImpostorTree::setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex, unsigned short minDetailIndex)
+    {
+        mLodBias.setMesh(factor, maxDetailIndex, minDetailIndex, mMovableType + " '" + mName + "'");
+    }
+
+    void ImpostorTree::setMaterialLodBias(Ogre::Real factor, unsigned short maxDetailIndex,
+                                          unsigned short minDetailIndex)
+    {
+        mLodBias.setMaterial(factor, maxDetailIndex, minDetailIndex, mMovableType + " '" + mName + "'");
+    }
+
+    void ImpostorTree::_notifyCurrentCamera(Ogre::Camera* camera)
+    {
+        Ogre::MovableObject::_notifyCurrentCamera(camera);
+        if (mParentNode)
+            mMaterialLodIndex = mLodBias.materialLodIndex(*getMaterial(), *this, camera);
+    }
+
+    Ogre::Technique* ImpostorTree::getTechnique() const
+    {
+        return getMaterial()->getBestTechnique(mMaterialLodIndex, this);
+    }
 
     void ImpostorTree::_updateRenderQueue(Ogre::RenderQueue* queue)
     {

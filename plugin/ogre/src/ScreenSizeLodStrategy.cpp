@@ -6,6 +6,8 @@
 #include <OgreNode.h>
 #include <OgreViewport.h>
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 
 template <> TreeLod::ScreenSizeLodStrategy* Ogre::Singleton<TreeLod::ScreenSizeLodStrategy>::msSingleton = nullptr;
@@ -40,6 +42,17 @@ namespace TreeLod
             return 0.0f;
         const Ogre::Matrix4& projection = camera.getProjectionMatrix();
         return Ogre::Math::PI * radius * radius * viewportArea(camera) * projection[0][0] * projection[1][1];
+    }
+
+    Ogre::Real ScreenSizeLodStrategy::radiusInPixels(Ogre::Real value)
+    {
+        const Ogre::Real maxValue = std::numeric_limits<Ogre::Real>::max();
+        return value >= maxValue ? maxValue : std::sqrt(std::max(value, 0.0f) / (4.0f * Ogre::Math::PI));
+    }
+
+    Ogre::Real ScreenSizeLodStrategy::pixelCountOf(Ogre::Real value)
+    {
+        return value >= std::numeric_limits<Ogre::Real>::max() ? value : 0.25f * value;
     }
 
     Ogre::Real ScreenSizeLodStrategy::valueOf(Ogre::Real radius, Ogre::Real squaredDepth, const Ogre::Camera& camera)

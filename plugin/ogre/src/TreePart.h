@@ -4,7 +4,10 @@
 // The owning object says which (useShadowedMaterials) and which bark level (barkLodIndex).
 #pragma once
 
+#include "TreeLod/ObjectLodBias.h"
+
 #include <OgreMaterialManager.h>
+#include <OgreTechnique.h>
 #include <OgreMovableObject.h>
 #include <OgreRenderable.h>
 #include <OgreSceneNode.h>
@@ -35,9 +38,21 @@ namespace TreeLod
         Ogre::IndexData mIndexData;            ///< ranged parts: start and count in a shared buffer
         std::vector<Ogre::IndexData*> mLevels; ///< bark parts: index data per mesh LoD level
 
+        unsigned short mMaterialLodIndex = 0;  ///< set by updateMaterialLod
+
         const Ogre::MaterialPtr& getMaterial() const override
         {
             return mShadowedMaterial && useShadowedMaterials() ? mShadowedMaterial : mMaterial;
+        }
+        /// The material's LoD index for `camera` by its own strategy, biased and clamped by `bias`
+        /// (what an Entity does per SubEntity).
+        void updateMaterialLod(const ObjectLodBias& bias, const Ogre::Camera* camera)
+        {
+            mMaterialLodIndex = bias.materialLodIndex(*getMaterial(), mOwner, camera);
+        }
+        Ogre::Technique* getTechnique() const override
+        {
+            return getMaterial()->getBestTechnique(mMaterialLodIndex, this);
         }
         void getRenderOperation(Ogre::RenderOperation& op) override
         {

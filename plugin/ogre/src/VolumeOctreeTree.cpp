@@ -3,6 +3,7 @@
 #include "TreeLod/VolumeOctreeTree.h"
 
 #include "TreeLod/ObjectParams.h"
+#include "TreeLod/ScreenSizeLodStrategy.h"
 #include "TreeLod/ShadowSetup.h"
 #include "TreePart.h"
 
@@ -40,6 +41,7 @@ namespace TreeLod
           mGpu(&VolumeOctreeResources::of(*asset).getGpu()),
           mCellOrders(&VolumeOctreeResources::of(*asset).getCellOrders()), mOptions(options)
     {
+        mLodBias.setMesh(mOptions.lodBias, 0, 99, "VolumeOctreeTree '" + name + "'");
         if (mOptions.level >= 0 && std::uint32_t(mOptions.level) >= mData->levelCount)
             OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
                         "parameter 'level': " + std::to_string(mOptions.level) + " is not a level of the octree (" +
@@ -112,10 +114,12 @@ namespace TreeLod
         }
         const std::uint32_t octant = volumeOctreeOctant(glm::vec3(-towards.x, -towards.y, -towards.z));
 
-        // The active level by the LoD camera (the viewer's for shadow cameras) and its bias.
+        // The active level, per cell as §3.1 has it, at the pixel scale read through
+        // treelod_screen_size (the LoD camera's, the viewer's for shadow cameras, with its bias and
+        // the mesh factor): r_px / radius pixels per metre at the node's depth.
         const Ogre::Camera* lod = camera->getLodCamera();
-        const Ogre::Viewport* viewport = lod->getViewport();
-        const float viewHeight = viewport ? float(viewport->getActualHeight()) : 1.0f;
+        const Ogre::Real radiusPx = ScreenSizeLodStrategy::radiusInPixels(mLodBias.screenSize(*this, camera));
+        const Ogre::Real radius = getBoundingRadiusScaled();
         const Ogre::Vector3 scale = mParentNode->_getDerivedScale();
         const float s = std::max({std::abs(scale.x), std::abs(scale.y), std::abs(scale.z)});
         const Ogre::Affine3 view = lod->getViewMatrix();
@@ -126,20 +130,41 @@ namespace TreeLod
             nearest = std::min(nearest, -(view * (toWorld * Ogre::Vector3(corner.x, corner.y, corner.z))).z);
         }
         nearest = std::max(nearest, 1e-6f);
-        const float lodPixels = mOptions.lodPixels / std::max(lod->getLodBias() * mOptions.lodBias, 1e-6f);
-        float focal, plane;
-        if (lod->getProjectionType() == Ogre::PT_PERSPECTIVE)
-            focal = float(lod->getProjectionMatrix()[1][1]) * 0.5f * viewHeight;
-        else
-            focal = viewHeight / float(lod->getOrthoWindowHeight()) * nearest;
-        mActive = mOptions.level >= 0 ? std::uint32_t(mOptions.level)
-                                      : volumeOctreeActiveLevel(*mData, nearest, focal * s, lodPixels);
-        plane = lod->getProjectionType() == Ogre::PT_PERSPECTIVE
-                    ? volumeOctreePlaneDepth(mData->cellEdge(mActive) * s, focal, lodPixels)
-                    : std::numeric_limits<float>::max();
+        const bool perspective = lod->getProjectionType() == Ogre::PT_PERSPECTIVE;
+        // What volumeOctreeActiveLevel takes: the focal length in pixels (perspective), or pixels
+        // per metre times `nearest` (orthographic).
+        float focal = std::numeric_limits<float>::max();
+        if (radiusPx < std::numeric_limits<Ogre::Real>::max() && radius > 0.0f)
+            focal = float(radiusPx / radius) *
+                    (perspective ? std::sqrt(float(mParentNode->getSquaredViewDepth(lod))) : nearest);
+        std::uint32_t active = mOptions.level >= 0 ? std::uint32_t(mOptions.level)
+                                                   : volumeOctreeActiveLevel(*mData, nearest, focal * s, mOptions.lodPixels);
+        if (mOptions.level < 0)
+        {
+            // Detail index 0 is the finest level (levelCount - 1).
+            const std::uint32_t last = mData->levelCount - 1;
+            active = last - std::min<std::uint32_t>(mLodBias.clampMesh(Ogre::ushort(last - active)), last);
+        }
+        mActive = active;
+        const float plane = perspective && focal < std::numeric_limits<float>::max()
+                                ? volumeOctreePlaneDepth(mData->cellEdge(mActive) * s, focal, mOptions.lodPixels)
+                                : std::numeric_limits<float>::max();
+        mPart->updateMaterialLod(mLodBias, camera);
         order(octant, mActive);
         mPart->setCustomParameter(0, Ogre::Vector4(float(mActive), plane, mPair.firstWeight, 1.0f - mPair.firstWeight));
         mPart->setCustomParameter(1, Ogre::Vector4(float(mPair.first), float(mPair.second), 0.0f, 0.0f));
+    }
+
+    void VolumeOctreeTree::setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex,
+                                          unsigned short minDetailIndex)
+    {
+        mLodBias.setMesh(factor, maxDetailIndex, minDetailIndex, "VolumeOctreeTree '" + mName + "'");
+    }
+
+    void VolumeOctreeTree::setMaterialLodBias(Ogre::Real factor, unsigned short maxDetailIndex,
+                                              unsigned short minDetailIndex)
+    {
+        mLodBias.setMaterial(factor, maxDetailIndex, minDetailIndex, "VolumeOctreeTree '" + mName + "'");
     }
 
     void VolumeOctreeTree::_updateRenderQueue(Ogre::RenderQueue* queue)

@@ -11,9 +11,10 @@
 //
 // Level of detail. Geometric (§6): the clouds are switched by an LoD value read through Ogre's
 // LodStrategy interface: ScreenSizeLodStrategy's ("treelod_screen_size": 4 pi r_px^2 of the
-// bounding sphere scaled by the node, the LoD camera's bias in it), times the `lodBias`
-// parameter, or, with lodStrategy=distance, DistanceLodBoxStrategy's (the squared distance to
-// the world bounding box over the camera's bias) divided by `lodBias`; its thresholds are the
+// bounding sphere scaled by the node, the LoD camera's bias in it), times the mesh LoD factor
+// (setMeshLodBias; the `lodBias` parameter sets it), or, with lodStrategy=distance,
+// DistanceLodBoxStrategy's (the squared distance to the world bounding box over the camera's
+// bias) divided by that factor; its thresholds are the
 // screen-size ones seen through the LoD camera's projection. Thresholds follow the shader LoD so that a switch changes little
 // (§6: "consistent with the corresponding shader LoD at the time of the switch"):
 //   - a layered level gives way to the next layered level where its shader walks
@@ -30,12 +31,13 @@
 // Parameters (createMovableObject params, or the registry): asset (required with the factory),
 // group, classic (true | false: draw chunk "classic-billboard-cloud"), level (force level 0,
 // 1, 2...), lodStrategy (pixel_count, the default | distance), listFactor (overrides the
-// chunk's shader LoD factor; 0 = low-res texture only), lodBias (> 0, multiplies the camera's),
+// chunk's shader LoD factor; 0 = low-res texture only), lodBias (> 0, setMeshLodBias's factor),
 // ambientOcclusion (true, the default | false: light like the polygonal reference, which has
 // no AO; the image-error study compares that way).
 #pragma once
 
 #include "TreeLod/BillboardCloudResources.h"
+#include "TreeLod/ObjectLodBias.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreMovableObject.h>
@@ -61,7 +63,7 @@ namespace TreeLod
             int level = -1;          ///< >= 0: always this level
             LodStrategy strategy = LodStrategy::PixelCount;
             float listFactor = -1.0f; ///< < 0: the chunk's
-            float lodBias = 1.0f;
+            float lodBias = 1.0f;     ///< the initial setMeshLodBias factor
             bool ambientOcclusion = true; ///< false: no AO on leaves or bark (the polygonal reference's lighting)
         };
 
@@ -85,6 +87,17 @@ namespace TreeLod
         /// Bark mesh LoD level in use (0 = full).
         unsigned short getBarkLodIndex() const { return mBarkLodIndex; }
 
+        /// As Entity::setMeshLodBias: `factor` (> 0) biases the LoD value as its strategy does
+        /// (> 1 keeps finer levels longer); the cloud level (0 = finest cloud) and the bark mesh's
+        /// LoD index (by the bark mesh's own strategy) are kept within [maxDetailIndex,
+        /// minDetailIndex]. A forced level is not clamped.
+        void setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0, unsigned short minDetailIndex = 99);
+        /// As Entity::setMaterialLodBias, for the material LoD of the drawn cloud level (0 = the
+        /// layered technique, 1 = the low-res texture alone).
+        void setMaterialLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0,
+                                unsigned short minDetailIndex = 99);
+        const ObjectLodBias& getLodBias() const { return mLodBias; }
+
         /// Shader LoD factor in use (the chunk's unless overridden); >= 0.
         float getListFactor() const { return mListFactor; }
         void setListFactor(float listFactor);
@@ -103,7 +116,8 @@ namespace TreeLod
         /// The level the strategy value `value` (its units, bias applied) selects; distance
         /// values are converted with the projection of the last camera seen.
         std::uint32_t levelForValue(Ogre::Real value) const;
-        /// The material LoD index for a pixel-count value (bias applied) at this list factor.
+        /// The material LoD index for a pixel-count value (material bias applied, clamped by
+        /// setMaterialLodBias) at this list factor.
         unsigned short materialLodIndexForPixelCount(Ogre::Real value) const;
 
         // MovableObject
@@ -136,7 +150,8 @@ namespace TreeLod
         unsigned short mBarkLodIndex = 0;
         Ogre::Real mLodValue = 0.0f;
         Ogre::Real mPixelCountValue = 0.0f;
-        Ogre::Real mBias = 1.0f;
+        Ogre::Real mBias = 1.0f; ///< the camera's LoD bias times the mesh factor
+        ObjectLodBias mLodBias;
         Ogre::Real mDistanceToPixels = 0.0f; ///< pixel-count value * squared distance, last camera
     };
 

@@ -4,10 +4,16 @@
 //
 // Level of detail (§6): a level is made for a tree height on screen at which its mean ellipsoid
 // is ELLIPSOID_TARGET_DIAMETER_PX (5) pixels across (EllipsoidLevel::targetHeightPx). The tree
-// draws the coarsest level whose target height is at least the tree's height on screen (the
-// tree's box height seen at the distance of its centre through the LoD camera, times the LoD
-// camera's bias and the object's lodBias), the finest when the tree is taller than every target.
-// lodBias is the paper's target-resolution factor: 1/2 or 1/4 draw coarser levels.
+// draws the coarsest level whose target height is at least the tree's height on screen, the
+// finest when the tree is taller than every target. The height is read through
+// ScreenSizeLodStrategy ("treelod_screen_size"): the projected radius r_px of the bounding
+// sphere seen by the LoD camera, scaled by the tree's box height over that radius. The LoD
+// camera's bias and the mesh LoD factor (setMeshLodBias; the `lodBias` parameter sets it)
+// multiply the value, a screen area: a factor of 1/4 halves the height (the paper's
+// target-resolution factor 1/2).
+// setMeshLodBias's detail indices are ellipsoid levels (0 finest; the lines then follow the
+// clamped level's target height) and the bark mesh's LoD index (by its own strategy).
+// setMaterialLodBias: the material LoD index of each part's material (by its strategy).
 //
 // Branches (§3.2): the lines of chunk "ellipsoid-lines" (capsules ray cast per fragment, at least a
 // pixel wide, TreeLodEllipsoidLine.vert) at the level the same rule gives for the lines' own
@@ -29,10 +35,11 @@
 //
 // Parameters (createMovableObject params, or the registry): asset (required), group, level
 // (force an ellipsoid level: 0 finest; the lines follow its target height), lodBias (> 0,
-// multiplies the LoD camera's bias), lines (true: the baked lines when the package has them).
+// setMeshLodBias's factor), lines (true: the baked lines when the package has them).
 #pragma once
 
 #include "TreeLod/EllipsoidTreeResources.h"
+#include "TreeLod/ObjectLodBias.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreMovableObject.h>
@@ -48,7 +55,7 @@ namespace TreeLod
         struct Options
         {
             int level = -1;       ///< >= 0: always this level
-            float lodBias = 1.0f; ///< > 0
+            float lodBias = 1.0f; ///< > 0, the initial setMeshLodBias factor
             bool lines = true;    ///< the baked lines when the package has them, else the bark mesh
         };
 
@@ -66,6 +73,12 @@ namespace TreeLod
         /// The line level drawn for the last camera, and its line count (0 without lines).
         std::size_t getLineLevel() const { return mLineLevel; }
         std::size_t getLineCount() const { return mLines ? mLines->levels[mLineLevel].indexCount / 6 : 0; }
+        /// As Entity::setMeshLodBias (the file comment says what it biases and clamps).
+        void setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0, unsigned short minDetailIndex = 99);
+        /// As Entity::setMaterialLodBias.
+        void setMaterialLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0,
+                                unsigned short minDetailIndex = 99);
+        const ObjectLodBias& getLodBias() const { return mLodBias; }
         /// The level for a tree `heightPx` tall on screen (bias applied), as §6 above.
         static std::size_t levelForHeight(const EllipsoidTreeGpu& gpu, float heightPx);
 
@@ -99,6 +112,7 @@ namespace TreeLod
         float mTreeHeight = 0.0f; ///< the reference's box height, metres
         Ogre::AxisAlignedBox mBounds;
         Ogre::Real mRadius = 0.0f;
+        ObjectLodBias mLodBias;
     };
 
     class EllipsoidTreeFactory : public Ogre::MovableObjectFactory

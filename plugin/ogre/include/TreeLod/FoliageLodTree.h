@@ -7,12 +7,17 @@
 // clusters that changed are rewritten, with partial buffer writes (§4); one draw per leaf
 // material covers all regions (unused slots hold degenerate triangles).
 //
-// Leaf count: from Ogre's absolute pixel-count LoD strategy, a continuous curve
-//     leaves = clamp(pixels * camera LoD bias / pixelsPerLeaf, minLeaves, maxLeaves)
-// where pixels is the projected area of the bounding sphere; leaves grow as they collapse
-// (FoliageLodBaker.h), keeping the crown's covered area. The LoD camera drives it, so
-// shadow cameras see the level the viewer sees. Bark: the asset's bark mesh with its
-// MeshLodGenerator levels, chosen by the mesh's own strategy and values. Materials are the
+// Leaf count: from ScreenSizeLodStrategy ("treelod_screen_size", the LoD camera's bias in it),
+// a continuous curve
+//     leaves = clamp(pixels * mesh LoD factor / pixelsPerLeaf, minLeaves, maxLeaves)
+// where pixels is the projected area of the bounding sphere, pi r_px^2 (the value's quarter,
+// Ogre's pixel_count units); leaves grow as they collapse (FoliageLodBaker.h), keeping the
+// crown's covered area. The LoD camera drives it, so shadow cameras see the level the viewer
+// sees. Bark: the asset's bark mesh with its MeshLodGenerator levels, chosen by the mesh's own
+// strategy and values, as an Entity chooses them. setMeshLodBias: the factor multiplies the
+// curve's pixels; the detail indices limit the bark mesh's LoD index (the leaf count has no
+// index: `leaves` fixes it). No material LoD of its own: setMaterialLodBias biases the LoD
+// index of each material (Material::getLodIndex by its strategy). Materials are the
 // reference's (leaf material shared), switched to their shadow-receiving clones when the
 // scene uses an integrated texture shadow technique.
 //
@@ -25,6 +30,7 @@
 #pragma once
 
 #include "TreeLod/FoliageLodState.h"
+#include "TreeLod/ObjectLodBias.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreMovableObject.h>
@@ -87,6 +93,13 @@ namespace TreeLod
         /// Bark mesh LoD level in use (0 = full).
         unsigned short getBarkLodIndex() const { return mBarkLodIndex; }
 
+        /// As Entity::setMeshLodBias (the file comment says what it biases and clamps).
+        void setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0, unsigned short minDetailIndex = 99);
+        /// As Entity::setMaterialLodBias, for the material LoD of the leaf and bark materials.
+        void setMaterialLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0,
+                                unsigned short minDetailIndex = 99);
+        const ObjectLodBias& getLodBias() const { return mLodBias; }
+
         // MovableObject
         const Ogre::String& getMovableType() const override;
         const Ogre::AxisAlignedBox& getBoundingBox() const override { return mBounds; }
@@ -119,6 +132,7 @@ namespace TreeLod
         Ogre::AxisAlignedBox mBounds;
         Ogre::Real mRadius = 0.0f;
         FoliageLodUpdateStats mStats;
+        ObjectLodBias mLodBias;
     };
 
     class FoliageLodTreeFactory : public Ogre::MovableObjectFactory

@@ -18,12 +18,13 @@
 // with INSTANCED=1), and their shadow-receiving / caster variants under integrated texture
 // shadows.
 //
-// LoD value: Ogre's absolute pixel count (4 pi r_px^2 of the instance's bounding sphere, see
-// ForestInstances.h) times the camera's LoD bias times the Forest's own bias. Instances are in
+// LoD value: treelod_screen_size's (ScreenSizeLodStrategy: 4 pi r_px^2 of the instance's bounding
+// sphere, see ForestInstances.h) times the camera's LoD bias times the Forest's mesh LoD factor
+// (setMeshLodBias, or setLodBias), per instance in one loop. Instances are in
 // the Forest's local space (its node's transform applies to all); LoD is measured there, which
 // equals the world's under a uniform node scale.
 //
-// Parameters (createMovableObject params): none required; "lodBias" (default 1).
+// Parameters (createMovableObject params): none required; "lodBias" (default 1: setLodBias).
 // Species and instances are added through the C++ API.
 //
 // Refinements of the first contract (public names unchanged):
@@ -89,6 +90,7 @@
 #include "TreeLod/ForestLevelProvider.h"
 #include "TreeLod/LevelCosts.h"
 #include "TreeLod/LevelSelection.h"
+#include "TreeLod/ObjectLodBias.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreCamera.h>
@@ -229,9 +231,15 @@ namespace TreeLod
         /// Recompute the local bounds after changing instances through getInstances().
         void updateBounds();
 
-        /// Multiplies the camera's LoD bias (> 0).
+        /// As Entity::setMeshLodBias: `factor` (> 0) multiplies every instance's LoD value (with
+        /// the camera's LoD bias), and each instance's level (its species' level index, 0 = the
+        /// nearest) is kept within [maxDetailIndex, minDetailIndex]. The levels fix their
+        /// materials (ForestLevel), so there is no material LoD bias.
+        void setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0, unsigned short minDetailIndex = 99);
+        const ObjectLodBias& getMeshLodBias() const { return mLodBias; }
+        /// setMeshLodBias's factor alone (the "lodBias" parameter).
         void setLodBias(Ogre::Real bias);
-        Ogre::Real getLodBias() const { return mLodBias; }
+        Ogre::Real getLodBias() const { return mLodBias.meshFactor; }
         /// Multiplies the LoD value of shadow casters (> 0; default 1: the viewer's levels). Below
         /// 1 the shadow textures draw coarser levels than the view: their fill, not the view's,
         /// bounds the worst frames when a shadow camera magnifies the trees near the viewer (LiSPSM).
@@ -294,6 +302,8 @@ namespace TreeLod
         /// Plan every budgeted species for `budget` (replan where its levels change).
         void applyErrorBudget(float budget);
         void updateShadowLevels(std::uint32_t species);
+        /// The kind's table of `levels` of `species`, within setMeshLodBias's limits.
+        std::vector<float> kindThresholds(const Species& species, const std::vector<ForestLevel>& levels) const;
         static constexpr std::size_t OFF_LADDER = std::numeric_limits<std::size_t>::max();
         /// The frameBudgetLadder() step that is `budget`, or OFF_LADDER.
         static std::size_t ladderStepOf(float budget);
@@ -330,7 +340,7 @@ namespace TreeLod
         Ogre::Camera* mCurrentCamera = nullptr;
         Ogre::AxisAlignedBox mBounds;
         Ogre::Real mRadius = 0.0f;
-        Ogre::Real mLodBias = 1.0f;
+        ObjectLodBias mLodBias;
         Ogre::Real mShadowLodBias = 1.0f;
         Ogre::Real mLodHysteresis = 0.15f;
         float mErrorBudget = DEFAULT_ERROR_BUDGET;      ///< in use

@@ -9,9 +9,14 @@
 // pictures are the Forest's. Bounds: what the turning quad may cover (ImpostorQuad::bounds).
 // Materials switch to the shadow-receiving clone under an integrated texture shadow technique.
 //
+// Level of detail: one quad, one geometric level (setMeshLodBias's indices have nothing to
+// clamp; its factor is kept for getLodBias). Material LoD as an Entity's: the material's own
+// strategy and lod_values pick its technique, biased and clamped by setMaterialLodBias.
+//
 // Parameters (createMovableObject params, or the registry): asset (required), group.
 #pragma once
 
+#include "TreeLod/ObjectLodBias.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreMovableObject.h>
@@ -44,15 +49,26 @@ namespace TreeLod
 
         const TreeAssetPtr& getAsset() const { return mAsset; }
 
+        /// As Entity::setMeshLodBias (the file comment says what it does here).
+        void setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0, unsigned short minDetailIndex = 99);
+        /// As Entity::setMaterialLodBias.
+        void setMaterialLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0,
+                                unsigned short minDetailIndex = 99);
+        const ObjectLodBias& getLodBias() const { return mLodBias; }
+        /// The material LoD index for the last camera.
+        unsigned short getMaterialLodIndex() const { return mMaterialLodIndex; }
+
         // MovableObject
         const Ogre::String& getMovableType() const override;
         const Ogre::AxisAlignedBox& getBoundingBox() const override { return mBounds; }
         Ogre::Real getBoundingRadius() const override { return mRadius; }
+        void _notifyCurrentCamera(Ogre::Camera* camera) override;
         void _updateRenderQueue(Ogre::RenderQueue* queue) override;
         void visitRenderables(Ogre::Renderable::Visitor* visitor, bool debugRenderables = false) override;
 
         // Renderable
         const Ogre::MaterialPtr& getMaterial() const override;
+        Ogre::Technique* getTechnique() const override;
         void getRenderOperation(Ogre::RenderOperation& op) override;
         void getWorldTransforms(Ogre::Matrix4* xform) const override;
         Ogre::Real getSquaredViewDepth(const Ogre::Camera* camera) const override;
@@ -68,6 +84,8 @@ namespace TreeLod
         Ogre::MaterialPtr mShadowedMaterial;
         Ogre::AxisAlignedBox mBounds;
         Ogre::Real mRadius = 0.0f;
+        ObjectLodBias mLodBias;
+        unsigned short mMaterialLodIndex = 0;
     };
 
     class ImpostorTreeFactory : public Ogre::MovableObjectFactory

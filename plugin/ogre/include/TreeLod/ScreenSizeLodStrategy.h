@@ -34,6 +34,12 @@ namespace TreeLod
         /// squared view depth into a value); 0 for an orthographic camera or one without a viewport.
         static Ogre::Real depthFactor(Ogre::Real radius, const Ogre::Camera& camera);
 
+        /// The projected radius in pixels r_px of a value, sqrt(value / (4 pi)); the largest
+        /// value (a camera at the node) stays the largest.
+        static Ogre::Real radiusInPixels(Ogre::Real value);
+        /// The value in the units of Ogre's pixel_count (pi r_px^2): a quarter; the largest stays.
+        static Ogre::Real pixelCountOf(Ogre::Real value);
+
         static ScreenSizeLodStrategy& getSingleton();
         static ScreenSizeLodStrategy* getSingletonPtr();
 

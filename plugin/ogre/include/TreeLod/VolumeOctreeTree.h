@@ -5,9 +5,15 @@
 //
 // Level of detail (§3.1): the distance planes of volumeOctreeDrawsCell. The active level is the
 // finest whose plane lies beyond the tree's nearest point; a cell of level l's plane is where it
-// covers lodPixels (default 4: one texel a pixel) on screen, divided by the LoD camera's bias and
-// the object's lodBias. The vertex program (materials/GLSL/TreeLodVolumeOctree.vert) decides per
-// cell between the active level and the level above.
+// covers lodPixels (default 4: one texel a pixel) on screen. The vertex program
+// (materials/GLSL/TreeLodVolumeOctree.vert) decides per cell between the active level and the
+// level above. Pixels per metre come from ScreenSizeLodStrategy ("treelod_screen_size"): the
+// projected radius r_px of the bounding sphere over its radius, the LoD camera's bias and the
+// mesh LoD factor (setMeshLodBias; the `lodBias` parameter sets it) in the value, a screen area:
+// a factor of 1/4 halves the pixels, one level coarser.
+// setMeshLodBias's detail indices count levels from the finest (index 0 = level levelCount - 1,
+// index levelCount - 1 = the root) and clamp the active level; setMaterialLodBias the material
+// LoD index of its material (by the material's strategy).
 //
 // Order (§6: the paper traverses the octree on the CPU every frame, its stated bottleneck): each
 // level's cells are sorted once per view octant at load (VolumeOctreeResources::getCellOrders); the index
@@ -24,6 +30,7 @@
 // the active level), lodBias (> 0), lodPixels (> 0).
 #pragma once
 
+#include "TreeLod/ObjectLodBias.h"
 #include "TreeLod/TreeAsset.h"
 #include "TreeLod/VolumeOctreeResources.h"
 
@@ -40,7 +47,7 @@ namespace TreeLod
         struct Options
         {
             int level = -1;          ///< >= 0: always this active level
-            float lodBias = 1.0f;    ///< > 0
+            float lodBias = 1.0f;    ///< > 0, the initial setMeshLodBias factor
             float lodPixels = 4.0f;  ///< > 0
         };
 
@@ -55,6 +62,13 @@ namespace TreeLod
         std::size_t getDrawnCellCount() const;
         /// The two input cameras blended for the last camera.
         const VolumeCameraPair& getCameraPair() const { return mPair; }
+
+        /// As Entity::setMeshLodBias (the file comment says what it biases and clamps).
+        void setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0, unsigned short minDetailIndex = 99);
+        /// As Entity::setMaterialLodBias.
+        void setMaterialLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0,
+                                unsigned short minDetailIndex = 99);
+        const ObjectLodBias& getLodBias() const { return mLodBias; }
 
         // MovableObject
         const Ogre::String& getMovableType() const override;
@@ -79,6 +93,7 @@ namespace TreeLod
         std::uint32_t mOctant = 8, mActive = 0, mOrderedActive = ~0u;
         VolumeCameraPair mPair;
         Ogre::Real mRadius = 0.0f;
+        ObjectLodBias mLodBias;
     };
 
     class VolumeOctreeTreeFactory : public Ogre::MovableObjectFactory
