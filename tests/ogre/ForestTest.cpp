@@ -26,6 +26,7 @@
 #include "TreeLod/ImpostorData.h"
 #include "TreeLod/LevelCalibration.h"
 #include "TreeLod/PackageWriter.h"
+#include "TreeLod/OgreBootstrap.h"
 #include "TreeLod/QuadFloors.h"
 #include "TreeLod/ShadowSetup.h"
 #include "TreeLod/TreeAssetManager.h"
@@ -34,10 +35,12 @@
 #include <OgreLogManager.h>
 #include <OgreManualObject.h>
 #include <OgreMaterialManager.h>
+#include <OgreRTShaderSystem.h>
 #include <OgreRenderQueue.h>
 #include <OgreRenderQueueSortingGrouping.h>
 #include <OgreSceneManager.h>
 #include <OgreSceneQuery.h>
+#include <OgreShadowCameraSetupPSSM.h>
 #include <OgreSubEntity.h>
 #include <OgreTechnique.h>
 
@@ -835,6 +838,13 @@ namespace TreeLod
         r.getContentNode().createChildSceneNode()->attachObject(forest);
     }
 
+    /// Whether a render target's texture reads back (RenderSystem_GLES2 reads zeros: ES has no
+    /// texture read-back).
+    bool texturesReadBack()
+    {
+        return Ogre::Root::getSingleton().getRenderSystem()->getName().find("OpenGL ES") == Ogre::String::npos;
+    }
+
     /// Mean luminance of the rows [top, bottom) of `image` (fractions of its height).
     double bandLuminance(const Image& image, double top, double bottom)
     {
@@ -876,9 +886,9 @@ namespace TreeLod
         const Image plain = render(Ogre::SHADOWTYPE_NONE, ShadowCamera::Focused);
         const Image focused = render(Ogre::SHADOWTYPE_TEXTURE_ADDITIVE_INTEGRATED, ShadowCamera::Focused);
         const Image pssm = render(Ogre::SHADOWTYPE_TEXTURE_ADDITIVE_INTEGRATED, ShadowCamera::PSSM);
-        ASSERT_EQ(sm.getShadowTextureCount(), std::size_t(PSSM_SPLITS));
+        ASSERT_EQ(sm.getShadowTextureConfigList().size(), std::size_t(PSSM_SPLITS));
         std::vector<double> casterFraction;
-        for (std::size_t i = 0; i < sm.getShadowTextureCount(); ++i)
+        for (std::size_t i = 0; i < std::size_t(texturesReadBack() ? PSSM_SPLITS : 0); ++i)
         {
             const Ogre::TexturePtr& texture = sm.getShadowTexture(i);
             ASSERT_EQ(texture->getFormat(), Ogre::PF_FLOAT32_R);
@@ -894,9 +904,10 @@ namespace TreeLod
         const double nearDrop = bandLuminance(plain, 0.6, 1.0) - bandLuminance(pssm, 0.6, 1.0);
         const double farDrop = bandLuminance(plain, 0.3, 0.6) - bandLuminance(pssm, 0.3, 0.6);
         const double focusedDrop = meanLuminance(plain) - meanLuminance(focused);
-        std::printf("PSSM: casters cover %.3f %.3f %.3f of the three textures; luminance drop near %.4f, far %.4f; "
-                    "focused drop %.4f, PSSM %.4f\n", casterFraction[0], casterFraction[1], casterFraction[2], nearDrop,
-                    farDrop, focusedDrop, meanLuminance(plain) - meanLuminance(pssm));
+        for (double f : casterFraction)
+            std::printf("PSSM: casters cover %.3f of a split's texture\n", f);
+        std::printf("PSSM: luminance drop near %.4f, far %.4f; focused drop %.4f, PSSM %.4f\n", nearDrop, farDrop,
+                    focusedDrop, meanLuminance(plain) - meanLuminance(pssm));
         writePng(OgreEnvironment::outDir() + "/forest-shadows-pssm-strip.png", sideBySide({plain, focused, pssm}));
         for (double f : casterFraction)
             EXPECT_GT(f, 0.001) << "every split's texture holds casters";
@@ -944,22 +955,30 @@ namespace TreeLod
             settings.textureSize = 512;
             r.setShadows(settings);
             const Image shadowed = toImage(r.render(view, 160, 128, 1));
-            const auto [lo, hi] = textureRange();
             const bool integrated = technique & Ogre::SHADOWDETAILTYPE_INTEGRATED;
+            if (!integrated)
+            {
+                EXPECT_LT(flipMean(shadowed, plain), 0.002) << "casters do not receive colour shadows";
+            }
+            if (!texturesReadBack())
+                continue;
+            const auto [lo, hi] = textureRange();
             std::printf("shadow technique %d: shadow texture red %.3f..%.3f; FLIP against unshadowed %.5f\n",
                         int(technique), lo, hi, flipMean(shadowed, plain));
             EXPECT_FLOAT_EQ(hi, 1.0f) << "cleared where nothing casts";
             if (technique == Ogre::SHADOWTYPE_TEXTURE_MODULATIVE)
+            {
                 EXPECT_NEAR(lo, 0.25f, 0.01f) << "modulative casters write the shadow colour";
+            }
             else if (!integrated)
+            {
                 EXPECT_NEAR(lo, 0.0f, 0.01f) << "additive casters write black";
+            }
             else
             {
                 EXPECT_GT(lo, 0.0f) << "integrated casters write depth";
                 EXPECT_LT(lo, 1.0f);
             }
-            if (!integrated)
-                EXPECT_LT(flipMean(shadowed, plain), 0.002) << "casters do not receive colour shadows";
         }
         // Stencil: refused by the set-up, logged once by the objects when set on Ogre directly.
         SunShadowSettings stencil;
@@ -991,6 +1010,212 @@ namespace TreeLod
         r.clearContent();
         EXPECT_EQ(counter.stencilLines, 1) << "one log line per scene manager";
         EXPECT_LT(flipMean(stencilled, plain), 0.002) << "trees draw unshadowed under stencil shadows";
+    }
+
+    /// An application's own materials drawn by OGRE's RTSS (the way OgreBites does it): the
+    /// shader generator on the renderer's scene manager, its scheme on the viewport, techniques
+    /// generated for materials without programs; with `pssm`, the RTSS's integrated PSSM
+    /// receiver (IntegratedPSSM3, as OGRE's Shadows and Terrain samples) on the generated
+    /// techniques. Undone by its destructor.
+    class RtssApplication : public Ogre::MaterialManager::Listener
+    {
+    public:
+        RtssApplication()
+        {
+            Ogre::ResourceGroupManager& rgm = Ogre::ResourceGroupManager::getSingleton();
+            for (const char* folder : {"/RTShaderLib/GLSL", "/RTShaderLib/materials"})
+                rgm.addResourceLocation(ogreMediaDirectory() + folder, "FileSystem", GROUP);
+            rgm.initialiseResourceGroup(GROUP);
+            EXPECT_TRUE(Ogre::RTShader::ShaderGenerator::initialize());
+            mGenerator = Ogre::RTShader::ShaderGenerator::getSingletonPtr();
+            mGenerator->addSceneManager(&OgreEnvironment::renderer().getSceneManager());
+            Ogre::MaterialManager::getSingleton().addListener(this);
+            OgreEnvironment::renderer().setMaterialScheme(Ogre::RTShader::ShaderGenerator::DEFAULT_SCHEME_NAME);
+        }
+        ~RtssApplication() override
+        {
+            OgreEnvironment::renderer().setMaterialScheme(Ogre::MaterialManager::DEFAULT_SCHEME_NAME);
+            Ogre::MaterialManager::getSingleton().removeListener(this);
+            Ogre::RTShader::ShaderGenerator::destroy();
+            Ogre::ResourceGroupManager::getSingleton().destroyResourceGroup(GROUP);
+        }
+
+        /// Integrated PSSM receiving on every generated technique, split at the scene manager's
+        /// PSSM camera setup's points.
+        void receivePssm()
+        {
+            auto* setup = dynamic_cast<Ogre::PSSMShadowCameraSetup*>(
+                OgreEnvironment::renderer().getSceneManager().getShadowCameraSetup().get());
+            ASSERT_TRUE(setup);
+            Ogre::RTShader::RenderState* state =
+                mGenerator->getRenderState(Ogre::RTShader::ShaderGenerator::DEFAULT_SCHEME_NAME);
+            if (!mPssm)
+            {
+                mPssm = static_cast<Ogre::RTShader::IntegratedPSSM3*>(
+                    mGenerator->createSubRenderState(Ogre::RTShader::IntegratedPSSM3::Type));
+                state->addTemplateSubRenderState(mPssm);
+            }
+            mPssm->setSplitPoints(setup->getSplitPoints());
+            mGenerator->invalidateScheme(Ogre::RTShader::ShaderGenerator::DEFAULT_SCHEME_NAME);
+        }
+
+        Ogre::Technique* handleSchemeNotFound(unsigned short, const Ogre::String& scheme, Ogre::Material* material,
+                                              unsigned short, const Ogre::Renderable*) override
+        {
+            // TreeLod's materials have programs: the RTSS leaves them, Ogre draws their own technique.
+            if (!mGenerator->createShaderBasedTechnique(*material, Ogre::MaterialManager::DEFAULT_SCHEME_NAME, scheme))
+                return nullptr;
+            mGenerator->validateMaterial(scheme, material->getName(), material->getGroup());
+            for (Ogre::Technique* technique : material->getTechniques())
+                if (technique->getSchemeName() == scheme)
+                    return technique;
+            return nullptr;
+        }
+
+    private:
+        static constexpr const char* GROUP = "ForestTest/Rtss";
+        Ogre::RTShader::ShaderGenerator* mGenerator = nullptr;
+        Ogre::RTShader::IntegratedPSSM3* mPssm = nullptr;
+    };
+
+    // The application's set-up, not TreeLod's: an RTSS-drawn ground receives the trees' shadows
+    // (integrated PSSM through the RTSS; Ogre's modulative texture shadows), and an application
+    // object, cast with TreeLod/BarkCaster as the scene's caster material, shadows the trees.
+    TEST(Forest, shadowsInAnRtssApplication)
+    {
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        Ogre::SceneManager& sm = r.getSceneManager();
+        const float h = treeHeight(tree.model);
+        RtssApplication application;
+        Ogre::MaterialManager& materials = Ogre::MaterialManager::getSingleton();
+        for (const auto& [name, colour] : {std::make_pair("ForestTest/AppGround", Ogre::ColourValue(0.45f, 0.5f, 0.3f)),
+                                           std::make_pair("ForestTest/AppBox", Ogre::ColourValue(0.6f, 0.6f, 0.6f))})
+            if (!materials.resourceExists(name, "TreeLod"))
+            {
+                Ogre::MaterialPtr material = materials.create(name, "TreeLod");
+                Ogre::Pass* pass = material->getTechnique(0)->getPass(0);
+                pass->setAmbient(colour);
+                pass->setDiffuse(colour);
+                material->setReceiveShadows(std::string(name) == "ForestTest/AppGround");
+            }
+        const LightingSpec lighting;
+        const glm::vec3 treeAt(0.0f, 0.0f, 0.0f);
+        const glm::vec3 boxAt = treeAt + glm::vec3(0.0f, 0.6f * h, 0.0f) + lighting.sunDirection * (0.9f * h);
+        Ogre::MovableObject* forest = nullptr;
+        Ogre::MovableObject* box = nullptr;
+        auto place = [&](bool trees) {
+            r.clearContent();
+            Ogre::ManualObject* ground = sm.createManualObject();
+            ground->setCastShadows(false);
+            ground->begin("ForestTest/AppGround", Ogre::RenderOperation::OT_TRIANGLE_LIST, "TreeLod");
+            const float s = 6.0f * h;
+            for (const glm::vec2 c : {glm::vec2(-s, -s), glm::vec2(s, -s), glm::vec2(s, s), glm::vec2(-s, s)})
+            {
+                ground->position(c.x, 0.0f, c.y);
+                ground->normal(0.0f, 1.0f, 0.0f);
+            }
+            ground->quad(0, 3, 2, 1);
+            ground->end();
+            r.getContentNode().createChildSceneNode()->attachObject(ground);
+            auto* cube = sm.createManualObject();
+            cube->begin("ForestTest/AppBox", Ogre::RenderOperation::OT_TRIANGLE_LIST, "TreeLod");
+            const float b = 0.2f * h;
+            for (int face = 0; face < 6; ++face)
+            {
+                const int axis = face / 2;
+                const float sign = face % 2 ? -1.0f : 1.0f;
+                Ogre::Vector3 n(0.0f), u(0.0f), v(0.0f);
+                n[axis] = sign;
+                u[(axis + 1) % 3] = 1.0f;
+                v[(axis + 2) % 3] = sign;
+                const Ogre::Vector3 base(boxAt.x, boxAt.y, boxAt.z);
+                for (const auto& [du, dv] : {std::make_pair(-1.0f, -1.0f), std::make_pair(1.0f, -1.0f),
+                                            std::make_pair(1.0f, 1.0f), std::make_pair(-1.0f, 1.0f)})
+                {
+                    cube->position(base + b * (n + du * u + dv * v));
+                    cube->normal(n);
+                }
+                cube->quad(Ogre::uint32(4 * face), Ogre::uint32(4 * face + 1), Ogre::uint32(4 * face + 2),
+                           Ogre::uint32(4 * face + 3));
+            }
+            cube->end();
+            box = cube;
+            r.getContentNode().createChildSceneNode()->attachObject(cube);
+            forest = nullptr;
+            if (trees)
+            {
+                static int serial = 0;
+                auto* f = static_cast<Forest*>(sm.createMovableObject("rtssForest" + std::to_string(serial++), "Forest"));
+                f->addSpecies(tree.asset, {ForestLevel{"mesh", 0, false, 0.0f}});
+                f->addInstances({instance(treeAt.x, treeAt.y, treeAt.z, 0.5f), instance(-1.2f * h, 0.0f, -0.8f * h, 2.0f)});
+                r.getContentNode().createChildSceneNode()->attachObject(f);
+                forest = f;
+            }
+        };
+        const CameraSpec view = look(glm::vec3(0.6f * h, 0.9f * h, 1.7f * h), glm::vec3(-0.4f * h, 0.3f * h, -0.3f * h), 50.0f);
+        auto render = [&](bool treesCast, bool boxCasts) {
+            if (forest)
+                forest->setCastShadows(treesCast);
+            box->setCastShadows(boxCasts);
+            r.render(view, 192, 144, 1); // shadow cameras framed by this view's receivers
+            return toImage(r.render(view, 192, 144, 1));
+        };
+        // Which pixels are trees: they differ from the scene without trees (both unshadowed).
+        r.setShadows(false);
+        place(false);
+        const Image noTrees = render(false, false);
+        place(true);
+        const Image unshadowed = render(false, false);
+        std::vector<bool> treePixel(unshadowed.pixels.size());
+        for (std::size_t i = 0; i < treePixel.size(); ++i)
+            treePixel[i] = glm::length(glm::vec3(unshadowed.pixels[i] - noTrees.pixels[i])) > 0.02f;
+        auto meanOver = [&](const Image& image, bool trees) {
+            double sum = 0.0;
+            std::size_t n = 0;
+            for (std::size_t i = 0; i < treePixel.size(); ++i)
+                if (treePixel[i] == trees)
+                {
+                    const glm::vec4& p = image.pixels[i];
+                    sum += 0.2126 * p.r + 0.7152 * p.g + 0.0722 * p.b;
+                    ++n;
+                }
+            return n ? sum / double(n) : 0.0;
+        };
+        sm.setShadowTextureCasterMaterial(materials.getByName("TreeLod/BarkCaster", "TreeLod"));
+        // Integrated PSSM: TreeLod's receivers and the RTSS's read the same depth textures.
+        SunShadowSettings settings;
+        settings.camera = ShadowCamera::PSSM;
+        settings.textureSize = 1024;
+        settings.farDistance = 12.0f * h;
+        r.setShadows(settings);
+        r.render(view, 192, 144, 1); // the view's near clip sets the split points
+        application.receivePssm();
+        const Image pssmNoCasters = render(false, false);
+        const Image pssmTrees = render(true, false);
+        const Image pssmBox = render(true, true);
+        // Ogre's modulative texture shadows: the RTSS draws Ogre's receiver pass on the ground.
+        settings.technique = Ogre::SHADOWTYPE_TEXTURE_MODULATIVE;
+        settings.camera = ShadowCamera::Focused;
+        r.setShadows(settings);
+        const Image modulativeNoCasters = render(false, false);
+        const Image modulativeTrees = render(true, false);
+        sm.setShadowTextureCasterMaterial(Ogre::MaterialPtr());
+        r.setShadows(false);
+        r.clearContent();
+        const double groundDrop = meanOver(pssmNoCasters, false) - meanOver(pssmTrees, false);
+        const double treeDrop = meanOver(pssmTrees, true) - meanOver(pssmBox, true);
+        const double modulativeDrop = meanOver(modulativeNoCasters, false) - meanOver(modulativeTrees, false);
+        std::printf("RTSS application: ground darkened by the trees' PSSM shadows %.4f, trees by the box's %.4f; "
+                    "modulative: ground %.4f, trees FLIP against unshadowed %.5f\n", groundDrop, treeDrop,
+                    modulativeDrop, flipMean(modulativeTrees, unshadowed));
+        writePng(OgreEnvironment::outDir() + "/forest-shadows-rtss-strip.png",
+                 sideBySide({unshadowed, pssmNoCasters, pssmTrees, pssmBox, modulativeTrees}));
+        EXPECT_GT(groundDrop, 0.005) << "the RTSS ground receives the trees' depth shadows";
+        EXPECT_GT(treeDrop, 0.005) << "the trees receive the application's caster";
+        EXPECT_GT(modulativeDrop, 0.005) << "the RTSS ground receives the trees' modulative shadows";
+        compareWithGolden(pssmBox, "forest-shadows-rtss-pssm", 0.02);
+        compareWithGolden(modulativeTrees, "forest-shadows-rtss-modulative", 0.02);
     }
 
     TEST(Forest, badInputIsRefusedAndNamed)

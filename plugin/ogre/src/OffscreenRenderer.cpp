@@ -198,6 +198,14 @@ namespace TreeLod
         Ogre::Viewport* vp = rt->addViewport(mCamera);
         vp->setOverlaysEnabled(false);
         vp->setShadowsEnabled(true);
+        vp->setMaterialScheme(mMaterialScheme);
+    }
+
+    void OffscreenRenderer::setMaterialScheme(const Ogre::String& scheme)
+    {
+        mMaterialScheme = scheme;
+        if (mTarget)
+            mTarget->getBuffer()->getRenderTarget()->getViewport(0)->setMaterialScheme(scheme);
     }
 
     void OffscreenRenderer::placeCamera(const CameraSpec& spec, int width, int height, int samplesPerAxis)

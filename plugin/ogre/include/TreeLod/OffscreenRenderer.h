@@ -83,6 +83,10 @@ namespace TreeLod
         /// factor's pixel count, so pixel-count LoD sees the output image's size.
         void setLodBias(float bias) { mLodBias = bias; }
 
+        /// The viewport's material scheme (Ogre::Viewport::setMaterialScheme), e.g. the RTSS's
+        /// for an application whose materials the RTSS draws; default Ogre's.
+        void setMaterialScheme(const Ogre::String& scheme);
+
         /// Render the scene from `camera` at width x height, supersampled with
         /// samplesPerAxis^2 samples per pixel (box filter in linear space, like the CPU
         /// reference renderer). Returns opaque RGBA8.
@@ -118,6 +122,7 @@ namespace TreeLod
         Ogre::TexturePtr mTarget;
         LightingSpec mLighting;
         float mLodBias = 1.0f;
+        Ogre::String mMaterialScheme = Ogre::MaterialManager::DEFAULT_SCHEME_NAME;
         float mShadowFarDistance = 0.0f;
     };
 }
