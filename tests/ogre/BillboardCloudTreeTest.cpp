@@ -677,6 +677,19 @@ namespace TreeLod
         EXPECT_THROW(tree->setMaterialLodBias(std::nanf("")), Ogre::InvalidParametersException);
     }
 
+    TEST(BillboardCloudTree, lodStrategyParameterNamesOgresStrategies)
+    {
+        const BakedTree& oak = bundled("oak");
+        BillboardCloudTree* tree = nullptr;
+        std::vector<CameraSpec> views;
+        for (const char* view : {"orbit:30,10,4", "orbit:30,10,8", "orbit:30,10,16", "orbit:30,10,32", "orbit:30,10,64", "orbit:30,10,128"})
+            views.push_back(camera(oak.model, view));
+        expectLodStrategyParameter([&](const Ogre::NameValuePairList& params) { tree = placeCloud(oak.asset, params); },
+                                   [&] { return unsigned(tree->getLevel()); },
+                                   [&](const CameraSpec& view) { OgreEnvironment::renderer().render(view, 128, 128, 1); },
+                                   views);
+    }
+
     TEST(BillboardCloudTree, materialLodBiasMovesTheLowResSwitch)
     {
         // A layered level drawn far away (forced) takes its material LoD 1, the low-res texture

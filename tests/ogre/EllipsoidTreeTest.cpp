@@ -475,4 +475,25 @@ namespace TreeLod
         expectMeshLodBiasLikeEntity(probe, views);
         r.clearContent();
     }
+
+    TEST(EllipsoidTree, lodStrategyParameterNamesOgresStrategies)
+    {
+        const BakedOak& t = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        r.setShadows(false);
+        EllipsoidTree* tree = nullptr;
+        std::vector<CameraSpec> views;
+        for (const float distance : {1.0f, 2.0f, 4.0f, 8.0f, 16.0f, 32.0f, 64.0f})
+            views.push_back(CameraSpec::framing(t.model.boundsMin, t.model.boundsMax, 0.0f, 10.0f, distance));
+        expectLodStrategyParameter(
+            [&](const Ogre::NameValuePairList& params) {
+                static int serial = 0;
+                r.clearContent();
+                tree = static_cast<EllipsoidTree*>(create(params, "ellipsoid-strategy" + std::to_string(serial++)));
+                r.getContentNode().attachObject(tree);
+            },
+            [&] { return unsigned(tree->getLevel()); }, [&](const CameraSpec& view) { r.render(view, 128, 128, 1); },
+            views);
+        r.clearContent();
+    }
 }

@@ -407,4 +407,18 @@ namespace TreeLod
         r.render(far, 256, 256, 1);
         EXPECT_LT(tree->getBarkLodIndex(), farBark) << "a factor on the bark mesh's pixel_count values";
     }
+
+    TEST(FoliageLodTree, lodStrategyParameterNamesOgresStrategies)
+    {
+        // The leaf count: more is finer; pixel_count's value is the default's within rounding.
+        const LodfTree& oak = bundledOak();
+        FoliageLodTree* tree = nullptr;
+        std::vector<CameraSpec> views;
+        for (const char* view : {"orbit:30,10,4", "orbit:30,10,8", "orbit:30,10,16", "orbit:30,10,32"})
+            views.push_back(camera(oak.model, view));
+        expectLodStrategyParameter([&](const Ogre::NameValuePairList& params) { tree = place(oak.asset, params); },
+                                   [&] { return unsigned(tree->getLeafCount()); },
+                                   [&](const CameraSpec& view) { OgreEnvironment::renderer().render(view, 128, 128, 1); },
+                                   views, true, 2);
+    }
 }

@@ -311,4 +311,51 @@ namespace TreeLod
         EXPECT_EQ(p.index(), p.indexCount - 1);
         p.setBias(1.0f, 0, 99);
     }
+
+    /// The lodStrategy parameter (ObjectLodBias.h) as a tree object reads it: `make(params)`
+    /// places a new object with `params` (the last one gone), `index()` is what it draws for the
+    /// last camera (0 = finest; LoDF: its leaf count, compared within `slack`). At each of `views`
+    /// (receding), pixel_count (Ogre's: a quarter of treelod_screen_size) draws what the default
+    /// draws, and still does under a camera LoD bias of 4, which Ogre's pixel_count leaves out
+    /// and the default does not; distance_box (the distance to the box, shorter than to the
+    /// centre) draws as fine or finer, never finer as the views recede; an unknown name is refused.
+    inline void expectLodStrategyParameter(const std::function<void(const Ogre::NameValuePairList&)>& make,
+                                           const std::function<unsigned()>& index,
+                                           const std::function<void(const CameraSpec&)>& render,
+                                           const std::vector<CameraSpec>& views, bool finerIsMore = false,
+                                           unsigned slack = 0)
+    {
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        auto indices = [&](const char* strategy, float cameraBias) {
+            make(strategy ? Ogre::NameValuePairList{{"lodStrategy", strategy}} : Ogre::NameValuePairList{});
+            r.setLodBias(cameraBias);
+            std::vector<unsigned> out;
+            for (const CameraSpec& view : views)
+            {
+                render(view);
+                out.push_back(index());
+            }
+            r.setLodBias(1.0f);
+            return out;
+        };
+        const std::vector<unsigned> byDefault = indices(nullptr, 1.0f), pixelCount = indices("pixel_count", 1.0f),
+                                    distance = indices("distance_box", 1.0f), biased = indices(nullptr, 4.0f),
+                                    pixelCountBiased = indices("pixel_count", 4.0f);
+        auto finer = [&](unsigned a, unsigned b) { return finerIsMore ? a >= b : a <= b; }; // a as fine as b or finer
+        for (std::size_t i = 0; i < views.size(); ++i)
+        {
+            std::printf("view %zu: default %u, pixel_count %u, distance_box %u; camera bias 4: default %u, "
+                        "pixel_count %u\n", i, byDefault[i], pixelCount[i], distance[i], biased[i], pixelCountBiased[i]);
+            EXPECT_NEAR(double(pixelCount[i]), double(byDefault[i]), double(slack)) << "view " << i;
+            EXPECT_NEAR(double(pixelCountBiased[i]), double(byDefault[i]), double(slack))
+                << "view " << i << ": Ogre's pixel_count leaves the camera's bias out";
+            EXPECT_TRUE(finer(distance[i], byDefault[i])) << "view " << i;
+            if (i > 0)
+            {
+                EXPECT_TRUE(finer(distance[i - 1], distance[i])) << "view " << i;
+            }
+        }
+        EXPECT_NE(biased, byDefault) << "treelod_screen_size has the camera's bias";
+        EXPECT_THROW(make({{"lodStrategy", "nearest"}}), Ogre::InvalidParametersException);
+    }
 }

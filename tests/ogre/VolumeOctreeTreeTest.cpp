@@ -688,4 +688,28 @@ namespace TreeLod
         expectMeshLodBiasLikeEntity(probe, views);
         r.clearContent();
     }
+
+    TEST(VolumeOctreeTree, lodStrategyParameterNamesOgresStrategies)
+    {
+        OgreEnvironment::renderer().setShadows(false);
+        const BakedOak& t = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        VolumeOctreeTree* tree = nullptr;
+        std::vector<CameraSpec> views;
+        for (const float distance : {0.5f, 1.0f, 2.0f, 4.0f, 8.0f, 16.0f})
+            views.push_back(CameraSpec::framing(t.model.boundsMin, t.model.boundsMax, 0.0f, 10.0f, distance));
+        expectLodStrategyParameter(
+            [&](const Ogre::NameValuePairList& extra) {
+                static int serial = 0;
+                r.clearContent();
+                Ogre::NameValuePairList params = {{"asset", t.asset->getName()}, {"group", t.asset->getGroup()}};
+                params.insert(extra.begin(), extra.end());
+                tree = static_cast<VolumeOctreeTree*>(r.getSceneManager().createMovableObject(
+                    "volume-strategy" + std::to_string(serial++), VolumeOctreeTreeFactory::FACTORY_TYPE_NAME, &params));
+                r.getContentNode().attachObject(tree);
+            },
+            [&] { return tree->getLevelCount() - 1 - tree->getActiveLevel(); },
+            [&](const CameraSpec& view) { r.render(view, 96, 96, 1); }, views);
+        r.clearContent();
+    }
 }

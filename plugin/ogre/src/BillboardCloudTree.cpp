@@ -66,6 +66,7 @@ namespace TreeLod
                             " is not a level of the cloud (it has " + std::to_string(levels) + ")",
                         "BillboardCloudTree '" + name + "'");
         mLodBias.setMesh(mOptions.lodBias, 0, 99, "BillboardCloudTree '" + name + "'");
+        mLodBias.strategy = mOptions.lodStrategy;
         mListFactor = mOptions.listFactor >= 0.0f ? mOptions.listFactor : mGpu->listFactor;
         updateSwitchValues();
 
@@ -167,9 +168,7 @@ namespace TreeLod
 
     std::uint32_t BillboardCloudTree::levelForValue(Ogre::Real value) const
     {
-        if (mOptions.strategy == LodStrategy::Distance)
-            value = value > 0.0f ? mDistanceToPixels / value : std::numeric_limits<Ogre::Real>::max();
-        return levelForPixelCount(value);
+        return levelForPixelCount(mLastCamera ? mLodBias.screenSizeOf(value, *this, mLastCamera) : value);
     }
 
     unsigned short BillboardCloudTree::materialLodIndexForPixelCount(Ogre::Real value) const
@@ -219,18 +218,9 @@ namespace TreeLod
         // strategies: TreeLod's screen size, or the distance to the bounding box.
         const Ogre::Camera* lod = camera->getLodCamera();
         mBias = lod->getLodBias() * mLodBias.meshFactor;
-        const Ogre::Real maxValue = std::numeric_limits<Ogre::Real>::max();
-        mPixelCountValue = mLodBias.screenSize(*this, camera);
-        mLodValue = mPixelCountValue;
-        mDistanceToPixels = ScreenSizeLodStrategy::depthFactor(getBoundingRadiusScaled(), *lod);
-        if (mOptions.strategy == LodStrategy::Distance)
-        {
-            // DistanceLodBoxStrategy's value (the camera's bias in it), with the mesh factor;
-            // under a perspective camera, its screen size through this projection.
-            mLodValue = mLodBias.meshValue(Ogre::DistanceLodBoxStrategy::getSingleton(), *this, camera);
-            if (mDistanceToPixels > 0.0f)
-                mPixelCountValue = mLodValue > 0.0f ? mDistanceToPixels / mLodValue : maxValue;
-        }
+        mLastCamera = camera;
+        mLodValue = mLodBias.value(*this, camera);
+        mPixelCountValue = mLodBias.screenSizeOf(mLodValue, *this, camera);
 
         if (mOptions.level < 0)
             mLevel = mLodBias.clampMesh(Ogre::ushort(std::min<std::uint32_t>(levelForPixelCount(mPixelCountValue), 0xffff)));
@@ -277,15 +267,7 @@ namespace TreeLod
                 p.bad("level", *p.find("level"), "a whole number");
             options.level = int(v);
         }
-        if (const Ogre::String* strategy = p.find("lodStrategy"))
-        {
-            if (*strategy == "pixel_count")
-                options.strategy = BillboardCloudTree::LodStrategy::PixelCount;
-            else if (*strategy == "distance")
-                options.strategy = BillboardCloudTree::LodStrategy::Distance;
-            else
-                p.bad("lodStrategy", *strategy, "pixel_count or distance");
-        }
+        options.lodStrategy = ObjectLodBias::strategyParam(p);
         p.flag("ambientOcclusion", options.ambientOcclusion);
         if (p.number("listFactor", 0.0, 1e6, v))
             options.listFactor = float(v);

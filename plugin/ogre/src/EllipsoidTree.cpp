@@ -50,6 +50,7 @@ namespace TreeLod
           mOptions(options)
     {
         mLodBias.setMesh(mOptions.lodBias, 0, 99, "EllipsoidTree '" + name + "'");
+        mLodBias.strategy = mOptions.lodStrategy;
         if (mOptions.level >= 0 && std::size_t(mOptions.level) >= mGpu->levels.size())
             OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
                         "parameter 'level': " + std::to_string(mOptions.level) + " is not a level of the ellipsoids (" +
@@ -216,6 +217,7 @@ namespace TreeLod
         if (p.number("lodBias", 1e-6, 1e6, value))
             options.lodBias = float(value);
         p.flag("lines", options.lines);
+        options.lodStrategy = ObjectLodBias::strategyParam(p);
         return new EllipsoidTree(name, p.loadAsset(name, "EllipsoidTree"), options);
     }
 }

@@ -51,6 +51,7 @@ namespace TreeLod
         // Ogre's convention (Mesh::_setBounds): a sphere about the object's origin holding the
         // box, so culling and pixel-count LoD see the same radius as an Entity of this tree.
         mRadius = Ogre::Math::boundingRadiusFromAABB(mBounds);
+        mLodBias.strategy = mOptions.lodStrategy;
         const std::vector<Ogre::String>& materials = mAsset->getMaterialNames();
         const std::vector<Ogre::String>& shadowed = mAsset->getShadowedMaterialNames();
 
@@ -284,6 +285,7 @@ namespace TreeLod
             options.pixelsPerLeaf = float(v);
         if (p.number("quantise", 0.0, 1024.0, v))
             options.quantiseLevels = std::uint32_t(v);
+        options.lodStrategy = ObjectLodBias::strategyParam(p);
         return options;
     }
 

@@ -2,7 +2,12 @@
 
 #include "TreeLod/ScreenSizeLodStrategy.h"
 
+#include <OgreCamera.h>
+#include <OgreDistanceLodStrategy.h>
 #include <OgreException.h>
+#include <OgreLodStrategyManager.h>
+#include <OgrePixelCountLodStrategy.h>
+#include <OgreViewport.h>
 
 #include <algorithm>
 #include <cmath>
@@ -50,9 +55,51 @@ namespace TreeLod
         return std::isfinite(biased) ? biased : std::numeric_limits<Ogre::Real>::max();
     }
 
+    Ogre::Real ObjectLodBias::value(const Ogre::MovableObject& object, const Ogre::Camera* camera) const
+    {
+        return meshValue(strategy ? *strategy : ScreenSizeLodStrategy::getSingleton(), object, camera);
+    }
+
     Ogre::Real ObjectLodBias::screenSize(const Ogre::MovableObject& object, const Ogre::Camera* camera) const
     {
-        return meshValue(ScreenSizeLodStrategy::getSingleton(), object, camera);
+        return screenSizeOf(value(object, camera), object, camera);
+    }
+
+    Ogre::Real ObjectLodBias::screenSizeOf(Ogre::Real value, const Ogre::MovableObject& object,
+                                           const Ogre::Camera* camera) const
+    {
+        const Ogre::Real maxValue = std::numeric_limits<Ogre::Real>::max();
+        if (!strategy || strategy == ScreenSizeLodStrategy::getSingletonPtr())
+            return value;
+        const Ogre::Camera& lod = *camera->getLodCamera();
+        if (dynamic_cast<const Ogre::DistanceLodStrategyBase*>(strategy))
+        {
+            const Ogre::Real toPixels = ScreenSizeLodStrategy::depthFactor(object.getBoundingRadiusScaled(), lod);
+            if (toPixels <= 0.0f) // orthographic: distance says nothing of the size
+                return meshValue(ScreenSizeLodStrategy::getSingleton(), object, camera);
+            return value > 0.0f ? toPixels / value : maxValue;
+        }
+        if (value >= maxValue)
+            return value;
+        Ogre::Real scale = 4.0f; // Ogre's pixel counts are pi r_px^2
+        if (strategy == Ogre::ScreenRatioPixelCountLodStrategy::getSingletonPtr() && lod.getViewport())
+            scale *= Ogre::Real(lod.getViewport()->getActualWidth()) * Ogre::Real(lod.getViewport()->getActualHeight());
+        return value * scale;
+    }
+
+    const Ogre::LodStrategy* ObjectLodBias::strategyParam(const ObjectParams& params)
+    {
+        const Ogre::String* name = params.find("lodStrategy");
+        if (!name)
+            return nullptr;
+        const Ogre::String& known = *name == "distance" ? Ogre::String("distance_box") : *name;
+        for (const char* supported : {ScreenSizeLodStrategy::NAME.c_str(), "distance_box", "distance_sphere",
+                                      "pixel_count", "screen_ratio_pixel_count"})
+            if (known == supported)
+                return Ogre::LodStrategyManager::getSingleton().getStrategy(known);
+        params.bad("lodStrategy", *name,
+                   "treelod_screen_size, distance_box (or distance), distance_sphere, pixel_count or "
+                   "screen_ratio_pixel_count");
     }
 
     unsigned short ObjectLodBias::clampMesh(unsigned short index) const

@@ -42,6 +42,7 @@ namespace TreeLod
           mCellOrders(&VolumeOctreeResources::of(*asset).getCellOrders()), mOptions(options)
     {
         mLodBias.setMesh(mOptions.lodBias, 0, 99, "VolumeOctreeTree '" + name + "'");
+        mLodBias.strategy = mOptions.lodStrategy;
         if (mOptions.level >= 0 && std::uint32_t(mOptions.level) >= mData->levelCount)
             OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
                         "parameter 'level': " + std::to_string(mOptions.level) + " is not a level of the octree (" +
@@ -194,6 +195,7 @@ namespace TreeLod
         }
         if (p.number("lodBias", 1e-6, 1e6, value))
             options.lodBias = float(value);
+        options.lodStrategy = ObjectLodBias::strategyParam(p);
         if (p.number("lodPixels", 1e-3, 1e6, value))
             options.lodPixels = float(value);
         return new VolumeOctreeTree(name, p.loadAsset(name, "VolumeOctreeTree"), options);

@@ -12,10 +12,10 @@
 // Level of detail. Geometric (§6): the clouds are switched by an LoD value read through Ogre's
 // LodStrategy interface: ScreenSizeLodStrategy's ("treelod_screen_size": 4 pi r_px^2 of the
 // bounding sphere scaled by the node, the LoD camera's bias in it), times the mesh LoD factor
-// (setMeshLodBias; the `lodBias` parameter sets it), or, with lodStrategy=distance,
-// DistanceLodBoxStrategy's (the squared distance to the world bounding box over the camera's
-// bias) divided by that factor; its thresholds are the
-// screen-size ones seen through the LoD camera's projection. Thresholds follow the shader LoD so that a switch changes little
+// (setMeshLodBias; the `lodBias` parameter sets it), or the one the lodStrategy parameter names
+// (ObjectLodBias.h: e.g. distance, DistanceLodBoxStrategy's squared distance to the world
+// bounding box over the camera's bias, divided by that factor, compared with the screen-size
+// thresholds seen through the LoD camera's projection). Thresholds follow the shader LoD so that a switch changes little
 // (§6: "consistent with the corresponding shader LoD at the time of the switch"):
 //   - a layered level gives way to the next layered level where its shader walks
 //     SWITCH_ENTRIES list entries (listFactor * projected cell diagonal = 4), the leaves the
@@ -30,7 +30,7 @@
 //
 // Parameters (createMovableObject params, or the registry): asset (required with the factory),
 // group, classic (true | false: draw chunk "classic-billboard-cloud"), level (force level 0,
-// 1, 2...), lodStrategy (pixel_count, the default | distance), listFactor (overrides the
+// 1, 2...), lodStrategy (treelod_screen_size, the default, or another: ObjectLodBias.h), listFactor (overrides the
 // chunk's shader LoD factor; 0 = low-res texture only), lodBias (> 0, setMeshLodBias's factor),
 // ambientOcclusion (true, the default | false: light like the polygonal reference, which has
 // no AO; the image-error study compares that way).
@@ -51,17 +51,11 @@ namespace TreeLod
     class BillboardCloudTree : public Ogre::MovableObject
     {
     public:
-        enum class LodStrategy
-        {
-            PixelCount, ///< ScreenSizeLodStrategy's value, times the bias
-            Distance    ///< squared distance to the bounding box, divided by the bias
-        };
-
         struct Options
         {
             bool classic = false;
             int level = -1;          ///< >= 0: always this level
-            LodStrategy strategy = LodStrategy::PixelCount;
+            const Ogre::LodStrategy* lodStrategy = nullptr; ///< null: treelod_screen_size (ObjectLodBias::strategy)
             float listFactor = -1.0f; ///< < 0: the chunk's
             float lodBias = 1.0f;     ///< the initial setMeshLodBias factor
             bool ambientOcclusion = true; ///< false: no AO on leaves or bark (the polygonal reference's lighting)
@@ -114,7 +108,7 @@ namespace TreeLod
         /// value's units: 4 pi r_px^2 of that radius); the rules of the file comment.
         static std::vector<Ogre::Real> switchPixelCounts(const BillboardCloudGpu& gpu, float listFactor, float radius);
         /// The level the strategy value `value` (its units, bias applied) selects; distance
-        /// values are converted with the projection of the last camera seen.
+        /// values are converted with the projection of the last camera seen (still alive).
         std::uint32_t levelForValue(Ogre::Real value) const;
         /// The material LoD index for a pixel-count value (material bias applied, clamped by
         /// setMaterialLodBias) at this list factor.
@@ -152,7 +146,7 @@ namespace TreeLod
         Ogre::Real mPixelCountValue = 0.0f;
         Ogre::Real mBias = 1.0f; ///< the camera's LoD bias times the mesh factor
         ObjectLodBias mLodBias;
-        Ogre::Real mDistanceToPixels = 0.0f; ///< pixel-count value * squared distance, last camera
+        const Ogre::Camera* mLastCamera = nullptr; ///< the last camera seen, for levelForValue
     };
 
     class BillboardCloudTreeFactory : public Ogre::MovableObjectFactory

@@ -35,7 +35,8 @@
 //
 // Parameters (createMovableObject params, or the registry): asset (required), group, level
 // (force an ellipsoid level: 0 finest; the lines follow its target height), lodBias (> 0,
-// setMeshLodBias's factor), lines (true: the baked lines when the package has them).
+// setMeshLodBias's factor), lines (true: the baked lines when the package has them), lodStrategy
+// (treelod_screen_size, the default, or another: ObjectLodBias.h).
 #pragma once
 
 #include "TreeLod/EllipsoidTreeResources.h"
@@ -56,6 +57,7 @@ namespace TreeLod
         {
             int level = -1;       ///< >= 0: always this level
             float lodBias = 1.0f; ///< > 0, the initial setMeshLodBias factor
+            const Ogre::LodStrategy* lodStrategy = nullptr; ///< null: treelod_screen_size (ObjectLodBias::strategy)
             bool lines = true;    ///< the baked lines when the package has them, else the bark mesh
         };
 

@@ -23,7 +23,8 @@
 //
 // Parameters (createMovableObject params, or the registry): asset (required with the
 // factory), group, leaves (a fixed leaf count instead of the curve), pixelsPerLeaf (default 4),
-// quantise (N: snap to N geometric levels, see FoliageLodState::quantise; 0 = continuous).
+// quantise (N: snap to N geometric levels, see FoliageLodState::quantise; 0 = continuous),
+// lodStrategy (treelod_screen_size, the default, or another: ObjectLodBias.h).
 // A quantised instance owns no index buffer: it draws the asset's shared level
 // (FoliageLodResources::getFoliageLodLevel), so changing level uploads nothing and instances at one
 // level draw identical geometry (what a Forest instances).
@@ -63,6 +64,7 @@ namespace TreeLod
             std::uint32_t fixedLeafCount = 0; ///< 0 = from the LoD strategy
             float pixelsPerLeaf = DEFAULT_PIXELS_PER_LEAF; ///< projected pixels per leaf at full curve
             std::uint32_t quantiseLevels = 0; ///< 0 = continuous
+            const Ogre::LodStrategy* lodStrategy = nullptr; ///< null: treelod_screen_size (ObjectLodBias::strategy)
         };
 
         FoliageLodTree(const Ogre::String& name, const TreeAssetPtr& asset, const Options& options);

@@ -6,7 +6,14 @@
 // what the indices mean for its technique. The LoD camera's own bias (Camera::setLodBias) is in
 // the strategy's value where the strategy puts it (treelod_screen_size and Ogre's distance
 // strategies; Ogre's pixel_count leaves it out, for meshes as for an Entity).
+//
+// The strategy an object reads its own levels through is treelod_screen_size unless its
+// `lodStrategy` parameter names another registered with Ogre's LodStrategyManager: distance_box,
+// distance_sphere ("distance" = distance_box), pixel_count or screen_ratio_pixel_count. Its value
+// is turned into treelod_screen_size's units, what the levels are written in (screenSize).
 #pragma once
+
+#include "TreeLod/ObjectParams.h"
 
 #include <OgreLodStrategy.h>
 #include <OgreMaterial.h>
@@ -16,6 +23,8 @@ namespace TreeLod
 {
     struct ObjectLodBias
     {
+        /// What the object's own levels are read through; null: treelod_screen_size.
+        const Ogre::LodStrategy* strategy = nullptr;
         Ogre::Real meshFactor = 1.0f;         ///< > 0; > 1 keeps more detail
         unsigned short maxMeshIndex = 0;      ///< the finest mesh level allowed
         unsigned short minMeshIndex = 99;     ///< the coarsest mesh level allowed
@@ -40,9 +49,18 @@ namespace TreeLod
         {
             return biasedValue(strategy, object, camera, meshFactor);
         }
-        /// The treelod_screen_size value (ScreenSizeLodStrategy) with the mesh factor: what the
-        /// objects' own levels compare.
+        /// The strategy's value (LodStrategy::getValue) with the mesh factor.
+        Ogre::Real value(const Ogre::MovableObject& object, const Ogre::Camera* camera) const;
+        /// That value in treelod_screen_size's units (ScreenSizeLodStrategy), what the objects'
+        /// own levels compare: a squared distance through the LoD camera's projection (under an
+        /// orthographic camera, treelod_screen_size's own value), Ogre's pixel counts times 4 (and
+        /// the viewport's area for the screen ratio).
         Ogre::Real screenSize(const Ogre::MovableObject& object, const Ogre::Camera* camera) const;
+        Ogre::Real screenSizeOf(Ogre::Real value, const Ogre::MovableObject& object, const Ogre::Camera* camera) const;
+
+        /// The object parameter `lodStrategy` (see above), null when absent; ObjectParams::bad for
+        /// a name that is not one of them.
+        static const Ogre::LodStrategy* strategyParam(const ObjectParams& params);
 
         unsigned short clampMesh(unsigned short index) const;
         unsigned short clampMaterial(unsigned short index) const;

@@ -27,7 +27,8 @@
 // gives (materials/GLSL/TreeLodVolumeOctree.frag, CASTER). Shadow cameras keep the viewer's levels.
 //
 // Parameters (createMovableObject params, or the registry): asset (required), group, level (force
-// the active level), lodBias (> 0), lodPixels (> 0).
+// the active level), lodBias (> 0), lodPixels (> 0), lodStrategy (treelod_screen_size, the
+// default, or another: ObjectLodBias.h).
 #pragma once
 
 #include "TreeLod/ObjectLodBias.h"
@@ -48,6 +49,7 @@ namespace TreeLod
         {
             int level = -1;          ///< >= 0: always this active level
             float lodBias = 1.0f;    ///< > 0, the initial setMeshLodBias factor
+            const Ogre::LodStrategy* lodStrategy = nullptr; ///< null: treelod_screen_size (ObjectLodBias::strategy)
             float lodPixels = 4.0f;  ///< > 0
         };
 
