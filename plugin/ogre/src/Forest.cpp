@@ -5,6 +5,7 @@
 #include "TreeLod/ErrorCurves.h"
 #include "TreeLod/LevelSelection.h"
 #include "TreeLod/ObjectParams.h"
+#include "TreeLod/ScreenSizeLodStrategy.h"
 #include "TreeLod/ShadowSetup.h"
 
 #include "TreeLod/TechniqueRegistry.h"
@@ -1419,11 +1420,8 @@ namespace TreeLod
         {
             const Ogre::Camera* lod = camera->getLodCamera();
             const Ogre::Vector3 eye = world.inverse() * lod->getDerivedPosition();
-            const Ogre::Viewport* viewport = lod->getViewport();
-            const float area = viewport ? float(viewport->getActualWidth()) * float(viewport->getActualHeight()) : 0.0f;
-            const Ogre::Matrix4& projection = lod->getProjectionMatrix();
             state.camera.lodPosition = glm::vec3(eye.x, eye.y, eye.z);
-            state.camera.lodPixelScale = area * std::abs(projection[0][0] * projection[1][1]);
+            state.camera.lodPixelScale = ScreenSizeLodStrategy::pixelScale(*lod); // treelod_screen_size's
             state.camera.lodOrthographic = lod->getProjectionType() == Ogre::PT_ORTHOGRAPHIC;
             state.lodBias = lod->getLodBias() * mLodBias.meshFactor * (shadowTexture ? mShadowLodBias : 1.0f);
             state.hasLod = true;

@@ -36,12 +36,17 @@ namespace TreeLod
         }
     }
 
+    Ogre::Real ScreenSizeLodStrategy::pixelScale(const Ogre::Camera& camera)
+    {
+        const Ogre::Matrix4& projection = camera.getProjectionMatrix();
+        return viewportArea(camera) * std::abs(projection[0][0] * projection[1][1]);
+    }
+
     Ogre::Real ScreenSizeLodStrategy::depthFactor(Ogre::Real radius, const Ogre::Camera& camera)
     {
         if (camera.getProjectionType() != Ogre::PT_PERSPECTIVE)
             return 0.0f;
-        const Ogre::Matrix4& projection = camera.getProjectionMatrix();
-        return Ogre::Math::PI * radius * radius * viewportArea(camera) * projection[0][0] * projection[1][1];
+        return Ogre::Math::PI * radius * radius * pixelScale(camera);
     }
 
     Ogre::Real ScreenSizeLodStrategy::radiusInPixels(Ogre::Real value)

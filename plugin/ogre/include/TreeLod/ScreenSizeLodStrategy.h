@@ -30,6 +30,11 @@ namespace TreeLod
         /// getBaseValue() at depth 0, 0 for a camera without a viewport.
         static Ogre::Real valueOf(Ogre::Real radius, Ogre::Real squaredDepth, const Ogre::Camera& camera);
 
+        /// W * H * |P00 * P11| of `camera`'s viewport and projection: a sphere of radius r has the
+        /// value pi r^2 * this / d^2 under a perspective camera, pi r^2 * this under an orthographic
+        /// one, times the bias (the Forest values its instances so, ForestInstances.h).
+        static Ogre::Real pixelScale(const Ogre::Camera& camera);
+
         /// value * d^2 for a perspective `camera` without its bias (the factor that turns a
         /// squared view depth into a value); 0 for an orthographic camera or one without a viewport.
         static Ogre::Real depthFactor(Ogre::Real radius, const Ogre::Camera& camera);
