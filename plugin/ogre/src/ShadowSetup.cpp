@@ -8,6 +8,7 @@
 #include <OgreShadowCameraSetupLiSPSM.h>
 #include <OgreShadowCameraSetupPSSM.h>
 
+#include <algorithm>
 #include <mutex>
 #include <set>
 
@@ -166,7 +167,9 @@ namespace TreeLod
         Ogre::Real farDistance = sceneManager.getShadowFarDistance();
         if (!(farDistance > nearClip))
             farDistance = viewCamera.getFarClipDistance() > nearClip ? viewCamera.getFarClipDistance() : 1000 * nearClip;
-        pssm->setSplitPadding(2.0f * nearClip);
         pssm->calculateSplitPoints(PSSM_SPLITS, nearClip, farDistance);
+        // Each split's shadow camera starts this much before the split (OGRE's Terrain sample: twice
+        // the near clip); at most half the first split, so that it starts in front of the eye.
+        pssm->setSplitPadding(std::min(2.0f * nearClip, 0.5f * pssm->getSplitPoints()[1]));
     }
 }
