@@ -800,26 +800,31 @@ namespace TreeLod
         compareWithGolden(shadowed, "forest-shadows", 0.02);
     }
 
-    /// Texture shadows for the tests below: Forest trees (mesh level) on a ground receiving the
-    /// sun's depth shadow (a clone of TreeLod/BarkShadowed), or no ground.
-    void placeShadowScene(const std::vector<ForestInstance>& trees, bool ground, float groundSize)
+    /// Texture shadows for the tests below: Forest trees (mesh level) on a ground (a clone of
+    /// TreeLod/Bark, or of TreeLod/BarkShadowed where `receiving`: the sun's depth shadow), or
+    /// none where `groundSize` is 0.
+    void placeShadowScene(const std::vector<ForestInstance>& trees, float groundSize, bool receiving)
     {
         OffscreenRenderer& r = OgreEnvironment::renderer();
         Ogre::SceneManager& sm = r.getSceneManager();
         Ogre::MaterialManager& materials = Ogre::MaterialManager::getSingleton();
-        if (!materials.resourceExists("ForestTest/ShadowGround", "TreeLod"))
+        for (const char* suffix : {"", "Shadowed"})
         {
-            Ogre::MaterialPtr material = materials.getByName("TreeLod/BarkShadowed", "TreeLod")->clone("ForestTest/ShadowGround");
+            const Ogre::String name = Ogre::String("ForestTest/ShadowSceneGround") + suffix;
+            if (materials.resourceExists(name, "TreeLod"))
+                continue;
+            Ogre::MaterialPtr material = materials.getByName(Ogre::String("TreeLod/Bark") + suffix, "TreeLod")->clone(name);
             material->getTechnique(0)->getPass(0)->getFragmentProgramParameters()->setNamedConstant(
                 "baseColour", Ogre::ColourValue(0.45f, 0.5f, 0.3f, 1.0f));
             material->load();
         }
         r.clearContent();
-        if (ground)
+        if (groundSize > 0.0f)
         {
             Ogre::ManualObject* quad = sm.createManualObject();
             quad->setCastShadows(false);
-            quad->begin("ForestTest/ShadowGround", Ogre::RenderOperation::OT_TRIANGLE_LIST, "TreeLod");
+            quad->begin(receiving ? "ForestTest/ShadowSceneGroundShadowed" : "ForestTest/ShadowSceneGround",
+                        Ogre::RenderOperation::OT_TRIANGLE_LIST, "TreeLod");
             const float s = groundSize;
             for (const glm::vec2 c : {glm::vec2(-s, -s), glm::vec2(s, -s), glm::vec2(s, s), glm::vec2(-s, s)})
             {
@@ -878,7 +883,7 @@ namespace TreeLod
             settings.technique = technique;
             settings.camera = camera;
             settings.textureSize = 1024;
-            placeShadowScene(row, true, 20.0f * h);
+            placeShadowScene(row, 20.0f * h, technique != Ogre::SHADOWTYPE_NONE);
             r.setShadows(settings);
             r.render(view, 256, 160, 1); // Ogre frames shadow cameras with the previous frame's receivers
             return toImage(r.render(view, 256, 160, 2));
@@ -929,7 +934,7 @@ namespace TreeLod
         const std::vector<ForestInstance> trees = {instance(-0.6f * h, 0, 0.3f * h, 0.5f, 0.9f),
                                                    instance(0.5f * h, 0, -0.4f * h, 2.0f, 1.1f)};
         const CameraSpec view = look(glm::vec3(0.5f * h, 1.3f * h, 2.3f * h), glm::vec3(0.0f, 0.25f * h, 0.0f), 45.0f);
-        placeShadowScene(trees, false, 0.0f);
+        placeShadowScene(trees, 0.0f, false);
         r.setShadows(false);
         const Image plain = toImage(r.render(view, 160, 128, 1));
         /// The shadow texture's darkest and brightest red, 0..1.
