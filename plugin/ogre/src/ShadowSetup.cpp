@@ -24,16 +24,16 @@ namespace TreeLod
             return (technique & Ogre::SHADOWDETAILTYPE_MODULATIVE) ? 1.0f : 2.0f;
         }
 
-        /// Logs "TreeLod: scene manager 'NAME' WHAT" once per scene manager and message.
-        void warnOnce(const Ogre::SceneManager& sceneManager, const Ogre::String& what)
+        /// The caster mode last written to the shared parameters, and the program manager (the
+        /// render system's) that holds them; reset when they are created.
+        const Ogre::GpuProgramManager* gLastManager = nullptr;
+        float gLastMode = -1.0f;
+
+        enum class Unsupported
         {
-            static std::mutex mutex;
-            static std::set<std::pair<Ogre::String, Ogre::String>> told;
-            std::lock_guard<std::mutex> lock(mutex);
-            if (told.insert({sceneManager.getName(), what}).second)
-                Ogre::LogManager::getSingleton().logWarning("TreeLod: scene manager '" + sceneManager.getName() +
-                                                            "' " + what);
-        }
+            Stencil,         ///< stencil shadows
+            ColourSelfShadow ///< colour texture shadows with self shadowing on
+        };
 
         const char* techniqueName(Ogre::ShadowTechnique technique)
         {
@@ -44,6 +44,30 @@ namespace TreeLod
             default: return "a stencil shadow technique";
             }
         }
+
+        /// Logs why `sceneManager`'s shadows are not what the trees support, once per scene
+        /// manager and reason (the objects call it every frame: the message is built once).
+        void warnOnce(const Ogre::SceneManager& sceneManager, Unsupported what)
+        {
+            static std::mutex mutex;
+            static std::set<std::pair<Ogre::String, Unsupported>> told;
+            {
+                std::lock_guard<std::mutex> lock(mutex);
+                if (!told.insert({sceneManager.getName(), what}).second)
+                    return;
+            }
+            const Ogre::String message =
+                what == Unsupported::Stencil
+                    ? Ogre::String("uses ") + techniqueName(sceneManager.getShadowTechnique()) +
+                          "; TreeLod's trees do not support stencil shadows (no edge lists): they neither cast nor "
+                          "receive them. Use texture shadows (TreeLod/ShadowSetup.h)"
+                    : Ogre::String("uses colour texture shadows with self shadowing on; TreeLod's trees draw "
+                                   "correctly there only as casters that do not receive: "
+                                   "setShadowTextureSelfShadow(false) (TreeLod/ShadowSetup.h)");
+            Ogre::LogManager::getSingleton().logWarning("TreeLod: scene manager '" + sceneManager.getName() + "' " +
+                                                        message);
+        }
+
     }
 
     ShadowCamera parseShadowCamera(const Ogre::String& name, const Ogre::String& where)
@@ -65,6 +89,7 @@ namespace TreeLod
             return;
         Ogre::GpuSharedParametersPtr params = programs.createSharedParameters(SHADOW_PARAMS_NAME);
         params->addConstantDefinition("shadowMode", Ogre::GCT_FLOAT4);
+        gLastManager = nullptr;
     }
 
     bool receivesDepthShadows(const Ogre::SceneManager* sceneManager)
@@ -75,27 +100,24 @@ namespace TreeLod
 
     void notifyShadowTechnique(const Ogre::SceneManager& sceneManager)
     {
-        const Ogre::ShadowTechnique technique = sceneManager.getShadowTechnique();
         if (sceneManager.isShadowTechniqueStencilBased())
         {
-            warnOnce(sceneManager, Ogre::String("uses ") + techniqueName(technique) +
-                                       "; TreeLod's trees do not support stencil shadows (no edge lists): they "
-                                       "neither cast nor receive them. Use texture shadows (TreeLod/ShadowSetup.h)");
+            warnOnce(sceneManager, Unsupported::Stencil);
             return;
         }
-        const float mode = casterMode(technique);
+        const float mode = casterMode(sceneManager.getShadowTechnique());
         if (mode != 0.0f && sceneManager.getShadowTextureSelfShadow())
-            warnOnce(sceneManager, "uses colour texture shadows with self shadowing on; TreeLod's trees draw "
-                                   "correctly there only as casters that do not receive: "
-                                   "setShadowTextureSelfShadow(false) (TreeLod/ShadowSetup.h)");
+            warnOnce(sceneManager, Unsupported::ColourSelfShadow);
+        // Every object calls this for every camera: the parameters are written only when the
+        // mode or the program manager changes.
         Ogre::GpuProgramManager* programs = Ogre::GpuProgramManager::getSingletonPtr();
-        if (!programs)
+        if (!programs || (programs == gLastManager && mode == gLastMode))
             return;
         createShadowParams();
-        const Ogre::GpuSharedParametersPtr params = programs->getSharedParameters(SHADOW_PARAMS_NAME);
-        const Ogre::GpuSharedParameters& read = *params; // the const accessor leaves it clean
-        if (read.getFloatPointer(read.getConstantDefinition("shadowMode").physicalIndex)[0] != mode)
-            params->setNamedConstant("shadowMode", Ogre::Vector4(mode, 0.0f, 0.0f, 0.0f));
+        programs->getSharedParameters(SHADOW_PARAMS_NAME)->setNamedConstant("shadowMode",
+                                                                            Ogre::Vector4(mode, 0.0f, 0.0f, 0.0f));
+        gLastManager = programs;
+        gLastMode = mode;
     }
 
     void setupSunShadows(Ogre::SceneManager& sceneManager, Ogre::Light& sun, const SunShadowSettings& settings,
