@@ -71,12 +71,13 @@ namespace TreeLod
             return *costs;
         };
         mErrorBudget = mScript.lod.maxError;
-        mScene = std::make_unique<ForestScene>(*mSceneManager, *mSceneManager->getRootSceneNode(), mScript, options);
+        // The camera first: PSSM shadows split the view of the scene manager's camera.
         mCamera = mSceneManager->createCamera("TreeLod/Browser/ForestCamera");
         mCameraNode = mSceneManager->getRootSceneNode()->createChildSceneNode();
         mCameraNode->attachObject(mCamera);
         mPathTime = pathStart();
         applyCameraSpec(*mCamera, *mCameraNode, cameraAt(mScript, mPathTime));
+        mScene = std::make_unique<ForestScene>(*mSceneManager, *mSceneManager->getRootSceneNode(), mScript, options);
         setShadows(mShadows);
         report(progress, "forest: building " + mScript.name, 1.0f);
     }
