@@ -10,7 +10,6 @@
 #include "TreeLod/TreeAssetManager.h"
 
 #include <OgreCamera.h>
-#include <OgreDistanceLodStrategy.h>
 #include <OgreException.h>
 #include <OgreMaterialManager.h>
 #include <OgreNode.h>
