@@ -10,7 +10,8 @@ namespace TreeLod
     {
         const char* const FOOTER = R"(Windowed (the default): a menu of samples, each with a thumbnail and a description:
 one per LoD technique on a single tree, shown as a split view (polygonal reference |
-technique | FLIP difference image), and the forest of the scene script.
+technique | FLIP difference image), the forest of the scene script, and the terrain sample: the
+--terrain-scene script's forest on Ogre's Terrain under PSSM shadows.
   keys: Up/Down choose a sample, Enter start it, Esc back to the menu (quits from the menu);
         N next technique, [ and ] LoD bias / 2 and x 2, H shadows, R wireframe, L freeze LoD,
         Space play/pause the forest's camera path; WASD/QE + mouse move the camera
@@ -21,6 +22,7 @@ technique | FLIP difference image), and the forest of the scene script.
   menu.png                  the sample menu
   forest-NNN.png            the forest sample at --frames frames spread evenly along the
                             scene's camera path (NNN = 000, 001, ...)
+  terrain-NNN.png           the terrain sample, the same way along its script's camera path
   split-TECHNIQUE.png       each technique sample's split view (every registered technique:
                             treelod render --help lists them), the tree framed whole
 --headless --soak N switches N times between samples and techniques as a user does (the menu,
@@ -66,6 +68,8 @@ Bad arguments exit 2; a failure while running exits 1.)";
         BrowserOptions o;
         o.scene = sourceDir + "/samples/scenes/single-tree.json";
         o.tree = sourceDir + "/media/oak.glb";
+        o.terrainScene = sourceDir + "/samples/scenes/terrain-pssm.json";
+        bool noTerrain = false;
         std::string size = "1280x720";
 
         CLI::App app{"treelod_browser: TreeLod's sample browser (OgreBites + trays)", "treelod_browser"};
@@ -75,6 +79,10 @@ Bad arguments exit 2; a failure while running exits 1.)";
         app.add_option("--tree", o.tree,
                        "tree of the single-tree samples: a .glb/.gltf file or preset:NAME?seed=S&leaves=N "
                        "(default media/oak.glb)");
+        app.add_option("--terrain-scene", o.terrainScene,
+                       "scene script of the terrain sample, with a heightfield ground (default "
+                       "samples/scenes/terrain-pssm.json)");
+        app.add_flag("--no-terrain", noTerrain, "no terrain sample");
         app.add_option("--screenshots", o.screenshots, "with --headless: folder for the PNGs (created)");
         app.add_option("--frames", o.frames, "with --headless: forest frames along the camera path (default 4)");
         app.add_option("--soak", o.soak,
@@ -117,6 +125,10 @@ Bad arguments exit 2; a failure while running exits 1.)";
         std::error_code ec;
         if (!std::filesystem::is_regular_file(o.scene, ec))
             return bad("--scene: " + o.scene + ": no such file");
+        if (noTerrain)
+            o.terrainScene.clear();
+        else if (!std::filesystem::is_regular_file(o.terrainScene, ec))
+            return bad("--terrain-scene: " + o.terrainScene + ": no such file");
         if (o.tree.rfind("preset:", 0) != 0 && !std::filesystem::is_regular_file(o.tree, ec))
             return bad("--tree: " + o.tree + ": no such file");
         BrowserOptionsResult r;

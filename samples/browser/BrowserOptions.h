@@ -10,6 +10,7 @@ namespace TreeLod
         bool headless = false;     ///< no interaction: render the screenshots and exit
         std::string scene;         ///< scene script of the forest sample (resolved path)
         std::string tree;          ///< source of the single-tree samples: a tree file or "preset:NAME?..."
+        std::string terrainScene;  ///< scene script of the terrain sample (a heightfield ground); "" = no terrain sample
         std::string screenshots;   ///< headless: folder for the PNGs (created)
         unsigned frames = 4;       ///< headless: forest frames along the scene's camera path, >= 1
         unsigned shadowSize = 0;   ///< > 0: every sample's shadow map side (else the script's; 2048 single trees)
@@ -32,7 +33,8 @@ namespace TreeLod
     };
 
     /// Parse argv. Defaults resolve against `sourceDir` (the TreeLod source tree):
-    /// scene samples/scenes/single-tree.json, tree media/oak.glb. Checks that the scene and a
+    /// scene samples/scenes/single-tree.json, tree media/oak.glb, terrain scene
+    /// samples/scenes/terrain-pssm.json (--no-terrain: none). Checks that the scenes and a
     /// tree file exist and that --headless has --screenshots or --soak; the scene's content is checked
     /// when it loads.
     BrowserOptionsResult parseBrowserOptions(int argc, char** argv, const std::string& sourceDir);

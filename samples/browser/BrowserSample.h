@@ -77,6 +77,8 @@ namespace TreeLod
         virtual bool hasCameraPath() const { return false; }
         virtual bool isPlaying() const { return false; }
         virtual void setPlaying(bool) {}
+        /// Headless: the screenshots' names, PREFIX-NNN.png (samples that are not split views).
+        virtual std::string getScreenshotPrefix() const { return "forest"; }
         /// Headless: put the camera where screenshot `index` of `count` is taken.
         virtual void setScreenshotView(unsigned index, unsigned count) = 0;
 

@@ -71,6 +71,7 @@ namespace TreeLod
             return *costs;
         };
         mErrorBudget = mScript.lod.maxError;
+        prepareSceneOptions(options);
         // The camera first: PSSM shadows split the view of the scene manager's camera.
         mCamera = mSceneManager->createCamera("TreeLod/Browser/ForestCamera");
         mCameraNode = mSceneManager->getRootSceneNode()->createChildSceneNode();

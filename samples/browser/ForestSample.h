@@ -61,7 +61,10 @@ namespace TreeLod
         std::vector<std::pair<std::string, std::string>> getStats() override;
         std::vector<std::string> getLevelHistogram() override;
 
-    private:
+    protected:
+        /// Before the ForestScene is made (TerrainSample: no ground mesh).
+        virtual void prepareSceneOptions(ForestSceneOptions&) {}
+
         /// Seconds of the script's camera path: its first and last keyframe times.
         double pathStart() const;
         double pathEnd() const;

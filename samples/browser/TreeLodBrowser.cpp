@@ -3,6 +3,7 @@
 #include "ForestSample.h"
 #include "SingleTreeView.h"
 #include "TechniqueSample.h"
+#include "TerrainSample.h"
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/LevelSelection.h"
 #include "TreeLod/OgreBootstrap.h"
@@ -77,9 +78,9 @@ namespace TreeLod
         std::unique_ptr<OgreBites::Label> caption;
     };
 
-    TreeLodBrowser::TreeLodBrowser(BrowserOptions options, SceneScript script)
+    TreeLodBrowser::TreeLodBrowser(BrowserOptions options, SceneScript script, std::optional<SceneScript> terrainScript)
         : OgreBites::ApplicationContext("TreeLod sample browser"), mOptions(std::move(options)),
-          mScript(std::move(script))
+          mScript(std::move(script)), mTerrainScript(std::move(terrainScript))
     {
     }
 
@@ -134,6 +135,7 @@ namespace TreeLod
         rgm.addResourceLocation(media + "/packs/SdkTrays.zip", "Zip", "Essential");
         rgm.addResourceLocation(media + "/RTShaderLib/materials", "FileSystem", Ogre::RGN_INTERNAL);
         rgm.addResourceLocation(media + "/RTShaderLib/GLSL", "FileSystem", Ogre::RGN_INTERNAL);
+        rgm.addResourceLocation(media + "/Terrain", "FileSystem", Ogre::RGN_INTERNAL); // the Terrain's GLSL includes
         addShadowVolumeLocation();
         addMaterialsLocations(materialsDirectory(), TREELOD_GROUP);
     }
@@ -279,6 +281,13 @@ namespace TreeLod
         if (mOptions.shadowSize > 0)
             script.shadows.textureSize = int(mOptions.shadowSize);
         mSamples.push_back(std::make_unique<ForestSample>(*mRoot, script));
+        if (mTerrainScript)
+        {
+            SceneScript terrain = *mTerrainScript;
+            if (mOptions.shadowSize > 0)
+                terrain.shadows.textureSize = int(mOptions.shadowSize);
+            mSamples.push_back(std::make_unique<TerrainSample>(*mRoot, terrain));
+        }
         auto view = std::make_shared<SingleTreeView>(*mRoot, mOptions.tree, mOptions.shadowSize > 0 ? mOptions.shadowSize : 2048);
         for (const TechniqueInfo& info : TechniqueRegistry::getSingleton().getTechniques())
             mSamples.push_back(std::make_unique<TechniqueSample>(view, info.name));
@@ -652,9 +661,9 @@ namespace TreeLod
             {
                 sample.setScreenshotView(f, mOptions.frames);
                 syncControls();
-                char name[32];
-                std::snprintf(name, sizeof name, "forest-%03u.png", f);
-                shoot(name);
+                char number[16];
+                std::snprintf(number, sizeof number, "-%03u.png", f);
+                shoot(sample.getScreenshotPrefix() + number);
             }
         }
         return written;

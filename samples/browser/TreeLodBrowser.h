@@ -53,7 +53,8 @@ namespace TreeLod
         /// Width of the trays' column, pixels.
         static constexpr int COLUMN_WIDTH = 270;
 
-        TreeLodBrowser(BrowserOptions options, SceneScript script);
+        /// `terrainScript`: the terrain sample's scene (a heightfield ground); none: no terrain sample.
+        TreeLodBrowser(BrowserOptions options, SceneScript script, std::optional<SceneScript> terrainScript = {});
         ~TreeLodBrowser() override;
 
         /// Headless: write the screenshots (see --help) into options.screenshots; returns their paths.
@@ -134,6 +135,7 @@ namespace TreeLod
 
         BrowserOptions mOptions;
         SceneScript mScript;
+        std::optional<SceneScript> mTerrainScript; ///< the terrain sample's scene, if any
         std::unique_ptr<Ogre::LogManager> mLogManager;
         std::unique_ptr<TreeLodPlugin> mPlugin;
         std::unique_ptr<CacheTreeBaker> mBaker;

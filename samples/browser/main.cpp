@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <optional>
 
 int main(int argc, char** argv)
 {
@@ -26,6 +27,23 @@ int main(int argc, char** argv)
         std::cerr << "treelod_browser: " << script.error().message() << std::endl;
         return 2;
     }
+    std::optional<SceneScript> terrainScript;
+    if (!options.terrainScene.empty())
+    {
+        Result<SceneScript> terrain = loadSceneScript(options.terrainScene, readGreyImage);
+        if (!terrain)
+        {
+            std::cerr << "treelod_browser: " << terrain.error().message() << std::endl;
+            return 2;
+        }
+        if (terrain->ground.kind != SceneGround::Kind::Heightfield)
+        {
+            std::cerr << "treelod_browser: --terrain-scene: " << options.terrainScene
+                      << ": the ground is not a heightfield" << std::endl;
+            return 2;
+        }
+        terrainScript = std::move(*terrain);
+    }
     // Debian's OGRE is GLX only: say so before Ogre half-starts.
     const char* display = std::getenv("DISPLAY");
     if (!display || !*display)
@@ -35,7 +53,7 @@ int main(int argc, char** argv)
                   << std::endl;
         return 1;
     }
-    TreeLodBrowser browser(options, *script);
+    TreeLodBrowser browser(options, *script, std::move(terrainScript));
     int code = 0;
     try
     {

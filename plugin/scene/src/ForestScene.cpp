@@ -160,7 +160,8 @@ namespace TreeLod
         applyLighting(mSceneManager, *mSun, sceneLighting(mScript));
         try
         {
-            buildGround();
+            if (mOptions.ground)
+                buildGround();
             buildSpecies();
             setShadows(mScript.shadows.enabled);
         }

@@ -77,12 +77,15 @@ namespace TreeLod
         /// This machine's costs of an asset's levels (LevelCalibration.h), for budgeted auto. Null,
         /// or an Ogre::Exception from it (its text logged as the reason): auto draws the fixed bands.
         std::function<std::vector<LevelCost>(TreeAsset& asset)> levelCosts;
+        /// false: no ground mesh; the application draws the script's ground itself (the browser's
+        /// terrain sample: Ogre's Terrain on the same heightfield, heights from groundHeight()).
+        bool ground = true;
     };
 
     class ForestScene
     {
     public:
-        /// Builds under `parent` (ground mesh, Forest) and sets the scene manager's ambient light,
+        /// Builds under `parent` (ground mesh unless options.ground is false, Forest) and sets the scene manager's ambient light,
         /// the sun (the light "TreeLodSun" when the scene manager has one, as OffscreenRenderer's
         /// does, else created and owned) and texture shadows as the script says. Throws Ogre::Exception with the script's file and the species' name when
         /// a bake or load fails.
