@@ -110,7 +110,11 @@ namespace TreeLod
         // The sun's shadows come from the shadow textures only; the Terrain does not cast (its
         // default), so its lightmap, the hills' own shadows, is left out too.
         profile->setLightmapEnabled(false);
-        profile->setLayerNormalMappingEnabled(false);
+        // Layer normal mapping stays on (with a flat normal map): OGRE 1.12's GLSL generator
+        // numbers a normal-map sampler per layer either way, and with it off, the shadow
+        // textures' inverseShadowmapSize constants read the sizes of the wrong texture units
+        // (1 / 1: the PCF taps land far off and the shadows vanish or turn into patches).
+        profile->setLayerNormalMappingEnabled(true);
         profile->setLayerParallaxMappingEnabled(false);
         profile->setLayerSpecularMappingEnabled(false);
         createLayerTextures(TREELOD_GROUP);
