@@ -16,6 +16,8 @@
 //   #endif
 // GLSL 1.20 and ES 1.00 are not targets: the programs fetch texels by integer coordinates and
 // pack cell indices in bits (texelFetch, uint, bit operators: GLSL 1.30, ES 3.00, SM4).
+// HLSL is compile-checked only (tests/shaders/validate-hlsl.py, glslang's HLSL front end); no
+// Direct3D runs it here. Cg (OGRE_CG without OGRE_HLSL) is not a target: it would take the GLSL side.
 //
 // The sources are GLSL with the differences to HLSL written as the macros below, in the style of
 // OGRE's OgreUnifiedShader.h (which TreeLod does not include: its GLSL side declares inputs with
