@@ -2,7 +2,7 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
@@ -24,21 +24,21 @@
 // LOW_RES_ONLY: the far technique (material LoD): the low-res texture alone, no lists.
 // CASTER: writes the shadow camera's window depth instead of a colour (TreeLodCaster.frag).
 // SHADOW_RECEIVER: the sun term is scaled by the sun's visibility in the shadow texture.
-uniform sampler2D lowRes;
+SAMPLER2D(lowRes, 0);
 #ifndef LOW_RES_ONLY
-uniform sampler2D hashAtlas;
+SAMPLER2D(hashAtlas, 1);
 #ifdef OGRE_GLSLES
 // ES 3.00 has no 16-bit normalised textures: the list entries are RGBA16UI there
 // (BillboardCloudResources picks the format with the language).
 uniform highp usampler2D listsAtlas;
 #define LIST_ENTRY(at) texelFetch(listsAtlas, at, 0)
 #else
-uniform sampler2D listsAtlas;
-#define LIST_ENTRY(at) uvec4(texelFetch(listsAtlas, at, 0) * 65535.0 + 0.5)
+SAMPLER2D(listsAtlas, 2);
+#define LIST_ENTRY(at) uvec4(TEX2D_FETCH(listsAtlas, at, 0) * 65535.0 + 0.5)
 #endif
-uniform sampler2D aoAtlas;
-uniform sampler2D leavesColour;
-uniform sampler2D leavesNormal;
+SAMPLER2D(aoAtlas, 3);
+SAMPLER2D(leavesColour, 4);
+SAMPLER2D(leavesNormal, 5);
 uniform int listsAtlasWidth;
 uniform float tileSize;      // texels per tile edge
 uniform int tileColumns;
@@ -52,35 +52,33 @@ uniform vec4 lodParams;
 uniform vec4 sunDirection;   // world space, towards the sun (w = 0 for a directional light)
 uniform vec4 sunColour;
 uniform vec4 ambientColour;
-#else
-in vec2 vClipZW;
 #endif
 
-in vec2 vUv;
-in vec2 vLowResUv;
-flat in vec4 vHash;          // hashX, hashY, hashWidth, hashHeight
-in vec3 vNormal;
-in vec3 vTangent;
-in vec3 vToCamera;
-
-out vec4 fragColour;
-
+#ifdef LOW_RES_ONLY
+#define SHADOW_UNIT0 1
+#define SHADOW_UNIT1 2
+#define SHADOW_UNIT2 3
+#else
+#define SHADOW_UNIT0 6
+#define SHADOW_UNIT1 7
+#define SHADOW_UNIT2 8
+#endif
 #include "TreeLodShading.glsl"
 
-const float LOW_RES_ALPHA_CUTOFF = 0.25; // BillboardCloudData.h
-const float LEAVES_COVERAGE_CUTOFF = 0.5; // BillboardCloudData.h: every leaf image, its material's cutoff baked in
-const float TWO_PI = 6.28318530718;
+STATIC const float LOW_RES_ALPHA_CUTOFF = 0.25; // BillboardCloudData.h
+STATIC const float LEAVES_COVERAGE_CUTOFF = 0.5; // BillboardCloudData.h: every leaf image, its material's cutoff baked in
+STATIC const float TWO_PI = 6.28318530718;
 
 // The low-res AO (§5.2): covered texels hold 0.5 + 0.5 * ao, empty ones 0, so a filtered alpha
 // at a leaf's edge mixes coverage into the value (decoding it would darken every edge). Take
 // ao from the covered texels of the bilinear footprint at the mip level the footprint selects.
 float lowResAo(vec2 uv, vec2 dx, vec2 dy, float filtered)
 {
-    vec2 size0 = vec2(textureSize(lowRes, 0));
+    vec2 size0 = vec2(TEX2D_SIZE(lowRes, 0));
     float rho2 = max(dot(dx * size0, dx * size0), dot(dy * size0, dy * size0));
     float top = floor(log2(max(size0.x, size0.y)));
     int level = int(clamp(floor(0.5 * log2(max(rho2, 1e-12)) + 0.5), 0.0, top));
-    ivec2 size = textureSize(lowRes, level);
+    ivec2 size = TEX2D_SIZE(lowRes, level);
     vec2 t = uv * vec2(size) - 0.5;
     vec2 f = fract(t);
     ivec2 base = ivec2(floor(t));
@@ -88,7 +86,7 @@ float lowResAo(vec2 uv, vec2 dx, vec2 dy, float filtered)
     for (int k = 0; k < 4; ++k)
     {
         ivec2 o = ivec2(k & 1, k >> 1);
-        float a = texelFetch(lowRes, clamp(base + o, ivec2(0), size - 1), level).a;
+        float a = TEX2D_FETCH(lowRes, clamp(base + o, ivec2_splat(0), size - 1), level).a;
         float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y) + 1e-4;
         if (a >= 0.5)
         {
@@ -99,7 +97,20 @@ float lowResAo(vec2 uv, vec2 dx, vec2 dy, float filtered)
     return weight > 0.0 ? clamp(sum / weight, 0.0, 1.0) : clamp(2.0 * filtered - 1.0, 0.0, 1.0);
 }
 
-void main()
+MAIN_PARAMETERS
+    IN(vec2 vUv, TEXCOORD0)
+    IN(vec2 vLowResUv, TEXCOORD1)
+    FLAT_IN(vec4 vHash, TEXCOORD2) // hashX, hashY, hashWidth, hashHeight
+    IN(vec3 vNormal, TEXCOORD3)
+    IN(vec3 vTangent, TEXCOORD4)
+    IN(vec3 vToCamera, TEXCOORD5)
+#ifdef CASTER
+    IN(vec2 vClipZW, TEXCOORD6)
+#endif
+#ifdef SHADOW_RECEIVER
+    SHADOW_POSITIONS_IN(TEXCOORD7, TEXCOORD8, TEXCOORD9)
+#endif
+MAIN_DECLARATION
 {
     vec3 N = normalize(vNormal);
     // Camera (or light) on the billboard's +normal side: walk front to back, tiles of side 0.
@@ -107,17 +118,18 @@ void main()
     // Footprints before any branch (derivatives are undefined in divergent control flow).
     vec2 lowResDx = dFdx(vLowResUv), lowResDy = dFdy(vLowResUv);
 
-    vec3 albedo;
+    // (Initialised for HLSL, which rejects reading a variable not set on every path.)
+    vec3 albedo = vec3_splat(0.0);
     vec3 n = front ? N : -N;
-    float ao;
+    float ao = 1.0;
     bool found = false;
 #ifndef LOW_RES_ONLY
     vec2 p = vUv * vHash.zw; // billboard coordinates: hash cells are unit squares
     float rho = max(length(dFdx(p)), length(dFdy(p))); // cells per pixel
     // 1. Hash fetch (§4.2): exact texel, 24-bit start and 8-bit length.
     ivec2 size = ivec2(vHash.zw + 0.5);
-    ivec2 cell = clamp(ivec2(floor(p)), ivec2(0), size - 1);
-    uvec4 h = uvec4(texelFetch(hashAtlas, ivec2(vHash.xy + 0.5) + cell, 0) * 255.0 + 0.5);
+    ivec2 cell = clamp(ivec2(floor(p)), ivec2_splat(0), size - 1);
+    uvec4 h = uvec4(TEX2D_FETCH(hashAtlas, ivec2(vHash.xy + 0.5) + cell, 0) * 255.0 + 0.5);
     uint start = h.r | (h.g << 8u) | (h.b << 16u);
     uint count = h.a;
     if (count == 0u)
@@ -145,7 +157,7 @@ void main()
         uint m = w.b >> 15u;
         if (m == 1u)
             local.x = 1.0 - local.x;
-        if (any(lessThan(local, vec2(0.0))) || any(greaterThan(local, vec2(1.0))))
+        if (any(lessThan(local, vec2_splat(0.0))) || any(greaterThan(local, vec2_splat(1.0))))
             continue;
         uint orientation = w.b & 0x7fffu;
         uint tile = orientation + (side ^ m) * orientations;
@@ -154,14 +166,14 @@ void main()
                   vec2(float(tileColumns), float(tileRows));
         // The Leaves Texture mip of this entry's footprint: texels per pixel = rho * tileSize / side.
         float lod = clamp(log2(max(rho * tileSize / edge, 1e-6)), 0.0, leavesMaxLod);
-        vec4 leaf = textureLod(leavesColour, uv, lod);
+        vec4 leaf = TEX2D_LOD(leavesColour, uv, lod);
         if (leaf.a < LEAVES_COVERAGE_CUTOFF)
             continue;
         found = true;
 #ifndef CASTER
         albedo = toLinear(leaf.rgb);
         // Normal map (tile frame) to the billboard frame (BillboardCloudData.h, Leaves Texture).
-        vec3 nt = textureLod(leavesNormal, uv, lod).xyz * 2.0 - 1.0;
+        vec3 nt = TEX2D_LOD(leavesNormal, uv, lod).xyz * 2.0 - 1.0;
         float mirror = m == 1u ? -1.0 : 1.0;
         nt.x *= mirror;
         nt.z *= mirror;
@@ -170,7 +182,7 @@ void main()
         if (dot(n, vToCamera) < 0.0)
             n = -n;
         // §5.2, Fig. 11: AO at the tile corners, bilinear at the local position.
-        vec4 corners = texelFetch(aoAtlas, at, 0);
+        vec4 corners = TEX2D_FETCH(aoAtlas, at, 0);
         ao = mix(mix(corners.r, corners.g, local.x), mix(corners.b, corners.a, local.x), local.y);
 #endif
         break;
@@ -182,7 +194,7 @@ void main()
     {
         // §5.1: the leaves the walk left out (or, LOW_RES_ONLY, all of them) from the low-res
         // texture; its alpha holds coverage and AO (0.5 + 0.5 * ao where covered).
-        vec4 texel = textureGrad(lowRes, vLowResUv, lowResDx, lowResDy);
+        vec4 texel = TEX2D_GRAD(lowRes, vLowResUv, lowResDx, lowResDy);
         if (texel.a < LOW_RES_ALPHA_CUTOFF)
             discard;
         albedo = toLinear(texel.rgb);
@@ -194,7 +206,7 @@ void main()
     float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5; // as TreeLodCaster.frag
     fragColour = casterOutput(depth);
 #else
-    float lambert = max(dot(n, normalize(sunDirection.xyz)), 0.0) * sunVisibility();
+    float lambert = max(dot(n, normalize(sunDirection.xyz)), 0.0) * SUN_VISIBILITY;
     vec3 colour = albedo * (ambientColour.rgb * mix(1.0, ao, lodParams.y) + sunColour.rgb * lambert);
     fragColour = vec4(toSrgb(colour), 1.0);
 #endif

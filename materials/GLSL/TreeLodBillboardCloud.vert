@@ -2,7 +2,7 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
@@ -17,7 +17,6 @@ uniform mat4 worldViewProj;
 uniform mat4 world;
 #ifdef CASTER
 uniform mat4 view;
-out vec2 vClipZW;
 #else
 uniform mat4 normalMatrix;
 uniform vec4 cameraPosition;
@@ -25,46 +24,54 @@ uniform vec4 cameraPosition;
 #ifdef SHADOW_RECEIVER
 #include "TreeLodShadowReceiver.glsl"
 #endif
-
-in vec4 vertex;
-in vec3 normal;
-in vec3 tangent;
-in vec2 uv0;
-in vec4 uv1;
-in vec4 uv2;
-
-out vec2 vUv;
-out vec2 vLowResUv;
-flat out vec4 vHash;
-out vec3 vNormal;
-out vec3 vTangent;
-out vec3 vToCamera;
 #ifdef INSTANCED
 #include "TreeLodInstance.glsl"
 #endif
 
-void main()
+MAIN_PARAMETERS
+    IN(vec4 vertex, POSITION)
+    IN(vec3 normal, NORMAL)
+    IN(vec3 tangent, TANGENT)
+    IN(vec2 uv0, TEXCOORD0)
+    IN(vec4 uv1, TEXCOORD1)
+    IN(vec4 uv2, TEXCOORD2)
+#ifdef INSTANCED
+    INSTANCE_IN
+#endif
+    OUT(vec2 vUv, TEXCOORD0)
+    OUT(vec2 vLowResUv, TEXCOORD1)
+    FLAT_OUT(vec4 vHash, TEXCOORD2)
+    OUT(vec3 vNormal, TEXCOORD3)
+    OUT(vec3 vTangent, TEXCOORD4)
+    OUT(vec3 vToCamera, TEXCOORD5)
+#ifdef CASTER
+    OUT(vec2 vClipZW, TEXCOORD6)
+#endif
+#ifdef SHADOW_RECEIVER
+    SHADOW_POSITIONS_OUT(TEXCOORD7, TEXCOORD8, TEXCOORD9)
+#endif
+MAIN_DECLARATION
 {
 #ifdef INSTANCED
-    vec4 local = instancePosition(vertex);
-    vec3 objectNormal = instanceDirection(normal);
-    vec3 objectTangent = instanceDirection(tangent);
+    vec4 local = instancePosition(uv4, uv5, vertex);
+    vec3 objectNormal = instanceDirection(uv5, normal);
+    vec3 objectTangent = instanceDirection(uv5, tangent);
 #else
     vec4 local = vertex;
     vec3 objectNormal = normal;
     vec3 objectTangent = tangent;
 #endif
-    gl_Position = worldViewProj * local;
-    vec3 position = (world * local).xyz;
+    gl_Position = mul(worldViewProj, local);
+    vec3 position = mul(world, local).xyz;
 #ifdef CASTER
     vClipZW = gl_Position.zw;
-    vNormal = mat3(world) * objectNormal;
-    vToCamera = vec3(view[0][2], view[1][2], view[2][2]);
+    vNormal = mul(toMat3(world), objectNormal);
+    vToCamera = row3(view, 2);
 #else
-    vNormal = mat3(normalMatrix) * objectNormal;
+    vNormal = mul(toMat3(normalMatrix), objectNormal);
     vToCamera = cameraPosition.xyz - position;
 #endif
-    vTangent = mat3(world) * objectTangent;
+    vTangent = mul(toMat3(world), objectTangent);
     vUv = uv0;
     vHash = uv1;
     vLowResUv = mix(uv2.xy, uv2.zw, uv0);

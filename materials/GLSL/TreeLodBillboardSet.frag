@@ -2,19 +2,19 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
 // The billboard-set floor: the impostor's sRGB colour written as it is (unlit), alpha tested.
-uniform sampler2D colourMap;
+SAMPLER2D(colourMap, 0);
 uniform float alphaCutoff;
-in vec2 vUv;
-out vec4 fragColour;
 
-void main()
+MAIN_PARAMETERS
+    IN(vec2 vUv, TEXCOORD0)
+MAIN_DECLARATION
 {
-    vec4 texel = texture(colourMap, vUv);
+    vec4 texel = TEX2D(colourMap, vUv);
     if (texel.a < alphaCutoff)
         discard;
     fragColour = vec4(texel.rgb, 1.0);

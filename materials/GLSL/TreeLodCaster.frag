@@ -2,28 +2,26 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
 #include "TreeLodShadowCaster.glsl"
 // Shadow caster; ALPHA_TEST: leaves cast the shadow of their texture's shape.
 #ifdef ALPHA_TEST
-uniform sampler2D diffuseMap;
+SAMPLER2D(diffuseMap, 0);
 uniform float alphaCutoff;
 uniform float alphaMaxLod;
 #include "TreeLodLeafAlpha.glsl"
 #endif
 
-in vec2 vClipZW;
-in vec2 vUv;
-
-out vec4 fragColour;
-
-void main()
+MAIN_PARAMETERS
+    IN(vec2 vClipZW, TEXCOORD0)
+    IN(vec2 vUv, TEXCOORD1)
+MAIN_DECLARATION
 {
 #ifdef ALPHA_TEST
-    if (leafAlpha(diffuseMap, vUv, alphaMaxLod) < alphaCutoff)
+    if (leafAlpha(SAMPLER2D_ARG(diffuseMap), vUv, alphaMaxLod) < alphaCutoff)
         discard;
 #endif
     // The shadow camera's window depth, 0..1 (shadow textures clear to 1); the receiver computes

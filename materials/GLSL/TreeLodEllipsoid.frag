@@ -2,11 +2,11 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 // Conservative depth is a desktop extension (ES 3.00 writes gl_FragDepth without the hint).
-#ifndef OGRE_GLSLES
+#ifdef OGRE_GLSL
 #extension GL_ARB_conservative_depth : enable
 #endif
 #include "TreeLodShaderSupport.glsl"
@@ -30,9 +30,17 @@
 // CASTER: writes the shadow camera's window depth of the hit instead (as TreeLodCaster.frag).
 // SHADOW_RECEIVER: the sun's visibility at the hit (its world position, inverseView * hit).
 uniform mat4 projection;
-uniform samplerCube noiseAlpha;
+#ifdef SHADOW_RECEIVER
+SAMPLERCUBE(noiseAlpha, 3); // after the shadow textures
+#else
+SAMPLERCUBE(noiseAlpha, 0);
+#endif
 #ifndef CASTER
-uniform samplerCube noiseNormal;
+#ifdef SHADOW_RECEIVER
+SAMPLERCUBE(noiseNormal, 4);
+#else
+SAMPLERCUBE(noiseNormal, 1);
+#endif
 uniform vec4 sunDirection; // view space, towards the sun (w = 0 for a directional light)
 uniform vec4 sunColour;
 uniform vec4 ambientColour;
@@ -42,29 +50,31 @@ uniform vec4 ambientColour;
 uniform mat4 inverseView;
 #endif
 
-in vec4 vNear;
-in vec4 vFar;
-flat in vec3 vCentre;
-flat in mat3 vToUnit;
-flat in vec4 vColour;
-flat in vec3 vNoise; // lod, alpha threshold, normal blend
-
-out vec4 fragColour;
 #ifdef GL_ARB_conservative_depth
 // The quad lies at the ellipsoid box's nearest depth (TreeLodEllipsoid.vert): the hit is never
 // nearer, so the depth test may run before the program.
 layout(depth_greater) out float gl_FragDepth;
 #endif
 
+#define SHADOW_UNIT0 0
+#define SHADOW_UNIT1 1
+#define SHADOW_UNIT2 2
 #include "TreeLodShading.glsl"
 
-void main()
+MAIN_PARAMETERS
+    IN(vec4 vNear, TEXCOORD0)
+    IN(vec4 vFar, TEXCOORD1)
+    FLAT_IN(vec3 vCentre, TEXCOORD2)
+    FLAT_IN(mat3 vToUnit, TEXCOORD3)
+    FLAT_IN(vec4 vColour, TEXCOORD6)
+    FLAT_IN(vec3 vNoise, TEXCOORD7) // lod, alpha threshold, normal blend
+MAIN_DECLARATION_DEPTH
 {
     vec3 from = vNear.xyz / vNear.w;
     vec3 dir = normalize(vFar.xyz / vFar.w - from);
-    vec3 k = vToUnit * dir;
+    vec3 k = mul(vToUnit, dir);
     float a = dot(k, k);
-    vec3 start = vToUnit * (from - vCentre);
+    vec3 start = mul(vToUnit, from - vCentre);
     float mid = -dot(start, k) / a;
     vec3 o = start + mid * k;
     float c = dot(o, o) - 1.0;
@@ -74,31 +84,31 @@ void main()
     // The near side; where the near plane cuts it or the noise opens a hole there, the far side.
     float t = mid - halfChord;
     vec3 u = o - halfChord * k;
-    if (t < 0.0 || (vNoise.y > 0.0 && textureLod(noiseAlpha, u, vNoise.x).r < vNoise.y))
+    if (t < 0.0 || (vNoise.y > 0.0 && TEXCUBE_LOD(noiseAlpha, u, vNoise.x).r < vNoise.y))
     {
         t = mid + halfChord;
         u = o + halfChord * k;
-        if (t < 0.0 || (vNoise.y > 0.0 && textureLod(noiseAlpha, u, vNoise.x).r < vNoise.y))
+        if (t < 0.0 || (vNoise.y > 0.0 && TEXCUBE_LOD(noiseAlpha, u, vNoise.x).r < vNoise.y))
             discard;
     }
     vec3 hit = from + t * dir;
-    vec4 clip = projection * vec4(hit, 1.0);
+    vec4 clip = mul(projection, vec4(hit, 1.0));
     float ndcDepth = clip.z / clip.w;
     if (ndcDepth > 1.0)
         discard; // beyond the far plane
-    float depth = 0.5 * ndcDepth + 0.5;
-    gl_FragDepth = depth;
+    float depth = 0.5 * ndcDepth + 0.5; // the casters' shadow depth (TreeLodShadowCaster.glsl)
+    gl_FragDepth = WINDOW_DEPTH(ndcDepth);
 #ifdef CASTER
     fragColour = casterOutput(depth);
 #else
     vec3 unitNormal = u;
     if (vNoise.z > 0.0)
-        unitNormal = mix(u, textureLod(noiseNormal, u, vNoise.x).rgb * 2.0 - 1.0, vNoise.z);
-    vec3 n = normalize(transpose(vToUnit) * unitNormal);
+        unitNormal = mix(u, TEXCUBE_LOD(noiseNormal, u, vNoise.x).rgb * 2.0 - 1.0, vNoise.z);
+    vec3 n = normalize(mul(transpose(vToUnit), unitNormal));
     if (dot(n, dir) > 0.0) // seen from inside
         n = -n;
 #ifdef SHADOW_RECEIVER
-    float shadow = sunVisibilityAtWorld(inverseView * vec4(hit, 1.0));
+    float shadow = sunVisibilityAtWorld(mul(inverseView, vec4(hit, 1.0)));
 #else
     float shadow = 1.0;
 #endif

@@ -2,7 +2,7 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
@@ -27,16 +27,9 @@ uniform vec4 ambientColour;
 uniform mat4 inverseView;
 #endif
 
-in vec3 vPosition;
-flat in vec3 vStart;
-flat in vec3 vEnd;
-flat in float vRadius;
-flat in float vPixel;
-flat in vec4 vColour;
-flat in vec4 vProjectionCentre; // the eye (w = 1) or a parallel projection's depth direction (w = 0)
-
-out vec4 fragColour;
-
+#define SHADOW_UNIT0 0
+#define SHADOW_UNIT1 1
+#define SHADOW_UNIT2 2
 #include "TreeLodShading.glsl"
 
 // Distance along rd from ro to the capsule (pa, pb, r), or -1 (Quilez's capsule intersection).
@@ -69,7 +62,15 @@ float capsule(vec3 ro, vec3 rd, vec3 pa, vec3 pb, float r)
     return best;
 }
 
-void main()
+MAIN_PARAMETERS
+    IN(vec3 vPosition, TEXCOORD0)
+    FLAT_IN(vec3 vStart, TEXCOORD1)
+    FLAT_IN(vec3 vEnd, TEXCOORD2)
+    FLAT_IN(float vRadius, TEXCOORD3)
+    FLAT_IN(float vPixel, TEXCOORD4)
+    FLAT_IN(vec4 vColour, TEXCOORD5)
+    FLAT_IN(vec4 vProjectionCentre, TEXCOORD6) // the eye (w = 1) or a parallel projection's depth direction (w = 0)
+MAIN_DECLARATION_DEPTH
 {
     // From the eye through the pixel, or along a parallel projection's depth axis (into the scene).
     vec3 rd = normalize(vProjectionCentre.w > 0.0 ? vPosition - vProjectionCentre.xyz : vProjectionCentre.xyz);
@@ -77,7 +78,7 @@ void main()
     float back = 2.0 * max(vRadius, vPixel) + length(vEnd - vStart);
     vec3 ro = vPosition - rd * back;
     float t = capsule(ro, rd, vStart, vEnd, vRadius);
-    vec3 hit, n;
+    vec3 hit = vec3_splat(0.0), n = vec3_splat(0.0); // (initialised for HLSL: set on every path not discarded)
     vec3 ba = vEnd - vStart;
     float baba = max(dot(ba, ba), 1e-30);
     if (t >= 0.0)
@@ -103,17 +104,17 @@ void main()
         n = -rd + dot(rd, axis) * axis;
         n = dot(n, n) > 1e-12 ? normalize(n) : -rd;
     }
-    vec4 clip = projection * vec4(hit, 1.0);
+    vec4 clip = mul(projection, vec4(hit, 1.0));
     float ndcDepth = clip.z / clip.w;
-    if (ndcDepth < -1.0 || ndcDepth > 1.0)
+    if (ndcDepth < NDC_NEAR || ndcDepth > 1.0)
         discard;
-    float depth = 0.5 * ndcDepth + 0.5;
-    gl_FragDepth = depth;
+    float depth = 0.5 * ndcDepth + 0.5; // the casters' shadow depth (TreeLodShadowCaster.glsl)
+    gl_FragDepth = WINDOW_DEPTH(ndcDepth);
 #ifdef CASTER
     fragColour = casterOutput(depth);
 #else
 #ifdef SHADOW_RECEIVER
-    float shadow = sunVisibilityAtWorld(inverseView * vec4(hit, 1.0));
+    float shadow = sunVisibilityAtWorld(mul(inverseView, vec4(hit, 1.0)));
 #else
     float shadow = 1.0;
 #endif

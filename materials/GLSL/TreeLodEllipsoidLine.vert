@@ -2,7 +2,7 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
@@ -21,32 +21,32 @@ uniform mat4 projection;
 uniform mat4 inverseProjection;
 uniform vec4 viewportSize; // width, height, 1 / width, 1 / height
 
-in vec4 vertex;
-in vec2 uv0;
-in vec4 uv1;
-in vec4 colour;
-
 #include "TreeLodInstance.glsl"
-
-out vec3 vPosition;     // view space: the quad's point, on the pixel's ray
-flat out vec3 vStart;   // view space
-flat out vec3 vEnd;
-flat out float vRadius;
-flat out float vPixel;  // view-space size of a pixel at the line (perspective: at its nearer end)
-flat out vec4 vColour;
-flat out vec4 vProjectionCentre; // projectionCentre(), for the fragment's ray
 
 // The projection's centre (w = 1) or, for a parallel projection, its direction (w = 0).
 vec4 projectionCentre()
 {
-    vec4 c = inverseProjection * vec4(0.0, 0.0, 1.0, 0.0);
+    vec4 c = mul(inverseProjection, vec4(0.0, 0.0, 1.0, 0.0));
     return abs(c.w) > 1e-9 * length(c.xyz) ? vec4(c.xyz / c.w, 1.0) : vec4(normalize(c.xyz), 0.0);
 }
 
-void main()
+MAIN_PARAMETERS
+    IN(vec4 vertex, POSITION)
+    IN(vec2 uv0, TEXCOORD0)
+    IN(vec4 uv1, TEXCOORD1)
+    IN(vec4 colour, COLOR)
+    INSTANCE_IN
+    OUT(vec3 vPosition, TEXCOORD0)     // view space: the quad's point, on the pixel's ray
+    FLAT_OUT(vec3 vStart, TEXCOORD1)   // view space
+    FLAT_OUT(vec3 vEnd, TEXCOORD2)
+    FLAT_OUT(float vRadius, TEXCOORD3)
+    FLAT_OUT(float vPixel, TEXCOORD4)  // view-space size of a pixel at the line (perspective: at its nearer end)
+    FLAT_OUT(vec4 vColour, TEXCOORD5)
+    FLAT_OUT(vec4 vProjectionCentre, TEXCOORD6) // projectionCentre(), for the fragment's ray
+MAIN_DECLARATION
 {
-    vec3 a = (worldView * instancePosition(vec4(vertex.xyz, 1.0))).xyz;
-    vec3 b = (worldView * instancePosition(vec4(uv1.xyz, 1.0))).xyz;
+    vec3 a = mul(worldView, instancePosition(uv4, uv5, vec4(vertex.xyz, 1.0))).xyz;
+    vec3 b = mul(worldView, instancePosition(uv4, uv5, vec4(uv1.xyz, 1.0))).xyz;
     float radius = uv1.w * uv4.w;
     vec4 centre = projectionCentre();
     vec3 p = mix(a, b, uv0.x);
@@ -72,5 +72,5 @@ void main()
     vRadius = radius;
     vColour = colour;
     vProjectionCentre = centre;
-    gl_Position = projection * vec4(vPosition, 1.0);
+    gl_Position = mul(projection, vec4(vPosition, 1.0));
 }

@@ -2,7 +2,7 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
@@ -20,37 +20,43 @@
 //   sRGB's linear toe makes the error), three square roots instead of two pow per channel.
 // CASTER: writes the shadow camera's window depth instead (as TreeLodCaster.frag).
 // SHADOW_RECEIVER: the sun term is scaled by the sun's visibility in the shadow texture.
-uniform sampler2D colourMap;  // sRGB albedo, coverage in alpha
+SAMPLER2D(colourMap, 0);  // sRGB albedo, coverage in alpha
 uniform float alphaCutoff;
-#ifdef CASTER
-in vec2 vClipZW;
-#else
-uniform sampler2D normalMap;  // normal x, y (n * 0.5 + 0.5) in the quad frame, ambient occlusion
+#ifndef CASTER
+SAMPLER2D(normalMap, 1);  // normal x, y (n * 0.5 + 0.5) in the quad frame, ambient occlusion
 uniform vec4 sunColour;
 uniform vec4 ambientColour;
-in vec3 vSunInQuad;
 #endif
 
-in vec2 vUv;
-
-out vec4 fragColour;
-
+#define SHADOW_UNIT0 2
+#define SHADOW_UNIT1 3
+#define SHADOW_UNIT2 4
 #include "TreeLodShading.glsl"
 
-void main()
+MAIN_PARAMETERS
+    IN(vec2 vUv, TEXCOORD0)
+#ifdef CASTER
+    IN(vec2 vClipZW, TEXCOORD1)
+#else
+    IN(vec3 vSunInQuad, TEXCOORD1)
+#endif
+#ifdef SHADOW_RECEIVER
+    SHADOW_POSITIONS_IN(TEXCOORD2, TEXCOORD3, TEXCOORD4)
+#endif
+MAIN_DECLARATION
 {
-    vec4 texel = texture(colourMap, vUv);
+    vec4 texel = TEX2D(colourMap, vUv);
     if (texel.a < alphaCutoff)
         discard;
 #ifdef CASTER
     float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5;
     fragColour = casterOutput(depth);
 #else
-    vec3 baked = texture(normalMap, vUv).xyz;
+    vec3 baked = TEX2D(normalMap, vUv).xyz;
     vec2 xy = baked.xy * 2.0 - 1.0;
     xy *= inversesqrt(max(dot(xy, xy), 1.0)); // a filtered normal may leave the unit disc
     vec3 n = vec3(xy, sqrt(max(1.0 - dot(xy, xy), 0.0)));
-    float lambert = max(dot(n, vSunInQuad), 0.0) * sunVisibility();
+    float lambert = max(dot(n, vSunInQuad), 0.0) * SUN_VISIBILITY;
     vec3 light = ambientColour.rgb * baked.z + sunColour.rgb * lambert;
     fragColour = vec4(min(texel.rgb * srgbScale(light), 1.0), 1.0);
 #endif

@@ -2,7 +2,7 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
@@ -20,28 +20,33 @@ uniform mat4 worldViewProj;
 uniform mat4 world;
 #ifdef CASTER
 uniform mat4 view;
-out vec2 vClipZW;
 #else
 uniform vec4 cameraPosition; // in the Forest's local space
 uniform vec4 sunDirection;   // world space, towards the sun (w = 0 for a directional light)
-out vec3 vSunInQuad;
 #endif
 #ifdef SHADOW_RECEIVER
 #include "TreeLodShadowReceiver.glsl"
 #endif
 
-in vec4 vertex;
-in vec2 uv0;
-in vec4 uv4;
-
-out vec2 vUv;
-
-void main()
+MAIN_PARAMETERS
+    IN(vec4 vertex, POSITION)
+    IN(vec2 uv0, TEXCOORD0)
+    IN(vec4 uv4, TEXCOORD4)
+    OUT(vec2 vUv, TEXCOORD0)
+#ifdef CASTER
+    OUT(vec2 vClipZW, TEXCOORD1)
+#else
+    OUT(vec3 vSunInQuad, TEXCOORD1)
+#endif
+#ifdef SHADOW_RECEIVER
+    SHADOW_POSITIONS_OUT(TEXCOORD2, TEXCOORD3, TEXCOORD4)
+#endif
+MAIN_DECLARATION
 {
     vec3 centre = uv4.xyz;
 #ifdef CASTER
     // The view's +z axis (towards the shadow camera) in the Forest's local space.
-    vec3 away = transpose(mat3(world)) * vec3(view[0][2], view[1][2], view[2][2]);
+    vec3 away = mul(transpose(toMat3(world)), row3(view, 2));
 #else
     vec3 away = cameraPosition.xyz - centre;
 #endif
@@ -50,17 +55,17 @@ void main()
     vec3 towards = vec3(f.x, 0.0, f.y);
     vec3 right = vec3(f.y, 0.0, -f.x);
     vec4 position = vec4(centre + uv4.w * (vertex.x * right + vec3(0.0, vertex.y, 0.0)), 1.0);
-    gl_Position = worldViewProj * position;
+    gl_Position = mul(worldViewProj, position);
     vUv = uv0;
 #ifdef CASTER
     vClipZW = gl_Position.zw;
 #else
-    mat3 toWorld = mat3(world);
+    mat3 toWorld = toMat3(world);
     vec3 sun = normalize(sunDirection.xyz);
-    vSunInQuad = vec3(dot(sun, normalize(toWorld * right)), dot(sun, normalize(toWorld * vec3(0.0, 1.0, 0.0))),
-                      dot(sun, normalize(toWorld * towards)));
+    vSunInQuad = vec3(dot(sun, normalize(mul(toWorld, right))), dot(sun, normalize(mul(toWorld, vec3(0.0, 1.0, 0.0)))),
+                      dot(sun, normalize(mul(toWorld, towards))));
 #endif
 #ifdef SHADOW_RECEIVER
-    passShadowPositions(world * position);
+    passShadowPositions(mul(world, position));
 #endif
 }

@@ -2,7 +2,7 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
@@ -11,7 +11,7 @@
 // LEAF: alpha test by discard; two-sided, the back side with backColour instead of baseColour.
 // SHADOW_RECEIVER: the sun term is scaled by the sun's visibility in the shadow texture.
 // AO: the vertex colour's red channel scales the ambient term (bark AO, García et al. 2007 §5.2).
-uniform sampler2D diffuseMap;
+SAMPLER2D(diffuseMap, 0);
 uniform vec4 sunDirection;  // world space, towards the sun (w = 0 for a directional light)
 uniform vec4 sunColour;
 uniform vec4 ambientColour;
@@ -20,23 +20,27 @@ uniform vec4 backColour;    // linear
 uniform float alphaCutoff;
 uniform float alphaMaxLod;  // coarsest mip level the alpha test reads (see leafAlpha)
 
-in vec3 vNormal;
-in vec3 vToCamera;
-in vec2 vUv;
-#ifdef AO
-in float vAo;
-#endif
-
-out vec4 fragColour;
-
+#define SHADOW_UNIT0 1
+#define SHADOW_UNIT1 2
+#define SHADOW_UNIT2 3
 #include "TreeLodShading.glsl"
 #include "TreeLodLeafAlpha.glsl"
 
-void main()
+MAIN_PARAMETERS
+    IN(vec3 vNormal, TEXCOORD0)
+    IN(vec3 vToCamera, TEXCOORD1)
+    IN(vec2 vUv, TEXCOORD2)
+#ifdef AO
+    IN(float vAo, TEXCOORD3)
+#endif
+#ifdef SHADOW_RECEIVER
+    SHADOW_POSITIONS_IN(TEXCOORD4, TEXCOORD5, TEXCOORD6)
+#endif
+MAIN_DECLARATION
 {
-    vec4 texel = texture(diffuseMap, vUv);
+    vec4 texel = TEX2D(diffuseMap, vUv);
 #ifdef LEAF
-    texel.a = leafAlpha(diffuseMap, vUv, alphaMaxLod);
+    texel.a = leafAlpha(SAMPLER2D_ARG(diffuseMap), vUv, alphaMaxLod);
 #endif
     vec3 n = normalize(vNormal);
     vec3 tint = baseColour.rgb;
@@ -52,7 +56,7 @@ void main()
     }
 #endif
     vec3 albedo = tint * toLinear(texel.rgb);
-    float lambert = max(dot(n, normalize(sunDirection.xyz)), 0.0) * sunVisibility();
+    float lambert = max(dot(n, normalize(sunDirection.xyz)), 0.0) * SUN_VISIBILITY;
 #ifdef AO
     float ao = vAo;
 #else

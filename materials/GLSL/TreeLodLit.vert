@@ -2,7 +2,7 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
@@ -14,18 +14,6 @@ uniform mat4 worldViewProj;
 uniform mat4 world;
 uniform mat4 normalMatrix;
 uniform vec4 cameraPosition;
-
-in vec4 vertex;
-in vec3 normal;
-in vec2 uv0;
-
-out vec3 vNormal;
-out vec3 vToCamera;
-out vec2 vUv;
-#ifdef AO
-in vec4 colour;
-out float vAo;
-#endif
 #ifdef SHADOW_RECEIVER
 #include "TreeLodShadowReceiver.glsl"
 #endif
@@ -33,23 +21,42 @@ out float vAo;
 #include "TreeLodInstance.glsl"
 #endif
 
-void main()
+MAIN_PARAMETERS
+    IN(vec4 vertex, POSITION)
+    IN(vec3 normal, NORMAL)
+    IN(vec2 uv0, TEXCOORD0)
+#ifdef AO
+    IN(vec4 colour, COLOR)
+#endif
+#ifdef INSTANCED
+    INSTANCE_IN
+#endif
+    OUT(vec3 vNormal, TEXCOORD0)
+    OUT(vec3 vToCamera, TEXCOORD1)
+    OUT(vec2 vUv, TEXCOORD2)
+#ifdef AO
+    OUT(float vAo, TEXCOORD3)
+#endif
+#ifdef SHADOW_RECEIVER
+    SHADOW_POSITIONS_OUT(TEXCOORD4, TEXCOORD5, TEXCOORD6)
+#endif
+MAIN_DECLARATION
 {
 #ifdef INSTANCED
-    vec4 position = instancePosition(vertex);
-    vec3 objectNormal = instanceDirection(normal);
+    vec4 position = instancePosition(uv4, uv5, vertex);
+    vec3 objectNormal = instanceDirection(uv5, normal);
 #else
     vec4 position = vertex;
     vec3 objectNormal = normal;
 #endif
-    gl_Position = worldViewProj * position;
-    vNormal = mat3(normalMatrix) * objectNormal;
-    vToCamera = cameraPosition.xyz - (world * position).xyz;
+    gl_Position = mul(worldViewProj, position);
+    vNormal = mul(toMat3(normalMatrix), objectNormal);
+    vToCamera = cameraPosition.xyz - mul(world, position).xyz;
     vUv = uv0;
 #ifdef AO
     vAo = colour.r;
 #endif
 #ifdef SHADOW_RECEIVER
-    passShadowPositions(world * position);
+    passShadowPositions(mul(world, position));
 #endif
 }

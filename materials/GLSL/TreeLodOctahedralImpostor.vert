@@ -2,7 +2,7 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
@@ -27,36 +27,21 @@ uniform vec4 cylinder; // radius, bottom, top, depth radius (metres, the tree's 
 uniform vec4 atlas;    // frames a side N, frame texels F, margin texels, 0
 #ifdef CASTER
 uniform mat4 view;
-out vec2 vClipZW;
 #else
 uniform vec4 cameraPosition; // in the Forest's local space
 uniform vec4 sunDirection;   // world space, towards the sun
-out vec3 vSun0;
-out vec3 vSun1;
-out vec3 vSun2;
-out vec4 vParallax01; // frames 0 and 1: frame-coordinate shift per unit of (depth - 0.5)
-out vec2 vParallax2;
 #endif
 #ifdef SHADOW_RECEIVER
 #include "TreeLodShadowReceiver.glsl"
 #endif
-
-in vec4 vertex;
-
 #include "TreeLodInstance.glsl"
-
-out vec4 vUv01; // frame coordinates (0..1 within a frame) of frames 0 and 1
-out vec2 vUv2;
-flat out vec4 vFrame01; // frame column, row of frames 0 and 1
-flat out vec2 vFrame2;
-flat out vec3 vWeights;
 
 vec2 hemiOctahedralEncode(vec3 d)
 {
     d.y = max(d.y, 0.0);
     float l1 = abs(d.x) + d.y + abs(d.z);
     if (l1 <= 0.0)
-        return vec2(0.0);
+        return vec2_splat(0.0);
     vec2 xz = d.xz / l1;
     return vec2(xz.x + xz.y, xz.x - xz.y);
 }
@@ -80,7 +65,7 @@ float halfHeight(vec3 up) { return 0.5 * (cylinder.z - cylinder.y) * abs(up.y) +
 float marginScale() { return atlas.y / (atlas.y - 2.0 * atlas.z); }
 
 /// A direction of the Forest's local space in the tree's own frame (the instance's rotation undone).
-vec3 intoTree(vec3 d) { return vec3(uv5.x * d.x - uv5.y * d.z, d.y, uv5.y * d.x + uv5.x * d.z); }
+vec3 intoTree(vec2 uv5, vec3 d) { return vec3(uv5.x * d.x - uv5.y * d.z, d.y, uv5.y * d.x + uv5.x * d.z); }
 
 /// Frame `cell`: this corner's frame coordinates (xy) and their shift per unit of encoded depth
 /// (zw); the sun in the frame's axes.
@@ -99,27 +84,47 @@ vec4 frameCoordinates(vec2 cell, vec3 v, vec3 corner, vec3 sunInTree, out vec3 s
     return vec4(uv, shift);
 }
 
-void main()
+MAIN_PARAMETERS
+    IN(vec4 vertex, POSITION)
+    INSTANCE_IN
+    OUT(vec4 vUv01, TEXCOORD0) // frame coordinates (0..1 within a frame) of frames 0 and 1
+    OUT(vec2 vUv2, TEXCOORD1)
+    FLAT_OUT(vec4 vFrame01, TEXCOORD2) // frame column, row of frames 0 and 1
+    FLAT_OUT(vec2 vFrame2, TEXCOORD3)
+    FLAT_OUT(vec3 vWeights, TEXCOORD4)
+#ifdef CASTER
+    OUT(vec2 vClipZW, TEXCOORD5)
+#else
+    OUT(vec3 vSun0, TEXCOORD5)
+    OUT(vec3 vSun1, TEXCOORD6)
+    OUT(vec3 vSun2, TEXCOORD7)
+    OUT(vec4 vParallax01, TEXCOORD8) // frames 0 and 1: frame-coordinate shift per unit of (depth - 0.5)
+    OUT(vec2 vParallax2, TEXCOORD9)
+#endif
+#ifdef SHADOW_RECEIVER
+    SHADOW_POSITIONS_OUT(TEXCOORD10, TEXCOORD11, TEXCOORD12)
+#endif
+MAIN_DECLARATION
 {
     float centreY = 0.5 * (cylinder.y + cylinder.z);
     vec3 centre = uv4.xyz + vec3(0.0, uv4.w * centreY, 0.0);
 #ifdef CASTER
-    vec3 away = transpose(mat3(world)) * vec3(view[0][2], view[1][2], view[2][2]);
+    vec3 away = mul(transpose(toMat3(world)), row3(view, 2));
 #else
     vec3 away = cameraPosition.xyz - centre;
 #endif
-    vec3 v = dot(away, away) > 0.0 ? intoTree(normalize(away)) : vec3(0.0, 0.0, 1.0);
+    vec3 v = dot(away, away) > 0.0 ? intoTree(uv5, normalize(away)) : vec3(0.0, 0.0, 1.0);
 
     // The quad, facing v.
     vec3 right, up;
     frameAxes(v, right, up);
     vec3 corner = (vertex.x * cylinder.x * right + vertex.y * halfHeight(up) * up) * marginScale();
-    vec4 position = vec4(centre + uv4.w * instanceDirection(corner), 1.0);
-    gl_Position = worldViewProj * position;
+    vec4 position = vec4(centre + uv4.w * instanceDirection(uv5, corner), 1.0);
+    gl_Position = mul(worldViewProj, position);
 
     // The three frames around v.
     vec2 grid = (hemiOctahedralEncode(v) * 0.5 + 0.5) * (atlas.x - 1.0);
-    vec2 base = clamp(floor(grid), vec2(0.0), vec2(atlas.x - 2.0));
+    vec2 base = clamp(floor(grid), vec2_splat(0.0), vec2_splat(atlas.x - 2.0));
     vec2 f = clamp(grid - base, 0.0, 1.0);
     vec2 cell0, cell1 = base + vec2(1.0, 0.0), cell2 = base + vec2(0.0, 1.0);
     if (f.x + f.y <= 1.0)
@@ -129,16 +134,16 @@ void main()
     }
     else
     {
-        cell0 = base + vec2(1.0);
+        cell0 = base + vec2_splat(1.0);
         vWeights = vec3(f.x + f.y - 1.0, 1.0 - f.y, 1.0 - f.x);
     }
     vFrame01 = vec4(cell0, cell1);
     vFrame2 = cell2;
 
 #ifdef CASTER
-    vec3 sunInTree = vec3(0.0);
+    vec3 sunInTree = vec3_splat(0.0);
 #else
-    vec3 sunInTree = intoTree(normalize(transpose(mat3(world)) * normalize(sunDirection.xyz)));
+    vec3 sunInTree = intoTree(uv5, normalize(mul(transpose(toMat3(world)), normalize(sunDirection.xyz))));
 #endif
     vec3 sun0, sun1, sun2;
     vec4 c0 = frameCoordinates(cell0, v, corner, sunInTree, sun0);
@@ -156,6 +161,6 @@ void main()
     vSun2 = sun2;
 #endif
 #ifdef SHADOW_RECEIVER
-    passShadowPositions(world * position);
+    passShadowPositions(mul(world, position));
 #endif
 }

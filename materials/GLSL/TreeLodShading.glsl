@@ -1,12 +1,13 @@
 // Shading helpers shared by the fragment programs (lit leaves and bark, billboard clouds, the
 // impostors): sRGB conversions, srgbScale and, with SHADOW_RECEIVER, the sun's visibility in its
-// texture shadow.
+// texture shadow. Programs that include it set SHADOW_UNIT0..2, the texture units of the shadow
+// textures, first.
 
-vec3 toLinear(vec3 c) { return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(0.04045, c)); }
+vec3 toLinear(vec3 c) { return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3_splat(2.4)), step(0.04045, c)); }
 vec3 toSrgb(vec3 c)
 {
     c = clamp(c, 0.0, 1.0);
-    return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+    return mix(c * 12.92, 1.055 * pow(c, vec3_splat(1.0 / 2.4)) - 0.055, step(0.0031308, c));
 }
 
 // toSrgb(toLinear(albedo) * k) ~= albedo * srgbScale(k), exact for a power-law transfer curve
@@ -26,19 +27,19 @@ vec3 srgbScale(vec3 k)
 // textures, one (focused, LiSPSM) or PSSM's three splits: a point is looked up in the first
 // texture that holds it, the finest (units past the scene's texture count hold Ogre's null shadow
 // texture, which is lit).
-uniform sampler2D shadowMap0;
-uniform sampler2D shadowMap1;
-uniform sampler2D shadowMap2;
+SAMPLER2D(shadowMap0, SHADOW_UNIT0);
+SAMPLER2D(shadowMap1, SHADOW_UNIT1);
+SAMPLER2D(shadowMap2, SHADOW_UNIT2);
 uniform vec4 shadowTexelSize;  // 1 / width, 1 / height (the sun's shadow textures share a size)
 uniform float shadowBias;
 
 // The fraction of the 3x3 texels around p (texture coordinates, window depth) that p is not behind.
-float filteredVisibility(sampler2D map, vec3 p)
+float filteredVisibility(SAMPLER2D_PARAM(map), vec3 p)
 {
     float lit = 0.0;
     for (int y = -1; y <= 1; ++y)
         for (int x = -1; x <= 1; ++x)
-            lit += p.z <= texture(map, p.xy + vec2(x, y) * shadowTexelSize.xy).r ? 1.0 : 0.0;
+            lit += p.z <= TEX2D(map, p.xy + vec2(x, y) * shadowTexelSize.xy).r ? 1.0 : 0.0;
     return lit / 9.0;
 }
 
@@ -55,26 +56,25 @@ float sunVisibilityAt(vec4 shadowPos0, vec4 shadowPos1, vec4 shadowPos2)
 {
     vec3 p = shadowTexturePoint(shadowPos0);
     if (p.z < 1.0)
-        return filteredVisibility(shadowMap0, p);
+        return filteredVisibility(SAMPLER2D_ARG(shadowMap0), p);
     p = shadowTexturePoint(shadowPos1);
     if (p.z < 1.0)
-        return filteredVisibility(shadowMap1, p);
+        return filteredVisibility(SAMPLER2D_ARG(shadowMap1), p);
     p = shadowTexturePoint(shadowPos2);
-    return p.z < 1.0 ? filteredVisibility(shadowMap2, p) : 1.0;
+    return p.z < 1.0 ? filteredVisibility(SAMPLER2D_ARG(shadowMap2), p) : 1.0;
 }
 
 #ifdef SHADOW_POS_PER_FRAGMENT // the program computes the point itself (ray-cast surfaces)
 uniform mat4 texViewProj[3];   // the sun's shadow cameras, world to texture clip space
 float sunVisibilityAtWorld(vec4 world)
 {
-    return sunVisibilityAt(texViewProj[0] * world, texViewProj[1] * world, texViewProj[2] * world);
+    return sunVisibilityAt(mul(texViewProj[0], world), mul(texViewProj[1], world), mul(texViewProj[2], world));
 }
 #else
-in vec4 vShadowPos0; // TreeLodShadowReceiver.glsl
-in vec4 vShadowPos1;
-in vec4 vShadowPos2;
-float sunVisibility() { return sunVisibilityAt(vShadowPos0, vShadowPos1, vShadowPos2); }
+// The inputs from TreeLodShadowReceiver.glsl (main's parameters, with the semantics of SHADOW_POSITIONS_OUT).
+#define SHADOW_POSITIONS_IN(s0, s1, s2) IN(vec4 vShadowPos0, s0) IN(vec4 vShadowPos1, s1) IN(vec4 vShadowPos2, s2)
+#define SUN_VISIBILITY sunVisibilityAt(vShadowPos0, vShadowPos1, vShadowPos2)
 #endif
 #else
-float sunVisibility() { return 1.0; }
+#define SUN_VISIBILITY 1.0
 #endif

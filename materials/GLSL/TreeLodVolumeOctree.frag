@@ -2,7 +2,7 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
@@ -17,26 +17,15 @@
 // cell and texel: a light ray through cells of alphas a_i is blocked with probability
 // 1 - prod(1 - a_i), the light camera's matte (the reconstruction's opacity, §2.1). Writes the
 // shadow camera's window depth, as TreeLodCaster.frag.
-uniform sampler2D codebook;
+SAMPLER2D(codebook, 0);
 uniform vec4 octree;      // cameras, slot texture width, atlas blocks a row, atlas width
 uniform float atlasHeight;
-
-in vec2 vTexel;
-flat in vec4 vColourBlocks;
-flat in vec4 vAlphaBlocks;
-flat in vec2 vWeights;
-#ifdef CASTER
-in vec2 vClipZW;
-flat in float vCell;
-#endif
-
-out vec4 fragColour;
 
 vec4 premultiplied(vec2 colourBlock, vec2 alphaBlock, vec2 texel)
 {
     vec2 size = vec2(octree.w, atlasHeight);
-    vec3 colour = texture(codebook, (colourBlock + texel) / size).rgb;
-    float alpha = texture(codebook, (alphaBlock + texel) / size).a;
+    vec3 colour = TEX2D(codebook, (colourBlock + texel) / size).rgb;
+    float alpha = TEX2D(codebook, (alphaBlock + texel) / size).a;
     return vec4(colour * alpha, alpha);
 }
 
@@ -54,13 +43,22 @@ float hash01(uint a, uint b)
 }
 #endif
 
-void main()
+MAIN_PARAMETERS
+    IN(vec2 vTexel, TEXCOORD0)
+    FLAT_IN(vec4 vColourBlocks, TEXCOORD1)
+    FLAT_IN(vec4 vAlphaBlocks, TEXCOORD2)
+    FLAT_IN(vec2 vWeights, TEXCOORD3)
+#ifdef CASTER
+    IN(vec2 vClipZW, TEXCOORD4)
+    FLAT_IN(float vCell, TEXCOORD5)
+#endif
+MAIN_DECLARATION
 {
-    vec2 texel = clamp(vTexel, vec2(0.5), vec2(3.5));
+    vec2 texel = clamp(vTexel, vec2_splat(0.5), vec2_splat(3.5));
     vec4 colour = vWeights.x * premultiplied(vColourBlocks.xy, vAlphaBlocks.xy, texel) +
                   vWeights.y * premultiplied(vColourBlocks.zw, vAlphaBlocks.zw, texel);
 #ifdef CASTER
-    ivec2 cell = ivec2(clamp(floor(vTexel), vec2(0.0), vec2(3.0)));
+    ivec2 cell = ivec2(clamp(floor(vTexel), vec2_splat(0.0), vec2_splat(3.0)));
     if (colour.a <= hash01(uint(vCell + 0.5), uint(cell.y * 4 + cell.x)))
         discard;
     float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5;

@@ -2,7 +2,7 @@
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
@@ -24,7 +24,7 @@
 uniform mat4 worldViewProj;
 uniform mat4 worldView;
 uniform vec4 octree;     // cameras, slot texture width, atlas blocks a row, atlas width
-uniform sampler2D slots;
+SAMPLER2D(slots, 1);
 #ifdef INSTANCED
 #include "TreeLodInstance.glsl"
 uniform mat4 projection;
@@ -35,26 +35,11 @@ uniform vec4 forestLevel;     // custom 1: L, first order entry, quads n(L), cel
 uniform vec4 octreeBox;       // origin, root edge (model metres)
 uniform vec4 cameraDirections[64]; // VOLUME_OCTREE_MAX_CAMERAS
 uniform float texelsWidth;
-uniform sampler2D cells;      // RGBA8: x | y << 9 | z << 18 | level << 27
-uniform sampler2D orders;     // RGBA8: cell indices
-
-in float vertex; // 4 quad + corner (0 to 3 counter-clockwise from (-1, -1))
+SAMPLER2D(cells, 2);          // RGBA8: x | y << 9 | z << 18 | level << 27
+SAMPLER2D(orders, 3);         // RGBA8: cell indices
 #else
 uniform vec4 lodState;   // active level, plane depth (view metres), weight of camera 0, of camera 1
 uniform vec4 cameraPair; // input camera 0, input camera 1
-
-in vec4 vertex; // the cell's centre
-in vec4 uv0;    // corner x, corner y, level, cell index
-in vec4 uv1;    // the parent's centre, half the cell's edge
-#endif
-
-out vec2 vTexel;             // billboard texels, (0, 0) top-left, (4, 4) bottom-right
-flat out vec4 vColourBlocks; // atlas texel origins of camera 0's and camera 1's colour codewords
-flat out vec4 vAlphaBlocks;  // ... of their alpha codewords
-flat out vec2 vWeights;
-#ifdef CASTER
-out vec2 vClipZW;
-flat out float vCell;
 #endif
 
 // The codewords of the slot of `cell` for `camera`: (colour, alpha), -1 when pruned.
@@ -62,10 +47,10 @@ ivec2 codewords(int cell, int camera)
 {
     int slot = cell * int(octree.x) + camera;
     int width = int(octree.y);
-    vec4 bytes = texelFetch(slots, ivec2(slot % width, slot / width), 0) * 255.0 + 0.5;
+    vec4 bytes = TEX2D_FETCH(slots, ivec2(slot % width, slot / width), 0) * 255.0 + 0.5;
     int colour = int(bytes.r) + 256 * int(bytes.g);
     int alpha = int(bytes.b) + 256 * int(bytes.a);
-    return colour == 65535 ? ivec2(-1) : ivec2(colour, alpha);
+    return colour == 65535 ? ivec2_splat(-1) : ivec2(colour, alpha);
 }
 
 vec2 blockOrigin(int block)
@@ -76,10 +61,10 @@ vec2 blockOrigin(int block)
 
 #ifdef INSTANCED
 // Entry i of a texture of 32-bit words (VolumeOctreeForestGpu).
-int fetchWord(sampler2D map, int i)
+int fetchWord(SAMPLER2D_PARAM(map), int i)
 {
     int width = int(texelsWidth);
-    ivec4 b = ivec4(texelFetch(map, ivec2(i % width, i / width), 0) * 255.0 + 0.5);
+    ivec4 b = ivec4(TEX2D_FETCH(map, ivec2(i % width, i / width), 0) * 255.0 + 0.5);
     return b.r | (b.g << 8) | (b.b << 16) | (b.a << 24);
 }
 
@@ -113,7 +98,24 @@ vec3 cameraPairOf(vec3 towards)
 }
 #endif
 
-void main()
+MAIN_PARAMETERS
+#ifdef INSTANCED
+    IN(float vertex, POSITION) // 4 quad + corner (0 to 3 counter-clockwise from (-1, -1))
+    INSTANCE_IN
+#else
+    IN(vec4 vertex, POSITION)  // the cell's centre
+    IN(vec4 uv0, TEXCOORD0)    // corner x, corner y, level, cell index
+    IN(vec4 uv1, TEXCOORD1)    // the parent's centre, half the cell's edge
+#endif
+    OUT(vec2 vTexel, TEXCOORD0)             // billboard texels, (0, 0) top-left, (4, 4) bottom-right
+    FLAT_OUT(vec4 vColourBlocks, TEXCOORD1) // atlas texel origins of camera 0's and camera 1's colour codewords
+    FLAT_OUT(vec4 vAlphaBlocks, TEXCOORD2)  // ... of their alpha codewords
+    FLAT_OUT(vec2 vWeights, TEXCOORD3)
+#ifdef CASTER
+    OUT(vec2 vClipZW, TEXCOORD4)
+    FLAT_OUT(float vCell, TEXCOORD5)
+#endif
+MAIN_DECLARATION
 {
 #ifdef INSTANCED
     int quad = int(vertex + 0.5) / 4, c = int(vertex + 0.5) % 4;
@@ -122,20 +124,20 @@ void main()
     vec3 rootCentre = octreeBox.xyz + 0.5 * octreeBox.w;
     bool orthographic = projection[3][3] > 0.5;
     vec3 towards = orthographic
-                       ? instanceLocalDirection(normalize(vec3(worldView[0][2], worldView[1][2], worldView[2][2])))
-                       : normalize(instanceLocalDirection(eyePosition.xyz - uv4.xyz) / uv4.w - rootCentre);
+                       ? instanceLocalDirection(uv5, normalize(row3(worldView, 2)))
+                       : normalize(instanceLocalDirection(uv5, eyePosition.xyz - uv4.xyz) / uv4.w - rootCentre);
     int octant = (towards.x > 0.0 ? 1 : 0) + (towards.y > 0.0 ? 2 : 0) + (towards.z > 0.0 ? 4 : 0);
-    int cell = fetchWord(orders, int(forestLevel.y) + octant * int(forestLevel.z) + quad);
-    int word = fetchWord(cells, cell);
+    int cell = fetchWord(SAMPLER2D_ARG(orders), int(forestLevel.y) + octant * int(forestLevel.z) + quad);
+    int word = fetchWord(SAMPLER2D_ARG(cells), cell);
     ivec3 coords = ivec3(word & 511, (word >> 9) & 511, (word >> 18) & 511);
     float level = float((word >> 27) & 15);
     float activeLevel = forestLevel.x;
     float edge = octreeBox.w / exp2(level);
     float halfEdge = 0.5 * edge;
     vec3 parentCentre = octreeBox.xyz + (vec3(coords / 2) + 0.5) * (2.0 * edge);
-    vec4 centre = instancePosition(vec4(octreeBox.xyz + (vec3(coords) + 0.5) * edge, 1.0));
-    float depth = -(worldView * centre).z;
-    float parentDepth = -(worldView * instancePosition(vec4(parentCentre, 1.0))).z;
+    vec4 centre = instancePosition(uv4, uv5, vec4(octreeBox.xyz + (vec3(coords) + 0.5) * edge, 1.0));
+    float depth = -mul(worldView, centre).z;
+    float parentDepth = -mul(worldView, instancePosition(uv4, uv5, vec4(parentCentre, 1.0))).z;
 #ifdef CASTER
     float plane = 3.0e38;
 #else
@@ -151,8 +153,8 @@ void main()
     float level = uv0.z;
     float activeLevel = lodState.x;
     vec4 centre = vec4(vertex.xyz, 1.0);
-    float depth = -(worldView * centre).z;
-    float parentDepth = -(worldView * vec4(uv1.xyz, 1.0)).z;
+    float depth = -mul(worldView, centre).z;
+    float parentDepth = -mul(worldView, vec4(uv1.xyz, 1.0)).z;
     float size = uv1.w;
     float cellIndex = uv0.w;
     vec2 corner = uv0.xy;
@@ -166,9 +168,9 @@ void main()
     if (!drawn || vWeights.x + vWeights.y <= 0.0)
     {
         gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // outside the clip volume
-        vTexel = vec2(0.0);
-        vColourBlocks = vec4(0.0);
-        vAlphaBlocks = vec4(0.0);
+        vTexel = vec2_splat(0.0);
+        vColourBlocks = vec4_splat(0.0);
+        vAlphaBlocks = vec4_splat(0.0);
 #ifdef CASTER
         vClipZW = vec2(0.0, 1.0);
         vCell = 0.0;
@@ -177,11 +179,11 @@ void main()
     }
     vColourBlocks = vec4(blockOrigin(max(first.x, 0)), blockOrigin(max(second.x, 0)));
     vAlphaBlocks = vec4(blockOrigin(max(first.y, 0)), blockOrigin(max(second.y, 0)));
-    vec3 right = normalize(vec3(worldView[0][0], worldView[1][0], worldView[2][0]));
-    vec3 up = normalize(vec3(worldView[0][1], worldView[1][1], worldView[2][1]));
+    vec3 right = normalize(row3(worldView, 0));
+    vec3 up = normalize(row3(worldView, 1));
     vec3 position = centre.xyz + (corner.x * right + corner.y * up) * size;
     vTexel = vec2(corner.x + 1.0, 1.0 - corner.y) * 2.0;
-    gl_Position = worldViewProj * vec4(position, 1.0);
+    gl_Position = mul(worldViewProj, vec4(position, 1.0));
 #ifdef CASTER
     vClipZW = gl_Position.zw;
     vCell = cellIndex;

@@ -19,7 +19,7 @@ VERSION_BLOCK = """#if defined(OGRE_GLSLES)
 #version 300 es
 #elif OGRE_GLSL >= 330
 #version 330 core
-#else
+#elif defined(OGRE_GLSL)
 #version 150
 #endif
 """
