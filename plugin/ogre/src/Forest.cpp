@@ -226,7 +226,7 @@ namespace TreeLod
         }
 
         /// The INSTANCED variant of vertex program `plain`: "<name>/Instanced", same source and
-        /// defines + INSTANCED=1, made once in the plain program's group. A unified program
+        /// entry point and target, defines + INSTANCED=1, made once in the plain program's group. A unified program
         /// (materials/TreeLod.program) is varied through the delegate the render system chose.
         Ogre::String instancedProgram(const Ogre::GpuProgramPtr& plain)
         {
@@ -245,6 +245,10 @@ namespace TreeLod
             Ogre::HighLevelGpuProgramPtr program =
                 programs.createProgram(name, plain->getGroup(), source->getLanguage(), Ogre::GPT_VERTEX_PROGRAM);
             program->setSourceFile(source->getSourceFile());
+            // HLSL's and Cg's compile parameters (GLSL has none; the rest are the language's defaults).
+            for (const char* parameter : {"entry_point", "target", "profiles"})
+                if (!source->getParameter(parameter).empty())
+                    program->setParameter(parameter, source->getParameter(parameter));
             const Ogre::String defines = source->getParameter("preprocessor_defines");
             program->setParameter("preprocessor_defines", defines.empty() ? "INSTANCED=1" : defines + ",INSTANCED=1");
             program->load();
