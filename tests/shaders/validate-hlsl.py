@@ -15,6 +15,28 @@ Microsoft's fxc/D3DCompile and nothing here runs the result. Three checks glslan
   (`param_named NAME int UNIT`, which the GLSL delegates use), and every such parameter names a
   texture of the HLSL program.
 
+Then the linkage of the stages, which Direct3D 11 checks when it draws: in every pass of the
+.material scripts that names a vertex and a fragment program, the fragment program's inputs must
+be the vertex program's outputs, in the same order, with the same semantics (name and index,
+TEXCOORD = TEXCOORD0), types and interpolation modifiers (`nointerpolation` from FLAT_OUT /
+FLAT_IN): TreeLodShaderSupport.glsl's convention, stricter than Direct3D, which lets a pixel
+shader read fewer components or a packed prefix. Both sides are main's parameters in the
+preprocessed text the compile step makes (`glslangValidator -D -E`, same defines); SV_Position
+and the values the rasteriser makes (SV_IsFrontFace, SV_SampleIndex, SV_PrimitiveID,
+SV_Coverage) are left out wherever they are declared, and the messages count the others from 0.
+The vertex side is checked as declared and as the Forest's INSTANCED=1 variant
+("<name>/Instanced", Forest.cpp instancedProgram; the Forest derives it for every pass of the
+materials it draws, here it is checked for every pass; a program whose defines have INSTANCED is
+its own variant). A material's program names resolve to the hlsl programs: a unified program to
+its first hlsl delegate, with that delegate's preprocessor_defines. Material scripts are read as
+OGRE 1.12's script compiler reads them: `: base` inheritance (the base's objects overlaid into the
+object, named children matched by class and name, unnamed ones by class and position), abstract
+objects, a pass's last vertex_program_ref / fragment_program_ref winning. Not handled:
+shadow_caster_* / shadow_receiver_*_program_ref (no script uses them; shadow caster materials
+are materials, checked as such), `import`, `$variables`, wildcard names, bases in another script,
+and materials made or reprogrammed in C++ (the clones of TreeAsset and the *Resources classes
+keep the scripts' programs; the Forest's instanced clone is the variant above).
+
 usage: validate-hlsl.py MATERIALS_DIR [--validator PATH]
 """
 import os
@@ -52,6 +74,175 @@ def resolve_includes(path, folders, seen=()):
     return "\n".join(out)
 
 
+class ScriptObject:
+    """An object of an OGRE script: `[abstract] CLS [NAME] [: BASE...] { ... }`; children are objects only."""
+
+    def __init__(self, cls, name, bases, abstract, line):
+        self.cls, self.name, self.bases, self.abstract, self.line = cls, name, bases, abstract, line
+        self.children = []
+
+    def clone(self):
+        copy = ScriptObject(self.cls, self.name, self.bases, self.abstract, self.line)
+        copy.children = [c.clone() for c in self.children]
+        return copy
+
+
+def script_objects(text):
+    """The top-level objects of an OGRE script (properties skipped: no check reads them).
+
+    Statements end at a line's end; a statement followed by `{` is an object's header."""
+    text = re.sub(r"/\*.*?\*/", lambda m: re.sub(r"[^\n]", " ", m.group(0)), text, flags=re.S)
+    text = re.sub(r"//[^\n]*", "", text)
+    tokens = [(m.group(0), text.count("\n", 0, m.start()) + 1)
+              for m in re.finditer(r'"[^"\n]*"|[{}]|[^\s{}"]+', text)]
+    top, stack, statement = [], [], []
+    for token, line in tokens:
+        if token == "{":
+            words = [w.strip('"') for w, _ in statement]
+            abstract = bool(words) and words[0] == "abstract"
+            words = words[1:] if abstract else words
+            if not words:
+                raise ValueError("line %d: `{` without an object header" % line)
+            bases = words[words.index(":") + 1:] if ":" in words else []
+            head = words[:words.index(":")] if ":" in words else words
+            obj = ScriptObject(head[0], head[1] if len(head) > 1 else "", bases, abstract,
+                               statement[0][1])
+            (stack[-1].children if stack else top).append(obj)
+            stack.append(obj)
+            statement = []
+        elif token == "}":
+            if not stack:
+                raise ValueError("line %d: unmatched `}`" % line)
+            stack.pop()
+            statement = []
+        else:
+            if statement and statement[-1][1] != line:
+                statement = []  # the previous line was a property
+            statement.append((token, line))
+    if stack:
+        raise ValueError("line %d: object %s %s not closed" % (stack[-1].line, stack[-1].cls, stack[-1].name))
+    return top
+
+
+def overlay(source, dest):
+    """OGRE's ScriptCompiler::overlayObject: the base `source`'s objects into `dest`."""
+    overrides = [[child, None] for child in source.children]
+    indices, overridden, highest = {}, set(), 0
+    for node in dest.children:  # pair named objects by class and name
+        indices[id(node)] = highest
+        for j, pair in enumerate(overrides):
+            if node.name and pair[0].cls == node.cls and pair[0].name == node.name:
+                if pair[1] is None:
+                    pair[1] = node
+                    highest = max(j, highest)
+                    indices[id(node)] = highest
+                    overridden.add(id(node))
+                break
+    for node in dest.children:  # then unnamed ones by class, in order
+        if id(node) not in overridden:
+            for pair in overrides[indices[id(node)]:]:
+                if not pair[0].name and pair[0].cls == node.cls and pair[1] is None:
+                    pair[1] = node
+                    break
+    at = 0
+    for base, node in overrides:
+        if node is not None:
+            overlay(base, node)
+            at = next(i for i, c in enumerate(dest.children) if c is node) + 1
+        else:
+            dest.children.insert(at, base.clone())
+            at += 1
+
+
+def resolve_bases(objects, top, script):
+    """OGRE's ScriptCompiler::processObjects: each object's bases overlaid in order, then its children's."""
+    for obj in objects:
+        for base in obj.bases:
+            found = [o for o in top if o.name == base]
+            if not found:
+                raise ValueError("%s:%d: %s %s: base %s not found in this script"
+                                 % (script, obj.line, obj.cls, obj.name, base))
+            overlay(found[-1], obj)
+        resolve_bases(obj.children, top, script)
+
+
+def material_passes(materials):
+    """(script, line, material, technique, pass, vertex program, fragment program) of every pass
+    of the non-abstract materials of MATERIALS_DIR/*.material; a program is None if not set."""
+    found = []
+    for script in sorted(f for f in os.listdir(materials) if f.endswith(".material")):
+        top = script_objects(open(os.path.join(materials, script)).read())
+        resolve_bases(top, top, script)
+        for material in top:
+            if material.cls != "material" or material.abstract:
+                continue
+            techniques = [c for c in material.children if c.cls == "technique"]
+            for t, technique in enumerate(techniques):
+                passes = [c for c in technique.children if c.cls == "pass"]
+                for n, pass_ in enumerate(passes):
+                    def program(cls):
+                        refs = [c.name for c in pass_.children if c.cls == cls]
+                        return refs[-1] if refs else None
+                    found.append((script, pass_.line, material.name, technique.name or str(t),
+                                  pass_.name or str(n), program("vertex_program_ref"),
+                                  program("fragment_program_ref")))
+    return found
+
+
+# Pixel-shader inputs the rasteriser makes, not the vertex program.
+RASTERISER_VALUES = {"SV_POSITION0", "SV_ISFRONTFACE0", "SV_SAMPLEINDEX0", "SV_PRIMITIVEID0", "SV_COVERAGE0"}
+INTERPOLATION = {"nointerpolation", "linear", "centroid", "noperspective", "sample"}
+
+
+def declared_at(resolved, macro, name):
+    """FILE:LINE of the IN/OUT/FLAT_IN/FLAT_OUT (`macro`) declaring `name` in a source with its
+    includes resolved (resolve_includes' #line directives), or "" unless there is exactly one.
+    (glslang's -E output does not keep line numbers across a skipped #include.)"""
+    hits, file, number = [], "?", 1
+    for text in resolved.split("\n"):
+        m = re.match(r'\s*#line\s+(\d+)\s+"([^"]*)"', text)
+        if m:
+            number, file = int(m.group(1)), m.group(2)
+            continue
+        if re.search(r"\b(?:FLAT_)?%s\(\s*\w+\s+%s\s*(?:\[[^]]*\]\s*)?," % (macro, re.escape(name)), text):
+            hits.append("%s:%d" % (file, number))
+        number += 1
+    return hits[0] if len(hits) == 1 else ""
+
+
+def stage_interface(preprocessed, entry, resolved):
+    """main's parameters in `glslangValidator -E` output: a list of dicts with direction,
+    interpolation, type, name, semantic (upper case, with its index), where (FILE:LINE or "")."""
+    text = "\n".join(line for line in preprocessed.split("\n") if not line.lstrip().startswith("#"))
+    m = re.search(r"\b\w+\s+%s\s*\(" % re.escape(entry), text)
+    if not m:
+        raise ValueError("no function %s in the preprocessed source" % entry)
+    parameters = []
+    for chunk in text[m.end():text.index(")", m.end())].split(","):
+        declaration, _, semantic = chunk.partition(":")
+        words = declaration.split()
+        if not words or "uniform" in words:
+            continue
+        declaration = re.sub(r"\s*\[", "[", " ".join(words))  # `float2 v [2]` as `float2 v[2]`
+        words = declaration.split()
+        name, array = re.match(r"(\w+)(.*)", words[-1]).groups()
+        semantic = semantic.strip().upper()
+        parameters.append({"direction": next((w for w in words if w in ("in", "out", "inout")), "in"),
+                           "interpolation": " ".join(w for w in words if w in INTERPOLATION),
+                           "type": words[-2] + array, "name": name,
+                           # Direct3D's semantic: a name and an index, TEXCOORD meaning TEXCOORD0.
+                           "semantic": semantic if not semantic or re.search(r"\d$", semantic) else semantic + "0"})
+        parameters[-1]["where"] = declared_at(resolved, "OUT" if parameters[-1]["direction"] == "out" else "IN", name)
+    return parameters
+
+
+def describe(parameter):
+    if parameter is None:
+        return "none"
+    return "%s %s%s %s%s" % (parameter["semantic"], parameter["interpolation"] + " " if parameter["interpolation"] else "",
+                             parameter["type"], parameter["name"], ", " + parameter["where"] if parameter["where"] else "")
+
+
 def main():
     args = sys.argv[1:]
     validator = "glslangValidator"
@@ -63,14 +254,15 @@ def main():
         sys.exit(__doc__)
     materials = args[0]
     folders = [materials, os.path.join(materials, "GLSL")]
-    found, units = [], {}
+    found, units, delegates = [], {}, {}
     for script in sorted(f for f in os.listdir(materials) if f.endswith(".program")):
         text = open(os.path.join(materials, script)).read()
         for kind, name, language, body, line in blocks(text, ("hlsl", "unified")):
             if language == "unified":
                 # The texture units of the unified program's samplers, for each HLSL delegate.
                 params = dict(re.findall(r"^\s*param_named\s+(\w+)\s+int\s+(\d+)", body, re.M))
-                for delegate in re.findall(r"^\s*delegate\s+(\S+)", body, re.M):
+                delegates[name] = re.findall(r"^\s*delegate\s+(\S+)", body, re.M)
+                for delegate in delegates[name]:
                     units[delegate] = (name, {k: int(v) for k, v in params.items()})
                 continue
         for kind, name, language, body, line in blocks(text, ("hlsl",)):
@@ -82,6 +274,7 @@ def main():
     if not found:
         sys.exit("no hlsl program in %s/*.program" % materials)
     checked, failures = 0, []
+    preprocessed = {}  # for link()
     for script, line, kind, name, source, defines, entry, target in found:
         where = "%s:%d %s (%s)" % (script, line, name, source)
         profile = PROFILE.match(target)
@@ -111,6 +304,8 @@ def main():
             if pre.returncode != 0:
                 failures.append("%s: preprocessing failed:\n%s" % (tag, (pre.stdout + pre.stderr).strip()))
                 continue
+            # For link(); a vertex program whose defines have INSTANCED is its own Forest variant.
+            preprocessed[(name, variant != defines)] = (pre.stdout, entry, text)
             problems = ["vector from one scalar (fxc rejects it; write vecN_splat): " + m.group(0)
                         for m in SCALAR_CONSTRUCTOR.finditer(pre.stdout)]
             textures = {t: int(u) for t, u in TEXTURE.findall(pre.stdout)}
@@ -134,7 +329,65 @@ def main():
     for f in failures:
         print("FAIL " + f)
     print("%d compilations of %d programs, %d failed" % (checked, len(found), len(failures)))
-    return 1 if failures else 0
+    mismatches = link(materials, found, delegates, preprocessed)
+    return 1 if failures or mismatches else 0
+
+
+def link(materials, found, delegates, preprocessed):
+    """The linkage check (module docstring); prints each mismatch and a summary, returns the mismatches.
+    `preprocessed` maps (hlsl program, the Forest's INSTANCED variant?) to (-E output, entry point,
+    source with includes resolved)."""
+    kinds = {name: kind for _, _, kind, name, *_ in found}
+    key = lambda p: p and (p["semantic"], p["type"], p["interpolation"])  # what must match
+
+    def hlsl(name, kind):
+        """The hlsl program a material's program name stands for, or an error."""
+        candidates = [d for d in delegates.get(name, [name]) if d in kinds]
+        if not candidates:
+            return None, "%s program %s has no hlsl program or delegate" % (kind, name)
+        if kinds[candidates[0]] != kind:
+            return None, "%s program %s is a %s program" % (kind, name, kinds[candidates[0]])
+        return candidates[0], None
+
+    passes, linkages, skipped, mismatches = 0, 0, 0, []
+    try:
+        found_passes = material_passes(materials)
+    except ValueError as e:
+        print("FAIL reading the materials: %s" % e)
+        return [str(e)]
+    for script, line, material, technique, pass_, vertex, fragment in found_passes:
+        where = "%s:%d: material %s technique %s pass %s" % (script, line, material, technique, pass_)
+        if not vertex or not fragment:
+            skipped += 1
+            continue
+        passes += 1
+        vs, error = hlsl(vertex, "vertex")
+        fs, error2 = hlsl(fragment, "fragment")
+        if error or error2:
+            mismatches += ["%s: %s" % (where, e) for e in (error, error2) if e]
+            continue
+        if (fs, False) not in preprocessed:
+            continue  # did not compile: reported above
+        inputs = [p for p in stage_interface(*preprocessed[(fs, False)]) if p["direction"] == "in"
+                  and p["semantic"] not in RASTERISER_VALUES]
+        for instanced in (False, True):
+            label = vertex + ("/Instanced" if instanced else "")
+            if (vs, instanced) not in preprocessed:
+                continue
+            linkages += 1
+            outputs = [p for p in stage_interface(*preprocessed[(vs, instanced)]) if p["direction"] == "out"
+                       and p["semantic"] != "SV_POSITION0"]
+            for n in range(max(len(outputs), len(inputs))):
+                o = outputs[n] if n < len(outputs) else None
+                i = inputs[n] if n < len(inputs) else None
+                if key(o) != key(i):
+                    mismatches.append("%s: vertex %s output %d (%s) vs fragment %s input %d (%s)"
+                                      % (where, label, n, describe(o), fragment, n, describe(i)))
+    for m in mismatches:
+        print("FAIL " + m)
+    print("%d passes linked (%d linkages: vertex programs as declared and as INSTANCED=1), %d passes "
+          "with one program only, %d mismatches" % (passes, linkages, skipped, len(mismatches)))
+    return mismatches
 
 
 if __name__ == "__main__":
