@@ -15,6 +15,8 @@ import re
 import subprocess
 import sys
 
+from shader_sources import resolve_includes
+
 VERSION_BLOCK = """#if defined(OGRE_GLSLES)
 #version 300 es
 #elif OGRE_GLSL >= 330
@@ -43,22 +45,6 @@ def programs(materials):
             found.append((script, line, m.group(1), m.group(2), m.group(3), source.group(1),
                           defines.group(1) if defines else ""))
     return found
-
-
-def resolve_includes(path, folders, seen=()):
-    out = []
-    for n, line in enumerate(open(path).read().split("\n"), 1):
-        m = re.match(r'\s*#include\s+[<"]([^>"]+)[>"]', line)
-        if not m:
-            out.append(line)
-            continue
-        hits = [os.path.join(d, m.group(1)) for d in folders if os.path.exists(os.path.join(d, m.group(1)))]
-        if not hits:
-            raise ValueError("%s:%d: #include %s: not in %s" % (path, n, m.group(1), ", ".join(folders)))
-        if hits[0] in seen:
-            raise ValueError("%s:%d: #include %s: included recursively" % (path, n, m.group(1)))
-        out.append(resolve_includes(hits[0], folders, seen + (hits[0],)))
-    return "\n".join(out)
 
 
 def main():

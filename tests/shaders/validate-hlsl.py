@@ -44,6 +44,8 @@ import re
 import subprocess
 import sys
 
+from shader_sources import resolve_includes
+
 PROFILE = re.compile(r"^(vs|ps)_([4-9])_\d$")
 SCALAR_CONSTRUCTOR = re.compile(r"\b(?:float|int|uint|bool)[234]\(\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?[uUfF]?\s*\)")
 TEXTURE = re.compile(r"\bTexture\w*\s+(\w+)\s*:\s*register\(\s*t(\d+)\s*\)")
@@ -54,24 +56,6 @@ def blocks(text, kinds):
     for m in re.finditer(r"^(vertex|fragment)_program\s+(\S+)\s+(\S+)\s*\{((?:[^{}]|\{[^{}]*\})*)\}", text, re.M):
         if m.group(3) in kinds:
             yield m.group(1), m.group(2), m.group(3), m.group(4), text.count("\n", 0, m.start()) + 1
-
-
-def resolve_includes(path, folders, seen=()):
-    """The source with its includes inlined, #line directives keeping file names and lines."""
-    out = ['#line 1 "%s"' % os.path.basename(path)]
-    for n, line in enumerate(open(path).read().split("\n"), 1):
-        m = re.match(r'\s*#include\s+[<"]([^>"]+)[>"]', line)
-        if not m:
-            out.append(line)
-            continue
-        hits = [os.path.join(d, m.group(1)) for d in folders if os.path.exists(os.path.join(d, m.group(1)))]
-        if not hits:
-            raise ValueError("%s:%d: #include %s: not in %s" % (path, n, m.group(1), ", ".join(folders)))
-        if hits[0] in seen:
-            raise ValueError("%s:%d: #include %s: included recursively" % (path, n, m.group(1)))
-        out.append(resolve_includes(hits[0], folders, seen + (hits[0],)))
-        out.append('#line %d "%s"' % (n + 1, os.path.basename(path)))
-    return "\n".join(out)
 
 
 class ScriptObject:
@@ -286,7 +270,7 @@ def main():
         if not path:
             failures.append("%s: source not found" % where)
             continue
-        text = resolve_includes(path, folders)
+        text = resolve_includes(path, folders, line_markers=True)
         variants = [defines]
         if kind == "vertex" and "INSTANCED" not in defines:
             variants.append(",".join(d for d in (defines, "INSTANCED=1") if d))
