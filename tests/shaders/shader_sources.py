@@ -1,6 +1,7 @@
 """Shared by validate-glsl.py and validate-hlsl.py: a program's source as OGRE hands it to the compiler."""
 import os
 import re
+import sys
 
 
 def resolve_includes(path, folders, line_markers=False, seen=()):
@@ -22,3 +23,17 @@ def resolve_includes(path, folders, line_markers=False, seen=()):
         if line_markers:
             out.append('#line %d "%s"' % (n + 1, os.path.basename(path)))
     return "\n".join(out)
+
+
+def command_line(usage):
+    """(materials folder, folders includes come from, validator) from `MATERIALS_DIR [--validator PATH]`."""
+    args = sys.argv[1:]
+    validator = "glslangValidator"
+    if "--validator" in args:
+        i = args.index("--validator")
+        validator = args[i + 1]
+        del args[i:i + 2]
+    if len(args) != 1:
+        sys.exit(usage)
+    materials = args[0]
+    return materials, [materials, os.path.join(materials, "GLSL")], validator

@@ -15,7 +15,7 @@ import re
 import subprocess
 import sys
 
-from shader_sources import resolve_includes
+from shader_sources import command_line, resolve_includes
 
 VERSION_BLOCK = """#if defined(OGRE_GLSLES)
 #version 300 es
@@ -48,16 +48,7 @@ def programs(materials):
 
 
 def main():
-    args = sys.argv[1:]
-    validator = "glslangValidator"
-    if "--validator" in args:
-        i = args.index("--validator")
-        validator = args[i + 1]
-        del args[i:i + 2]
-    if len(args) != 1:
-        sys.exit(__doc__)
-    materials = args[0]
-    folders = [materials, os.path.join(materials, "GLSL")]
+    materials, folders, validator = command_line(__doc__)
     checked, failures = 0, []
     found = programs(materials)
     if not found:

@@ -44,7 +44,7 @@ import re
 import subprocess
 import sys
 
-from shader_sources import resolve_includes
+from shader_sources import command_line, resolve_includes
 
 PROFILE = re.compile(r"^(vs|ps)_([4-9])_\d$")
 SCALAR_CONSTRUCTOR = re.compile(r"\b(?:float|int|uint|bool)[234]\(\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?[uUfF]?\s*\)")
@@ -228,16 +228,7 @@ def describe(parameter):
 
 
 def main():
-    args = sys.argv[1:]
-    validator = "glslangValidator"
-    if "--validator" in args:
-        i = args.index("--validator")
-        validator = args[i + 1]
-        del args[i:i + 2]
-    if len(args) != 1:
-        sys.exit(__doc__)
-    materials = args[0]
-    folders = [materials, os.path.join(materials, "GLSL")]
+    materials, folders, validator = command_line(__doc__)
     found, units, delegates = [], {}, {}
     for script in sorted(f for f in os.listdir(materials) if f.endswith(".program")):
         text = open(os.path.join(materials, script)).read()
