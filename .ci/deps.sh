@@ -4,7 +4,7 @@ set -euo pipefail
 packages=(cmake g++ make pkg-config
   libogre-1.12-dev libglm-dev libtinygltf-dev libopenimageio-dev libeigen3-dev libembree-dev
   libsquish-dev libtbb-dev nlohmann-json3-dev libcli11-dev libgtest-dev googletest libbenchmark-dev
-  xvfb xauth libgl1-mesa-dri file gdb python3 glslang-tools)
+  xvfb xauth libgl1-mesa-dri file gdb python3 python3-matplotlib glslang-tools)
 for flag in "$@"; do
   case $flag in
     --with-fuzzers) packages+=(clang libclang-rt-14-dev) ;;

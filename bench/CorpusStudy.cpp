@@ -2,8 +2,8 @@
 // generator's atlas and multi-material variants, and third-party trees when present), measured
 // headless through the plugin.
 //
-// Per tree, the package is baked with every technique asked for (their default options; the
-// classic billboard cloud at the multi-layered cloud's memory, García et al. 2007 Fig. 13). Per
+// Per tree, the package is baked with every technique asked for (their default options; a paper's
+// baseline technique, TechniqueRoles::paperBaseline, at its technique's memory). Per
 // view the reference ("mesh") and each technique are rendered by the same Ogre pipeline at S x S
 // supersampling, from azimuth 30 degrees at the crown's height (--azimuths N: from N azimuths 360/N
 // apart starting there, the metrics averaged; one 30 px view moves by a few thousandths of FLIP
@@ -13,8 +13,9 @@
 // Image error is taken over the square around the reference tree (its box with a 15 % margin, the
 // same pixels for every technique and run): FLIP (mean), multi-scale RMSE, and the coverage (the
 // technique's tree pixels over the reference's, whole frame); and each technique's chunk bytes.
-// The billboard
-// clouds are drawn without their AO term, since the polygonal reference has none.
+// Techniques
+// with an ambient occlusion term draw without it (TechniqueRoles::referenceShadingParams), since the
+// polygonal reference has none.
 // Output in --out: summary.md (per tree and technique: near / mid / far), summary.json,
 // error.csv, and worst-<technique>.png: reference | technique | FLIP of the technique's worst case
 // (magnified crops).
@@ -52,8 +53,7 @@ namespace TreeLod
         struct StudyArgs
         {
             std::vector<std::string> trees;
-            std::vector<std::string> techniques{"billboard-cloud", "classic-billboard-cloud", "lodf", "impostor",
-                                                "octahedral-impostor"};
+            std::vector<std::string> techniques; ///< default: budgeted auto's candidates but the reference
             std::vector<std::string> options; ///< TECHNIQUE.NAME=VALUE, as `treelod bake --option`
             std::vector<std::string> params;  ///< TECHNIQUE.NAME=VALUE, the object's createMovableObject parameters
             int size = 512;
@@ -162,9 +162,7 @@ namespace TreeLod
                      return all;
                  }())
             {
-                Ogre::NameValuePairList params;
-                if (technique.find("billboard-cloud") != std::string::npos)
-                    params["ambientOcclusion"] = "false";
+                Ogre::NameValuePairList params = registry.get(technique).roles.referenceShadingParams;
                 std::map<std::string, BakeOptions> assigned = assignmentsByTechnique(args.params, args, "--param");
                 for (const auto& [name, value] : assigned[technique])
                     params[name] = value;
@@ -344,12 +342,16 @@ namespace TreeLod
                                         {"bytes", r.bytes}});
             }
 
-            // The issue's targets, where both techniques were measured.
-            const bool clouds = std::count(args.techniques.begin(), args.techniques.end(), "billboard-cloud") &&
-                                std::count(args.techniques.begin(), args.techniques.end(), "classic-billboard-cloud");
-            if (clouds)
+            // Each technique against its paper's baseline (TechniqueRoles::paperBaseline), where both ran.
+            const auto studied = [&](const std::string& t) {
+                return std::count(args.techniques.begin(), args.techniques.end(), t) > 0;
+            };
+            for (const TechniqueInfo& info : TechniqueRegistry::getSingleton().getTechniques())
             {
-                md << "\n## Multi-layered against classic cloud at equal memory (FLIP)\n\n| tree";
+                const std::string technique = info.name, baseline = info.roles.paperBaseline;
+                if (baseline.empty() || !studied(technique) || !studied(baseline))
+                    continue;
+                md << "\n## " << technique << " against " << baseline << " at equal memory (FLIP)\n\n| tree";
                 for (const View& view : VIEWS)
                     md << " | " << view.name;
                 md << " |\n|---|";
@@ -362,19 +364,19 @@ namespace TreeLod
                     md << "| " << tree;
                     for (const View& view : VIEWS)
                     {
-                        const Row* l = findRow(rows, tree, "billboard-cloud", view.name);
-                        const Row* c = findRow(rows, tree, "classic-billboard-cloud", view.name);
+                        const Row* l = findRow(rows, tree, technique, view.name);
+                        const Row* c = findRow(rows, tree, baseline, view.name);
                         if (!l || !c)
                             continue;
                         ++cases;
                         wins += l->flip <= c->flip;
-                        md << format(" | %.4f vs %.4f %s", l->flip, c->flip, l->flip <= c->flip ? "(layered)" : "(classic)");
+                        md << format(" | %.4f vs %.4f %s", l->flip, c->flip,
+                                     l->flip <= c->flip ? ("(" + technique + ")").c_str() : ("(" + baseline + ")").c_str());
                     }
                     md << " |\n";
                 }
-                md << format("\nThe multi-layered cloud is at or below the classic one in %d of %d cases.\n", wins, cases);
-                json["layeredWins"] = wins;
-                json["cloudCases"] = cases;
+                md << format("\n%s is at or below %s in %d of %d cases.\n", technique.c_str(), baseline.c_str(), wins, cases);
+                json["againstPaperBaseline"][technique] = {{"baseline", baseline}, {"wins", wins}, {"cases", cases}};
             }
 
             md << "\n## Worst case of each technique\n\n";
@@ -400,12 +402,18 @@ namespace TreeLod
 int main(int argc, char** argv)
 {
     TreeLod::StudyArgs args;
+    for (const TreeLod::TechniqueInfo& info : TreeLod::TechniqueRegistry::getSingleton().getTechniques())
+        if (info.roles.autoCandidate && info.name != TreeLod::REFERENCE_TECHNIQUE)
+            args.techniques.push_back(info.name);
     CLI::App app{"Every technique against the polygonal tree over a corpus of trees: tree-box FLIP and multi-scale "
                  "RMSE near, mid and far. Needs an X server (xvfb-run)."};
     app.add_option("--trees", args.trees,
                    "trees: .glb/.gltf paths or generated:PRESET[:LEAVES[:IMAGES[:MATERIALS[:FOLD]]]] (default: the bundled "
                    "trees, generated:oak:3000:4:6, generated:oak:3000:1:1:45 and media/third-party/*.glb)");
-    app.add_option("--techniques", args.techniques, "techniques to bake and compare")->capture_default_str();
+    app.add_option("--techniques", args.techniques,
+                   "techniques to bake and compare (default: those budgeted auto chooses among, as `treelod info "
+                   "--techniques` lists them)")
+        ->capture_default_str();
     app.add_option("--option", args.options, "a baker's option, TECHNIQUE.NAME=VALUE (as treelod bake --option)");
     app.add_option("--param", args.params,
                    "an object parameter, TECHNIQUE.NAME=VALUE (as createMovableObject's, e.g. billboard-cloud.level=1)");

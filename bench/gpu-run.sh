@@ -62,6 +62,8 @@ EOF
   # Texture shadows need OGRE's ShadowVolume programs; the bundle holds no OGRE media.
   rm -rf "$gpu/ogre-media"; mkdir -p "$gpu/ogre-media"
   cp -r /usr/share/OGRE/Media/ShadowVolume "$gpu/ogre-media/"
+  # TreeLod's media as the build tree merges them (materials/ and every technique's media/).
+  rm -rf "$gpu/media"; cp -rL "$build/share/TreeLod/media" "$gpu/media"
   stale=0
   for f in "$build/bin/treelod_frames" "$build"/lib/*.so; do
     if [ "$f" -nt "$gpu/bundle.tar.xz" ]; then stale=1; fi
@@ -86,11 +88,11 @@ EOF
     rm -rf "$stage"
   fi
   # What travels: the tracked tree, the bundle and one compressed payload (the package lists, the
-  # packages they name, OGRE's media, the settings); the device takes 64 MiB in all.
+  # packages they name, TreeLod's and OGRE's media, the settings); the device takes 64 MiB in all.
   payload=$(python3 - "$gpu" <<'EOF'
 import json, os, sys
 gpu = sys.argv[1]
-files = {"settings.env", "ogre-media"}
+files = {"settings.env", "ogre-media", "media"}
 for s in sorted(os.listdir(os.path.join(gpu, "runs"))):
     base = os.path.join(gpu, "runs", s)
     files.update(os.path.relpath(os.path.join(base, f), gpu) for f in ("packages.json", "command.txt"))
@@ -113,12 +115,12 @@ EOF
   ;;
 
 device)
-  # The payload unpacks over .gpu (package lists, packages, OGRE's media, the settings).
+  # The payload unpacks over .gpu (package lists, packages, TreeLod's and OGRE's media, the settings).
   [ -f "$gpu/payload.tar.xz" ] && tar -C "$gpu" -xJf "$gpu/payload.tar.xz"
   [ -f "$gpu/settings.env" ] || fail "$gpu/settings.env is missing: run bench/gpu-run.sh prepare here, carry .gpu/payload.tar.xz"
   eval "$(cat "$gpu/settings.env")"
   : "${GB:?run through .gpu/on-device.sh (GB is the unpacked bundle)}" "${OUT:?OUT is the folder that comes back}"
-  export TREELOD_MATERIALS_DIR=$root/materials TREELOD_OGRE_MEDIA_DIR=$root/$gpu/ogre-media
+  export TREELOD_MATERIALS_DIR=$root/$gpu/media TREELOD_OGRE_MEDIA_DIR=$root/$gpu/ogre-media
   mkdir -p "$OUT"
   { "$GB/bin/glxinfo" -B 2>&1 | grep -E "OpenGL (renderer|version)" || true; nproc; } | tee "$OUT/device.txt"
   # The command the prepare step printed, with this machine's paths: the bundle's binary and

@@ -51,8 +51,8 @@ foreach(tool treelod treelod_frames)
   endif()
 endforeach()
 
-# ---- data: materials (scripts, programs, the white texture, GLSL/) and the plot script ----
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/materials/ DESTINATION ${TREELOD_INSTALL_DATADIR}/media)
+# ---- data: the plot script; the media (materials/ and every technique's media/, merged into one
+# folder) are installed by treelod_merge_media (cmake/TreeLodTechnique.cmake) ----
 install(FILES ${PROJECT_SOURCE_DIR}/bench/plot.py DESTINATION ${TREELOD_INSTALL_DATADIR})
 
 # ---- headers: those of the exported libraries (OffscreenRenderer.h and OgreBootstrap.h belong to

@@ -1,9 +1,11 @@
 # treelod_add_technique(<Name>
 #   [RUNTIME_SOURCES src...] [RUNTIME_LIBS lib...]   the chunk format, its descriptor (TechniqueDescriptor.h)
 #   [BAKE_SOURCES src...]    [BAKE_LIBS lib...]      the baker and its registration (BakeTechniques.h)
-#   [OGRE_SOURCES src...]    [OGRE_LIBS lib...])     the Ogre technique (TreeTechnique.h), built into Plugin_TreeLod
+#   [OGRE_SOURCES src...]    [OGRE_LIBS lib...])     the Ogre technique (TechniqueRegistry.h), built into Plugin_TreeLod
 #
-# One technique = one folder with an include/ directory and this call. Each half is a static
+# One technique = one folder with an include/ directory and this call; its media/ folder (material
+# and program scripts, GLSL/), when it has one, joins TreeLod's resource location (the build tree's
+# share/TreeLod/media and the installed one: treelod_merge_media). Each half is a static
 # library (TreeLod<Name>Runtime, TreeLod<Name>Bake, TreeLod<Name>Ogre) whose namespace-scope
 # registration object registers the technique; it is linked whole (WHOLE_ARCHIVE) into the
 # aggregates TreeLodTechniques (runtime halves), TreeLodBakeTechniques (bake halves) and into
@@ -23,6 +25,9 @@ endfunction()
 function(treelod_add_technique name)
   cmake_parse_arguments(T "" "" "RUNTIME_SOURCES;RUNTIME_LIBS;BAKE_SOURCES;BAKE_LIBS;OGRE_SOURCES;OGRE_LIBS" ${ARGN})
   set(include $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include> $<INSTALL_INTERFACE:include>)
+  if(IS_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/media)
+    set_property(GLOBAL APPEND PROPERTY TREELOD_MEDIA_DIRS ${CMAKE_CURRENT_SOURCE_DIR}/media)
+  endif()
   if(T_RUNTIME_SOURCES)
     add_library(TreeLod${name}Runtime STATIC ${T_RUNTIME_SOURCES})
     target_include_directories(TreeLod${name}Runtime PUBLIC ${include})
@@ -42,8 +47,34 @@ function(treelod_add_technique name)
   if(T_OGRE_SOURCES AND TARGET Plugin_TreeLod)
     add_library(TreeLod${name}Ogre STATIC ${T_OGRE_SOURCES})
     target_include_directories(TreeLod${name}Ogre PUBLIC ${include})
-    # The plugin's headers and what they need, without linking the plugin (it links this library).
+    # The plugin's headers and every technique's (TreeLodTechniques): an Ogre half may use another's
+    # classes, as the octahedral impostor draws with the impostor's ImpostorTree; all are in the plugin.
     target_link_libraries(TreeLod${name}Ogre PUBLIC TreeLodOgreHeaders ${T_OGRE_LIBS} PRIVATE treelod_warnings)
     target_link_libraries(Plugin_TreeLod PRIVATE "$<LINK_LIBRARY:WHOLE_ARCHIVE,TreeLod${name}Ogre>")
   endif()
+endfunction()
+
+# treelod_merge_media(<folder>): <folder> (the build tree's share/TreeLod/media) holds a link to every
+# file of materials/ and of each technique's media/, GLSL/ included, as one resource location; a
+# file name two folders both provide is an error. The install merges the same folders.
+function(treelod_merge_media folder)
+  get_property(media GLOBAL PROPERTY TREELOD_MEDIA_DIRS)
+  if(IS_SYMLINK ${folder})
+    file(REMOVE ${folder}) # a link to materials/ in trees configured before techniques had media
+  endif()
+  file(REMOVE_RECURSE ${folder})
+  set(seen "")
+  foreach(dir ${PROJECT_SOURCE_DIR}/materials ${media})
+    file(GLOB_RECURSE files RELATIVE ${dir} CONFIGURE_DEPENDS ${dir}/*)
+    foreach(file IN LISTS files)
+      if(file IN_LIST seen)
+        message(FATAL_ERROR "${dir}/${file}: another media folder already has ${file} (TreeLod's resource location is one folder)")
+      endif()
+      list(APPEND seen ${file})
+      get_filename_component(parent ${folder}/${file} DIRECTORY)
+      file(MAKE_DIRECTORY ${parent})
+      file(CREATE_LINK ${dir}/${file} ${folder}/${file} SYMBOLIC)
+    endforeach()
+    install(DIRECTORY ${dir}/ DESTINATION ${TREELOD_INSTALL_DATADIR}/media)
+  endforeach()
 endfunction()

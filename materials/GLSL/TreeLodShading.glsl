@@ -11,7 +11,7 @@ vec3 toSrgb(vec3 c)
 }
 
 // toSrgb(toLinear(albedo) * k) ~= albedo * srgbScale(k), exact for a power-law transfer curve
-// (the impostors light sRGB albedo without conversions, docs/impostor.md "Cost"): least-squares
+// (the impostors light sRGB albedo without conversions, techniques/impostor/README.md "Cost"): least-squares
 // fit over 8-bit albedo and k in [0, 1.2], mean error 1.3/255, worst 6.5/255 (dark albedo at
 // k < 0.1) against the exact conversions.
 vec3 srgbScale(vec3 k)

@@ -1,21 +1,20 @@
 // treelod bake INPUT.glb -o OUT.treelod [--technique NAME]... [--leaf-material NAME]... [--error-curves] [-q]
-// treelod bake CAPTURE_FOLDER -o OUT.treelod [--technique volume-octree] [--option volume-octree.NAME=VALUE]... [-q]
+// treelod bake CAPTURE_FOLDER -o OUT.treelod [--technique NAME]... [--option NAME.OPTION=VALUE]... [-q]
 // Imports the tree, bakes one chunk set per technique plus the "meta" chunk (source file
 // name, its sourceHashOf() as the bake cache records it, options) and writes the package atomically:
-// on any error nothing is written and the exit code is 2. A capture folder (photographs,
-// CaptureSet.h) bakes volume-octree only, with a reference of bounds only (ModelChunk.h).
+// on any error nothing is written and the exit code is 2. A capture folder (photographs and their
+// cameras) bakes the techniques that bake from photographs (BakeTechnique::bakeCapture), with a
+// reference of bounds only (ModelChunk.h).
 #include "CliSupport.h"
 #include "Commands.h"
 
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/BakeCache.h"
 #include "TreeLod/BakeTechniques.h"
-#include "TreeLod/CaptureSet.h"
 #include "TreeLod/ErrorCurves.h"
 #include "TreeLod/GltfImporter.h"
 #include "TreeLod/Package.h"
 #include "TreeLod/PackageWriter.h"
-#include "TreeLod/VolumeOctreeBaker.h"
 
 #ifdef TREELOD_WITH_OGRE
 #include "TreeLod/ErrorCurveMeasurer.h"
@@ -55,25 +54,44 @@ namespace TreeLod
             return p.filename().string();
         }
 
-        /// `treelod bake CAPTURE_FOLDER`: the photographs' volume octree and a reference of bounds only.
+        /// The registered bakers that bake from a capture folder, for messages: "volume-octree".
+        std::string captureBakers()
+        {
+            std::string names;
+            for (const BakeTechnique& t : bakeTechniques())
+                if (t.bakeCapture)
+                    names += (names.empty() ? "" : ", ") + std::string(t.name);
+            return names;
+        }
+
+        /// `treelod bake CAPTURE_FOLDER`: the chunks of the techniques that bake from photographs
+        /// (BakeTechnique::bakeCapture; all of them without --technique) and a reference of bounds only.
         int runBakeCapture(const BakeArgs& args)
         {
             const std::string& folder = args.input;
+            std::vector<const BakeTechnique*> techniques;
+            for (const BakeTechnique& t : bakeTechniques())
+                if (t.bakeCapture && args.techniques.empty())
+                    techniques.push_back(&t);
             for (const std::string& name : args.techniques)
-                if (name != VOLUME_OCTREE_CHUNK)
+            {
+                const BakeTechnique* t = findBakeTechnique(name);
+                if (!t || !t->bakeCapture)
                     return printError(fail(folder, "option --technique",
                                            "'" + name + "': a capture folder (photographs) can only bake " +
-                                               VOLUME_OCTREE_CHUNK));
+                                               captureBakers()));
+                if (std::find(techniques.begin(), techniques.end(), t) == techniques.end())
+                    techniques.push_back(t);
+            }
+            if (techniques.empty())
+                return printError(fail(folder, "", "this build has no technique that bakes from photographs"));
             if (!args.leafMaterials.empty())
                 return printError(fail(folder, "option --leaf-material", "applies to glTF input, not to photographs"));
             if (args.errorCurves)
                 return printError(fail(folder, "option --error-curves",
                                        "error curves compare the levels with the polygonal tree, and photographs "
                                        "have none"));
-            const BakeTechnique* technique = findBakeTechnique(VOLUME_OCTREE_CHUNK);
-            if (!technique)
-                return printError(fail(folder, "", std::string("this build has no ") + VOLUME_OCTREE_CHUNK + " baker"));
-            BakeOptions values;
+            std::map<const BakeTechnique*, BakeOptions> values;
             nlohmann::json optionsJson = nlohmann::json::object();
             for (const std::string& option : args.options)
             {
@@ -81,17 +99,16 @@ namespace TreeLod
                 if (!parsed)
                     return printError(parsed.error());
                 const auto& [name, key, value] = parsed.value();
-                if (name != VOLUME_OCTREE_CHUNK)
+                const BakeTechnique* t = findBakeTechnique(name);
+                if (!t || std::find(techniques.begin(), techniques.end(), t) == techniques.end())
                     return printError(fail("", "option --option '" + option + "'",
                                            "'" + name + "' is not a technique being baked"));
-                values[key] = value;
+                values[t][key] = value;
                 optionsJson[name][key] = value;
             }
-            if (Result<void> checked = checkBakeOptions(*technique, values, args.output); !checked)
-                return printError(checked.error());
-            VolumeOctreeOptions options;
-            if (Result<void> parsed = parseVolumeOctreeBakeOptions(values, options, nullptr, args.output); !parsed)
-                return printError(parsed.error());
+            for (const auto& [technique, given] : values)
+                if (Result<void> checked = checkBakeOptions(*technique, given, args.output); !checked)
+                    return printError(checked.error());
 
             const std::filesystem::path outDir = std::filesystem::path(args.output).parent_path();
             std::error_code ec;
@@ -99,25 +116,24 @@ namespace TreeLod
                 return printError(fail(args.output, "", "directory '" + outDir.string() + "' does not exist"));
 
             const ProgressCallback progress = makeProgress(args.quiet);
-            report(progress, "capture: read", 0.0f);
-            Result<CaptureSet> capture = readCaptureSet(folder);
-            if (!capture)
-                return printError(capture.error());
-            report(progress, "capture: read", 1.0f);
             Result<std::string> hash = sourceHashOf(folder);
             if (!hash)
                 return printError(hash.error());
-
             PackageWriter writer;
             PackageMeta meta;
             meta.source = folderName(folder);
             meta.sourceHash = hash.value();
             meta.optionsJson = optionsJson.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-            meta.techniques = {REFERENCE_CHUNK, VOLUME_OCTREE_CHUNK};
-            if (Result<void> baked =
-                    addVolumeOctreeChunk(writer, capture.value(), meta.source, options, args.output, progress);
-                !baked)
-                return printError(baked.error());
+            meta.techniques = {REFERENCE_CHUNK};
+            std::string baked = REFERENCE_CHUNK;
+            for (const BakeTechnique* t : techniques)
+            {
+                if (Result<void> added = t->bakeCapture(writer, folder, meta.source, values[t], args.output, progress);
+                    !added)
+                    return printError(added.error());
+                meta.techniques.push_back(t->name);
+                baked += std::string(", ") + t->name;
+            }
             if (Result<void> added = addMetaChunk(writer, meta); !added)
                 return printError(added.error());
 
@@ -126,9 +142,8 @@ namespace TreeLod
             if (Result<void> written = writeFileAtomic(args.output, bytes); !written)
                 return printError(written.error());
             report(progress, "write", 1.0f);
-            std::printf("wrote %s: %zu chunks (%s, %s + meta), %zu bytes; %zu photographs, no polygons\n",
-                        args.output.c_str(), writer.chunkCount(), REFERENCE_CHUNK, VOLUME_OCTREE_CHUNK, bytes.size(),
-                        capture->cameras.size());
+            std::printf("wrote %s: %zu chunks (%s + meta), %zu bytes; from photographs, no polygons\n",
+                        args.output.c_str(), writer.chunkCount(), baked.c_str(), bytes.size());
             return EXIT_OK;
         }
 
@@ -264,10 +279,10 @@ namespace TreeLod
                               o.description;
         }
         CLI::App* cmd = app.add_subcommand(
-            "bake", "bake a .glb/.gltf tree, or a capture folder of photographs (volume-octree), into a .treelod package");
+            "bake", "bake a .glb/.gltf tree, or a capture folder of photographs, into a .treelod package");
         cmd->add_option("input", args->input,
-                        ".glb or .gltf file, or a capture folder (cameras.json and RGBA photographs: volume-octree "
-                        "only, without its synthesis options cameras, resolution, samplesPerPixel)")
+                        ".glb or .gltf file, or a capture folder (cameras.json and RGBA photographs), which only "
+                        "the techniques that bake from photographs take: " + captureBakers())
             ->required();
         cmd->add_option("-o,--output", args->output, ".treelod file to write (atomically)")->required();
         cmd->add_option("--technique", args->techniques, help)->allow_extra_args(false);

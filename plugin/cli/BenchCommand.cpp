@@ -67,7 +67,7 @@ namespace TreeLod
         {
             std::string scene;
             std::string output;
-            std::string techniques = "auto,lodf,billboard-cloud";
+            std::string techniques; // set where the option is added: defaultBenchTechniques()
             std::string lodBiases = "1,0.5,0.25";
             std::uint32_t frames = 0; // 0 = the script's
             double scale = 1.0;
@@ -147,31 +147,6 @@ namespace TreeLod
             std::string skipped;   ///< the whole run (e.g. too many entities)
             bool hasPicture = false;
         };
-
-        /// A run that stands for something every technique is compared with.
-        struct ComparisonRun
-        {
-            std::string technique;
-            std::string label; ///< what the plots call it
-            char marker;       ///< its point in the trade plot (a matplotlib marker)
-        };
-        const std::vector<ComparisonRun>& comparisonRuns()
-        {
-            static const std::vector<ComparisonRun> runs = {
-                {REFERENCE_TECHNIQUE, "polygonal reference (mesh, 1 spp)", 'o'},
-                {FLOOR_TECHNIQUE, "floor: the Forest's one-quad level", 's'},
-                {"entities", "floor: one Ogre entity per tree (a quad)", '^'},
-                {"merged-quads", "floor: quads merged into a few batches", 'x'},
-                {"billboard-set", "floor: a plain Ogre BillboardSet (unlit)", 'D'}};
-            return runs;
-        }
-        bool isComparisonRun(const std::string& technique)
-        {
-            for (const ComparisonRun& run : comparisonRuns())
-                if (run.technique == technique)
-                    return true;
-            return false;
-        }
 
         /// The reference on a sampled frame: supersampled image and its temporal noise.
         struct ReferenceSample
@@ -505,6 +480,7 @@ namespace TreeLod
                 const double techniqueOnShared = reference ? medianOver(run, reference) : NAN;
                 const double referenceOnShared = reference ? medianOver(*reference, &run) : NAN;
                 // Ratios of medians measured in this run (the floors' own medians over their timed frames).
+                const std::string floor = TechniqueRegistry::getSingleton().getFloor().name;
                 json ratios = json::object();
                 for (const ComparisonRun& c : comparisonRuns())
                     if (c.technique != REFERENCE_TECHNIQUE)
@@ -519,7 +495,7 @@ namespace TreeLod
                                    {"worstFrame", worst},
                                    {"cpuMs", toJson(statsOf(cpuMs))},
                                    {"speedupVsReference", num(referenceOnShared / techniqueOnShared)},
-                                   {"ratioToFloor", ratios.contains(FLOOR_TECHNIQUE) ? ratios[FLOOR_TECHNIQUE] : json(nullptr)},
+                                   {"ratioToFloor", ratios.contains(floor) ? ratios[floor] : json(nullptr)},
                                    {"ratioToFloors", ratios},
                                    {"maxUploadedBytesPerFrame", maxUploaded},
                                    {"instanceBytes", run.instanceBytes},
@@ -838,7 +814,7 @@ namespace TreeLod
 
         /// The error curves of every package that the budgeted auto choices draw, measured here (an
         /// OffscreenRenderer of this process) where a package lacks them: treelod_frames links no baker.
-        Result<void> bakeErrorCurves(const SceneScript& script, const std::vector<std::string>& autoChoices,
+        Result<void> bakeErrorCurves(const SceneScript& script, const std::vector<LodPolicy>& autoChoices,
                                      const CacheTreeBaker& baker, const ProgressCallback& progress)
         {
             if (autoChoices.empty())
@@ -881,18 +857,18 @@ namespace TreeLod
             if (Result<std::vector<float>> biases = parseLodBiases(args.lodBiases); !biases)
                 return printError(biases.error());
             // Every run draws from these: the reference, the floors, then the techniques.
-            std::vector<std::string> drawn = {REFERENCE_TECHNIQUE, FLOOR_TECHNIQUE};
-            std::vector<std::string> autoChoices; // budgeted auto needs the error curves of what it draws
-            for (const std::string& t : splitList(args.techniques))
+            Result<std::vector<BenchRun>> asked = parseBenchRuns(splitList(args.techniques));
+            if (!asked)
+                return printError(asked.error());
+            std::vector<LodPolicy> drawn;
+            for (const BenchRun& c : comparisonBenchRuns())
+                drawn.push_back(c.policy);
+            std::vector<LodPolicy> autoChoices; // budgeted auto needs the error curves of what it draws
+            for (const BenchRun& run : *asked)
             {
-                float budget = 0.0f;
-                const bool isAuto = parseAutoTechnique(t, budget);
-                if (!isAuto && bakeTechniqueOf(t).empty())
-                    return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: auto, auto@E, auto~MS, " +
-                                                                   knownSceneTechniques() + ")"));
-                drawn.push_back(t == "auto" ? "" : t);
-                if (isAuto)
-                    autoChoices.push_back(drawn.back());
+                drawn.push_back(run.policy);
+                if (run.policy.mode != LodPolicy::Mode::Fixed)
+                    autoChoices.push_back(run.policy);
             }
             if (args.samples == 0 || frames == 0)
                 return printError(fail("", "--frames/--samples", "must be >= 1"));
@@ -981,11 +957,14 @@ namespace TreeLod
         cmd->add_option("-o,--output", args->output, "output directory")->required();
 #ifdef TREELOD_WITH_OGRE
         const std::string known = knownSceneTechniques();
+        const std::string comparisons = describeComparisonRuns();
+        args->techniques = defaultBenchTechniques();
 #else
         const std::string known = "(none: this build has no Ogre plugin)";
+        const std::string comparisons = known;
 #endif
         cmd->add_option("--techniques", args->techniques,
-                        "comma-separated techniques besides the reference (mesh) and the floor (impostor): auto (the "
+                        "comma-separated techniques besides the comparison runs (" + comparisons + "): auto (the "
                         "script's choice), auto@E (budgeted auto at error budget E), auto~MS (under a frame budget of "
                         "MS milliseconds) or any of " + known)
             ->capture_default_str();

@@ -50,7 +50,7 @@ namespace TreeLod
             std::string scene;
             std::string packages;
             std::string output;
-            std::string techniques = "auto,lodf,billboard-cloud";
+            std::string techniques = defaultBenchTechniques();
             std::string lodBiases = "1,0.5,0.25";
             std::uint32_t frames = 0; // 0 = the script's
             double scale = 1.0;
@@ -136,16 +136,13 @@ namespace TreeLod
             if (!parsedBiases)
                 return printError(parsedBiases.error());
             const std::vector<float>& biases = *parsedBiases;
-            std::vector<std::string> techniques;
-            for (const std::string& t : splitList(args.techniques))
-            {
-                float budget = 0.0f;
-                if (!parseAutoTechnique(t, budget) && bakeTechniqueOf(t).empty())
-                    return printError(fail("", "--techniques", "unknown technique '" + t + "' (known: auto, auto@E, auto~MS, " +
-                                                                   knownSceneTechniques() + ")"));
-                if (args.skipComparisons || (t != REFERENCE_TECHNIQUE && t != FLOOR_TECHNIQUE && !isQuadFloor(t)))
-                    techniques.push_back(t); // otherwise run once below, with the comparisons
-            }
+            Result<std::vector<BenchRun>> asked = parseBenchRuns(splitList(args.techniques));
+            if (!asked)
+                return printError(asked.error());
+            std::vector<BenchRun> techniques;
+            for (const BenchRun& run : *asked)
+                if (args.skipComparisons || !isComparisonRun(run.name))
+                    techniques.push_back(run); // otherwise run once below, with the comparisons
             std::vector<std::uint32_t> counts = script.counts;
             if (!args.counts.empty())
             {
@@ -196,13 +193,10 @@ namespace TreeLod
             // Budgeted auto needs this machine's cost of every level: calibrated once per package and
             // renderer (cached), before any scene exists, since calibrating draws alone.
             std::map<std::string, std::vector<LevelCost>> levelCosts; // by assetCostKey
-            std::vector<std::string> autoChoices; // as ForestSceneOptions::technique
-            for (const std::string& t : techniques)
-            {
-                float budget = 0.0f;
-                if (parseAutoTechnique(t, budget))
-                    autoChoices.push_back(t == "auto" ? "" : t);
-            }
+            std::vector<LodPolicy> autoChoices;
+            for (const BenchRun& run : techniques)
+                if (run.policy.mode != LodPolicy::Mode::Fixed)
+                    autoChoices.push_back(run.policy);
             if (!autoChoices.empty())
                 for (const auto& [source, bake] : scenePackages(script, autoChoices))
                 {
@@ -254,20 +248,23 @@ namespace TreeLod
                 options.placement.totalCount = count;
                 options.placement.scale = args.scale;
                 options.uploadBudget = args.uploadBudget;
-                std::vector<std::pair<std::string, std::vector<float>>> plan;
+                std::vector<std::pair<BenchRun, std::vector<float>>> plan;
                 if (!args.skipComparisons)
-                    plan = {{REFERENCE_TECHNIQUE, {1.0f}}, {FLOOR_TECHNIQUE, {1.0f}}, {"entities", {1.0f}}, {"merged-quads", {1.0f}},
-                            {"billboard-set", {1.0f}}};
-                for (const std::string& t : techniques)
+                    for (const BenchRun& c : comparisonBenchRuns())
+                        plan.push_back({c, {1.0f}});
+                for (const BenchRun& t : techniques)
                     plan.push_back({t, biases});
-                for (const auto& [technique, runBiases] : plan)
+                for (const auto& [benchRun, runBiases] : plan)
                 {
-                    options.technique = technique == "auto" ? "" : technique;
+                    const std::string& technique = benchRun.name;
+                    options.policy = benchRun.policy;
                     const std::uint32_t placed = std::uint32_t(generatePlacements(script, options.placement).size());
-                    if (technique == "entities" && placed > args.entityLimit)
+                    const TechniqueRegistry& registry = TechniqueRegistry::getSingleton();
+                    const BaselineInfo* baseline = registry.findBaseline(technique);
+                    if (baseline && baseline->oneObjectPerTree && placed > args.entityLimit)
                     {
                         json run = {{"trees", placed}, {"technique", technique}, {"lodBias", 1.0},
-                                    {"skipped", std::to_string(placed) + " entities > --entity-limit " +
+                                    {"skipped", std::to_string(placed) + " objects > --entity-limit " +
                                                     std::to_string(args.entityLimit)},
                                     {"frames", json::array()}};
                         runsJson.push_back(run);
@@ -324,7 +321,7 @@ namespace TreeLod
                                 row["frameMs"] = timing.frameMilliseconds;
                                 row["batches"] = timing.batches;
                                 row["triangles"] = timing.triangles;
-                                if (!isQuadFloor(technique))
+                                if (!baseline)
                                 {
                                     row["visible"] = stats.visibleInstances;
                                     row["levels"] = levelHistogram(scene->getForest());
@@ -402,7 +399,7 @@ int main(int argc, char** argv)
     app.add_option("--packages", args.packages, "package list written by `treelod bench` (packages.json)")->required();
     app.add_option("-o,--output", args.output, "output directory (timings.json, images/)")->required();
     app.add_option("--techniques", args.techniques,
-                   "techniques besides the reference (mesh) and the floors (impostor, entities, merged-quads, billboard-set)")
+                   "techniques besides the comparison runs (" + describeComparisonRuns() + ")")
         ->capture_default_str();
     app.add_option("--lod-bias", args.lodBiases, "comma-separated LoD biases")->capture_default_str();
     app.add_option("--frames", args.frames, "frames along the path (default: the script's)");

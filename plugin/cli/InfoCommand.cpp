@@ -1,7 +1,8 @@
-// treelod info FILE [--json]
+// treelod info FILE [--json] | treelod info --techniques [--json]
 // What a .treelod package holds (version, size, chunks with their checksums, the reference
 // model's counts, what each technique's descriptor says of its chunk) or what a .glb/.gltf imports
-// to (the same counts plus texture sizes).
+// to (the same counts plus texture sizes). --techniques: the techniques this build registers, with
+// their roles in the trade (TechniqueRoles), the measurement baselines and the default bands.
 // The kind is told by content (the "TRLD" magic), not by extension. A package with a damaged
 // chunk is still listed (crc "BAD"), then the command exits 2.
 #include "CliSupport.h"
@@ -13,6 +14,11 @@
 #include "TreeLod/TechniqueDescriptor.h"
 
 #include <nlohmann/json.hpp>
+
+#ifdef TREELOD_WITH_OGRE
+#include "TreeLod/Forest.h"
+#include "TreeLod/TechniqueRegistry.h"
+#endif
 
 #include <cstdio>
 #include <cstring>
@@ -31,6 +37,7 @@ namespace TreeLod
             std::string input;
             std::vector<std::string> leafMaterials;
             bool json = false;
+            bool techniques = false;
         };
 
         /// One row per texture: what the model holds and, for packages, the GPU copy.
@@ -83,7 +90,7 @@ namespace TreeLod
                         size.z);
             if (!hasPolygons(m))
                 std::printf("  no polygons: baked from photographs, the bounds are the capture's volume (only "
-                            "volume-octree draws it)\n");
+                            "techniques that bake from photographs draw it)\n");
             std::printf("  textures %zu\n", textures.size());
             for (std::size_t i = 0; i < textures.size(); ++i)
             {
@@ -269,8 +276,93 @@ namespace TreeLod
             return EXIT_OK;
         }
 
+#ifdef TREELOD_WITH_OGRE
+        /// `treelod info --techniques`: every registered technique with its roles, the baselines and
+        /// the default bands; what the Forest, the bench and `treelod render` read from the registry.
+        int infoTechniques(const InfoArgs& args)
+        {
+            const TechniqueRegistry& registry = TechniqueRegistry::getSingleton();
+            const std::vector<ForestBand> bands = Forest::getAutoBands();
+            json techniques = json::array();
+            for (const TechniqueInfo& t : registry.getTechniques())
+            {
+                json options = json::array();
+                for (const TechniqueParameter& p : t.roles.parameters)
+                    options.push_back({{"option", "--" + p.flag}, {"parameter", p.name}, {"description", p.description}});
+                techniques.push_back(
+                    {{"name", t.name},
+                     {"description", t.description},
+                     {"chunk", t.chunkTechnique},
+                     {"movableType", t.movableType},
+                     {"forestLevel", bool(t.forestLevels)},
+                     {"floor", t.roles.floor},
+                     {"autoCandidate", t.roles.autoCandidate},
+                     {"defaultBandMinHeightPx",
+                      t.roles.defaultBandMinHeight >= 0.0f ? json(t.roles.defaultBandMinHeight) : json(nullptr)},
+                     {"benchDefault", t.roles.benchDefault},
+                     {"comparison", t.roles.comparisonLabel.empty() ? json(nullptr) : json(t.roles.comparisonLabel)},
+                     {"renderOptions", options}});
+            }
+            json baselines = json::array();
+            for (const BaselineInfo& b : registry.getBaselines())
+                baselines.push_back({{"name", b.name}, {"comparison", b.comparisonLabel}, {"chunk", b.chunkTechnique}});
+            json defaultBands = json::array();
+            for (const ForestBand& b : bands)
+                defaultBands.push_back({{"technique", b.technique}, {"minHeightPx", b.minHeightPixels}});
+            if (args.json)
+            {
+                const json j = {{"techniques", techniques}, {"baselines", baselines}, {"defaultBands", defaultBands}};
+                std::printf("%s\n", j.dump(2).c_str());
+                return EXIT_OK;
+            }
+            std::printf("techniques (name: roles; chunk; MovableObject type):\n");
+            for (const json& t : techniques)
+            {
+                std::string roles;
+                auto add = [&](const std::string& role) { roles += (roles.empty() ? "" : ", ") + role; };
+                if (t["autoCandidate"].get<bool>())
+                    add("auto candidate");
+                if (!t["defaultBandMinHeightPx"].is_null())
+                    add("default band from " + std::to_string(int(t["defaultBandMinHeightPx"].get<float>())) + " px");
+                if (t["floor"].get<bool>())
+                    add("floor");
+                if (t["benchDefault"].get<bool>())
+                    add("bench default");
+                if (!t["comparison"].is_null())
+                    add("compared with every bench run");
+                if (!t["forestLevel"].get<bool>())
+                    add("no Forest level");
+                for (const json& o : t["renderOptions"])
+                    add("render " + o["option"].get<std::string>());
+                std::printf("  %s: %s; chunk %s; %s\n    %s\n", t["name"].get<std::string>().c_str(),
+                            roles.empty() ? "-" : roles.c_str(), t["chunk"].get<std::string>().c_str(),
+                            t["movableType"].get<std::string>().c_str(), t["description"].get<std::string>().c_str());
+            }
+            std::printf("baselines (drawn without the Forest, compared with every bench run):\n");
+            for (const BaselineInfo& b : registry.getBaselines())
+                std::printf("  %s: %s; chunk %s\n", b.name.c_str(), b.comparisonLabel.c_str(), b.chunkTechnique.c_str());
+            std::printf("default bands (\"auto\" without a budget):");
+            for (std::size_t i = 0; i < bands.size(); ++i)
+                std::printf("%s %s from %g px", i ? "," : "", bands[i].technique.c_str(), double(bands[i].minHeightPixels));
+            std::printf("\n");
+            return EXIT_OK;
+        }
+#endif
+
         int runInfo(const InfoArgs& args)
         {
+            if (args.techniques)
+            {
+#ifdef TREELOD_WITH_OGRE
+                if (!args.input.empty())
+                    return printError(fail(args.input, "--techniques", "takes no file"));
+                return infoTechniques(args);
+#else
+                return printError(fail("", "--techniques", "this build has no Ogre plugin, which registers the techniques"));
+#endif
+            }
+            if (args.input.empty())
+                return printError(fail("", "info", "a file to describe, or --techniques"));
             return isPackage(args.input) ? infoPackage(args) : infoGltf(args);
         }
     }
@@ -279,7 +371,10 @@ namespace TreeLod
     {
         auto args = std::make_shared<InfoArgs>();
         CLI::App* cmd = app.add_subcommand("info", "list what a .treelod package or a .glb/.gltf holds");
-        cmd->add_option("file", args->input, ".treelod, .glb or .gltf file")->required();
+        cmd->add_option("file", args->input, ".treelod, .glb or .gltf file");
+        cmd->add_flag("--techniques", args->techniques,
+                      "list the registered techniques with their roles (auto candidate, default band, floor, "
+                      "render options), the measurement baselines and the default bands");
         cmd->add_option("--leaf-material", args->leafMaterials,
                         "glTF only: materials with this name are leaves (repeatable; default: alphaMode MASK/BLEND)")
             ->allow_extra_args(false);

@@ -10,8 +10,10 @@
 #include "TreeLod/ModelChunk.h"
 #include "TreeLod/ReferenceRenderer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <map>
 
 #ifdef TREELOD_WITH_OGRE
 #include "TreeLod/OffscreenRenderer.h"
@@ -33,13 +35,11 @@ namespace TreeLod
             std::string size = "512x512";
             std::string renderer = "ogre";
             int supersample = 3;
-            std::uint32_t leaves = 0;
-            float pixelsPerLeaf = 0.0f;
             float lodBias = 1.0f;
             bool shadows = false;
             std::string shadowCamera = "focused";
-            int level = -1;
-            float listFactor = -1.0f;
+            /// The techniques' object parameters (TechniqueRoles::parameters) by option flag; "" = not given.
+            std::map<std::string, std::string> techniqueParams;
             std::vector<std::string> leafMaterials;
             bool verbose = false;
         };
@@ -110,14 +110,18 @@ namespace TreeLod
                     TreeAssetPtr asset = TreeAssetManager::getSingleton().loadFromBytes(
                         input->name, Ogre::RGN_DEFAULT, input->packageBytes);
                     Ogre::NameValuePairList params;
-                    if (args.leaves > 0)
-                        params["leaves"] = std::to_string(args.leaves);
-                    if (args.pixelsPerLeaf > 0.0f)
-                        params["pixelsPerLeaf"] = std::to_string(args.pixelsPerLeaf);
-                    if (args.level >= 0)
-                        params["level"] = std::to_string(args.level);
-                    if (args.listFactor >= 0.0f)
-                        params["listFactor"] = std::to_string(args.listFactor);
+                    for (const auto& [flag, value] : args.techniqueParams)
+                    {
+                        if (value.empty())
+                            continue;
+                        const auto& declared = technique->roles.parameters;
+                        const auto it = std::find_if(declared.begin(), declared.end(),
+                                                     [&](const TechniqueParameter& p) { return p.flag == flag; });
+                        if (it == declared.end())
+                            return printError(fail("", "--" + flag, "technique '" + args.technique +
+                                                                        "' has no such parameter"));
+                        params[it->name] = value;
+                    }
                     renderer.setShadows(args.shadows, 2048, parseShadowCamera(args.shadowCamera, "--shadow-camera"));
                     renderer.setLodBias(args.lodBias);
                     Ogre::MovableObject* object = TechniqueRegistry::getSingleton().createInstance(
@@ -155,13 +159,15 @@ namespace TreeLod
 #endif
         cmd->add_option("--technique", args->technique,
                         "LoD technique: " + techniques + " (mesh: the polygonal reference); a .glb is baked in memory");
-        cmd->add_option("--leaves", args->leaves, "lodf: draw exactly this many leaves (default: from screen size)");
-        cmd->add_option("--pixels-per-leaf", args->pixelsPerLeaf, "lodf: projected pixels per leaf (default 4)");
-        cmd->add_option("--level", args->level, "billboard clouds, ellipsoids: draw this level (0 finest; clouds: "
-                                               "2 low-res only) instead of the LoD strategy's");
-        cmd->add_option("--list-factor", args->listFactor,
-                        "billboard-cloud: shader LoD, list entries walked per pixel of projected hash-cell diagonal "
-                        "(0 = low-res texture only; default from the package)");
+#ifdef TREELOD_WITH_OGRE
+        // Each technique's object parameters (TechniqueRoles::parameters), one option per flag.
+        std::map<std::string, std::string> help;
+        for (const TechniqueInfo& info : TechniqueRegistry::getSingleton().getTechniques())
+            for (const TechniqueParameter& p : info.roles.parameters)
+                help[p.flag] += (help[p.flag].empty() ? "" : "; ") + info.name + ": " + p.description;
+        for (const auto& [flag, text] : help)
+            cmd->add_option("--" + flag, args->techniqueParams[flag], text);
+#endif
         cmd->add_option("--lod-bias", args->lodBias, "camera LoD bias (> 1 = more detail)");
         cmd->add_flag("--shadows", args->shadows, "texture shadows from the sun (2048^2 float depth)");
         cmd->add_option("--shadow-camera", args->shadowCamera,

@@ -158,28 +158,35 @@ namespace TreeLod
         return names;
     }
 
+    std::string ForestSample::menuLabel(const LodPolicy& policy)
+    {
+        return policy.mode == LodPolicy::Mode::Script ? std::string(SCRIPT_TECHNIQUE) : policy.toString();
+    }
+
     std::string ForestSample::getTechnique() const
     {
         // The one asked for while its bakes run (the menu keeps showing the choice).
-        const std::string& technique = mScene->isTechniquePending() ? mScene->getPendingTechnique() : mScene->getTechnique();
-        return technique.empty() ? std::string(SCRIPT_TECHNIQUE) : technique;
+        return menuLabel(mScene->isPolicyPending() ? mScene->getPendingPolicy() : mScene->getPolicy());
     }
 
     void ForestSample::setTechnique(const std::string& technique)
     {
+        requestPolicy(technique == SCRIPT_TECHNIQUE ? LodPolicy::scriptChoice() : LodPolicy::fixed(technique));
+    }
+
+    void ForestSample::requestPolicy(const LodPolicy& policy)
+    {
         mBakeError.clear();
-        mScene->requestTechnique(technique == SCRIPT_TECHNIQUE ? "" : technique);
+        mScene->requestPolicy(policy);
     }
 
     void ForestSample::setErrorBudget(float budget)
     {
         mErrorBudget = budget;
-        // Budgeted species re-plan in place; otherwise the scene is rebuilt as "auto@budget".
-        if (!mScene->isTechniquePending() && mScene->setErrorBudget(budget))
+        // Budgeted species re-plan in place; otherwise the scene is rebuilt under budgeted auto.
+        if (!mScene->isPolicyPending() && mScene->setErrorBudget(budget))
             return;
-        char technique[32];
-        std::snprintf(technique, sizeof technique, "auto@%g", double(budget));
-        setTechnique(technique);
+        requestPolicy(LodPolicy::automatic(budget));
     }
 
     void ForestSample::setLodBias(float bias)
@@ -202,7 +209,7 @@ namespace TreeLod
 
     bool ForestSample::isSettled() const
     {
-        return !mScene->isTechniquePending() && mScene->getForest().getStats().pendingLevels == 0;
+        return !mScene->isPolicyPending() && mScene->getForest().getStats().pendingLevels == 0;
     }
 
     bool ForestSample::isLodFrozen() const { return mScene->getForest().isLodFrozen(); }
@@ -224,11 +231,8 @@ namespace TreeLod
         if (s.pendingLevels > 0 || s.fallbackInstances > 0)
             stats.emplace_back("Levels uploading", std::to_string(s.pendingLevels) + " (" +
                                                        formatCount(s.fallbackInstances) + " trees at a fallback)");
-        if (mScene->isTechniquePending())
-            stats.emplace_back("Baking", getTechnique() + " (drawing " +
-                                             (mScene->getTechnique().empty() ? std::string(SCRIPT_TECHNIQUE)
-                                                                             : mScene->getTechnique()) +
-                                             " meanwhile)");
+        if (mScene->isPolicyPending())
+            stats.emplace_back("Baking", getTechnique() + " (drawing " + menuLabel(mScene->getPolicy()) + " meanwhile)");
         if (!mBakeError.empty())
             stats.emplace_back("Bake failed", mBakeError);
         // "oak: budget 0.04: lodf 3000 >= 117 px, ...": how, here; which levels, in the level box.

@@ -38,6 +38,10 @@ namespace TreeLod
         std::vector<std::string> getTechniques() const override;
         std::string getTechnique() const override;
         void setTechnique(const std::string& technique) override;
+        /// setTechnique's and the budget slider's way to the scene: bakes run, then it switches.
+        void requestPolicy(const LodPolicy& policy);
+        /// The menu's name for `policy`: SCRIPT_TECHNIQUE, a technique, or "auto@E".
+        static std::string menuLabel(const LodPolicy& policy);
         float getLodBias() const override { return mLodBias; }
         void setLodBias(float bias) override;
         bool getShadows() const override { return mShadows; }

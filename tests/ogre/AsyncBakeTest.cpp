@@ -1,6 +1,6 @@
 // Baking off the frame path: TreeAssetManager::requireAsync runs the registered
 // TreeBaker on a worker thread while the render thread goes on drawing; ForestScene's
-// requestTechnique/update switch a scene's technique once its bakes have ended. A gated baker
+// requestPolicy/update switch a scene's policy once its bakes have ended. A gated baker
 // (it waits until the test opens its gate) makes "not ready yet" deterministic.
 #include "OgreTestSupport.h"
 
@@ -189,7 +189,7 @@ namespace TreeLod
                                                       "async.json", "");
         ASSERT_TRUE(script.ok()) << script.error().message();
         ForestSceneOptions options;
-        options.technique = "impostor";
+        options.policy = LodPolicy::fixed("impostor");
         ForestScene scene(r.getSceneManager(), r.getContentNode(), *script, options);
         const CameraSpec camera = scene.cameraAtFrame(0, 1);
         const Image quads = toImage(r.render(camera, 96, 64, 1));
@@ -198,21 +198,21 @@ namespace TreeLod
 
         // Asked for lodf with the gate closed: quads go on drawing, frame after frame.
         baker.close();
-        scene.requestTechnique(FOLIAGE_LOD_CHUNK);
-        EXPECT_TRUE(scene.isTechniquePending());
-        EXPECT_EQ(scene.getPendingTechnique(), FOLIAGE_LOD_CHUNK);
+        scene.requestPolicy(LodPolicy::fixed(FOLIAGE_LOD_CHUNK));
+        EXPECT_TRUE(scene.isPolicyPending());
+        EXPECT_EQ(scene.getPendingPolicy(), LodPolicy::fixed(FOLIAGE_LOD_CHUNK));
         for (int f = 0; f < 3; ++f)
         {
             EXPECT_FALSE(scene.update());
             const Image frame = toImage(r.render(camera, 96, 64, 1));
-            EXPECT_EQ(scene.getTechnique(), "impostor");
+            EXPECT_EQ(scene.getPolicy(), LodPolicy::fixed("impostor"));
             EXPECT_EQ(scene.getForest().getLevels(0).front().technique, "impostor");
             EXPECT_LT(flipMean(quads, frame), 0.001) << "the current technique keeps drawing";
         }
         baker.open();
         ASSERT_TRUE(waitFor([&] { return scene.update(); }));
-        EXPECT_FALSE(scene.isTechniquePending());
-        EXPECT_EQ(scene.getTechnique(), FOLIAGE_LOD_CHUNK);
+        EXPECT_FALSE(scene.isPolicyPending());
+        EXPECT_EQ(scene.getPolicy(), LodPolicy::fixed(FOLIAGE_LOD_CHUNK));
         EXPECT_EQ(scene.getForest().getLevels(0).front().technique, FOLIAGE_LOD_CHUNK);
         const Image leaves = toImage(r.render(camera, 96, 64, 1));
         EXPECT_GT(treeCoverage(leaves, background), 0.01);
@@ -220,7 +220,7 @@ namespace TreeLod
 
         // A failed bake: update() throws naming the script and the source; lodf stays.
         baker.fail = true;
-        scene.requestTechnique("impostor");
+        scene.requestPolicy(LodPolicy::fixed("impostor"));
         std::string error;
         ASSERT_TRUE(waitFor([&] {
             try
@@ -235,8 +235,8 @@ namespace TreeLod
         }));
         EXPECT_NE(error.find("async.json"), std::string::npos) << error;
         EXPECT_NE(error.find("preset:shrub"), std::string::npos) << error;
-        EXPECT_FALSE(scene.isTechniquePending());
-        EXPECT_EQ(scene.getTechnique(), FOLIAGE_LOD_CHUNK);
+        EXPECT_FALSE(scene.isPolicyPending());
+        EXPECT_EQ(scene.getPolicy(), LodPolicy::fixed(FOLIAGE_LOD_CHUNK));
         baker.fail = false;
     }
 }

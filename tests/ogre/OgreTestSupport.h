@@ -196,7 +196,7 @@ namespace TreeLod
         sm.destroyQuery(query);
     }
 
-    // Golden images: each render is compared with tests/golden/NAME.png by FLIP (mean below
+    // Golden images: each render is compared with GOLDEN_DIR/NAME.png by FLIP (mean below
     // the bound stated per test); with TREELOD_GOLDEN=update the goldens are rewritten
     // instead (then open them and look before committing). On a failure the render and the
     // FLIP heat map are left in build/test-out/ogre/ for inspection.
@@ -244,10 +244,15 @@ namespace TreeLod
         EXPECT_LT(flipped->mean, bound) << name << ": see " << actualPath;
     }
 
-    /// compareWithGoldenFile with tests/golden/NAME.png.
-    inline void compareWithGolden(const Image& actual, const std::string& name, double bound)
+#ifndef TREELOD_GOLDEN_DIR
+#define TREELOD_GOLDEN_DIR "tests/golden" // a technique's tests: its golden/ folder (tests/ogre/CMakeLists.txt)
+#endif
+    /// compareWithGoldenFile with TREELOD_GOLDEN_DIR/NAME.png. Static: the folder is the including
+    /// source's own.
+    static inline void compareWithGolden(const Image& actual, const std::string& name, double bound)
     {
-        compareWithGoldenFile(actual, OgreEnvironment::sourcePath("tests/golden/" + name + ".png"), name, bound);
+        compareWithGoldenFile(actual, OgreEnvironment::sourcePath(std::string(TREELOD_GOLDEN_DIR) + "/" + name + ".png"),
+                              name, bound);
     }
 
     /// A tree object's Entity-style mesh LoD bias, seen through callbacks: set it, read the

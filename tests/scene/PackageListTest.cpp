@@ -143,22 +143,7 @@ namespace TreeLod
 
     TEST(ForestScene, budgetedAutoNamesItsBudgetAndBakesEveryTechniqueItChoosesAmong)
     {
-        float budget = -1.0f;
-        EXPECT_TRUE(parseAutoTechnique("auto", budget));
-        EXPECT_TRUE(std::isnan(budget)) << "plain auto takes the script's budget";
-        EXPECT_TRUE(parseAutoTechnique("auto@0.05", budget));
-        EXPECT_FLOAT_EQ(budget, 0.05f);
-        EXPECT_TRUE(parseAutoTechnique("auto@0", budget));
-        EXPECT_EQ(budget, 0.0f);
-        float frameBudget = -1.0f;
-        EXPECT_TRUE(parseAutoTechnique("auto~40", budget, &frameBudget));
-        EXPECT_TRUE(std::isnan(budget)) << "under a frame budget, the script's error budget to start from";
-        EXPECT_EQ(frameBudget, 40.0f);
-        EXPECT_TRUE(parseAutoTechnique("auto@0.05", budget, &frameBudget));
-        EXPECT_TRUE(std::isnan(frameBudget)) << "no frame budget: the script's";
-        for (const char* bad : {"auto@", "auto@x", "auto@1.5", "auto@-0.1", "auto@nan", "auto@0.1x", "lodf", "autox",
-                                "auto~", "auto~0", "auto~-5", "auto~inf", "auto~16ms"})
-            EXPECT_FALSE(parseAutoTechnique(bad, budget, &frameBudget)) << bad;
+        // The policy's grammar is LodPolicyTest's; here what a scene bakes for each policy.
 
         Result<SceneScript> script = parseSceneScript(R"({"name": "t", "ground": {"kind": "plane", "size": 100},
             "species": [{"name": "s", "source": "preset:shrub", "leaves": 100, "techniques": "auto"}],
@@ -169,7 +154,9 @@ namespace TreeLod
         ASSERT_TRUE(script.ok()) << script.error().message();
         for (const std::string& choice : {std::string(""), std::string("auto@0.05"), std::string("auto~40")})
         {
-            const auto packages = scenePackages(*script, {choice});
+            Result<LodPolicy> policy = LodPolicy::parse(choice);
+            ASSERT_TRUE(policy.ok()) << choice;
+            const auto packages = scenePackages(*script, {*policy});
             ASSERT_EQ(packages.size(), 1u);
             EXPECT_EQ(packages.begin()->second,
                       (std::vector<std::string>{"billboard-cloud", "classic-billboard-cloud", "ellipsoids", "impostor",

@@ -142,15 +142,7 @@ namespace TreeLod
                                       const CrossedQuadsOptions& options, const std::string& label,
                                       const ProgressCallback& progress)
     {
-        if (Result<void> reference = addReferenceChunkIfMissing(writer, model, label, progress); !reference)
-            return reference;
-        Result<CrossedQuadsData> data = bakeCrossedQuads(model, options, label, progress);
-        if (!data)
-            return data.error();
-        Result<void> added = writer.addChunk(CROSSED_QUADS_CHUNK, 0, CROSSED_QUADS_CHUNK_FORMAT_VERSION,
-                                             encodeCrossedQuadsChunk(data.value()));
-        if (!added)
-            return fail(label, added.error().element, added.error().reason);
-        return {};
+        return addBakedChunk(writer, model, label, progress, CROSSED_QUADS_CHUNK, CROSSED_QUADS_CHUNK_FORMAT_VERSION,
+                             encodeCrossedQuadsChunk, [&]() { return bakeCrossedQuads(model, options, label, progress); });
     }
 }

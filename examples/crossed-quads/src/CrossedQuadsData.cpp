@@ -1,8 +1,7 @@
 // CrossedQuadsData: the "crossed-quads" chunk (layout and meaning in CrossedQuadsData.h).
 #include "TreeLod/CrossedQuadsData.h"
 
-#include "TreeLod/ByteReader.h"
-#include "TreeLod/ByteWriter.h"
+#include "TreeLod/ChunkCodec.h"
 #include "TreeLod/Package.h"
 
 #include <cmath>
@@ -12,7 +11,11 @@ namespace TreeLod
     namespace
     {
         constexpr std::uint32_t KNOWN_FLAGS = 0;
-        constexpr std::size_t QUAD_RECORD_BYTES = 5 * 4;
+        /// The quad records (their textures follow them); the count limits serve decode and validate.
+        constexpr ArrayLayout QUADS{5 * 4, 1, 1, CROSSED_QUADS_MAX_QUADS, "quads"};
+
+        /// A quad record's fields, one list for the encoder and the decoder.
+        constexpr auto quadFields = [](auto& s, auto& q) { s.fields(q.azimuth, q.left, q.right, q.bottom, q.top); };
 
         std::string quadElement(std::size_t i) { return chunkElement(CROSSED_QUADS_CHUNK, 0) + ", quad " + std::to_string(i); }
     }
@@ -40,9 +43,8 @@ namespace TreeLod
     Result<void> CrossedQuadsData::validate(const std::string& label) const
     {
         const std::string name = chunkElement(CROSSED_QUADS_CHUNK, 0);
-        if (quads.empty() || quads.size() > CROSSED_QUADS_MAX_QUADS)
-            return fail(label, name, std::to_string(quads.size()) + " quads (1.." +
-                                         std::to_string(CROSSED_QUADS_MAX_QUADS) + " needed)");
+        if (std::string problem = QUADS.countProblem(quads.size()); !problem.empty())
+            return fail(label, name, problem);
         if (!(alphaCutoff > 0.0f && alphaCutoff <= 1.0f))
             return fail(label, name, "alpha cutoff " + std::to_string(alphaCutoff) + " outside (0, 1]");
         for (std::size_t i = 0; i < quads.size(); ++i)
@@ -67,18 +69,10 @@ namespace TreeLod
     std::vector<std::uint8_t> encodeCrossedQuadsChunk(const CrossedQuadsData& data)
     {
         ByteWriter w;
-        w.reserve(64 + data.quads.size() * (QUAD_RECORD_BYTES + 64) + data.textureBytes());
+        w.reserve(64 + data.quads.size() * (QUADS.recordBytes + 64) + data.textureBytes());
         w.u32(KNOWN_FLAGS);
         w.f32(data.alphaCutoff);
-        w.u32(std::uint32_t(data.quads.size()));
-        for (const CrossedQuad& q : data.quads)
-        {
-            w.f32(q.azimuth);
-            w.f32(q.left);
-            w.f32(q.right);
-            w.f32(q.bottom);
-            w.f32(q.top);
-        }
+        writeArray(w, data.quads, QUADS, quadFields);
         for (const CrossedQuad& q : data.quads)
             writeGpuTexture(w, q.colour);
         return w.take();
@@ -89,30 +83,12 @@ namespace TreeLod
         const std::string name = chunkElement(CROSSED_QUADS_CHUNK, 0);
         ByteReader r(bytes.data(), bytes.size(), label, name);
         CrossedQuadsData data;
-        const std::uint32_t flags = r.u32();
-        if (r.ok() && (flags & ~KNOWN_FLAGS) != 0)
-            r.failHere("unknown flags " + std::to_string(flags));
+        readFlags(r, KNOWN_FLAGS);
         data.alphaCutoff = r.f32();
-        // count() checks the records fit in the bytes left before anything is allocated.
-        const std::uint32_t count = r.count(QUAD_RECORD_BYTES);
-        if (r.ok() && (count < 1 || count > CROSSED_QUADS_MAX_QUADS))
-            r.failHere(std::to_string(count) + " quads (1.." + std::to_string(CROSSED_QUADS_MAX_QUADS) + " needed)");
-        if (!r.ok())
-            return r.error();
-        data.quads.resize(count);
-        for (std::uint32_t i = 0; i < count; ++i)
-        {
-            r.setElement(quadElement(i));
-            CrossedQuad& q = data.quads[i];
-            q.azimuth = r.f32();
-            q.left = r.f32();
-            q.right = r.f32();
-            q.bottom = r.f32();
-            q.top = r.f32();
-        }
-        for (std::uint32_t i = 0; i < count && r.ok(); ++i)
-            if (!readGpuTexture(r, quadElement(i) + ", texture", data.quads[i].colour))
-                break;
+        // The count is checked against the bytes left and QUADS' limits before anything is allocated.
+        readArray(r, data.quads, QUADS, quadFields);
+        for (std::size_t i = 0; i < data.quads.size() && r.ok(); ++i)
+            readGpuTexture(r, quadElement(i) + ", texture", data.quads[i].colour);
         return finishDecode(r, label, name, std::move(data));
     }
 }

@@ -27,7 +27,7 @@ namespace TreeLod
             void checkLevel(TreeAsset& asset, const ForestLevel& level, Ogre::AxisAlignedBox&) override
             {
                 if (level.lowRes)
-                    OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, "lowRes is for billboard-cloud levels only",
+                    OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS, "lowRes: the mesh has no low-res level",
                                 "ReferenceLevels::checkLevel");
                 if (Result<void> polygons = requirePolygons(asset.getReference().model, asset.getName(), "technique 'mesh'");
                     !polygons)
@@ -42,6 +42,10 @@ namespace TreeLod
 
         void registerReference(TechniqueRegistry& registry)
         {
+            TechniqueRoles roles;
+            roles.autoCandidate = true;
+            roles.comparisonLabel = "polygonal reference (mesh, 1 spp)";
+            roles.plotMarker = 'o';
             registry.add({REFERENCE_TECHNIQUE, "polygonal reference: bark with MeshLodGenerator levels, every leaf", REFERENCE_CHUNK,
                           Ogre::EntityFactory::FACTORY_TYPE_NAME,
                           [](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset,
@@ -59,7 +63,7 @@ namespace TreeLod
                                   lines.push_back({"bark LoD " + std::to_string(level) + "  ", drawn ? 1.0 : 0.0, ""});
                               }
                               return lines;
-                          }});
+                          }, roles});
         }
 
         const TechniqueRegistry::Registration registration(&registerReference);

@@ -109,6 +109,35 @@ namespace TreeLod
         return out;
     }
 
+    const TechniqueInfo& TechniqueRegistry::getFloor() const
+    {
+        for (const TechniqueInfo& t : mTechniques)
+            if (t.roles.floor)
+                return t;
+        OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND,
+                    "no registered technique is the floor (TechniqueRoles::floor; known: " + describe() + ")",
+                    "TechniqueRegistry::getFloor");
+    }
+
+    void TechniqueRegistry::addBaseline(BaselineInfo info)
+    {
+        for (BaselineInfo& b : mBaselines)
+            if (b.name == info.name)
+            {
+                b = std::move(info);
+                return;
+            }
+        mBaselines.push_back(std::move(info));
+    }
+
+    const BaselineInfo* TechniqueRegistry::findBaseline(const Ogre::String& name) const
+    {
+        for (const BaselineInfo& b : mBaselines)
+            if (b.name == name)
+                return &b;
+        return nullptr;
+    }
+
     Ogre::MovableObject* TechniqueRegistry::createInstance(const Ogre::String& technique,
                                                            Ogre::SceneManager& sceneManager,
                                                            const Ogre::String& name, TreeAsset& asset,

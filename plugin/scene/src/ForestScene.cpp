@@ -1,7 +1,6 @@
 #include "TreeLod/ForestScene.h"
 
 #include "TreeLod/ErrorCurves.h"
-#include "TreeLod/ImpostorData.h"
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/ShadowSetup.h"
 #include "TreeLod/TechniqueRegistry.h"
@@ -34,15 +33,20 @@ namespace TreeLod
         /// A linear-space grass colour for the ground (what the Lit bark shader multiplies its white texture by).
         const Ogre::ColourValue GROUND_COLOUR(0.10f, 0.16f, 0.05f, 1.0f);
 
-        /// A species' bands for a technique choice ("" = the script's), distance bands still
-        /// open (minHeightPixels 0: ForestScene converts them with the asset's height), and the
-        /// bake techniques they draw from, "reference" included. Throws on an unknown technique.
+        /// Whether `species` draws by budgeted auto under `policy`.
+        bool budgeted(const LodPolicy& policy, const SceneSpecies& species)
+        {
+            return policy.isAuto() || (policy.mode == LodPolicy::Mode::Script && species.autoTechnique);
+        }
+
+        /// A species' bands under `policy`, distance bands still open (minHeightPixels 0:
+        /// ForestScene converts them with the asset's height), and the bake techniques they draw
+        /// from, "reference" included. Throws on an unknown technique.
         std::vector<ForestBand> speciesBands(const SceneScript& script, const SceneSpecies& species,
-                                             const std::string& technique, std::set<std::string>& bake)
+                                             const LodPolicy& policy, std::set<std::string>& bake)
         {
             std::vector<ForestBand> bands;
-            float budget = 0.0f;
-            if (parseAutoTechnique(technique, budget) || (technique.empty() && species.autoTechnique))
+            if (budgeted(policy, species))
             {
                 // Budgeted auto chooses among these; the fixed bands draw from a subset of them.
                 bake.insert(REFERENCE_CHUNK);
@@ -50,8 +54,8 @@ namespace TreeLod
                     bake.insert(bakeTechniqueOf(name));
                 return Forest::getAutoBands();
             }
-            if (!technique.empty())
-                bands = {ForestBand{technique, 0.0f}};
+            if (policy.mode == LodPolicy::Mode::Fixed)
+                bands = {ForestBand{policy.technique, 0.0f}};
             else
                 for (const TechniqueBand& band : species.bands)
                     bands.push_back(ForestBand{band.technique, band.minPixels});
@@ -88,37 +92,77 @@ namespace TreeLod
 
     std::string bakeTechniqueOf(const std::string& technique)
     {
-        if (isQuadFloor(technique))
-            return IMPOSTOR_CHUNK;
-        const TechniqueInfo* info = TechniqueRegistry::getSingleton().find(technique);
+        const TechniqueRegistry& registry = TechniqueRegistry::getSingleton();
+        if (const BaselineInfo* baseline = registry.findBaseline(technique))
+            return baseline->chunkTechnique;
+        const TechniqueInfo* info = registry.find(technique);
         return info && info->forestLevels ? info->chunkTechnique : "";
     }
 
-    bool parseAutoTechnique(const std::string& technique, float& budget, float* frameBudgetMs)
+    std::vector<ComparisonRun> comparisonRuns()
     {
-        budget = std::numeric_limits<float>::quiet_NaN();
-        if (frameBudgetMs)
-            *frameBudgetMs = std::numeric_limits<float>::quiet_NaN();
-        if (technique == "auto")
-            return true;
-        const bool frame = technique.rfind("auto~", 0) == 0;
-        if (!frame && technique.rfind("auto@", 0) != 0)
-            return false;
-        const std::string number = technique.substr(5);
-        char* end = nullptr;
-        const double value = std::strtod(number.c_str(), &end);
-        if (number.empty() || *end != '\0' || (frame ? !(value > 0.0 && value <= 1e6) : !(value >= 0.0 && value <= 1.0)))
-            return false;
-        if (!frame)
-            budget = float(value);
-        else if (frameBudgetMs)
-            *frameBudgetMs = float(value);
-        return true;
+        const TechniqueRegistry& registry = TechniqueRegistry::getSingleton();
+        std::vector<ComparisonRun> runs;
+        for (const TechniqueInfo& t : registry.getTechniques())
+            if (!t.roles.comparisonLabel.empty())
+                runs.push_back({t.name, t.roles.comparisonLabel, t.roles.plotMarker, false});
+        for (const BaselineInfo& b : registry.getBaselines())
+            runs.push_back({b.name, b.comparisonLabel, b.plotMarker, b.oneObjectPerTree});
+        return runs;
     }
 
-    bool isQuadFloor(const std::string& technique)
+    bool isComparisonRun(const std::string& technique)
     {
-        return technique == "entities" || technique == "merged-quads" || technique == "billboard-set";
+        const std::vector<ComparisonRun> runs = comparisonRuns();
+        return std::any_of(runs.begin(), runs.end(), [&](const ComparisonRun& r) { return r.technique == technique; });
+    }
+
+    Result<std::vector<BenchRun>> parseBenchRuns(const std::vector<std::string>& names)
+    {
+        std::vector<BenchRun> runs;
+        for (const std::string& name : names)
+        {
+            Result<LodPolicy> policy = LodPolicy::parse(name, "--techniques");
+            if (!policy)
+                return policy.error();
+            if (name == "auto")
+                policy = LodPolicy::scriptChoice(); // the bench's "auto": each species as its script says
+            if (policy->mode == LodPolicy::Mode::Fixed && bakeTechniqueOf(name).empty())
+                return fail("", "--techniques",
+                            "unknown technique '" + name + "' (known: auto, auto@E, auto~MS, " + knownSceneTechniques() + ")");
+            runs.push_back({name, *policy});
+        }
+        return runs;
+    }
+
+    std::vector<BenchRun> comparisonBenchRuns()
+    {
+        std::vector<BenchRun> runs;
+        for (const ComparisonRun& c : comparisonRuns())
+            runs.push_back({c.technique, LodPolicy::fixed(c.technique)});
+        return runs;
+    }
+
+    std::string describeComparisonRuns()
+    {
+        std::string out;
+        for (const ComparisonRun& r : comparisonRuns())
+            out += (out.empty() ? "" : ", ") + r.technique;
+        return out;
+    }
+
+    std::string defaultBenchTechniques()
+    {
+        std::string list = "auto";
+        for (const TechniqueInfo& t : TechniqueRegistry::getSingleton().getTechniques())
+            if (t.roles.benchDefault)
+                list += "," + t.name;
+        return list;
+    }
+
+    bool isBaseline(const std::string& technique)
+    {
+        return TechniqueRegistry::getSingleton().findBaseline(technique) != nullptr;
     }
 
     std::string knownSceneTechniques()
@@ -126,17 +170,19 @@ namespace TreeLod
         std::string known;
         for (const TechniqueInfo& t : TechniqueRegistry::getSingleton().getTechniques())
             if (t.forestLevels)
-                known += t.name + ", ";
-        return known + "entities, merged-quads, billboard-set";
+                known += (known.empty() ? "" : ", ") + t.name;
+        for (const BaselineInfo& b : TechniqueRegistry::getSingleton().getBaselines())
+            known += (known.empty() ? "" : ", ") + b.name;
+        return known;
     }
 
     std::map<std::string, std::vector<std::string>> scenePackages(const SceneScript& script,
-                                                                  const std::vector<std::string>& techniques)
+                                                                  const std::vector<LodPolicy>& policies)
     {
         std::map<std::string, std::set<std::string>> wanted;
-        for (const std::string& technique : techniques)
+        for (const LodPolicy& policy : policies)
             for (const SceneSpecies& species : script.species)
-                speciesBands(script, species, technique, wanted[speciesSource(species)]);
+                speciesBands(script, species, policy, wanted[speciesSource(species)]);
         std::map<std::string, std::vector<std::string>> packages;
         for (const auto& [source, bake] : wanted)
             packages[source] = std::vector<std::string>(bake.begin(), bake.end());
@@ -146,7 +192,7 @@ namespace TreeLod
     ForestScene::ForestScene(Ogre::SceneManager& sceneManager, Ogre::SceneNode& parent, const SceneScript& script,
                              const ForestSceneOptions& options)
         : mSceneManager(sceneManager), mParent(parent), mScript(script), mOptions(options),
-          mTechnique(options.technique)
+          mPolicy(options.policy)
     {
         mPlacements = generatePlacements(mScript, mOptions.placement);
         if (mSceneManager.hasLight(SUN_NAME))
@@ -290,9 +336,7 @@ namespace TreeLod
         mForestNode->attachObject(mForest);
         mForest->setUploadBudget(mOptions.uploadBudget);
         mForest->setShadowLodBias(mScript.shadows.lodBias);
-        float errorBudget = 0.0f, frameBudget = 0.0f;
-        parseAutoTechnique(mTechnique, errorBudget, &frameBudget);
-        mForest->setFrameBudgetMs(std::isnan(frameBudget) ? mScript.lod.frameBudgetMs : frameBudget);
+        mForest->setFrameBudgetMs(std::isnan(mPolicy.frameBudgetMs) ? mScript.lod.frameBudgetMs : mPolicy.frameBudgetMs);
 
         // Bands per species; then one bake request per distinct source with every technique its
         // species draw (two species sharing a file share one package and one asset).
@@ -300,7 +344,7 @@ namespace TreeLod
         std::vector<std::vector<ForestBand>> bands(mScript.species.size());
         std::map<std::string, std::set<std::string>> techniques; // source -> bake techniques
         for (std::size_t s = 0; s < mScript.species.size(); ++s)
-            bands[s] = speciesBands(mScript, mScript.species[s], mTechnique, techniques[speciesSource(mScript.species[s])]);
+            bands[s] = speciesBands(mScript, mScript.species[s], mPolicy, techniques[speciesSource(mScript.species[s])]);
         std::map<std::string, TreeAssetPtr> assets;
         for (const auto& [source, wanted] : techniques)
         {
@@ -324,7 +368,7 @@ namespace TreeLod
             mAssets.push_back(asset);
             // Distance bands: the screen height a tree of this asset has at that distance from the
             // script's camera (the bench and the browser render at the script's resolution).
-            if (mTechnique.empty() && !species.autoTechnique)
+            if (mPolicy.mode == LodPolicy::Mode::Script && !species.autoTechnique)
             {
                 const Ogre::AxisAlignedBox bounds = asset->getBounds();
                 const float height = float(bounds.getMaximum().y - bounds.getMinimum().y) *
@@ -334,19 +378,16 @@ namespace TreeLod
                         bands[s][b].minHeightPixels =
                             height * float(mScript.height) / (2.0f * species.bands[b].maxDistance * tanHalfFov);
             }
-            if (isQuadFloor(mTechnique))
+            if (mPolicy.mode == LodPolicy::Mode::Fixed && isBaseline(mPolicy.technique))
                 continue; // drawn by the floor below, not the Forest
             try
             {
-                float budget = std::numeric_limits<float>::quiet_NaN(); // NaN: the script's
-                const bool budgeted =
-                    parseAutoTechnique(mTechnique, budget) || (mTechnique.empty() && species.autoTechnique);
-                if (std::isnan(budget))
-                    budget = mScript.lod.maxError;
+                const bool isBudgeted = budgeted(mPolicy, species);
+                const float budget = std::isnan(mPolicy.errorBudget) ? mScript.lod.maxError : mPolicy.errorBudget;
                 const std::size_t notesBefore = mLevelNotes.size();
                 std::vector<LevelCost> costs;
                 std::string noCosts = "no level costs given";
-                if (budgeted && mOptions.levelCosts && asset->hasChunk(ERROR_CURVES_CHUNK))
+                if (isBudgeted && mOptions.levelCosts && asset->hasChunk(ERROR_CURVES_CHUNK))
                     try
                     {
                         costs = mOptions.levelCosts(*asset);
@@ -366,7 +407,7 @@ namespace TreeLod
                 else
                 {
                     const std::vector<ForestLevel> levels = Forest::levelsForBands(*asset, bands[s]);
-                    if (budgeted)
+                    if (isBudgeted)
                         mLevelNotes.push_back(
                             LevelNote{species.name, -1,
                                       std::string("fixed auto bands: ") +
@@ -389,21 +430,18 @@ namespace TreeLod
         instances.reserve(mPlacements.size());
         for (const PlacedTree& tree : mPlacements)
             instances.push_back(ForestInstance{tree.position, tree.rotation, tree.scale, tree.species});
-        if (mTechnique == "entities")
-            mEntityFloor = std::make_unique<EntityFloor>(mSceneManager, *mForestNode, mAssets, instances);
-        else if (mTechnique == "merged-quads")
-            mMergedQuadFloor = std::make_unique<MergedQuadFloor>(mSceneManager, *mForestNode, mAssets, instances);
-        else if (mTechnique == "billboard-set")
-            mBillboardSetFloor = std::make_unique<BillboardSetFloor>(mSceneManager, *mForestNode, mAssets, instances);
+        const BaselineInfo* baseline = mPolicy.mode == LodPolicy::Mode::Fixed
+                                           ? TechniqueRegistry::getSingleton().findBaseline(mPolicy.technique)
+                                           : nullptr;
+        if (baseline)
+            mBaseline = baseline->create(mSceneManager, *mForestNode, mAssets, instances);
         else
             mForest->addInstances(instances);
     }
 
     void ForestScene::destroyForest()
     {
-        mEntityFloor.reset();
-        mMergedQuadFloor.reset();
-        mBillboardSetFloor.reset();
+        mBaseline.reset();
         if (mForest)
         {
             mForestNode->detachAllObjects();
@@ -413,21 +451,21 @@ namespace TreeLod
         }
     }
 
-    void ForestScene::setTechnique(const std::string& technique)
+    void ForestScene::setPolicy(const LodPolicy& policy)
     {
         destroyForest();
-        mTechnique = technique;
+        mPolicy = policy;
         buildSpecies();
     }
 
-    void ForestScene::requestTechnique(const std::string& technique)
+    void ForestScene::requestPolicy(const LodPolicy& policy)
     {
         std::vector<std::shared_ptr<TreeAssetRequest>> bakes;
-        for (const auto& [source, techniques] : scenePackages(mScript, {technique}))
+        for (const auto& [source, techniques] : scenePackages(mScript, {policy}))
             bakes.push_back(TreeAssetManager::getSingleton().requireAsync(
                 source, std::vector<Ogre::String>(techniques.begin(), techniques.end()), mOptions.group));
         mPendingBakes = std::move(bakes);
-        mPendingTechnique = technique;
+        mPendingPolicy = policy;
         mPendingRequested = true;
     }
 
@@ -450,11 +488,11 @@ namespace TreeLod
             catch (const Ogre::Exception& e)
             {
                 OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
-                            mScript.file + ": technique '" + mPendingTechnique + "': " + e.getDescription(),
+                            mScript.file + ": technique '" + mPendingPolicy.toString() + "': " + e.getDescription(),
                             "ForestScene::update");
             }
         }
-        setTechnique(mPendingTechnique); // its require() calls find the packages baked
+        setPolicy(mPendingPolicy); // its require() calls find the packages baked
         return true;
     }
 
@@ -483,12 +521,8 @@ namespace TreeLod
 
     std::uint64_t ForestScene::getGpuBytes() const
     {
-        if (mEntityFloor)
-            return mEntityFloor->getGpuBytes();
-        if (mMergedQuadFloor)
-            return mMergedQuadFloor->getGpuBytes();
-        if (mBillboardSetFloor)
-            return mBillboardSetFloor->getGpuBytes();
+        if (mBaseline)
+            return mBaseline->getGpuBytes();
         return mForest ? mForest->getGpuBytes() : 0;
     }
 }

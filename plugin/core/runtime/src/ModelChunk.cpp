@@ -1,7 +1,6 @@
 #include "TreeLod/ModelChunk.h"
 
-#include "TreeLod/ByteReader.h"
-#include "TreeLod/ByteWriter.h"
+#include "TreeLod/ChunkCodec.h"
 #include "TreeLod/Package.h"
 
 #include <algorithm>
@@ -13,11 +12,12 @@ namespace TreeLod
     namespace
     {
         constexpr std::size_t ALIGN = 16;
-        constexpr std::size_t VERTEX_BYTES = 32;
-        constexpr std::size_t LEAF_BYTES = 64;
-        constexpr std::size_t NODE_BYTES = 20;
-        constexpr std::size_t MATERIAL_MIN_BYTES = 4 + 16 + 12 + 4 + 4 + 4;
-        constexpr std::size_t TEXTURE_MIN_BYTES = 4 + 4 * 4 + 8 + 4;
+        constexpr ArrayLayout MATERIALS{4 + 16 + 12 + 4 + 4 + 4};
+        constexpr ArrayLayout TEXTURES{4 + 4 * 4 + 8 + 4};
+        constexpr ArrayLayout VERTICES{32, ALIGN};
+        constexpr ArrayLayout WORDS{4, ALIGN};
+        constexpr ArrayLayout LEAVES{64, ALIGN};
+        constexpr ArrayLayout NODES{20, ALIGN};
         constexpr std::uint32_t MATERIAL_LEAF = 1u;
         constexpr std::uint32_t MATERIAL_DOUBLE_SIDED = 2u;
 
@@ -48,67 +48,33 @@ namespace TreeLod
         bool finite(const glm::vec3& v) { return finite(v.x) && finite(v.y) && finite(v.z); }
         bool finite(const glm::vec4& v) { return finite(glm::vec3(v)) && finite(v.w); }
 
-        // ---- encoding ----
+        // Record fields, one list for the encoder and the decoder.
+        constexpr auto vertexFields = [](auto& s, auto& v) { s.fields(v.position, v.normal, v.uv); };
+        constexpr auto wordField = [](auto& s, auto& v) { s.fields(v); };
+        constexpr auto leafFields = [](auto& s, auto& l) {
+            s.fields(l.firstVertex, l.vertexCount, l.firstIndex, l.indexCount, l.material, l.centre, l.normal, l.area,
+                     l.uvMin, l.uvMax);
+        };
+        constexpr auto nodeFields = [](auto& s, auto& n) { s.fields(n.position, n.radius, n.parent); };
 
-        void writeVertices(ByteWriter& w, const std::vector<Vertex>& vertices)
-        {
-            w.u32(std::uint32_t(vertices.size()));
-            w.align(ALIGN);
-            w.reserve(vertices.size() * VERTEX_BYTES);
-            for (const Vertex& v : vertices)
-            {
-                w.vec3(v.position);
-                w.vec3(v.normal);
-                w.vec2(v.uv);
-            }
-        }
-
-        void writeU32s(ByteWriter& w, const std::vector<std::uint32_t>& values)
-        {
-            w.u32(std::uint32_t(values.size()));
-            w.align(ALIGN);
-            w.reserve(values.size() * 4);
-            for (std::uint32_t v : values)
-                w.u32(v);
-        }
-
-        // ---- decoding: each returns false with the reader's error set ----
-
+        /// Vertices whose normal and uv are finite; false with the reader's error set.
         bool readVertices(ByteReader& r, const std::string& what, std::vector<Vertex>& out)
         {
             r.setElement(what);
-            std::uint32_t n = r.count(VERTEX_BYTES, ALIGN);
-            r.align(ALIGN);
-            if (!r.ok())
-                return false;
-            out.resize(n);
-            for (std::uint32_t i = 0; i < n; ++i)
-            {
-                Vertex& v = out[i];
-                v.position = r.vec3();
-                v.normal = r.vec3();
-                v.uv = r.vec2();
+            return readArray(r, out, VERTICES, [&](ByteReader& r, Vertex& v, std::uint32_t i) {
+                vertexFields(r, v);
                 if (!finite(v.normal) || !finite(v.uv))
                 {
                     r.setElement(what + " " + std::to_string(i));
                     r.failHere("normal or uv is not finite");
-                    return false;
                 }
-            }
-            return r.ok();
+            });
         }
 
-        bool readU32s(ByteReader& r, const std::string& what, std::vector<std::uint32_t>& out)
+        bool readWords(ByteReader& r, const std::string& what, std::vector<std::uint32_t>& out)
         {
             r.setElement(what);
-            std::uint32_t n = r.count(4, ALIGN);
-            r.align(ALIGN);
-            if (!r.ok())
-                return false;
-            out.resize(n);
-            for (std::uint32_t i = 0; i < n; ++i)
-                out[i] = r.u32();
-            return r.ok();
+            return readArray(r, out, WORDS, wordField);
         }
     }
 
@@ -230,56 +196,20 @@ namespace TreeLod
         const TreeModel& m = chunk.model;
         ByteWriter w;
         w.string(m.name);
-
-        w.u32(std::uint32_t(m.materials.size()));
-        for (const Material& mat : m.materials)
-        {
+        writeArray(w, m.materials, MATERIALS, [](ByteWriter& w, const Material& mat) {
             w.string(mat.name);
-            w.vec4(mat.baseColour);
-            w.vec3(mat.backColour);
-            w.i32(mat.texture);
-            w.f32(mat.alphaCutoff);
-            w.u32((mat.isLeaf ? MATERIAL_LEAF : 0u) | (mat.doubleSided ? MATERIAL_DOUBLE_SIDED : 0u));
-        }
-
-        w.u32(std::uint32_t(chunk.textures.size()));
-        for (const GpuTexture& tex : chunk.textures)
-            writeGpuTexture(w, tex);
-
-        writeVertices(w, m.barkVertices);
-        writeU32s(w, m.barkIndices);
-        writeU32s(w, m.barkTriangleMaterial);
-        writeVertices(w, m.leafVertices);
-        writeU32s(w, m.leafIndices);
-
-        w.u32(std::uint32_t(m.leaves.size()));
-        w.align(ALIGN);
-        w.reserve(m.leaves.size() * LEAF_BYTES);
-        for (const Leaf& leaf : m.leaves)
-        {
-            w.u32(leaf.firstVertex);
-            w.u32(leaf.vertexCount);
-            w.u32(leaf.firstIndex);
-            w.u32(leaf.indexCount);
-            w.u32(leaf.material);
-            w.vec3(leaf.centre);
-            w.vec3(leaf.normal);
-            w.f32(leaf.area);
-            w.vec2(leaf.uvMin);
-            w.vec2(leaf.uvMax);
-        }
-
-        w.u32(std::uint32_t(m.skeleton.size()));
-        w.align(ALIGN);
-        for (const SkeletonNode& node : m.skeleton)
-        {
-            w.vec3(node.position);
-            w.f32(node.radius);
-            w.i32(node.parent);
-        }
-
-        w.vec3(m.boundsMin);
-        w.vec3(m.boundsMax);
+            w.fields(mat.baseColour, mat.backColour, mat.texture, mat.alphaCutoff,
+                     (mat.isLeaf ? MATERIAL_LEAF : 0u) | (mat.doubleSided ? MATERIAL_DOUBLE_SIDED : 0u));
+        });
+        writeArray(w, chunk.textures, TEXTURES, writeGpuTexture);
+        writeArray(w, m.barkVertices, VERTICES, vertexFields);
+        writeArray(w, m.barkIndices, WORDS, wordField);
+        writeArray(w, m.barkTriangleMaterial, WORDS, wordField);
+        writeArray(w, m.leafVertices, VERTICES, vertexFields);
+        writeArray(w, m.leafIndices, WORDS, wordField);
+        writeArray(w, m.leaves, LEAVES, leafFields);
+        writeArray(w, m.skeleton, NODES, nodeFields);
+        w.fields(m.boundsMin, m.boundsMax);
         return w.take();
     }
 
@@ -303,55 +233,33 @@ namespace TreeLod
 
         m.name = r.string(MODEL_CHUNK_MAX_STRING);
 
-        // ---- materials ----
+        // ---- materials and textures ----
         r.setElement(chunkName + ", materials");
-        const std::uint32_t materialCount = r.count(MATERIAL_MIN_BYTES);
-        if (!r.ok())
-            return r.error();
-        m.materials.resize(materialCount);
-        for (std::uint32_t i = 0; i < materialCount; ++i)
-        {
-            Material& mat = m.materials[i];
-            r.setElement(chunkName + ", material " + std::to_string(i));
+        readArray(r, m.materials, MATERIALS, [&](ByteReader& r, Material& mat, std::uint32_t i) {
+            const std::string element = chunkName + ", material " + std::to_string(i);
+            r.setElement(element);
             mat.name = r.string(MODEL_CHUNK_MAX_STRING);
-            r.setElement(chunkName + ", material " + std::to_string(i) + " '" + mat.name + "'");
-            mat.baseColour = r.vec4();
-            mat.backColour = r.vec3();
-            mat.texture = r.i32();
-            mat.alphaCutoff = r.f32();
-            const std::uint32_t flags = r.u32();
-            if (!r.ok())
-                return r.error();
-            if (flags & ~(MATERIAL_LEAF | MATERIAL_DOUBLE_SIDED))
-                r.failHere("unknown flags " + std::to_string(flags));
-            else if (!finite(mat.baseColour) || !finite(mat.backColour) || !finite(mat.alphaCutoff))
+            r.setElement(element + " '" + mat.name + "'");
+            std::uint32_t flags = 0;
+            r.fields(mat.baseColour, mat.backColour, mat.texture, mat.alphaCutoff, flags);
+            checkFlags(r, flags, MATERIAL_LEAF | MATERIAL_DOUBLE_SIDED);
+            if (!finite(mat.baseColour) || !finite(mat.backColour) || !finite(mat.alphaCutoff))
                 r.failHere("colour or alpha cutoff is not finite");
-            else if (mat.texture < -1)
+            if (mat.texture < -1)
                 r.failHere("texture index " + std::to_string(mat.texture) + " is negative");
-            if (!r.ok())
-                return r.error();
             mat.isLeaf = (flags & MATERIAL_LEAF) != 0;
             mat.doubleSided = (flags & MATERIAL_DOUBLE_SIDED) != 0;
-        }
-
-        // ---- textures ----
+        });
         r.setElement(chunkName + ", textures");
-        const std::uint32_t textureCount = r.count(TEXTURE_MIN_BYTES);
+        readArray(r, chunk.textures, TEXTURES, [&](ByteReader& r, GpuTexture& tex, std::uint32_t i) {
+            if (readGpuTexture(r, chunkName + ", texture " + std::to_string(i), tex) &&
+                tex.format != GpuTextureFormat::RGBA8)
+                r.failHere("format " + std::to_string(std::uint32_t(tex.format)) + ": reference textures are RGBA8");
+        });
         if (!r.ok())
             return r.error();
-        chunk.textures.resize(textureCount);
-        for (std::uint32_t i = 0; i < textureCount; ++i)
-        {
-            if (!readGpuTexture(r, chunkName + ", texture " + std::to_string(i), chunk.textures[i]))
-                return r.error();
-            if (chunk.textures[i].format != GpuTextureFormat::RGBA8)
-            {
-                r.failHere("format " + std::to_string(std::uint32_t(chunk.textures[i].format)) +
-                           ": reference textures are RGBA8");
-                return r.error();
-            }
-        }
-        for (std::uint32_t i = 0; i < materialCount; ++i)
+        const std::size_t textureCount = chunk.textures.size();
+        for (std::size_t i = 0; i < m.materials.size(); ++i)
             if (m.materials[i].texture >= std::int32_t(textureCount))
                 return fail(label, chunkName + ", material " + std::to_string(i) + " '" + m.materials[i].name + "'",
                             "texture " + std::to_string(m.materials[i].texture) + " out of range (" +
@@ -359,42 +267,27 @@ namespace TreeLod
 
         // ---- geometry ----
         if (!readVertices(r, chunkName + ", bark vertex", m.barkVertices) ||
-            !readU32s(r, chunkName + ", bark indices", m.barkIndices) ||
-            !readU32s(r, chunkName + ", bark triangle materials", m.barkTriangleMaterial) ||
+            !readWords(r, chunkName + ", bark indices", m.barkIndices) ||
+            !readWords(r, chunkName + ", bark triangle materials", m.barkTriangleMaterial) ||
             !readVertices(r, chunkName + ", leaf vertex", m.leafVertices) ||
-            !readU32s(r, chunkName + ", leaf indices", m.leafIndices))
+            !readWords(r, chunkName + ", leaf indices", m.leafIndices))
             return r.error();
 
         r.setElement(chunkName + ", leaves");
-        const std::uint32_t leafCount = r.count(LEAF_BYTES, ALIGN);
-        r.align(ALIGN);
-        if (!r.ok())
-            return r.error();
-        m.leaves.resize(leafCount);
-        std::uint64_t leafIndexTotal = 0;
-        for (std::uint32_t i = 0; i < leafCount; ++i)
-        {
-            Leaf& leaf = m.leaves[i];
-            leaf.firstVertex = r.u32();
-            leaf.vertexCount = r.u32();
-            leaf.firstIndex = r.u32();
-            leaf.indexCount = r.u32();
-            leaf.material = r.u32();
-            leaf.centre = r.vec3();
-            leaf.normal = r.vec3();
-            leaf.area = r.f32();
-            leaf.uvMin = r.vec2();
-            leaf.uvMax = r.vec2();
+        readArray(r, m.leaves, LEAVES, [&](ByteReader& r, Leaf& leaf, std::uint32_t i) {
+            leafFields(r, leaf);
             if (!finite(leaf.centre) || !finite(leaf.normal) || !finite(leaf.area) || !finite(leaf.uvMin) ||
                 !finite(leaf.uvMax))
             {
                 r.setElement(chunkName + ", leaf " + std::to_string(i));
                 r.failHere("record has a value that is not finite");
             }
-            leafIndexTotal += leaf.indexCount;
-        }
+        });
         if (!r.ok())
             return r.error();
+        std::uint64_t leafIndexTotal = 0;
+        for (const Leaf& leaf : m.leaves)
+            leafIndexTotal += leaf.indexCount;
         // Leaves own their index ranges (TreeModel.h), so the ranges are disjoint; this also
         // bounds the work TreeModel::validate does to one pass over the indices.
         if (leafIndexTotal > m.leafIndices.size())
@@ -402,8 +295,8 @@ namespace TreeLod
                         "leaf index ranges overlap (they cover " + std::to_string(leafIndexTotal) +
                             " indices, the model has " + std::to_string(m.leafIndices.size()) + ")");
         std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges; // (firstIndex, leaf)
-        ranges.reserve(leafCount);
-        for (std::uint32_t i = 0; i < leafCount; ++i)
+        ranges.reserve(m.leaves.size());
+        for (std::uint32_t i = 0; i < m.leaves.size(); ++i)
             if (m.leaves[i].indexCount > 0)
                 ranges.emplace_back(m.leaves[i].firstIndex, i);
         std::sort(ranges.begin(), ranges.end());
@@ -416,34 +309,24 @@ namespace TreeLod
         }
 
         r.setElement(chunkName + ", skeleton");
-        const std::uint32_t nodeCount = r.count(NODE_BYTES, ALIGN);
-        r.align(ALIGN);
+        readArray(r, m.skeleton, NODES, [&](ByteReader& r, SkeletonNode& node, std::uint32_t i) {
+            nodeFields(r, node);
+            std::string problem;
+            if (node.parent < -1 || node.parent >= std::int32_t(i))
+                problem = "parent " + std::to_string(node.parent) + " must be -1 or an earlier node";
+            else if (!finite(node.position) || !finite(node.radius))
+                problem = "position or radius is not finite";
+            if (!problem.empty())
+            {
+                r.setElement(chunkName + ", skeleton node " + std::to_string(i));
+                r.failHere(problem);
+            }
+        });
         if (!r.ok())
             return r.error();
-        m.skeleton.resize(nodeCount);
-        for (std::uint32_t i = 0; i < nodeCount; ++i)
-        {
-            SkeletonNode& node = m.skeleton[i];
-            node.position = r.vec3();
-            node.radius = r.f32();
-            node.parent = r.i32();
-            if (r.ok() && (node.parent < -1 || node.parent >= std::int32_t(i)))
-            {
-                r.setElement(chunkName + ", skeleton node " + std::to_string(i));
-                r.failHere("parent " + std::to_string(node.parent) + " must be -1 or an earlier node");
-            }
-            else if (r.ok() && (!finite(node.position) || !finite(node.radius)))
-            {
-                r.setElement(chunkName + ", skeleton node " + std::to_string(i));
-                r.failHere("position or radius is not finite");
-            }
-            if (!r.ok())
-                return r.error();
-        }
 
         r.setElement(chunkName + ", bounds");
-        m.boundsMin = r.vec3();
-        m.boundsMax = r.vec3();
+        r.fields(m.boundsMin, m.boundsMax);
         if (!r.ok())
             return r.error();
         if (!finite(m.boundsMin) || !finite(m.boundsMax))
@@ -455,7 +338,7 @@ namespace TreeLod
 
         // model.textures: a copy of mip level 0 of each texture (see the header).
         m.textures.resize(textureCount);
-        for (std::uint32_t i = 0; i < textureCount; ++i)
+        for (std::size_t i = 0; i < textureCount; ++i)
         {
             const GpuTexture& tex = chunk.textures[i];
             TextureImage& image = m.textures[i];

@@ -1,92 +1,32 @@
-// Forest: thousands of trees of several TreeAssets in one MovableObject. MovableObject type
-// "Forest".
+// Forest: thousands of trees of several TreeAssets in one MovableObject (type "Forest"), no
+// SceneNode per tree: culling, level choice and one instanced draw per (species, level, part).
+// Manual: docs/forest.md.
 //
-// Instances live in a ForestInstances (packed structure of arrays, no SceneNode per tree). A
-// species is one TreeAsset drawn by a list of levels, near to far; each level is one
-// technique's drawable at one of its own levels of detail, planned, checked and built by the
-// technique's ForestLevelProvider (TechniqueRegistry.h): e.g. "mesh" (the polygonal reference),
-// "lodf" at a quantised leaf count, "billboard-cloud" level N with its layered or low-res
-// material, "impostor" (one camera-facing quad, the cheapest representation).
-// Every frame and for every camera that renders the Forest (the viewer's and the shadow
-// cameras), _updateRenderQueue culls all instances against that camera's frustum and picks each
-// visible one's level from its LoD camera (Camera::getLodCamera(), so shadows see the viewer's
-// levels, times setShadowLodBias) in one loop (ForestInstances::cull), then queues one
-// instanced draw per (species, level, part) with at least one instance: the instance data
-// (24 bytes: position + scale as uv4 float4, cos/sin of the rotation about +Y as uv5 float2)
-// goes into a per-camera, per-bucket instance vertex buffer written with HBL_DISCARD and grown
-// by doubling. Parts are drawn with instanced clones of the asset's materials (vertex programs
-// with INSTANCED=1), and their shadow-receiving / caster variants under integrated texture
-// shadows.
+// A species is one TreeAsset drawn by levels, near to far, each one technique's drawable at one of
+// its own levels (ForestLevelProvider). Levels come from fixed screen-height bands (levelsForBands,
+// getAutoBands) or are budgeted (addBudgetedSpecies): the cheapest within an error budget, from the
+// asset's error curves and this machine's costs (LevelSelection.h), optionally held to a frame
+// budget (docs/forest.md, "Budgeted levels"). Each camera that renders the Forest (the viewer's,
+// the shadow cameras) culls and picks levels from its LoD camera in one loop (ForestInstances::cull).
 //
-// LoD value: treelod_screen_size's (ScreenSizeLodStrategy: 4 pi r_px^2 of the instance's bounding
-// sphere, see ForestInstances.h) times the camera's LoD bias times the Forest's mesh LoD factor
-// (setMeshLodBias, or setLodBias), per instance in one loop. Instances are in
-// the Forest's local space (its node's transform applies to all); LoD is measured there, which
-// equals the world's under a uniform node scale.
-//
-// Parameters (createMovableObject params): none required; "lodBias" (default 1: setLodBias).
-// Species and instances are added through the C++ API.
-//
-// Refinements of the first contract (public names unchanged):
-// - Units. ForestLevel::minPixelCount is the LoD value of the asset's reference sphere:
-//   Ogre's sphere about the tree's origin holding TreeAsset::getBounds(), the value an Entity,
-//   FoliageLodTree or BillboardCloudTree of the asset sees (so their switch values carry over).
-//   A species' ForestKind sphere is tighter (centre and half diagonal of the box holding the
-//   reference and, where drawn, the billboard cloud) and its thresholds are the levels' values
-//   times (kind radius / reference radius)^2: the same switches, better culling.
-// - Bark: a level draws its bark mesh at the MeshLodGenerator level the mesh gives for the
-//   largest value the level is drawn at (the first level: full detail); levelsForBands splits
-//   a technique's levels where that mesh's LoD levels switch, so each tree's bark is the one
-//   it would pick alone (BillboardCloudTree, FoliageLodTree: biased value against the mesh's).
-// - Per-camera state: each camera keeps its own ForestVisibility, instance buffers (one per
-//   bucket; its vertex data clones the part's declaration and binding, not its buffers, and
-//   adds the instance buffer) and Renderables; nothing is allocated once a camera has seen
-//   its largest bucket sizes. A frozen LoD keeps each camera's last LoD camera data.
-// - Materials: the Forest clones each part's material (and its shadow caster's) once, with
-//   every pass's vertex program swapped for its INSTANCED variant "<program>/Instanced" (made
-//   in code from the plain program: same source, defines + INSTANCED=1, shared by every
-//   Forest); the clones are the Forest's and go with it. Parts whose materials read the instance
-//   data already (ForestPartOptions::instancedMaterial, the impostor's) are used as they are.
-// - Blending parts (ForestPartOptions::backToFront, the volume octree's): each camera's bucket
-//   lists its trees far to near in the instance buffer, and the draw is queued at its farthest
-//   tree's depth, so Ogre's transparent queue sorts it among the others.
-// - Residency ("model only what a scene requires"; no stall when a level first shows):
-//   addSpecies plans every level from decoded chunks (ForestLevelProvider::checkLevel; the bark
-//   mesh that levelsForBands plans with is the one upload there) and builds
-//   the last level only, the fallback of every other. A level's drawables (asset buffers and
-//   textures, instanced materials) are built the first time a camera sees trees at it; queued
-//   levels are built in the order asked for, in _updateRenderQueue, while this Root frame's
-//   bytes are below setUploadBudget (0 = no limit). Trees whose level is not resident yet draw
-//   getDrawnLevel, the nearest resident level, coarser first. A level that fails to build is
-//   logged and keeps its fallback. Uploads run on the render thread (GL): the budget bounds
-//   them per frame. Levels are never evicted while the Forest lives.
-// - Budgeted species (addBudgetedSpecies; docs/forest.md, "Budgeted levels"): levels chosen from
-//   the asset's error curves and this machine's costs (LevelSelection.h) for the Forest's error
-//   budget, and chosen again when it changes (setErrorBudget, or the frame budget's controller):
-//   the kind's table is replaced (ForestInstances::setKindThresholds; its sphere holds every
-//   candidate level, so it does not change), levels drawn before at the same switch value keep
-//   their parts, levels whose drawables were uploaded are rebuilt at once, the last level is
-//   built before anything changes (a failure leaves the old plan), the others are built when
-//   needed, as under "Residency". Each camera's buckets of the species are reset.
-//   Shadow casters of a budgeted species draw, per level, chooseShadowLevels' level for the
-//   shadow error budget: the cheapest of that level and the coarser ones within it.
-//   A frame budget (setFrameBudgetMs) re-plans every FRAME_BUDGET_INTERVAL viewer frames: the
-//   viewer's visible trees of budgeted species are counted by height on screen (their LoD value,
-//   bias included), each step of frameBudgetLadder() is predicted as the sum of the levels'
-//   calibrated costs (LevelCost::msAt), and the finest step within the budget is taken
-//   (chooseFrameBudgetStep, with hysteresis) from the next viewer frame. The prediction counts
-//   the viewer's trees only, not shadow passes nor what else the frame draws, and not how much
-//   nearer trees hide: it is a model of the calibration. GL3Plus in OGRE 1.12 has no timer
-//   queries to close the loop inside the Forest; an application that times its frames reports
-//   them (notifyFrameTime) and the predictions are scaled by measured / predicted.
-// - ForestStats describe the last viewer camera (one whose LoD camera is itself, outside shadow
-//   texture rendering); they are cleared before each viewer's visibility pass, so a viewer that
-//   does not see the Forest's bounds reports nothing visible. Cameras without a viewport (area
-//   0) see every tree at its last level. A camera's state (instance buffers, Renderables) lives
-//   until the camera is destroyed (a Camera::Listener drops it) or the Forest is.
+// Units: metres in the Forest's local space (a uniform node scale keeps LoD exact); switch values
+// (ForestLevel::minPixelCount) are treelod_screen_size's 4 pi r_px^2 of the asset's reference
+// sphere, the one an Entity of the asset sees, times the camera's LoD bias and setMeshLodBias's
+// factor ("lodBias"). A species' tighter culling sphere scales its thresholds to the same switches.
+// Bark: a level draws the bark mesh LoD of the largest value it covers; levels split where it switches.
+// Materials: instanced clones, vertex programs swapped for "<program>/Instanced" (INSTANCED=1);
+// ForestPartOptions::instancedMaterial parts are used as they are.
+// Per-camera state: instance buffers (24 bytes a visible tree) and Renderables, dropped with the
+// camera; a warmed-up frame allocates nothing.
+// Residency: driven from the render thread, which uploads. addSpecies builds the last level only;
+// others are built when a camera first needs them, within setUploadBudget's bytes a frame, their
+// trees drawn at the nearest resident level meanwhile; nothing is evicted. Bakes run elsewhere.
+// Budgeted species: re-planned in place when the error budget changes (setErrorBudget, the frame
+// budget's controller); the last level is built first, so a failure keeps the old plan.
 #pragma once
 
 #include "TreeLod/ForestInstances.h"
+#include "TreeLod/FrameBudgetController.h"
 #include "TreeLod/ForestLevelProvider.h"
 #include "TreeLod/LevelCosts.h"
 #include "TreeLod/LevelSelection.h"
@@ -134,8 +74,10 @@ namespace TreeLod
         explicit Forest(const Ogre::String& name);
         ~Forest() override;
 
-        /// The default technique choice ("techniques": "auto"): lodf while the tree is at least
-        /// 160 px tall on screen, billboard-cloud down to 24 px, then impostor.
+        /// The default technique choice ("techniques": "auto"): a band per technique whose roles
+        /// give a default band (TechniqueRoles::defaultBandMinHeight), largest first, the floor's
+        /// last (`treelod info --techniques` lists them). Ogre::ItemIdentityException when no
+        /// technique is the floor.
         static std::vector<ForestBand> getAutoBands();
 
         /// The levels `bands` give for `asset`: each band's technique contributes its own levels
@@ -162,9 +104,8 @@ namespace TreeLod
         /// conversion. Throws Ogre::InvalidParametersException for a tree without height.
         static Ogre::Real pixelCountForHeight(TreeAsset& asset, Ogre::Real heightPixels);
 
-        /// The techniques budgeted auto chooses among: the reference, lodf, both billboard clouds,
-        /// the ellipsoids (with their lines), the octahedral impostor and the impostor (docs/octahedral-impostor.md, "On the front":
-        /// baked with AO it made auto worse; without, auto is faster and more accurate with it).
+        /// The techniques budgeted auto chooses among: those whose roles say autoCandidate, in the
+        /// registry's order (`treelod info --techniques` lists them).
         static std::vector<Ogre::String> getAutoTechniques();
 
         /// Budgeted auto (docs/forest.md, "Budgeted levels"): the levels chooseLevels
@@ -187,7 +128,7 @@ namespace TreeLod
         /// budget, the start of its controller, which then sets the budget itself.
         void setErrorBudget(float budget);
         /// The error budget the budgeted species are planned for now.
-        float getErrorBudget() const { return mErrorBudget; }
+        float getErrorBudget() const { return mBudget.getErrorBudget(); }
         /// Shadow casters' own error budget, in [0, 1] (default DEFAULT_SHADOW_ERROR_BUDGET); see
         /// "Budgeted species". Throws as setErrorBudget.
         void setShadowErrorBudget(float budget);
@@ -199,7 +140,7 @@ namespace TreeLod
         /// none, the error budget holds); finite and >= 0, else Ogre::InvalidParametersException.
         /// Turning it off plans for the last setErrorBudget again.
         void setFrameBudgetMs(float milliseconds);
-        float getFrameBudgetMs() const { return mFrameBudgetMs; }
+        float getFrameBudgetMs() const { return mBudget.getFrameBudgetMs(); }
         /// The application's measured time of the frame just drawn (ms, finite and > 0; others are
         /// ignored): under a frame budget the controller scales its predictions by the running ratio
         /// of measured to predicted time, closing the loop on what the calibration cannot see
@@ -207,7 +148,7 @@ namespace TreeLod
         /// prediction stands alone.
         void notifyFrameTime(float milliseconds);
         /// Measured over predicted time, as the controller applies it (1 until frames are reported).
-        double getFrameTimeRatio() const { return mFrameTimeRatio; }
+        double getFrameTimeRatio() const { return mBudget.getFrameTimeRatio(); }
         /// Viewer frames between two re-plans of the frame budget.
         static constexpr unsigned FRAME_BUDGET_INTERVAL = 8;
 
@@ -304,9 +245,6 @@ namespace TreeLod
         void updateShadowLevels(std::uint32_t species);
         /// The kind's table of `levels` of `species`, within setMeshLodBias's limits.
         std::vector<float> kindThresholds(const Species& species, const std::vector<ForestLevel>& levels) const;
-        static constexpr std::size_t OFF_LADDER = std::numeric_limits<std::size_t>::max();
-        /// The frameBudgetLadder() step that is `budget`, or OFF_LADDER.
-        static std::size_t ladderStepOf(float budget);
         /// The frame budget's measurement on the viewer's cull: prediction and the step it wants.
         void measureFrameBudget(const CameraState& state);
 
@@ -343,19 +281,8 @@ namespace TreeLod
         ObjectLodBias mLodBias;
         Ogre::Real mShadowLodBias = 1.0f;
         Ogre::Real mLodHysteresis = 0.15f;
-        float mErrorBudget = DEFAULT_ERROR_BUDGET;      ///< in use
-        float mUserErrorBudget = DEFAULT_ERROR_BUDGET;  ///< the last setErrorBudget
+        FrameBudgetController mBudget{DEFAULT_ERROR_BUDGET}; ///< the error budget, set or under a frame budget
         float mShadowErrorBudget = DEFAULT_SHADOW_ERROR_BUDGET;
-        float mFrameBudgetMs = 0.0f;
-        /// frameBudgetLadder() step in use, OFF_LADDER when the error budget is not one of its steps
-        /// (the controller then takes its first choice whatever it is).
-        std::size_t mFrameBudgetStep = ladderStepOf(DEFAULT_ERROR_BUDGET);
-        std::size_t mWantedBudgetStep = mFrameBudgetStep; ///< the controller's choice, applied next viewer frame
-        unsigned mFrameBudgetFrames = 0;    ///< viewer frames since the last measurement
-        double mFrameTimeRatio = 1.0;       ///< measured / predicted: rises at once, falls slowly (notifyFrameTime)
-        double mReportedMs = 0.0;           ///< frame times reported since the last measurement
-        unsigned mReportedFrames = 0;
-        double mPlanPredictedMs = 0.0;      ///< the prediction for the plan those frames drew
         bool mLodFrozen = false;
         ForestStats mStats;
         std::uint64_t mInstanceBufferBytes = 0;

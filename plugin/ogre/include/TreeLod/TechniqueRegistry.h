@@ -7,11 +7,14 @@
 // browser shows of an object's state. A technique registers itself from its own source file with
 // one namespace-scope TechniqueRegistry::Registration; the registry runs every registration when
 // the registry is first used. TreeAsset, the Forest, ForestScene, `treelod render`/`bench` and the
-// browser iterate the registry and name no technique. The registry is one per process, made on
+// browser iterate the registry and name no technique; what differs between techniques in the trade
+// (auto candidacy, default bands, the floor, render options) is each one's TechniqueRoles, and
+// the measurement baselines drawn without a technique (the speed floors) are BaselineInfos. The registry is one per process, made on
 // first use (no Ogre::Root needed: a bench lists techniques before it renders); the plugin adds
 // the factories to Root when it installs.
 #pragma once
 
+#include "TreeLod/ForestBaseline.h"
 #include "TreeLod/ForestLevelProvider.h"
 
 #include <OgreCommon.h>
@@ -33,8 +36,6 @@ namespace TreeLod
 
     /// The technique every measurement compares against: the polygonal reference (an Entity).
     constexpr const char* REFERENCE_TECHNIQUE = "mesh";
-    /// The cheapest technique: the bench's floor and a Forest's far level.
-    constexpr const char* FLOOR_TECHNIQUE = "impostor";
 
     /// One line of an object's state for the sample browser: label, a bar filled to `fraction`
     /// (none when < 0), suffix; e.g. {"leaves ", 0.25, " 300/1200"}.
@@ -43,6 +44,50 @@ namespace TreeLod
         Ogre::String label;
         double fraction = -1.0;
         Ogre::String suffix;
+    };
+
+    /// An object parameter that `treelod render` offers as `--<flag> VALUE`, passed to the
+    /// technique's `create` as params[name].
+    struct TechniqueParameter
+    {
+        Ogre::String name;        ///< the object's parameter ("leaves")
+        Ogre::String flag;        ///< the option, without dashes ("leaves", "pixels-per-leaf")
+        Ogre::String description; ///< its help text
+    };
+
+    /// What a technique is in the trade, besides how it draws. The Forest, the bench, the corpus
+    /// study and the CLI read these instead of naming techniques; `treelod info --techniques`
+    /// lists them.
+    struct TechniqueRoles
+    {
+        bool floor = false;         ///< the cheapest level: the bench's floor, the default bands' last (one technique)
+        bool autoCandidate = false; ///< budgeted auto may choose its levels (Forest::getAutoTechniques)
+        /// Tree height on screen (pixels) from which its band of Forest::getAutoBands starts; < 0: not
+        /// in the default bands (the floor's band reaches 0).
+        float defaultBandMinHeight = -1.0f;
+        bool benchDefault = false; ///< drawn by `treelod bench` and studied by the corpus study by default
+        /// Non-empty: every bench run is compared with this one, which the plots call so.
+        Ogre::String comparisonLabel;
+        char plotMarker = 'o'; ///< its point in the bench's trade plot (a matplotlib marker)
+        std::vector<TechniqueParameter> parameters; ///< `treelod render` options of its objects
+        /// The technique its paper measures it against, baked at equal memory (the corpus study
+        /// compares the two where both run); empty if none.
+        Ogre::String paperBaseline;
+        /// Object parameters under which it shades as the polygonal reference does (which has no
+        /// ambient occlusion term), for image-error studies.
+        Ogre::NameValuePairList referenceShadingParams;
+    };
+
+    /// A measurement baseline drawn without the Forest (ForestBaseline.h): the bench compares
+    /// every technique with it; a scene script or --techniques names it as a technique.
+    struct BaselineInfo
+    {
+        Ogre::String name;            ///< its name in --techniques and scene scripts ("entities", ...)
+        Ogre::String comparisonLabel; ///< what the plots call it
+        char plotMarker = 'o';        ///< its point in the trade plot (a matplotlib marker)
+        Ogre::String chunkTechnique;  ///< the package chunk it draws from
+        ForestBaselineFactory create; ///< draws a scene's trees
+        bool oneObjectPerTree = false; ///< one Ogre object per tree: runs skip it above a tree count (--entity-limit)
     };
 
     struct TechniqueInfo
@@ -63,6 +108,7 @@ namespace TreeLod
         /// The state of an object `create` made (level, leaves, ...), for the sample browser's
         /// level panel; may be empty.
         std::function<std::vector<TechniqueStateLine>(Ogre::MovableObject& object)> describeState;
+        TechniqueRoles roles; ///< what it is in the trade (auto candidate, default band, floor, ...)
     };
 
     class TechniqueRegistry
@@ -89,6 +135,14 @@ namespace TreeLod
         const std::vector<TechniqueInfo>& getTechniques() const { return mTechniques; }
         /// "mesh, billboard-cloud, ..." for messages.
         Ogre::String describe() const;
+        /// The technique whose roles say floor, or Ogre::ItemIdentityException when none is registered.
+        const TechniqueInfo& getFloor() const;
+
+        /// Add or replace a measurement baseline (kept in the order added).
+        void addBaseline(BaselineInfo info);
+        /// nullptr when unknown.
+        const BaselineInfo* findBaseline(const Ogre::String& name) const;
+        const std::vector<BaselineInfo>& getBaselines() const { return mBaselines; }
 
         /// Create `technique` for `asset` or throw Ogre::InvalidParametersException naming
         /// the known techniques.
@@ -109,5 +163,6 @@ namespace TreeLod
         void sortTechniques();
 
         std::vector<TechniqueInfo> mTechniques;
+        std::vector<BaselineInfo> mBaselines;
     };
 }

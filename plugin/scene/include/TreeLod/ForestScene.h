@@ -17,8 +17,9 @@
 #pragma once
 
 #include "TreeLod/Forest.h"
+#include "TreeLod/ForestBaseline.h"
+#include "TreeLod/LodPolicy.h"
 #include "TreeLod/OgreGreyImage.h"
-#include "TreeLod/QuadFloors.h" // readGreyImageOgre: loadSceneScript's reader on this side
 #include "TreeLod/SceneScript.h"
 #include "TreeLod/TreeAsset.h"
 #include "TreeLod/TreeAssetManager.h"
@@ -37,38 +38,64 @@ namespace TreeLod
     /// The source string of a species (its file, or "preset:NAME?seed=S&leaves=N&height=H").
     std::string speciesSource(const SceneSpecies& species);
 
-    /// The bake technique (chunk) an Ogre-side technique draws from: mesh -> reference,
-    /// quad, entities, merged-quads, billboard-set -> impostor, others their own name. Empty for an unknown technique.
+    /// The bake technique (chunk) a technique or measurement baseline draws from (its registered
+    /// chunkTechnique: mesh -> reference). Empty for an unknown technique.
     std::string bakeTechniqueOf(const std::string& technique);
 
-    /// The speed floors drawn without the Forest (QuadFloors.h): "entities" (one Ogre Entity per
-    /// tree), "merged-quads" (every tree's quad in a few static batches) and "billboard-set" (a
-    /// plain Ogre BillboardSet per species, unlit).
-    bool isQuadFloor(const std::string& technique);
+    /// Whether `technique` names a measurement baseline drawn without the Forest (the speed floors:
+    /// TechniqueRegistry::getBaselines, ForestBaseline.h).
+    bool isBaseline(const std::string& technique);
 
-    /// Whether `technique` is budgeted auto: "auto" (`budget` = NaN: the script's), "auto@E" with E
-    /// in [0, 1] (`budget` = E) or "auto~B", under a frame budget of B ms in (0, 1e6] (`budget` =
-    /// NaN, `*frameBudgetMs` = B; NaN for the others: the script's). False for anything else, a
-    /// bad number included.
-    bool parseAutoTechnique(const std::string& technique, float& budget, float* frameBudgetMs = nullptr);
+    /// A run every bench run is compared with: a technique whose roles give a comparison label
+    /// (the reference, the floor), or a measurement baseline.
+    struct ComparisonRun
+    {
+        std::string technique;
+        std::string label;             ///< what the plots call it
+        char marker = 'o';             ///< its point in the trade plot (a matplotlib marker)
+        bool oneObjectPerTree = false; ///< a baseline of one Ogre object per tree (treelod_frames --entity-limit)
+    };
+    /// The registry's comparison runs: techniques with a comparison label in registry order (the
+    /// reference first), then the baselines in the order registered.
+    std::vector<ComparisonRun> comparisonRuns();
+    bool isComparisonRun(const std::string& technique);
+    /// "mesh, impostor, entities, ..." for help texts.
+    std::string describeComparisonRuns();
+    /// A run of `treelod bench` or treelod_frames: its name as --techniques spells it, and what it
+    /// draws. "auto" there is the script's own choice; "auto@E" and "auto~MS" budgeted auto; any
+    /// other name one technique or measurement baseline alone (LodPolicy).
+    struct BenchRun
+    {
+        std::string name;
+        LodPolicy policy;
+    };
+    /// The names of --techniques, parsed once: an error naming the option for an unknown technique
+    /// or a bad budget.
+    Result<std::vector<BenchRun>> parseBenchRuns(const std::vector<std::string>& names);
+    /// The comparison runs as BenchRuns (each technique or baseline alone).
+    std::vector<BenchRun> comparisonBenchRuns();
+
+    /// What `treelod bench` and treelod_frames draw without --techniques: "auto" and the techniques
+    /// whose roles say benchDefault ("auto,lodf,billboard-cloud").
+    std::string defaultBenchTechniques();
 
     /// The techniques bakeTechniqueOf knows, for messages: "mesh, lodf, billboard-cloud, ...".
     std::string knownSceneTechniques();
 
     /// The packages that drawing `script` needs: per species source, the sorted bake techniques
-    /// ("reference" always) of every choice in `techniques` (each as ForestSceneOptions::technique:
-    /// "" = the script's own choice). What a ForestScene of each choice requires through the
-    /// TreeBaker, so a program can bake it all first (`treelod bench`). Throws Ogre::Exception
-    /// naming the script and the species for an unknown technique.
+    /// ("reference" always) of every policy in `policies` (each as ForestSceneOptions::policy).
+    /// What a ForestScene of each policy requires through the TreeBaker, so a program can bake it
+    /// all first (`treelod bench`). Throws Ogre::Exception naming the script and the species for
+    /// an unknown technique.
     std::map<std::string, std::vector<std::string>> scenePackages(const SceneScript& script,
-                                                                  const std::vector<std::string>& techniques);
+                                                                  const std::vector<LodPolicy>& policies);
 
     struct ForestSceneOptions
     {
-        /// "" = the script's technique choice; else every species drawn with this technique alone;
-        /// "entities" / "merged-quads" / "billboard-set": a speed floor (QuadFloors.h) instead of the Forest, whose
-        /// getForest() then holds no species.
-        std::string technique;
+        /// The script's choice by default; budgeted auto for every species; or every species drawn
+        /// with one technique alone, or by a measurement baseline (isBaseline) instead of the
+        /// Forest, whose getForest() then holds no species.
+        LodPolicy policy;
         PlacementOptions placement;
         /// Forest::setUploadBudget: bytes of levels built per frame (0 = no limit: every level the
         /// first frame needs is built in it).
@@ -99,20 +126,20 @@ namespace TreeLod
         const std::vector<PlacedTree>& getPlacements() const { return mPlacements; }
         const std::vector<TreeAssetPtr>& getAssets() const { return mAssets; } ///< per species
 
-        /// Re-create the Forest's species for another technique choice ("" = the script's),
-        /// keeping the instances; bakes what the new choice needs.
-        void setTechnique(const std::string& technique);
-        const std::string& getTechnique() const { return mTechnique; }
-        /// setTechnique without waiting for bakes: they run on worker threads
-        /// (TreeAssetManager::requireAsync) while the current choice keeps drawing, and update()
+        /// Re-create the Forest's species for another policy, keeping the instances; bakes what the
+        /// new policy needs.
+        void setPolicy(const LodPolicy& policy);
+        const LodPolicy& getPolicy() const { return mPolicy; }
+        /// setPolicy without waiting for bakes: they run on worker threads
+        /// (TreeAssetManager::requireAsync) while the current policy keeps drawing, and update()
         /// switches once they have ended. A later request replaces an earlier one.
-        void requestTechnique(const std::string& technique);
-        /// Once per frame: switches to the requested technique when its bakes have ended; true when
+        void requestPolicy(const LodPolicy& policy);
+        /// Once per frame: switches to the requested policy when its bakes have ended; true when
         /// it did. Throws Ogre::Exception naming the script and the source when a bake failed (the
-        /// request is dropped, the current choice stays).
+        /// request is dropped, the current policy stays).
         bool update();
-        bool isTechniquePending() const { return mPendingRequested; }
-        const std::string& getPendingTechnique() const { return mPendingTechnique; }
+        bool isPolicyPending() const { return mPendingRequested; }
+        const LodPolicy& getPendingPolicy() const { return mPendingPolicy; }
 
         /// Texture shadows on or off (the script's size and shadow camera setup), reaching
         /// getShadowFarDistance() metres from the camera; the ground receives them.
@@ -142,9 +169,9 @@ namespace TreeLod
         Ogre::SceneNode& mParent;
         SceneScript mScript;
         ForestSceneOptions mOptions;
-        std::string mTechnique;
+        LodPolicy mPolicy;
         bool mPendingRequested = false;
-        std::string mPendingTechnique;
+        LodPolicy mPendingPolicy;
         std::vector<std::shared_ptr<TreeAssetRequest>> mPendingBakes;
         std::vector<PlacedTree> mPlacements;
         std::vector<TreeAssetPtr> mAssets;
@@ -157,9 +184,7 @@ namespace TreeLod
         std::string levelNote(const LevelNote& note) const;
         std::vector<LevelNote> mLevelNotes;
         Forest* mForest = nullptr;
-        std::unique_ptr<EntityFloor> mEntityFloor;
-        std::unique_ptr<MergedQuadFloor> mMergedQuadFloor;
-        std::unique_ptr<BillboardSetFloor> mBillboardSetFloor;
+        std::unique_ptr<ForestBaseline> mBaseline; ///< a measurement baseline drawn instead of the Forest
         Ogre::SceneNode* mForestNode = nullptr;
         Ogre::ManualObject* mGround = nullptr;
         Ogre::SceneNode* mGroundNode = nullptr;

@@ -22,6 +22,11 @@ namespace TreeLod
     /// `label` names the output in errors.
     using BakeFunction = Result<void> (*)(PackageWriter& writer, const TreeModel& model, const BakeOptions& options,
                                           const std::string& label, const ProgressCallback& progress);
+    /// Adds a technique's chunks baked from the capture folder `folder` (photographs and their
+    /// cameras, no polygons) and a reference of bounds only; `source` names the tree in them.
+    using CaptureBakeFunction = Result<void> (*)(PackageWriter& writer, const std::string& folder,
+                                                 const std::string& source, const BakeOptions& options,
+                                                 const std::string& label, const ProgressCallback& progress);
 
     /// One option a baker reads.
     struct BakeOptionInfo
@@ -37,6 +42,7 @@ namespace TreeLod
         const char* description;
         BakeFunction bake;
         std::vector<BakeOptionInfo> options; ///< what `options` may hold
+        CaptureBakeFunction bakeCapture = nullptr; ///< null: bakes from polygons only
     };
 
     /// Add (or replace, by name) a baker. Registration happens during static initialisation.

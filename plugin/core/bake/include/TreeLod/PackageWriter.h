@@ -114,6 +114,33 @@ namespace TreeLod
     Result<void> addReferenceChunkIfMissing(PackageWriter& writer, const TreeModel& model, const std::string& label,
                                             const ProgressCallback& progress = {});
 
+    /// Add chunk (technique, level 0, formatVersion) holding `encode(data)`; an error names `label`.
+    template <typename Data>
+    Result<void> addEncodedChunk(PackageWriter& writer, const std::string& technique, std::uint32_t formatVersion,
+                                 std::vector<std::uint8_t> (*encode)(const Data&), const Data& data,
+                                 const std::string& label)
+    {
+        Result<void> added = writer.addChunk(technique, 0, formatVersion, encode(data));
+        if (!added)
+            return fail(label, added.error().element, added.error().reason);
+        return {};
+    }
+
+    /// What an add<X>Chunk does: the reference chunk unless `writer` has it, then `bake()` (a
+    /// Result<Data>), then addEncodedChunk. The first error is returned; nothing is added after it.
+    template <typename Data, typename Bake>
+    Result<void> addBakedChunk(PackageWriter& writer, const TreeModel& model, const std::string& label,
+                               const ProgressCallback& progress, const std::string& technique,
+                               std::uint32_t formatVersion, std::vector<std::uint8_t> (*encode)(const Data&), Bake bake)
+    {
+        if (Result<void> reference = addReferenceChunkIfMissing(writer, model, label, progress); !reference)
+            return reference;
+        Result<Data> data = bake();
+        if (!data)
+            return data.error();
+        return addEncodedChunk(writer, technique, formatVersion, encode, data.value(), label);
+    }
+
     /// Add the "meta" chunk (level 0, format 1): meta.toJson() as UTF-8 text.
     Result<void> addMetaChunk(PackageWriter& writer, const PackageMeta& meta);
 

@@ -5,6 +5,7 @@
 // zeros, so a decoder may read a whole record and check ok() once. count() checks a
 // declared element count against the bytes left before the caller allocates, which bounds
 // the memory a hostile input can make a decoder take to a small multiple of its size.
+// Arrays, flags and their standard errors: ChunkCodec.h.
 #pragma once
 
 #include "TreeLod/Result.h"
@@ -62,6 +63,9 @@ namespace TreeLod
             float x = f32(), y = f32(), z = f32(), w = f32();
             return {x, y, z, w};
         }
+
+        /// Each value in the layout of its type (ByteWriter::fields), in order.
+        template <typename... T> void fields(T&... values) { (field(values), ...); }
 
         /// u32 byte length + bytes; fails if longer than `maxLength`.
         std::string string(std::size_t maxLength = 4096)
@@ -134,6 +138,16 @@ namespace TreeLod
         std::size_t remaining() const { return mSize - mOffset; }
 
     private:
+        void field(std::uint8_t& v) { v = u8(); }
+        void field(std::uint16_t& v) { v = u16(); }
+        void field(std::uint32_t& v) { v = u32(); }
+        void field(std::int32_t& v) { v = i32(); }
+        void field(std::uint64_t& v) { v = u64(); }
+        void field(float& v) { v = f32(); }
+        void field(glm::vec2& v) { v = vec2(); }
+        void field(glm::vec3& v) { v = vec3(); }
+        void field(glm::vec4& v) { v = vec4(); }
+
         std::uint64_t little(int n)
         {
             const std::uint8_t* p = take(std::size_t(n));

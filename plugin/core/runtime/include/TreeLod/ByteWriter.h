@@ -1,5 +1,5 @@
 // ByteWriter: builds the little-endian byte layout of a package chunk (Package.h).
-// The counterpart of ByteReader; every chunk format encodes with it.
+// The counterpart of ByteReader; every chunk format encodes with it (arrays and flags: ChunkCodec.h).
 #pragma once
 
 #include <glm/glm.hpp>
@@ -42,6 +42,10 @@ namespace TreeLod
             f32(v.w);
         }
 
+        /// Each value in the layout of its type (u8, u16, u32, i32, u64, f32, vec2, vec3, vec4), in
+        /// order: with ByteReader::fields, one list of a record's fields serves both directions.
+        template <typename... T> void fields(const T&... values) { (field(values), ...); }
+
         /// u32 byte length, then the bytes (no terminator).
         void string(const std::string& s)
         {
@@ -70,6 +74,18 @@ namespace TreeLod
         std::vector<std::uint8_t> take() { return std::move(mBytes); }
 
     private:
+        void field(std::uint8_t v) { u8(v); }
+        void field(std::uint16_t v) { u16(v); }
+        void field(std::uint32_t v) { u32(v); }
+        void field(std::int32_t v) { i32(v); }
+        void field(std::uint64_t v) { u64(v); }
+        void field(float v) { f32(v); }
+        void field(const glm::vec2& v) { vec2(v); }
+        void field(const glm::vec3& v) { vec3(v); }
+        void field(const glm::vec4& v) { vec4(v); }
+        /// No conversions: a value of another type has no stored layout.
+        template <typename T> void field(const T&) = delete;
+
         void little(std::uint64_t v, int n)
         {
             for (int i = 0; i < n; ++i)

@@ -1,0 +1,77 @@
+# Test and benchmark helpers for tests/, bench/ and each technique's folder (techniques/<name>/CMakeLists.txt).
+#
+# treelod_add_test(NAME [OGRE | USES_OGRE] SOURCES... [LIBS ...]): one gtest executable, tests
+#   discovered by ctest. OGRE: a headless Ogre test binary, whose main() (tests/ogre/OgreTestMain.cpp)
+#   tears the Root down before returning. Both label the tests "ogre" (ctest -L ogre / -LE ogre).
+# treelod_add_ogre_tests(SOURCES... [RENDER_SYSTEM_TESTS Suite.test...]): a technique's Ogre tests
+#   join test_ogre (tests/ogre/CMakeLists.txt: one executable, one Ogre start-up per process); their
+#   goldens are the technique's golden/ folder; RENDER_SYSTEM_TESTS run again under GL and GLES2.
+# treelod_add_cli_test(NAME SCRIPT [ARGS...]): `bash SCRIPT <treelod> <source dir> <output dir> ARGS`.
+
+# Test data and caches stay inside the build tree (XDG_CACHE_HOME).
+set(TREELOD_TEST_ENV
+  "XDG_CACHE_HOME=${CMAKE_BINARY_DIR}/test-cache"
+  "TREELOD_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
+  "TREELOD_TEST_OUT=${CMAKE_BINARY_DIR}/test-out")
+
+function(treelod_add_test name)
+  cmake_parse_arguments(T "OGRE;USES_OGRE" "" "SOURCES;LIBS" ${ARGN})
+  if(T_OGRE)
+    add_executable(${name} ${T_SOURCES} ${PROJECT_SOURCE_DIR}/tests/ogre/OgreTestMain.cpp)
+    target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/ogre)
+    target_link_libraries(${name} PRIVATE GTest::gtest ${T_LIBS} treelod_warnings)
+  else()
+    add_executable(${name} ${T_SOURCES})
+    target_link_libraries(${name} PRIVATE GTest::gtest_main ${T_LIBS} treelod_warnings)
+  endif()
+  target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/core) # TestTrees.h, TestOutput.h
+  target_compile_definitions(${name} PRIVATE
+    TREELOD_SOURCE_DIR="${PROJECT_SOURCE_DIR}" TREELOD_BINARY_DIR="${CMAKE_BINARY_DIR}")
+  if(T_OGRE OR T_USES_OGRE)
+    set(label ogre)
+  else()
+    set(label core)
+    set_property(GLOBAL APPEND PROPERTY TREELOD_CORE_TEST_TARGETS ${name})
+  endif()
+  gtest_discover_tests(${name} PROPERTIES ENVIRONMENT "${TREELOD_TEST_ENV}" LABELS ${label} DISCOVERY_TIMEOUT 60)
+  set_property(GLOBAL APPEND PROPERTY TREELOD_TEST_TARGETS ${name})
+endfunction()
+
+function(treelod_add_ogre_tests)
+  cmake_parse_arguments(T "" "" "SOURCES;RENDER_SYSTEM_TESTS" ${ARGN})
+  foreach(source IN LISTS T_SOURCES)
+    set_property(GLOBAL APPEND PROPERTY TREELOD_OGRE_TEST_SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/${source})
+  endforeach()
+  set_property(GLOBAL APPEND PROPERTY TREELOD_RENDER_SYSTEM_TESTS ${T_RENDER_SYSTEM_TESTS})
+endfunction()
+
+function(treelod_add_cli_test name script)
+  if(TARGET treelod AND TARGET Plugin_TreeLod)
+    add_test(NAME ${name}
+      COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/${script} $<TARGET_FILE:treelod> ${PROJECT_SOURCE_DIR}
+              ${CMAKE_BINARY_DIR}/test-out/${name} ${ARGN})
+    set_tests_properties(${name} PROPERTIES ENVIRONMENT "${TREELOD_TEST_ENV}")
+  endif()
+endfunction()
+
+# Benchmarks (bench/CMakeLists.txt builds them; speed targets are checked there, never in tests):
+# treelod_add_core_bench_sources(SOURCES...): Google Benchmark sources joining treelod_core_bench.
+# treelod_add_study(NAME SOURCES...): a headless Ogre study (render, measure against the reference,
+#   write CSV/Markdown/SVG); StudySupport.h is bench/'s. Needs TreeLodOffscreen.
+function(treelod_add_core_bench_sources)
+  foreach(source IN LISTS ARGN)
+    set_property(GLOBAL APPEND PROPERTY TREELOD_CORE_BENCH_SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/${source})
+  endforeach()
+endfunction()
+
+function(treelod_add_study name)
+  if(NOT TREELOD_BUILD_BENCHMARKS OR NOT TARGET TreeLodOffscreen)
+    return()
+  endif()
+  add_executable(${name} ${ARGN})
+  target_link_libraries(${name} PRIVATE TreeLodOffscreen TreeLodBakeTechniques CLI11::CLI11
+    nlohmann_json::nlohmann_json treelod_warnings)
+  target_compile_definitions(${name} PRIVATE TREELOD_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/bench # StudySupport.h
+    ${PROJECT_SOURCE_DIR}/plugin/scene/include)                         # RgbaImageConversion.h, via StudySupport.h
+endfunction()

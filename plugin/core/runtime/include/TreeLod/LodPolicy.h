@@ -1,0 +1,50 @@
+// LodPolicy: how the species of a forest scene choose their levels, as one value. It is parsed
+// once where a user writes it (a scene script's choice, `--techniques`, the browser's controls) and
+// passed down as a value:
+//   ""         Script   each species as its script says (distance bands, or "auto")
+//   "auto"     Auto     budgeted auto at the script's error budget (docs/forest.md)
+//   "auto@E"   Auto     budgeted auto at error budget E, the mean FLIP allowed, in [0, 1]
+//   "auto~MS"  Auto     budgeted auto under a frame budget of MS milliseconds, in (0, 1e6]
+//   any other  Fixed    every species drawn by that one technique or measurement baseline
+#pragma once
+
+#include "TreeLod/Result.h"
+
+#include <limits>
+#include <string>
+
+namespace TreeLod
+{
+    struct LodPolicy
+    {
+        enum class Mode
+        {
+            Script,
+            Auto,
+            Fixed
+        };
+
+        Mode mode = Mode::Script;
+        std::string technique; ///< Fixed: the technique or baseline every species is drawn with
+        /// Auto: mean FLIP allowed, [0, 1]; NaN: the script's (or the Forest's default).
+        float errorBudget = std::numeric_limits<float>::quiet_NaN();
+        /// Auto: frame time the error budget follows, milliseconds; NaN: none.
+        float frameBudgetMs = std::numeric_limits<float>::quiet_NaN();
+
+        static LodPolicy scriptChoice() { return {}; }
+        static LodPolicy automatic(float errorBudget = std::numeric_limits<float>::quiet_NaN(),
+                                   float frameBudgetMs = std::numeric_limits<float>::quiet_NaN());
+        static LodPolicy fixed(std::string technique);
+
+        /// `text` as in the table above. An "auto@" or "auto~" with a number out of range, or not a
+        /// number, is an error naming `element`. A fixed technique is not checked here (the
+        /// technique registry knows the names).
+        static Result<LodPolicy> parse(const std::string& text, const std::string& element = "technique");
+        /// The text parse reads back ("auto@0.05", "lodf", "").
+        std::string toString() const;
+
+        bool isAuto() const { return mode == Mode::Auto; }
+        bool operator==(const LodPolicy& other) const;
+        bool operator!=(const LodPolicy& other) const { return !(*this == other); }
+    };
+}

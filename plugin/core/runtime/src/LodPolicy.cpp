@@ -1,0 +1,77 @@
+#include "TreeLod/LodPolicy.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace TreeLod
+{
+    LodPolicy LodPolicy::automatic(float errorBudget, float frameBudgetMs)
+    {
+        LodPolicy policy;
+        policy.mode = Mode::Auto;
+        policy.errorBudget = errorBudget;
+        policy.frameBudgetMs = frameBudgetMs;
+        return policy;
+    }
+
+    LodPolicy LodPolicy::fixed(std::string technique)
+    {
+        LodPolicy policy;
+        policy.mode = Mode::Fixed;
+        policy.technique = std::move(technique);
+        return policy;
+    }
+
+    Result<LodPolicy> LodPolicy::parse(const std::string& text, const std::string& element)
+    {
+        if (text.empty())
+            return scriptChoice();
+        if (text == "auto")
+            return automatic();
+        const bool frame = text.rfind("auto~", 0) == 0;
+        if (!frame && text.rfind("auto@", 0) != 0)
+            return fixed(text);
+        const std::string number = text.substr(5);
+        char* end = nullptr;
+        const double value = std::strtod(number.c_str(), &end);
+        const bool isNumber = !number.empty() && *end == '\0';
+        if (frame)
+        {
+            if (!isNumber || !(value > 0.0 && value <= 1e6))
+                return fail("", element, "'" + text + "': the frame budget after 'auto~' must be milliseconds in (0, 1e6]");
+            return automatic(std::numeric_limits<float>::quiet_NaN(), float(value));
+        }
+        if (!isNumber || !(value >= 0.0 && value <= 1.0))
+            return fail("", element, "'" + text + "': the error budget after 'auto@' must be a mean FLIP in [0, 1]");
+        return automatic(float(value));
+    }
+
+    std::string LodPolicy::toString() const
+    {
+        char text[48];
+        switch (mode)
+        {
+        case Mode::Script:
+            return "";
+        case Mode::Fixed:
+            return technique;
+        case Mode::Auto:
+            if (std::isfinite(frameBudgetMs))
+                std::snprintf(text, sizeof text, "auto~%g", double(frameBudgetMs));
+            else if (std::isfinite(errorBudget))
+                std::snprintf(text, sizeof text, "auto@%g", double(errorBudget));
+            else
+                return "auto";
+            return text;
+        }
+        return "";
+    }
+
+    bool LodPolicy::operator==(const LodPolicy& other) const
+    {
+        const auto same = [](float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); };
+        return mode == other.mode && technique == other.technique && same(errorBudget, other.errorBudget) &&
+               same(frameBudgetMs, other.frameBudgetMs);
+    }
+}

@@ -1,0 +1,79 @@
+// LodPolicy: a scene's level choice parsed once from its text, and written back.
+#include "TreeLod/LodPolicy.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace TreeLod
+{
+    TEST(LodPolicy, parsesTheScriptChoiceAutoWithItsBudgetsAndOneTechnique)
+    {
+        Result<LodPolicy> script = LodPolicy::parse("");
+        ASSERT_TRUE(script.ok());
+        EXPECT_EQ(script->mode, LodPolicy::Mode::Script);
+
+        Result<LodPolicy> plain = LodPolicy::parse("auto");
+        ASSERT_TRUE(plain.ok());
+        EXPECT_TRUE(plain->isAuto());
+        EXPECT_TRUE(std::isnan(plain->errorBudget)) << "plain auto takes the script's budget";
+        EXPECT_TRUE(std::isnan(plain->frameBudgetMs));
+
+        Result<LodPolicy> error = LodPolicy::parse("auto@0.05");
+        ASSERT_TRUE(error.ok());
+        EXPECT_FLOAT_EQ(error->errorBudget, 0.05f);
+        EXPECT_TRUE(std::isnan(error->frameBudgetMs)) << "no frame budget: the script's";
+        Result<LodPolicy> zero = LodPolicy::parse("auto@0");
+        ASSERT_TRUE(zero.ok());
+        EXPECT_EQ(zero->errorBudget, 0.0f);
+
+        Result<LodPolicy> frame = LodPolicy::parse("auto~40");
+        ASSERT_TRUE(frame.ok());
+        EXPECT_TRUE(frame->isAuto());
+        EXPECT_TRUE(std::isnan(frame->errorBudget)) << "under a frame budget, the script's error budget to start from";
+        EXPECT_EQ(frame->frameBudgetMs, 40.0f);
+
+        // Anything else is one technique; whether it exists is the registry's to say.
+        for (const char* name : {"lodf", "autox", "entities"})
+        {
+            Result<LodPolicy> fixed = LodPolicy::parse(name);
+            ASSERT_TRUE(fixed.ok()) << name;
+            EXPECT_EQ(fixed->mode, LodPolicy::Mode::Fixed) << name;
+            EXPECT_EQ(fixed->technique, name);
+        }
+    }
+
+    TEST(LodPolicy, aBadBudgetIsAnErrorNamingTheElementAndTheRange)
+    {
+        for (const char* bad : {"auto@", "auto@x", "auto@1.5", "auto@-0.1", "auto@nan", "auto@0.1x"})
+        {
+            Result<LodPolicy> policy = LodPolicy::parse(bad, "--techniques");
+            ASSERT_FALSE(policy.ok()) << bad;
+            EXPECT_NE(policy.error().message().find("--techniques"), std::string::npos) << policy.error().message();
+            EXPECT_NE(policy.error().message().find("[0, 1]"), std::string::npos) << policy.error().message();
+        }
+        for (const char* bad : {"auto~", "auto~0", "auto~-5", "auto~inf", "auto~16ms", "auto~1e7"})
+        {
+            Result<LodPolicy> policy = LodPolicy::parse(bad);
+            ASSERT_FALSE(policy.ok()) << bad;
+            EXPECT_NE(policy.error().message().find("(0, 1e6]"), std::string::npos) << policy.error().message();
+        }
+    }
+
+    TEST(LodPolicy, writesBackWhatItParses)
+    {
+        for (const char* text : {"", "auto", "auto@0.05", "auto@0", "auto@1", "auto~40", "auto~16.5", "lodf"})
+        {
+            Result<LodPolicy> policy = LodPolicy::parse(text);
+            ASSERT_TRUE(policy.ok()) << text;
+            EXPECT_EQ(policy->toString(), text);
+            Result<LodPolicy> again = LodPolicy::parse(policy->toString());
+            ASSERT_TRUE(again.ok());
+            EXPECT_EQ(*again, *policy) << text;
+        }
+        // The browser's slider makes a policy without text: it writes as the menu shows it.
+        EXPECT_EQ(LodPolicy::automatic(0.04f).toString(), "auto@0.04");
+        EXPECT_NE(LodPolicy::automatic(0.04f), LodPolicy::automatic(0.05f));
+        EXPECT_NE(LodPolicy::fixed("lodf"), LodPolicy::automatic());
+    }
+}
