@@ -220,8 +220,8 @@ namespace TreeLod
         if (hasPolygons(model))
             return {};
         return fail(label, chunkElement(REFERENCE_CHUNK, 0),
-                    "no polygons: the tree was baked from photographs (a capture folder) and only volume-octree "
-                    "draws it; " + use + " needs a polygonal tree");
+                    "no polygons: the tree was baked from photographs (a capture folder) and only the techniques "
+                    "baked from photographs draw it; " + use + " needs a polygonal tree");
     }
 
     Result<ReferenceChunk> decodeReferenceChunk(const std::vector<std::uint8_t>& bytes, const std::string& label)
