@@ -118,8 +118,16 @@ namespace TreeLod
                         const auto it = std::find_if(declared.begin(), declared.end(),
                                                      [&](const TechniqueParameter& p) { return p.flag == flag; });
                         if (it == declared.end())
+                        {
+                            std::string owners;
+                            for (const TechniqueInfo& t : TechniqueRegistry::getSingleton().getTechniques())
+                                for (const TechniqueParameter& p : t.roles.parameters)
+                                    if (p.flag == flag)
+                                        owners += (owners.empty() ? "" : ", ") + t.name;
                             return printError(fail("", "--" + flag, "technique '" + args.technique +
-                                                                        "' has no such parameter"));
+                                                                        "' has no such parameter (techniques that take it: " +
+                                                                        owners + ")"));
+                        }
                         params[it->name] = value;
                     }
                     renderer.setShadows(args.shadows, 2048, parseShadowCamera(args.shadowCamera, "--shadow-camera"));
@@ -166,7 +174,7 @@ namespace TreeLod
             for (const TechniqueParameter& p : info.roles.parameters)
                 help[p.flag] += (help[p.flag].empty() ? "" : "; ") + info.name + ": " + p.description;
         for (const auto& [flag, text] : help)
-            cmd->add_option("--" + flag, args->techniqueParams[flag], text);
+            cmd->add_option("--" + flag, args->techniqueParams[flag], text)->type_name("VALUE");
 #endif
         cmd->add_option("--lod-bias", args->lodBias, "camera LoD bias (> 1 = more detail)");
         cmd->add_flag("--shadows", args->shadows, "texture shadows from the sun (2048^2 float depth)");

@@ -48,4 +48,17 @@ for bad in lodf.nosuch=1 lodf.clusterSize=0 impostor.resolution=64 lodf.clusterS
   [ "$code" = 2 ] && [ ! -e "$out/badopt.treelod" ] || { echo "--option $bad not refused"; exit 1; }
   grep -q "option" "$out/badopt.txt" || { echo "--option $bad: error does not name the option:"; cat "$out/badopt.txt"; exit 1; }
 done
+# Render options are the techniques' own (TechniqueRoles::parameters): --level is not lodf's, and
+# --leaves takes a number; both exit 2 naming what is wrong, and write nothing.
+set +e
+"$treelod" render "$out/oak.treelod" --technique lodf --level 1 --size 64x64 -o "$out/badparam.png" 2> "$out/badparam.txt"
+code=$?
+"$treelod" render "$out/oak.treelod" --technique lodf --leaves many --size 64x64 -o "$out/badleaves.png" 2> "$out/badleaves.txt"
+leavesCode=$?
+set -e
+[ "$code" = 2 ] && [ ! -e "$out/badparam.png" ] || { echo "--level on lodf not refused"; exit 1; }
+grep -qF -- "--level: technique 'lodf' has no such parameter (techniques that take it: billboard-cloud" "$out/badparam.txt" \
+  || { echo "--level on lodf: error does not say whose it is:"; cat "$out/badparam.txt"; exit 1; }
+[ "$leavesCode" = 2 ] && [ ! -e "$out/badleaves.png" ] || { echo "--leaves many not refused"; exit 1; }
+grep -qF "parameter 'leaves'" "$out/badleaves.txt" || { echo "--leaves many: error:"; cat "$out/badleaves.txt"; exit 1; }
 echo "lodf CLI ok"
