@@ -105,9 +105,9 @@ namespace TreeLod
         std::vector<ComparisonRun> runs;
         for (const TechniqueInfo& t : registry.getTechniques())
             if (!t.roles.comparisonLabel.empty())
-                runs.push_back({t.name, t.roles.comparisonLabel, t.roles.plotMarker, false});
+                runs.push_back({t.name, t.roles.comparisonLabel, t.roles.plotMarker});
         for (const BaselineInfo& b : registry.getBaselines())
-            runs.push_back({b.name, b.comparisonLabel, b.plotMarker, b.oneObjectPerTree});
+            runs.push_back({b.name, b.comparisonLabel, b.plotMarker});
         return runs;
     }
 

@@ -57,7 +57,6 @@ namespace TreeLod
             TechniqueRoles roles;
             roles.floor = true;
             roles.autoCandidate = true;
-            roles.defaultBandMinHeight = 0.0f;
             roles.comparisonLabel = "floor: the Forest's one-quad level";
             roles.plotMarker = 's';
             registry.add({IMPOSTOR_CHUNK,

@@ -9,9 +9,9 @@
 // the registry is first used. TreeAsset, the Forest, ForestScene, `treelod render`/`bench` and the
 // browser iterate the registry and name no technique; what differs between techniques in the trade
 // (auto candidacy, default bands, the floor, render options) is each one's TechniqueRoles, and
-// the measurement baselines drawn without a technique (the speed floors) are BaselineInfos. The registry is one per process, made on
-// first use (no Ogre::Root needed: a bench lists techniques before it renders); the plugin adds
-// the factories to Root when it installs.
+// the measurement baselines drawn without a technique (the speed floors) are BaselineInfos. The
+// registry is one per process, made on first use (no Ogre::Root needed: a bench lists techniques
+// before it renders); the plugin adds the factories to Root when it installs.
 #pragma once
 
 #include "TreeLod/ForestBaseline.h"

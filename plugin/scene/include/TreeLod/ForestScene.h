@@ -52,8 +52,7 @@ namespace TreeLod
     {
         std::string technique;
         std::string label;             ///< what the plots call it
-        char marker = 'o';             ///< its point in the trade plot (a matplotlib marker)
-        bool oneObjectPerTree = false; ///< a baseline of one Ogre object per tree (treelod_frames --entity-limit)
+        char marker = 'o';  ///< its point in the trade plot (a matplotlib marker)
     };
     /// The registry's comparison runs: techniques with a comparison label in registry order (the
     /// reference first), then the baselines in the order registered.
