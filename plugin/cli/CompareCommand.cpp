@@ -120,7 +120,7 @@ namespace TreeLod
         auto options = std::make_shared<CompareOptions>();
         CLI::App* command = app.add_subcommand(
             "compare", "Compare a test image with a reference: FLIP, multi-scale RMSE (per band), PSNR");
-        command->add_option("reference", options->reference, "Reference image (PNG or any format OpenImageIO reads)")
+        command->add_option("reference", options->reference, "Reference image (PNG or JPEG)")
             ->required();
         command->add_option("test", options->test, "Test image, same size as the reference")->required();
         command->add_flag("--json", options->json, "Print one JSON object instead of text");

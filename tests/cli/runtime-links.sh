@@ -7,7 +7,7 @@ status=0
 for binary in "$@"; do
   [ -e "$binary" ] || { echo "runtime-links: $binary does not exist"; exit 1; }
   libs=$(ldd "$binary") # whole, before grep: grep -q closing the pipe early would fail it under pipefail
-  leaked=$(grep -Ei 'OpenImageIO|embree|squish|tinygltf|libgdal|libav' <<< "$libs" || true)
+  leaked=$(grep -Ei 'libpng|libjpeg|embree|squish|tinygltf' <<< "$libs" || true)
   if [ -n "$leaked" ]; then
     echo "runtime-links: $binary loads bake-only libraries:"; echo "$leaked"; status=1
   fi

@@ -1,12 +1,12 @@
 // Binary glTF 2.0 writer for TreeModel (layout in GltfExporter.h), through tinygltf.
-// Images are encoded to PNG in memory with OpenImageIO and stored in the binary buffer
+// Images are encoded to PNG in memory (ImageCodec.h) and stored in the binary buffer
 // (image.bufferView), so tinygltf's own image writer is never needed.
 #include "TreeLod/GltfExporter.h"
 
 #include "TreeLod/AtomicFile.h"
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
+#include "TreeLod/ImageCodec.h"
+
 #include <tiny_gltf.h>
 
 #include <algorithm>
@@ -44,7 +44,8 @@ namespace TreeLod
             return tinygltf::Value(std::move(array));
         }
 
-        Result<std::vector<unsigned char>> encodePng(const TextureImage& texture)
+        /// RGB when every texel is opaque, RGBA otherwise; zlib level 9.
+        Result<std::vector<unsigned char>> texturePng(const TextureImage& texture)
         {
             bool opaque = true;
             for (std::size_t i = 3; i < texture.rgba.size(); i += 4)
@@ -61,18 +62,10 @@ namespace TreeLod
             else
                 pixels = texture.rgba;
 
-            std::vector<unsigned char> bytes;
-            OIIO::Filesystem::IOVecOutput proxy(bytes);
-            std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create("png");
-            if (!out || !out->set_ioproxy(&proxy))
-                return fail("", "image '" + texture.name + "'", "cannot create an in-memory PNG writer");
-            OIIO::ImageSpec spec(texture.width, texture.height, channels, OIIO::TypeDesc::UINT8);
-            spec.attribute("png:compressionLevel", 9);
-            spec.attribute("oiio:UnassociatedAlpha", 1); // straight alpha as stored
-            if (!out->open("memory.png", spec) || !out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) ||
-                !out->close())
-                return fail("", "image '" + texture.name + "'", "PNG encoding failed: " + out->geterror());
-            return bytes;
+            Result<std::vector<std::uint8_t>> png = encodePng(pixels.data(), texture.width, texture.height, channels, 9);
+            if (!png)
+                return fail("", "image '" + texture.name + "'", png.error().reason);
+            return png;
         }
 
         /// Builds buffer views into one binary buffer, each 4-byte aligned.
@@ -210,7 +203,7 @@ namespace TreeLod
             model.samplers.push_back(sampler);
         for (std::size_t t = 0; t < tree.textures.size(); ++t)
         {
-            Result<std::vector<unsigned char>> png = encodePng(tree.textures[t]);
+            Result<std::vector<unsigned char>> png = texturePng(tree.textures[t]);
             if (!png)
                 return png.error();
             tinygltf::Image image;

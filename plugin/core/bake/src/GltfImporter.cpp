@@ -2,13 +2,14 @@
 // check is checked here before use: every index into accessors, buffer views and buffers,
 // every byte range, the .glb chunk layout, and JSON nesting. tinygltf reads files only through
 // the FsCallbacks below and decodes no image: its image callback keeps the encoded bytes, and
-// OpenImageIO decodes the images that materials use (PNG, JPEG; palette PNGs keep tRNS alpha).
+// libpng and libjpeg-turbo decode the images that materials use (ImageCodec.h; palette PNGs keep
+// tRNS alpha).
 #include "TreeLod/GltfImporter.h"
 
 #include "TreeLod/LeafExtraction.h"
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
+#include "TreeLod/ImageCodec.h"
+
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -347,9 +348,8 @@ namespace TreeLod
             return std::uint32_t(p[0]) << 24 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[2]) << 8 | std::uint32_t(p[3]);
         }
 
-        /// Walk the PNG chunks (after the signature) up to IEND. OpenImageIO 2.4 leaks a string
-        /// when libpng runs out of data (its read callback longjmps), so a PNG that ends early
-        /// is refused here, with a clearer message.
+        /// Walk the PNG chunks (after the signature) up to IEND: a PNG that ends early is refused
+        /// naming the chunk, a clearer message than the decoder's.
         Result<void> checkPngChunks(const std::uint8_t* data, std::size_t size, const std::string& file,
                                     const std::string& where)
         {
@@ -427,25 +427,19 @@ namespace TreeLod
         }
 
         /// Decode PNG or JPEG bytes to RGBA8 (straight alpha; grey and RGB get alpha 255).
-        Result<TextureImage> decodeImage(const std::uint8_t* data, std::size_t size, const std::string& file,
-                                         const std::string& where)
+        Result<TextureImage> decodeTexture(const std::uint8_t* data, std::size_t size, const std::string& file,
+                                           const std::string& where)
         {
-            static const std::uint8_t pngSignature[8] = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
-            const char* format = nullptr;
-            if (size >= 8 && std::memcmp(data, pngSignature, 8) == 0)
-            {
-                format = "png";
+            const ImageFormat format = sniffImageFormat(data, size);
+            if (format == ImageFormat::Unknown)
+                return fail(file, where, "unsupported image format (not PNG or JPEG)");
+            const bool png = format == ImageFormat::Png;
+            if (png)
                 if (auto r = checkPngChunks(data, size, file, where); !r)
                     return r.error();
-            }
-            else if (size >= 3 && data[0] == 0xFF && data[1] == 0xD8 && data[2] == 0xFF)
-                format = "jpeg";
-            else
-                return fail(file, where, "unsupported image format (not PNG or JPEG)");
 
             // The size the header claims is checked before the decoder sees the bytes: opening a
             // progressive JPEG that claims 65500 x 65500 has libjpeg allocate 1 GB for its frame.
-            const bool png = std::strcmp(format, "png") == 0;
             std::uint64_t declaredWidth = 0, declaredHeight = 0;
             if (declaredSize(data, size, png, declaredWidth, declaredHeight) &&
                 beyondSizeLimit(declaredWidth, declaredHeight))
@@ -453,55 +447,25 @@ namespace TreeLod
                                              std::to_string(declaredWidth) + "x" + std::to_string(declaredHeight) +
                                              " pixels, larger than " + sizeLimit() + "; not decoded");
 
-            OIIO::Filesystem::IOMemReader reader(data, size);
-            auto input = OIIO::ImageInput::create(format);
-            if (!input || !input->supports("ioproxy"))
-                return fail(file, where, std::string("OpenImageIO cannot read ") + format + " from memory: " + OIIO::geterror());
-            OIIO::ImageSpec config, spec;
-            config.attribute("oiio:UnassociatedAlpha", 1); // keep straight alpha
-            input->set_ioproxy(&reader);
-            const std::string fakeName = std::string("memory.") + format;
-            if (!input->open(fakeName, spec, config))
-                return fail(file, where, "cannot decode " + std::string(format) + ": " + oneLine(input->geterror()));
-            const int w = spec.width, h = spec.height, channels = spec.nchannels;
-            if (w <= 0 || h <= 0 || spec.depth > 1 || channels < 1 || channels > 4)
-            {
-                input->close();
-                return fail(file, where, "unusable image layout " + std::to_string(w) + "x" + std::to_string(h) + " with " +
-                                             std::to_string(channels) + " channels");
-            }
-            if (beyondSizeLimit(std::uint64_t(w), std::uint64_t(h)))
-            {
-                input->close();
-                return fail(file, where, "image of " + std::to_string(w) + "x" + std::to_string(h) +
-                                             " pixels is larger than " + sizeLimit());
-            }
-            std::vector<std::uint8_t> pixels(std::size_t(w) * h * channels);
-            if (!input->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, pixels.data()))
-            {
-                std::string why = oneLine(input->geterror());
-                input->close();
-                return fail(file, where, "cannot decode " + std::string(format) + ": " + why);
-            }
-            input->close();
-            (void)input->geterror(); // clear warnings so OIIO does not print them at exit
-
+            Result<DecodedImage> decoded = decodeImage(data, size, std::uint32_t(kMaxImageSide), kMaxImagePixels);
+            if (!decoded)
+                return fail(file, where, oneLine(decoded.error().reason));
+            const DecodedImage& image = *decoded;
             TextureImage out;
-            out.width = w;
-            out.height = h;
-            out.rgba.resize(std::size_t(w) * h * 4);
-            const std::size_t n = std::size_t(w) * h;
+            out.width = image.width;
+            out.height = image.height;
+            out.rgba.resize(std::size_t(image.width) * std::size_t(image.height) * 4);
+            const std::size_t n = std::size_t(image.width) * std::size_t(image.height);
+            const std::size_t channels = std::size_t(image.channels);
             for (std::size_t i = 0; i < n; ++i)
             {
-                const std::uint8_t* s = &pixels[i * channels];
+                const std::size_t s = i * channels;
                 std::uint8_t* o = &out.rgba[i * 4];
-                switch (channels)
-                {
-                case 1: o[0] = o[1] = o[2] = s[0]; o[3] = 255; break;
-                case 2: o[0] = o[1] = o[2] = s[0]; o[3] = s[1]; break;
-                case 3: o[0] = s[0]; o[1] = s[1]; o[2] = s[2]; o[3] = 255; break;
-                default: o[0] = s[0]; o[1] = s[1]; o[2] = s[2]; o[3] = s[3]; break;
-                }
+                const bool grey = channels < 3;
+                o[0] = image.byte(s);
+                o[1] = image.byte(grey ? s : s + 1);
+                o[2] = image.byte(grey ? s : s + 2);
+                o[3] = channels == 2 || channels == 4 ? image.byte(s + channels - 1) : 255;
             }
             return out;
         }
@@ -705,7 +669,7 @@ namespace TreeLod
             else
                 return fail(mFile, where, "no image data");
 
-            auto decoded = decodeImage(bytes, size, mFile, where);
+            auto decoded = decodeTexture(bytes, size, mFile, where);
             if (!decoded)
                 return decoded.error();
             TextureImage& tex = *decoded;

@@ -2,7 +2,7 @@
 
 #include "TreeLod/AtomicFile.h"
 
-#include <OpenImageIO/imageio.h>
+#include "TreeLod/ImageCodec.h"
 
 #include <algorithm>
 #include <cmath>
@@ -19,53 +19,26 @@ namespace TreeLod
             return fail(path, "", "file does not exist");
         if (std::filesystem::is_directory(path, ec))
             return fail(path, "", "is a directory, not an image");
+        Result<std::vector<std::uint8_t>> bytes = readFile(path);
+        if (!bytes)
+            return fail(path, "", bytes.error().reason);
+        Result<DecodedImage> decoded = decodeImage(bytes->data(), bytes->size(), 1u << 20, std::uint64_t(1) << 28);
+        if (!decoded)
+            return fail(path, "", decoded.error().reason);
 
-        // Ask for straight (unassociated) alpha: by default OpenImageIO premultiplies
-        // PNG colour by alpha on read, which would change the stored values.
-        OIIO::ImageSpec config;
-        config.attribute("oiio:UnassociatedAlpha", 1);
-        std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path, &config);
-        if (!in)
-        {
-            std::string why = OIIO::geterror();
-            return fail(path, "", "not an image or unsupported format" + (why.empty() ? "" : " (" + why + ")"));
-        }
-        const OIIO::ImageSpec spec = in->spec();
-        if (spec.deep)
-            return fail(path, "", "unsupported: deep image");
-        if (spec.width <= 0 || spec.height <= 0 || spec.depth > 1)
-            return fail(path, "", "unsupported size " + std::to_string(spec.width) + "x" +
-                                      std::to_string(spec.height) + "x" + std::to_string(spec.depth));
-        if (spec.nchannels <= 0)
-            return fail(path, "", "unsupported: no channels");
-        if (std::int64_t(spec.width) * spec.height > std::int64_t(1) << 28)
-            return fail(path, "", "unsupported: image too large (" + std::to_string(spec.width) + "x" +
-                                      std::to_string(spec.height) + ")");
-
-        const int channels = spec.nchannels;
-        std::vector<float> data(std::size_t(spec.width) * spec.height * channels);
-        if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data()))
-            return fail(path, "", "cannot decode pixels: " + in->geterror());
-        in->close();
-
-        // Channel layout: 1 = grey, 2 = grey + alpha, 3 = RGB, 4+ = RGBA (extra channels
-        // dropped). A declared alpha channel wins over the position rule.
-        int alpha = spec.alpha_channel;
-        if (alpha < 0 && (channels == 2 || channels >= 4))
-            alpha = channels == 2 ? 1 : 3;
-        const bool grey = channels < 3;
-
-        Image image(spec.width, spec.height);
+        // Channel layout: 1 = grey, 2 = grey + alpha, 3 = RGB, 4 = RGBA.
+        const int channels = decoded->channels;
+        Image image(decoded->width, decoded->height);
         for (std::size_t i = 0; i < image.pixels.size(); ++i)
         {
-            const float* p = &data[i * channels];
-            glm::vec4 c;
-            if (grey)
-                c = glm::vec4(p[0], p[0], p[0], 1.0f);
+            const std::size_t s = i * std::size_t(channels);
+            glm::vec4 c(1.0f);
+            if (channels < 3)
+                c = glm::vec4(glm::vec3(decoded->unit(s)), 1.0f);
             else
-                c = glm::vec4(p[0], p[1], p[2], 1.0f);
-            if (alpha >= 0 && alpha < channels)
-                c.a = p[alpha];
+                c = glm::vec4(decoded->unit(s), decoded->unit(s + 1), decoded->unit(s + 2), 1.0f);
+            if (channels == 2 || channels == 4)
+                c.a = decoded->unit(s + std::size_t(channels) - 1);
             image.pixels[i] = c;
         }
         return image;
@@ -101,22 +74,10 @@ namespace TreeLod
                 bytes[i * 4 + c] = unitToByte(std::isnan(v) ? 0.0f : v);
             }
 
-        return writeFileAtomicVia(path, [&](const std::string& temp) -> Result<void> {
-            std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create("png");
-            if (!out)
-                return fail(path, "", "PNG writer unavailable: " + OIIO::geterror());
-            OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::UINT8);
-            spec.alpha_channel = 3;
-            // The bytes are straight alpha already; stop the writer dividing by alpha.
-            spec.attribute("oiio:UnassociatedAlpha", 1);
-            if (!out->open(temp, spec))
-                return fail(path, "", "cannot open for writing: " + out->geterror());
-            if (!out->write_image(OIIO::TypeDesc::UINT8, bytes.data()))
-                return fail(path, "", "cannot write pixels: " + out->geterror());
-            if (!out->close())
-                return fail(path, "", "cannot finish file: " + out->geterror());
-            return {};
-        });
+        Result<std::vector<std::uint8_t>> png = encodePng(bytes.data(), image.width, image.height, 4, 6);
+        if (!png)
+            return fail(path, "", png.error().reason);
+        return writeFileAtomic(path, *png);
     }
 
     void bleedValues(std::vector<glm::vec3>& values, const std::vector<std::uint8_t>& known, int width, int height,

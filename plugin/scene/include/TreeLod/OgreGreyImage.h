@@ -1,6 +1,6 @@
 // readGreyImageOgre: the runtime side's GreyImageReader (GreyImage.h) over Ogre::Image, for
 // programs that read scene scripts without TreeLodBake (treelod_frames; docs/architecture.md,
-// "Runtime vs bake"). The bake side's reader is readGreyImage (Image.h, OpenImageIO).
+// "Runtime vs bake"). The bake side's reader is readGreyImage (Image.h, libpng and libjpeg).
 #pragma once
 
 #include "TreeLod/GreyImage.h"

@@ -12,7 +12,7 @@
 //   glTF image), alphaMode, alphaCutoff, doubleSided, and the back colour of leaves from the
 //   material's extras {"treelodBackColour": [r, g, b]} (linear).
 // - Images: .glb bufferViews, data URIs, and files relative to the .gltf; PNG (palette + tRNS
-//   alpha kept) and JPEG, decoded with OpenImageIO. A missing external image that a material
+//   alpha kept) and JPEG, decoded with libpng and libjpeg-turbo. A missing external image that a material
 //   uses is an Error naming the image and the path.
 // - The bark skeleton from a mesh's extras {"treelodSkeleton": {"positions": [x,y,z,...],
 //   "radii": [...], "parents": [...]}} (parents before children; -1 = root), transformed by

@@ -35,11 +35,11 @@ namespace TreeLod
         bool empty() const { return pixels.empty(); }
     };
 
-    /// Read a PNG (or any format OpenImageIO knows) as RGBA in [0, 1]; grey and RGB get
-    /// alpha 1, palette images keep their tRNS alpha.
+    /// Read a PNG or JPEG as RGBA in [0, 1] (samples as stored: no gamma or colour-space
+    /// conversion); grey and RGB get alpha 1, palette images keep their tRNS alpha.
     Result<Image> readImage(const std::string& path);
 
-    /// readImage's red channel, clamped to [0, 1] (16-bit and float files keep their precision):
+    /// readImage's red channel, clamped to [0, 1] (16-bit PNGs keep their precision):
     /// the GreyImageReader of the bake side (scene scripts' heightfields, SceneScript.h).
     Result<GreyImage> readGreyImage(const std::string& path);
 

@@ -1,6 +1,6 @@
 // GreyImage: one channel of a picture, what a scene script's heightfield needs. The script
 // library reads no image formats itself (docs/architecture.md, "Runtime vs bake"): the caller
-// injects a GreyImageReader, readGreyImage (Image.h, TreeLodBake, OpenImageIO) on the bake side,
+// injects a GreyImageReader, readGreyImage (Image.h, TreeLodBake, libpng and libjpeg) on the bake side,
 // readGreyImageOgre (OgreGreyImage.h, TreeLodScene, Ogre::Image) on the runtime side.
 #pragma once
 
