@@ -2,7 +2,8 @@
 #
 # treelod_add_test(NAME [OGRE | USES_OGRE] SOURCES... [LIBS ...]): one gtest executable, tests
 #   discovered by ctest. OGRE: a headless Ogre test binary, whose main() (tests/ogre/OgreTestMain.cpp)
-#   tears the Root down before returning. Both label the tests "ogre" (ctest -L ogre / -LE ogre).
+#   tears the Root down before returning; ctest runs it once per gtest suite ("Suite.*"). Both label the
+#   tests "ogre" (ctest -L ogre / -LE ogre).
 # treelod_add_ogre_tests(SOURCES... [RENDER_SYSTEM_TESTS Suite.test...]): a technique's Ogre tests
 #   join test_ogre (tests/ogre/CMakeLists.txt: one executable, one Ogre start-up per process); their
 #   goldens are the technique's golden/ folder; RENDER_SYSTEM_TESTS run again under GL and GLES2.
@@ -25,6 +26,9 @@ function(treelod_add_test name)
     target_link_libraries(${name} PRIVATE GTest::gtest_main ${T_LIBS} treelod_warnings)
   endif()
   target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/core) # TestTrees.h, TestOutput.h
+  # The test sources themselves at -O1 in Release (after -O3, so it wins): they are assertions and
+  # set-up, a third of the build's compile time at -O3; what they test is built as configured.
+  target_compile_options(${name} PRIVATE $<$<CONFIG:Release>:-O1>)
   target_compile_definitions(${name} PRIVATE
     TREELOD_SOURCE_DIR="${PROJECT_SOURCE_DIR}" TREELOD_BINARY_DIR="${CMAKE_BINARY_DIR}")
   if(T_OGRE OR T_USES_OGRE)
@@ -33,7 +37,22 @@ function(treelod_add_test name)
     set(label core)
     set_property(GLOBAL APPEND PROPERTY TREELOD_CORE_TEST_TARGETS ${name})
   endif()
-  gtest_discover_tests(${name} PROPERTIES ENVIRONMENT "${TREELOD_TEST_ENV}" LABELS ${label} DISCOVERY_TIMEOUT 60)
+  if(T_OGRE)
+    # One ctest test per suite (cmake/TreeLodSuiteTests.cmake, after each link): the suite's tests
+    # share the Ogre start-up and the trees they keep. `ctest -R Suite\.` still selects a suite.
+    set(suites ${CMAKE_CURRENT_BINARY_DIR}/${name}_suites.cmake)
+    string(REPLACE ";" "|" environment "${TREELOD_TEST_ENV}")
+    add_custom_command(TARGET ${name} POST_BUILD
+      COMMAND ${CMAKE_COMMAND} -D TEST_EXECUTABLE=$<TARGET_FILE:${name}> -D CTEST_FILE=${suites}
+              -D LABEL=${label} -D WORKING_DIRECTORY=${CMAKE_CURRENT_BINARY_DIR} -D ENVIRONMENT=${environment}
+              -P ${PROJECT_SOURCE_DIR}/cmake/TreeLodSuiteTests.cmake
+      BYPRODUCTS ${suites} VERBATIM)
+    file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/${name}_include.cmake
+      "if(EXISTS \"${suites}\")\n  include(\"${suites}\")\nelse()\n  add_test(${name}_NOT_BUILT ${name}_NOT_BUILT)\nendif()\n")
+    set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES ${CMAKE_CURRENT_BINARY_DIR}/${name}_include.cmake)
+  else()
+    gtest_discover_tests(${name} PROPERTIES ENVIRONMENT "${TREELOD_TEST_ENV}" LABELS ${label} DISCOVERY_TIMEOUT 60)
+  endif()
   set_property(GLOBAL APPEND PROPERTY TREELOD_TEST_TARGETS ${name})
 endfunction()
 

@@ -21,7 +21,7 @@ namespace
 {
     using Bytes = std::vector<std::uint8_t>;
 
-    std::string outDir()
+    std::string codecOutDir()
     {
         const char* env = std::getenv("TREELOD_TEST_OUT");
         std::filesystem::path dir = std::filesystem::path(env ? env : TREELOD_BINARY_DIR "/test-out") / "image-codec";
@@ -31,25 +31,25 @@ namespace
 
     std::string saveBytes(const std::string& name, const Bytes& bytes)
     {
-        const std::string path = outDir() + "/" + name;
+        const std::string path = codecOutDir() + "/" + name;
         std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
                                                     std::streamsize(bytes.size()));
         return path;
     }
 
-    void putU32(Bytes& out, std::uint32_t v)
+    void appendU32(Bytes& out, std::uint32_t v)
     {
         for (int shift = 24; shift >= 0; shift -= 8)
             out.push_back(std::uint8_t(v >> shift));
     }
 
-    void putChunk(Bytes& out, const char* type, const Bytes& data)
+    void appendPngChunk(Bytes& out, const char* type, const Bytes& data)
     {
-        putU32(out, std::uint32_t(data.size()));
+        appendU32(out, std::uint32_t(data.size()));
         const std::size_t start = out.size();
         out.insert(out.end(), type, type + 4);
         out.insert(out.end(), data.begin(), data.end());
-        putU32(out, std::uint32_t(crc32(0, out.data() + start, uInt(out.size() - start))));
+        appendU32(out, std::uint32_t(::crc32(0, out.data() + start, uInt(out.size() - start))));
     }
 
     /// A PNG of `rows` (each starting with its filter byte), bit depth and colour type as given.
@@ -57,16 +57,16 @@ namespace
     {
         Bytes out = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
         Bytes header;
-        putU32(header, width);
-        putU32(header, height);
+        appendU32(header, width);
+        appendU32(header, height);
         header.insert(header.end(), {std::uint8_t(depth), std::uint8_t(colourType), 0, 0, 0});
-        putChunk(out, "IHDR", header);
+        appendPngChunk(out, "IHDR", header);
         uLongf packed = compressBound(uLong(rows.size()));
         Bytes deflated(packed);
         EXPECT_EQ(compress(deflated.data(), &packed, rows.data(), uLong(rows.size())), Z_OK);
         deflated.resize(packed);
-        putChunk(out, "IDAT", deflated);
-        putChunk(out, "IEND", {});
+        appendPngChunk(out, "IDAT", deflated);
+        appendPngChunk(out, "IEND", {});
         return out;
     }
 
@@ -137,7 +137,7 @@ TEST(ImageCodec, LowBitGreyAndRgbColourKeyExpand)
     // 8-bit RGB with a tRNS colour key (10, 20, 30): that pixel gets alpha 0, the other 255.
     Bytes rgb = handMadePng(2, 1, 8, 2, {0, 10, 20, 30, 40, 50, 60});
     Bytes keyed(rgb.begin(), rgb.begin() + 33); // signature + IHDR
-    putChunk(keyed, "tRNS", {0, 10, 0, 20, 0, 30});
+    appendPngChunk(keyed, "tRNS", {0, 10, 0, 20, 0, 30});
     keyed.insert(keyed.end(), rgb.begin() + 33, rgb.end());
     Result<DecodedImage> k = decodeImage(keyed.data(), keyed.size(), 64, 64);
     ASSERT_TRUE(k.ok()) << k.error().message();
@@ -204,7 +204,7 @@ TEST(ImageCodec, BrokenFilesAreNamedAndNothingIsReturned)
     const Bytes truncated(png.begin(), png.begin() + std::ptrdiff_t(png.size() - 20));
     Result<Image> r = readImage(saveBytes("truncated.png", truncated));
     ASSERT_FALSE(r.ok());
-    EXPECT_EQ(r.error().file, outDir() + "/truncated.png");
+    EXPECT_EQ(r.error().file, codecOutDir() + "/truncated.png");
     EXPECT_NE(r.error().reason.find("cannot decode PNG"), std::string::npos) << r.error().reason;
 
     Bytes badCrc = png;

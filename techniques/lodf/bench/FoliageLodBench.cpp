@@ -30,7 +30,7 @@ namespace
 {
     using namespace TreeLod;
 
-    constexpr std::uint32_t kLeaves = 100000;
+    constexpr std::uint32_t kLodfLeaves = 100000;
 
     /// F^r of the generated oak, or an error message.
     struct Input
@@ -45,7 +45,7 @@ namespace
             Input out;
             GeneratorOptions options;
             options.preset = TreePreset::Oak;
-            options.leafCount = kLeaves;
+            options.leafCount = kLodfLeaves;
             options.textureSize = 32;
             Result<TreeModel> model = generateTree(options);
             if (!model)

@@ -9,6 +9,8 @@
 #include "TreeLod/Colour.h"
 #include "TreeLod/Image.h"
 
+#include <glm/gtc/constants.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -18,9 +20,7 @@ namespace TreeLod
 {
     namespace
     {
-        constexpr float kPi = 3.14159265358979f;
 
-        float radians(float degrees) { return degrees * (kPi / 180.0f); }
         float clamp01(float v) { return std::clamp(v, 0.0f, 1.0f); }
         float fract(float v) { return v - std::floor(v); }
         float smoothstep(float a, float b, float x)
@@ -105,21 +105,21 @@ namespace TreeLod
             {
                 // Obovate envelope, widest past the middle, with 4-5 rounded lobes per
                 // side (sides offset by a quarter lobe, as real lobes alternate).
-                const float envelope = std::pow(std::sin(kPi * std::pow(s, 0.75f)), 0.7f) * (0.7f + 0.3f * s);
+                const float envelope = std::pow(std::sin(glm::pi<float>() * std::pow(s, 0.75f)), 0.7f) * (0.7f + 0.3f * s);
                 const float phase = leftSide ? 0.0f : 0.6f;
-                const float lobe = 0.5f + 0.5f * std::cos(2.0f * kPi * 4.5f * s + phase);
+                const float lobe = 0.5f + 0.5f * std::cos(2.0f * glm::pi<float>() * 4.5f * s + phase);
                 return maxHalf * envelope * (0.55f + 0.45f * std::pow(lobe, 0.7f));
             }
             case TreePreset::Birch:
             {
                 // Ovate, widest at a third, drawn-out tip, double-serrate margin.
-                const float envelope = std::pow(std::sin(kPi * std::pow(s, 0.62f)), 0.85f);
+                const float envelope = std::pow(std::sin(glm::pi<float>() * std::pow(s, 0.62f)), 0.85f);
                 const float teeth = 1.0f - 0.045f * fract(s * 16.0f) - 0.025f * fract(s * 32.0f);
                 return maxHalf * envelope * teeth;
             }
             case TreePreset::Shrub:
             default:
-                return maxHalf * std::pow(std::sin(kPi * std::pow(s, 0.8f)), 0.8f);
+                return maxHalf * std::pow(std::sin(glm::pi<float>() * std::pow(s, 0.8f)), 0.8f);
             }
         }
 
@@ -142,7 +142,7 @@ namespace TreeLod
                 {
                     // Forward-angled needles that reach at most `reach` sideways and stay
                     // below the top edge; shorter towards the tip of the spray.
-                    const float angle = radians(52.0f + 14.0f * hash2(i, side, 7)); // from the twig
+                    const float angle = glm::radians(52.0f + 14.0f * hash2(i, side, 7)); // from the twig
                     const glm::vec2 dir(float(side) * std::sin(angle), std::cos(angle));
                     float length = reach * (1.0f - 0.4f * y) * (0.85f + 0.15f * hash2(i, side, 9)) / dir.x * float(side);
                     length = std::min(length, (0.97f - y) / dir.y);
@@ -153,7 +153,7 @@ namespace TreeLod
             // A tuft at the tip.
             for (int k = -2; k <= 2; ++k)
             {
-                const float angle = radians(14.0f * float(k));
+                const float angle = glm::radians(14.0f * float(k));
                 const glm::vec2 a(0.0f, 0.9f);
                 needles.push_back({a, a + glm::vec2(std::sin(angle), std::cos(angle)) * 0.085f});
             }
@@ -417,7 +417,7 @@ namespace TreeLod
                 {
                     // Deep vertical furrows between ridges that wander along the stem.
                     const float warp = tileFbm(u, v, 4, 3, 3, 21) - 0.5f;
-                    const float ridge = std::abs(std::sin(kPi * (u * 9.0f + warp * 2.5f)));
+                    const float ridge = std::abs(std::sin(glm::pi<float>() * (u * 9.0f + warp * 2.5f)));
                     const float furrow = smoothstep(0.15f, 0.6f, ridge);
                     col = glm::mix(rgb(38, 30, 24), rgb(108, 94, 78), furrow * (0.7f + 0.6f * n));
                     break;

@@ -17,6 +17,8 @@
 
 #include "TreeLod/LeafTexture.h"
 
+#include <glm/gtc/constants.hpp>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -27,11 +29,9 @@ namespace TreeLod
 {
     namespace
     {
-        constexpr float kPi = 3.14159265358979f;
         constexpr std::uint32_t kMinLeaves = 100;
         constexpr std::uint32_t kMaxLeaves = 200000;
 
-        float radians(float degrees) { return degrees * (kPi / 180.0f); }
 
         /// Portable random numbers: std::mt19937 is specified bit for bit, the std
         /// distributions are not, so the mapping to floats is our own.
@@ -109,8 +109,8 @@ namespace TreeLod
             switch (shape)
             {
             case Conical: return 0.2f + 0.8f * r;
-            case Spherical: return 0.2f + 0.8f * std::sin(kPi * r);
-            case Hemispherical: return 0.2f + 0.8f * std::sin(0.5f * kPi * r);
+            case Spherical: return 0.2f + 0.8f * std::sin(glm::pi<float>() * r);
+            case Hemispherical: return 0.2f + 0.8f * std::sin(0.5f * glm::pi<float>() * r);
             case Cylindrical: return 1.0f;
             case TaperedCylindrical: return 0.5f + 0.5f * r;
             case Flame: return r <= 0.7f ? r / 0.7f : (1.0f - r) / 0.3f;
@@ -462,8 +462,8 @@ namespace TreeLod
                 const float sideways = 0.5f * rnd.spread(lp.curveV) / float(n);
                 if (stem.level > 0 || i > 0) // the trunk leaves the ground as planted
                 {
-                    frame = rotateFrame(frame, frame.x, radians(bend));
-                    frame = rotateFrame(frame, frame.y, radians(sideways));
+                    frame = rotateFrame(frame, frame.x, glm::radians(bend));
+                    frame = rotateFrame(frame, frame.y, glm::radians(sideways));
                 }
                 if (lp.attractionUp != 0.0f)
                 {
@@ -473,7 +473,7 @@ namespace TreeLod
                     if (len > 1e-4f)
                     {
                         axis /= len;
-                        const float target = lp.attractionUp > 0.0f ? declination : kPi - declination;
+                        const float target = lp.attractionUp > 0.0f ? declination : glm::pi<float>() - declination;
                         const float angle = std::min(std::abs(lp.attractionUp) * 2.0f / float(n), 1.0f) * target;
                         frame = rotateFrame(frame, axis, lp.attractionUp > 0.0f ? angle : -angle);
                     }
@@ -511,8 +511,8 @@ namespace TreeLod
                 if (p.trunks > 1)
                 {
                     // Several stems from the ground, spread around by the golden angle.
-                    const float azimuth = radians(float(k) * 137.5f + rnd.spread(20.0f));
-                    const float lean = radians(rnd.range(p.trunkLeanMin, p.trunkLeanMax));
+                    const float azimuth = glm::radians(float(k) * 137.5f + rnd.spread(20.0f));
+                    const float lean = glm::radians(rnd.range(p.trunkLeanMin, p.trunkLeanMax));
                     frame = rotateFrame(frame, frame.z, azimuth);
                     frame = rotateFrame(frame, frame.x, lean);
                     glm::vec3 out(frame.z.x, 0.0f, frame.z.z);
@@ -587,8 +587,8 @@ namespace TreeLod
                     child.radius = std::max(minRadius, std::min(child.radius, 0.9f * parent.radiusAt(t)));
 
                     Frame frame = parent.segments[parent.segmentAt(t)];
-                    frame = rotateFrame(frame, frame.z, radians(rotation));
-                    frame = rotateFrame(frame, frame.x, radians(down));
+                    frame = rotateFrame(frame, frame.z, glm::radians(rotation));
+                    frame = rotateFrame(frame, frame.x, glm::radians(down));
                     growStem(child, parent.pointAt(t), frame, cp, 0.0f, rnd);
                     stems.push_back(std::move(child));
                 }
@@ -645,7 +645,7 @@ namespace TreeLod
                 const Stem& s = stems[si];
                 const int sides = p.level[std::size_t(s.level)].sides;
                 const std::size_t rings = s.points.size() - 1; // the last point is the apex
-                const float vScale = 1.0f / (2.0f * kPi * std::max(s.radius, 1e-6f));
+                const float vScale = 1.0f / (2.0f * glm::pi<float>() * std::max(s.radius, 1e-6f));
                 const float segLength = s.length / float(s.segments.size());
                 const std::uint32_t base = std::uint32_t(model.barkVertices.size());
                 for (std::size_t i = 0; i < rings; ++i)
@@ -655,7 +655,7 @@ namespace TreeLod
                     const float v = float(i) * segLength * vScale;
                     for (int k = 0; k <= sides; ++k)
                     {
-                        const float a = 2.0f * kPi * float(k % sides) / float(sides);
+                        const float a = 2.0f * glm::pi<float>() * float(k % sides) / float(sides);
                         const glm::vec3 dir = f.x * std::cos(a) + f.y * std::sin(a);
                         model.barkVertices.push_back({s.points[i] + dir * r, dir, {float(k) / float(sides), v}});
                     }
@@ -756,7 +756,7 @@ namespace TreeLod
                         p.leafStart + (1.0f - p.leafStart) * (float(j) + 0.5f + rnd.spread(0.45f)) / float(n), 0.0f, 1.0f);
                     rotation += 137.5f + rnd.spread(25.0f);
                     const Frame f = s.segments[s.segmentAt(t)];
-                    const float phi = radians(rotation);
+                    const float phi = glm::radians(rotation);
                     const glm::vec3 radial = f.x * std::cos(phi) + f.y * std::sin(phi);
                     // Two draws, in this order: operands of + are unsequenced, so they are named.
                     const float along = 0.5f * spread * rnd.spread(1.0f);
@@ -764,7 +764,7 @@ namespace TreeLod
                     const glm::vec3 basePos = s.pointAt(t) + radial * out + f.z * along;
 
                     // Leaf axis: off the stem by the leaf down angle, bent up or down.
-                    const float down = radians(p.leafDownAngle + rnd.spread(p.leafDownAngleV));
+                    const float down = glm::radians(p.leafDownAngle + rnd.spread(p.leafDownAngleV));
                     glm::vec3 axis = f.z * std::cos(down) + radial * std::sin(down);
                     axis = glm::normalize(axis + up * p.leafBend);
                     // Face: towards the sky and outwards from the trunk, rolled at random.
@@ -775,7 +775,7 @@ namespace TreeLod
                     if (glm::length(face) < 1e-3f)
                         face = glm::cross(axis, f.x);
                     face = glm::normalize(face);
-                    face = rotateAbout(face, axis, radians(rnd.spread(p.leafTwistV)));
+                    face = rotateAbout(face, axis, glm::radians(rnd.spread(p.leafTwistV)));
                     const glm::vec3 across = glm::cross(axis, face);
 
                     const float sizeJitter = 1.0f + rnd.spread(0.15f);
@@ -814,7 +814,7 @@ namespace TreeLod
         /// `degrees` towards the face; u = 0.5 on the midrib. Same draws, so the same tree.
         void foldLeaves(float degrees, TreeModel& model)
         {
-            const float c = std::cos(radians(degrees)), s = std::sin(radians(degrees));
+            const float c = std::cos(glm::radians(degrees)), s = std::sin(glm::radians(degrees));
             std::vector<Vertex> vertices;
             std::vector<std::uint32_t> indices;
             vertices.reserve(model.leafVertices.size() / 2 * 3);
