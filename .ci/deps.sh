@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Install TreeLod's build and test dependencies from Debian 12's archive (only what is missing).
 set -euo pipefail
-packages=(cmake g++ make pkg-config
+packages=(cmake g++ make ninja-build lld pkg-config
   libogre-1.12-dev libglm-dev libtinygltf-dev libpng-dev libjpeg-dev libeigen3-dev libembree-dev
   libsquish-dev libtbb-dev nlohmann-json3-dev libcli11-dev libgtest-dev googletest libbenchmark-dev
   xvfb xauth libgl1-mesa-dri file gdb python3 python3-matplotlib glslang-tools)

@@ -9,6 +9,12 @@
 #   goldens are the technique's golden/ folder; RENDER_SYSTEM_TESTS run again under GL and GLES2.
 # treelod_add_cli_test(NAME SCRIPT [ARGS...]): `bash SCRIPT <treelod> <source dir> <output dir> ARGS`.
 
+# The test sources' own optimisation (after the configuration's, so it wins): they are assertions
+# and set-up, a third of the Release build's compile time at -O3; what they test is built as
+# configured. tests/run.sh's sanitizer trees compile them at -O0.
+set(TREELOD_TEST_CXX_FLAGS "$<$<CONFIG:Release>:-O1>" CACHE STRING
+  "Compile options of the test executables' own sources (the libraries they test keep the configuration's)")
+
 # Test data and caches stay inside the build tree (XDG_CACHE_HOME).
 set(TREELOD_TEST_ENV
   "XDG_CACHE_HOME=${CMAKE_BINARY_DIR}/test-cache"
@@ -26,9 +32,7 @@ function(treelod_add_test name)
     target_link_libraries(${name} PRIVATE GTest::gtest_main ${T_LIBS} treelod_warnings)
   endif()
   target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/core) # TestTrees.h, TestOutput.h
-  # The test sources themselves at -O1 in Release (after -O3, so it wins): they are assertions and
-  # set-up, a third of the build's compile time at -O3; what they test is built as configured.
-  target_compile_options(${name} PRIVATE $<$<CONFIG:Release>:-O1>)
+  target_compile_options(${name} PRIVATE ${TREELOD_TEST_CXX_FLAGS})
   target_compile_definitions(${name} PRIVATE
     TREELOD_SOURCE_DIR="${PROJECT_SOURCE_DIR}" TREELOD_BINARY_DIR="${CMAKE_BINARY_DIR}")
   if(T_OGRE OR T_USES_OGRE)

@@ -114,7 +114,9 @@ namespace TreeLod
             const bool impostor = runs->back().curveLevel == 2u;
             EXPECT_EQ(impostor, worstAdded < WORST_VIEW_BUDGET_FACTOR * 0.02f) << "worst view +" << worstAdded;
             if (!impostor)
+            {
                 EXPECT_EQ(runs->size(), 1u) << "lodf at every height";
+            }
         }
         // Budget 1 still draws the cheapest, whatever its worst view.
         Fixture f;

@@ -1,0 +1,248 @@
+// Helpers of the Forest tests (ForestTest.cpp, ForestShadowTest.cpp, ForestLevelPlanTest.cpp,
+// ForestFloorTest.cpp): the oak package every Forest test draws (reference, lodf, billboard-cloud,
+// impostor of media/oak.glb, baked with the core bakers (few AO rays) and cached in
+// $TREELOD_TEST_OUT/forest, keyed by the test binary's modification time), grids of instances,
+// views and counts.
+#pragma once
+
+#include "OgreTestSupport.h"
+#include "TreeLod/AtomicFile.h"
+
+#include "TreeLod/BillboardCloudResources.h"
+#include "TreeLod/FoliageLodResources.h"
+#include "TreeLod/BillboardCloudBaker.h"
+#include "TreeLod/BillboardCloudTree.h"
+#include "TreeLod/ErrorCurveMeasurer.h"
+#include "TreeLod/FoliageLodBaker.h"
+#include "TreeLod/FoliageLodTree.h"
+#include "TreeLod/Forest.h"
+#include "TreeLod/GltfImporter.h"
+#include "TreeLod/ImpostorBaker.h"
+#include "TreeLod/ImpostorData.h"
+#include "TreeLod/LevelCalibration.h"
+#include "TreeLod/PackageWriter.h"
+#include "TreeLod/OgreBootstrap.h"
+#include "TreeLod/QuadFloors.h"
+#include "TreeLod/ShadowSetup.h"
+#include "TreeLod/TreeAssetManager.h"
+
+#include <OgreEntity.h>
+#include <OgreLogManager.h>
+#include <OgreManualObject.h>
+#include <OgreMaterialManager.h>
+#include <OgreRTShaderSystem.h>
+#include <OgreRenderQueue.h>
+#include <OgreRenderQueueSortingGrouping.h>
+#include <OgreSceneManager.h>
+#include <OgreSceneQuery.h>
+#include <OgreShadowCameraSetupPSSM.h>
+#include <OgreSubEntity.h>
+#include <OgreTechnique.h>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <map>
+
+namespace TreeLod
+{
+    namespace
+    {
+        struct ForestTree
+        {
+            TreeModel model;
+            TreeAssetPtr asset;
+        };
+
+        /// `baked`, encoded by `encode`, added as chunk `chunk` level 0; when baking failed, a
+        /// test failure naming the error.
+        template <typename T, typename Encode>
+        void addBakedChunk(PackageWriter& writer, const char* chunk, std::uint32_t version, const Result<T>& baked,
+                           Encode encode)
+        {
+            EXPECT_TRUE(baked.ok()) << (baked.ok() ? "" : baked.error().message());
+            if (baked.ok())
+            {
+                EXPECT_TRUE(writer.addChunk(chunk, 0, version, encode(baked.value())).ok()) << chunk;
+            }
+        }
+
+        inline std::vector<std::uint8_t> bakePackage(const TreeModel& model, const std::string& name)
+        {
+            PackageWriter writer;
+            Result<void> added = addFoliageLodChunk(writer, model, name); // and the reference
+            EXPECT_TRUE(added.ok()) << (added.ok() ? "" : added.error().message());
+            BillboardCloudOptions cloudOptions;
+            cloudOptions.aoRays = 4;
+            addBakedChunk(writer, BILLBOARD_CLOUD_CHUNK, BILLBOARD_CLOUD_CHUNK_FORMAT_VERSION,
+                          bakeBillboardCloud(model, cloudOptions, name), encodeBillboardCloudChunk);
+            ImpostorOptions impostorOptions;
+            impostorOptions.aoRays = 4;
+            impostorOptions.resolution = 128;
+            addBakedChunk(writer, IMPOSTOR_CHUNK, IMPOSTOR_CHUNK_FORMAT_VERSION,
+                          bakeImpostor(model, impostorOptions, name), encodeImpostorChunk);
+            return writer.toBytes();
+        }
+
+        /// media/oak.glb with every chunk the Forest draws, loaded as "oak.forest-test".
+        inline const ForestTree& oak()
+        {
+            return OgreEnvironment::keep<ForestTree>("forest.oak", [] {
+                ForestTree t;
+                Result<TreeModel> model = importGltf(OgreEnvironment::sourcePath("media/oak.glb"));
+                EXPECT_TRUE(model.ok()) << (model.ok() ? "" : model.error().message());
+                t.model = std::move(model.value());
+                const std::vector<std::uint8_t> bytes =
+                    cachedPackage("forest", "oak", [&] { return bakePackage(t.model, "oak"); });
+                t.asset = TreeAssetManager::getSingleton().loadFromBytes("oak.forest-test", Ogre::RGN_DEFAULT, bytes);
+                return t;
+            });
+        }
+
+        const glm::vec3 BACKGROUND = LightingSpec().background;
+
+        /// A fresh Forest (through its factory) under a child of the content node, content cleared.
+        inline Forest* placeForest(const Ogre::NameValuePairList& params = {}, Ogre::SceneNode** node = nullptr)
+        {
+            static int serial = 0;
+            OffscreenRenderer& r = OgreEnvironment::renderer();
+            r.clearContent();
+            r.setShadows(false);
+            r.setLodBias(1.0f);
+            Ogre::MovableObject* object =
+                r.getSceneManager().createMovableObject("forest-" + std::to_string(serial++), "Forest", &params);
+            Ogre::SceneNode* parent = r.getContentNode().createChildSceneNode();
+            parent->attachObject(object);
+            if (node)
+                *node = parent;
+            return static_cast<Forest*>(object);
+        }
+
+        inline Ogre::Camera& ogreCamera()
+        {
+            return *OgreEnvironment::renderer().getSceneManager().getCamera("TreeLodOffscreenCamera");
+        }
+
+        ForestInstance instance(float x, float y, float z, float rotation = 0.0f, float scale = 1.0f,
+                                std::uint32_t species = 0)
+        {
+            return ForestInstance{glm::vec3(x, y, z), rotation, scale, species};
+        }
+
+        /// n x n trees `spacing` metres apart centred on the origin, rotations varied.
+        inline std::vector<ForestInstance> grid(int n, float spacing, std::uint32_t species = 0)
+        {
+            std::vector<ForestInstance> out;
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i)
+                    out.push_back(instance((float(i) - 0.5f * float(n - 1)) * spacing, 0.0f,
+                                           (float(j) - 0.5f * float(n - 1)) * spacing, 0.7f * float(i * n + j),
+                                           0.8f + 0.05f * float((i + 2 * j) % 8), species));
+            return out;
+        }
+
+        /// A child of `parent` placed, turned and scaled as `t` (a Forest instance as a separate object).
+        inline Ogre::SceneNode* instanceNode(Ogre::SceneNode& parent, const ForestInstance& t)
+        {
+            Ogre::SceneNode* node = parent.createChildSceneNode(
+                Ogre::Vector3(t.position.x, t.position.y, t.position.z),
+                Ogre::Quaternion(Ogre::Radian(t.rotationY), Ogre::Vector3::UNIT_Y));
+            node->setScale(Ogre::Vector3(t.scale));
+            return node;
+        }
+
+        /// Every `factor` x `factor` block averaged (goldens of pictures rendered large).
+        inline Image shrink(const Image& image, int factor)
+        {
+            Image out(image.width / factor, image.height / factor);
+            for (int y = 0; y < out.height; ++y)
+                for (int x = 0; x < out.width; ++x)
+                {
+                    glm::vec4 sum(0.0f);
+                    for (int j = 0; j < factor; ++j)
+                        for (int i = 0; i < factor; ++i)
+                            sum += image.at(x * factor + i, y * factor + j);
+                    out.at(x, y) = sum / float(factor * factor);
+                }
+            return out;
+        }
+
+        /// Renderables the object queues into each (group, priority).
+        inline std::map<std::pair<int, int>, std::size_t> queued(Ogre::MovableObject& object)
+        {
+            Ogre::RenderQueue queue;
+            object._notifyCurrentCamera(&ogreCamera());
+            object._updateRenderQueue(&queue);
+            struct Counter : Ogre::QueuedRenderableVisitor
+            {
+                std::size_t count = 0;
+                void visit(Ogre::RenderablePass*) override { ++count; }
+                void visit(const Ogre::Pass*, Ogre::RenderableList& list) override { count += list.size(); }
+            };
+            std::map<std::pair<int, int>, std::size_t> out;
+            for (std::size_t id = 0; id < Ogre::RENDER_QUEUE_COUNT; ++id)
+                if (const auto& group = queue._getQueueGroups()[id])
+                    for (const auto& priority : group->getIterator())
+                    {
+                        Counter counter;
+                        priority.second->getSolidsBasic().acceptVisitor(
+                            &counter, Ogre::QueuedRenderableCollection::OM_PASS_GROUP);
+                        if (counter.count > 0)
+                            out[{int(id), int(priority.first)}] += counter.count;
+                    }
+            return out;
+        }
+
+        float treeHeight(const TreeModel& model) { return model.boundsMax.y - model.boundsMin.y; }
+
+        /// A Forest of `tree` over a 5 x 5 grid 1.4 tree heights apart, its levels (`levels`) the
+        /// automatic bands'.
+        inline Forest* autoBandsGrid(const ForestTree& tree, std::vector<ForestLevel>& levels)
+        {
+            Forest* forest = placeForest();
+            levels = Forest::levelsForBands(*tree.asset, Forest::getAutoBands());
+            forest->addSpecies(tree.asset, levels);
+            forest->addInstances(grid(5, 1.4f * treeHeight(tree.model)));
+            return forest;
+        }
+
+        /// Perspective camera at `eye` looking at `target`.
+        inline CameraSpec look(const glm::vec3& eye, const glm::vec3& target, float fov = 40.0f)
+        {
+            CameraSpec spec;
+            spec.position = eye;
+            spec.target = target;
+            spec.fovYDegrees = fov;
+            spec.nearClip = 0.1f;
+            spec.farClip = 20000.0f;
+            return spec;
+        }
+
+        /// The Forest's level of every instance per species (levelCounts) as one list.
+        inline std::vector<std::uint32_t> flatCounts(const Forest& forest)
+        {
+            std::vector<std::uint32_t> out;
+            for (const auto& species : forest.getStats().levelCounts)
+                out.insert(out.end(), species.begin(), species.end());
+            return out;
+        }
+
+        /// Mean level index of the visible instances of species 0.
+        inline double meanLevel(const Forest& forest)
+        {
+            const std::vector<std::uint32_t>& counts = forest.getStats().levelCounts.at(0);
+            double sum = 0.0, n = 0.0;
+            for (std::size_t l = 0; l < counts.size(); ++l)
+            {
+                sum += double(l) * counts[l];
+                n += counts[l];
+            }
+            return n > 0.0 ? sum / n : -1.0;
+        }
+    }
+}
