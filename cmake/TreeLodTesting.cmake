@@ -9,9 +9,10 @@
 #   goldens are the technique's golden/ folder; RENDER_SYSTEM_TESTS run again under GL and GLES2.
 # treelod_add_cli_test(NAME SCRIPT [ARGS...]): `bash SCRIPT <treelod> <source dir> <output dir> ARGS`.
 
-# The test sources' own optimisation (after the configuration's, so it wins): they are assertions
-# and set-up, a third of the Release build's compile time at -O3; what they test is built as
-# configured. tests/run.sh's sanitizer trees compile them at -O0.
+# The test sources' own optimisation (after the configuration's, so it wins): -O1 in Release, where
+# -O3 spent a third of the build's compile time on assertions and set-up; what they test is built
+# as configured. Not lower: header code they instantiate (GLM, the chunk codecs) runs in their
+# loops, and at -O0 under ASan some tests took 3 to 7 times as long.
 set(TREELOD_TEST_CXX_FLAGS "$<$<CONFIG:Release>:-O1>" CACHE STRING
   "Compile options of the test executables' own sources (the libraries they test keep the configuration's)")
 

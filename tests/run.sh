@@ -76,8 +76,7 @@ run_ctest "$build"
 # with delete[] (inside OGRE, on every texture load).
 export ASAN_OPTIONS=abort_on_error=1:alloc_dealloc_mismatch=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-# The test sources at -O0 (TREELOD_TEST_CXX_FLAGS, cmake/TreeLodTesting.cmake), instrumented all the same.
-CXX=clang++ configure "$asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DTREELOD_TEST_CXX_FLAGS=-O0 \
+CXX=clang++ configure "$asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
   -DTREELOD_SANITIZERS=address,undefined -DTREELOD_BUILD_FUZZERS=ON -DTREELOD_BUILD_TESTS=ON \
   -DTREELOD_BUILD_BENCHMARKS=OFF -DTREELOD_BUILD_SAMPLES=OFF
 # Every gtest binary: the core ones (label "core") and the Ogre ones (label "ogre", run a suite
@@ -139,7 +138,7 @@ export LP_NUM_THREADS=0
 # Mesa's shader disk cache writes from threads of its own, whose barriers TSan cannot see in the
 # uninstrumented driver (a race report at teardown on a cold cache): off here.
 export MESA_SHADER_CACHE_DISABLE=true
-CXX=clang++ configure "$tsan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DTREELOD_TEST_CXX_FLAGS=-O0 \
+CXX=clang++ configure "$tsan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
   -DTREELOD_SANITIZERS=thread \
   -DTREELOD_BUILD_TESTS=ON -DTREELOD_BUILD_BENCHMARKS=OFF -DTREELOD_BUILD_SAMPLES=OFF
 cmake --build "$tsan" -j"$jobs" --target test_bakecache test_async_bake

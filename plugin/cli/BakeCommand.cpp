@@ -54,7 +54,7 @@ namespace TreeLod
             return p.filename().string();
         }
 
-        /// The registered bakers that bake from a capture folder, for messages: "volume-octree".
+        /// The registered bakers that bake from a capture folder, comma-separated, for messages.
         std::string captureBakers()
         {
             std::string names;

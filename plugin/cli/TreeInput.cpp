@@ -34,7 +34,7 @@ namespace TreeLod
             for (const std::string& chunk : chunks)
                 if (package->findChunk(chunk, 0) < 0)
                 {
-                    if (!hasPolygons(input.model)) // photographs bake volume-octree only
+                    if (!hasPolygons(input.model)) // photographs bake only what bakes from a capture folder
                         return requirePolygons(input.model, path, "chunk '" + chunk + "'").error();
                     return fail(path, chunkElement(chunk, 0), "missing: bake the package with --technique " + chunk);
                 }

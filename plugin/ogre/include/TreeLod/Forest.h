@@ -81,9 +81,8 @@ namespace TreeLod
         static std::vector<ForestBand> getAutoBands();
 
         /// The levels `bands` give for `asset`: each band's technique contributes its own levels
-        /// (ForestLevelProvider::getSpans: lodf halving leaf counts on its pixel curve,
-        /// billboard-cloud layered, low-res, then coarser clouds, mesh and impostor one; split where
-        /// the bark mesh's LoD switches) clipped to the band's screen-size range. At most ForestInstances::MAX_THRESHOLDS + 1. Throws
+        /// (ForestLevelProvider::getSpans, each technique's own spans on its pixel curve; split
+        /// where the bark mesh's LoD switches) clipped to the band's screen-size range. At most ForestInstances::MAX_THRESHOLDS + 1. Throws
         /// Ogre::InvalidParametersException naming the band and technique when a technique is
         /// unknown or the asset lacks its chunk.
         static std::vector<ForestLevel> levelsForBands(TreeAsset& asset, const std::vector<ForestBand>& bands);

@@ -31,10 +31,10 @@ namespace TreeLod
     struct ForestLevel
     {
         Ogre::String technique;            ///< a registered technique with a ForestLevelProvider
-        std::uint32_t techniqueLevel = 0;  ///< the technique's own level (lodf: leaf count, 0 = all;
-                                           ///< clouds: cloud level; one-level techniques: 0)
-        bool lowRes = false;               ///< the level's second material technique (billboard-cloud:
-                                           ///< the low-res material of a layered level)
+        std::uint32_t techniqueLevel = 0;  ///< the technique's own level (its README says what it
+                                           ///< counts; one-level techniques: 0)
+        bool lowRes = false;               ///< the level's second material technique (a low-res
+                                           ///< material of the same level, where one is baked)
         Ogre::Real minPixelCount = 0.0f;   ///< Ogre pixel-count units; the last level's is 0
     };
 

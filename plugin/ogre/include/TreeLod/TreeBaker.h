@@ -16,8 +16,8 @@ namespace TreeLod
     public:
         virtual ~TreeBaker() = default;
 
-        /// The path of a package that holds the chunks of `techniques` (bake technique names:
-        /// "reference", "lodf", "billboard-cloud", "classic-billboard-cloud", "impostor") for
+        /// The path of a package that holds the chunks of `techniques` (bake technique names,
+        /// BakeTechniques.h, and "reference") for
         /// `source` (a tree file or a generator source such as "preset:oak?seed=1"), baking the
         /// missing ones. Throws Ogre::Exception with a message naming the source on failure.
         virtual Ogre::String requirePackage(const Ogre::String& source, const std::vector<Ogre::String>& techniques) = 0;

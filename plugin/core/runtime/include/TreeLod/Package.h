@@ -16,7 +16,7 @@
 //
 //   chunk table, chunkCount entries of 64 bytes at tableOffset
 //     0  char[32] technique             UTF-8 name, 1..32 bytes, zero-padded; printable ASCII
-//                                       only ("reference", "meta", "billboardcloud", ...)
+//                                       only ("reference", "meta", a technique's name)
 //    32  u32      level                 level of detail within the technique (0 = finest)
 //    36  u32      formatVersion         version of that technique's chunk layout
 //    40  u64      offset                multiple of PACKAGE_ALIGNMENT, past header and table
@@ -66,7 +66,7 @@ namespace TreeLod
     /// One chunk table entry.
     struct ChunkInfo
     {
-        std::string technique;          ///< "reference", "meta", later "billboardcloud", "lodf"...
+        std::string technique;          ///< "reference", "meta" or a technique's registered name
         std::uint32_t level = 0;
         std::uint32_t formatVersion = 1;
         std::uint64_t offset = 0;       ///< from the start of the file
