@@ -31,6 +31,10 @@ for top in SCANNED:
                 if name.endswith(".h"):
                     headers.setdefault(name, []).append(path)
 
+if not any(path.startswith("plugin/") for path in files) or not any(path.startswith("techniques/") for path in files):
+    print(f"layers: no sources of plugin/ and techniques/ under {os.path.abspath(root)}")
+    sys.exit(1)
+
 edges = {}  # (from folder, to folder) -> first (file, line, header)
 header_edges = {}
 problems = []
