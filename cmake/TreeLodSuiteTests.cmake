@@ -1,6 +1,6 @@
-# Script mode, run after a test binary is linked (treelod_add_test OGRE): one ctest test per gtest
-# suite, named "Suite.*" and run as `BINARY --gtest_filter=Suite.*`, so a suite's tests share one
-# process (one headless Ogre start-up, one bake of each tree OgreEnvironment::keep holds).
+# Script mode, run after a test binary is linked (treelod_add_test): one ctest test per gtest suite,
+# named "Suite.*" and run as `BINARY --gtest_filter=Suite.*`, so a suite's tests share one process
+# (one headless Ogre start-up, one bake of each tree the suite keeps).
 #   -D TEST_EXECUTABLE=... -D CTEST_FILE=... -D LABEL=... -D WORKING_DIRECTORY=...
 #   -D ENVIRONMENT=NAME=VALUE|NAME=VALUE...   ('|' separates; ';' would split the argument)
 execute_process(COMMAND "${TEST_EXECUTABLE}" --gtest_list_tests

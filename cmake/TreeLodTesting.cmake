@@ -1,9 +1,10 @@
 # Test and benchmark helpers for tests/, bench/ and each technique's folder (techniques/<name>/CMakeLists.txt).
 #
-# treelod_add_test(NAME [OGRE | USES_OGRE] SOURCES... [LIBS ...]): one gtest executable, tests
-#   discovered by ctest. OGRE: a headless Ogre test binary, whose main() (tests/ogre/OgreTestMain.cpp)
-#   tears the Root down before returning; ctest runs it once per gtest suite ("Suite.*"). Both label the
-#   tests "ogre" (ctest -L ogre / -LE ogre).
+# treelod_add_test(NAME [OGRE | USES_OGRE] SOURCES... [LIBS ...]): one gtest executable, which ctest
+#   runs once per gtest suite ("Suite.*"). OGRE: a headless Ogre test binary, whose main()
+#   (tests/ogre/OgreTestMain.cpp) tears the Root down before returning; the others' main() is
+#   tests/core/TestMain.cpp. Both OGRE and USES_OGRE label the tests "ogre" (ctest -L ogre / -LE ogre),
+#   the others "core".
 # treelod_add_ogre_tests(SOURCES... [RENDER_SYSTEM_TESTS Suite.test...]): a technique's Ogre tests
 #   join test_ogre (tests/ogre/CMakeLists.txt: one executable, one Ogre start-up per process); their
 #   goldens are the technique's golden/ folder; RENDER_SYSTEM_TESTS run again under GL and GLES2.
@@ -27,11 +28,10 @@ function(treelod_add_test name)
   if(T_OGRE)
     add_executable(${name} ${T_SOURCES} ${PROJECT_SOURCE_DIR}/tests/ogre/OgreTestMain.cpp)
     target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/ogre)
-    target_link_libraries(${name} PRIVATE GTest::gtest ${T_LIBS} treelod_warnings)
   else()
-    add_executable(${name} ${T_SOURCES})
-    target_link_libraries(${name} PRIVATE GTest::gtest_main ${T_LIBS} treelod_warnings)
+    add_executable(${name} ${T_SOURCES} ${PROJECT_SOURCE_DIR}/tests/core/TestMain.cpp)
   endif()
+  target_link_libraries(${name} PRIVATE GTest::gtest ${T_LIBS} treelod_warnings)
   target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/core) # TestTrees.h, TestOutput.h
   target_compile_options(${name} PRIVATE ${TREELOD_TEST_CXX_FLAGS})
   target_compile_definitions(${name} PRIVATE
@@ -42,22 +42,19 @@ function(treelod_add_test name)
     set(label core)
     set_property(GLOBAL APPEND PROPERTY TREELOD_CORE_TEST_TARGETS ${name})
   endif()
-  if(T_OGRE)
-    # One ctest test per suite (cmake/TreeLodSuiteTests.cmake, after each link): the suite's tests
-    # share the Ogre start-up and the trees they keep. `ctest -R Suite\.` still selects a suite.
-    set(suites ${CMAKE_CURRENT_BINARY_DIR}/${name}_suites.cmake)
-    string(REPLACE ";" "|" environment "${TREELOD_TEST_ENV}")
-    add_custom_command(TARGET ${name} POST_BUILD
-      COMMAND ${CMAKE_COMMAND} -D TEST_EXECUTABLE=$<TARGET_FILE:${name}> -D CTEST_FILE=${suites}
-              -D LABEL=${label} -D WORKING_DIRECTORY=${CMAKE_CURRENT_BINARY_DIR} -D ENVIRONMENT=${environment}
-              -P ${PROJECT_SOURCE_DIR}/cmake/TreeLodSuiteTests.cmake
-      BYPRODUCTS ${suites} VERBATIM)
-    file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/${name}_include.cmake
-      "if(EXISTS \"${suites}\")\n  include(\"${suites}\")\nelse()\n  add_test(${name}_NOT_BUILT ${name}_NOT_BUILT)\nendif()\n")
-    set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES ${CMAKE_CURRENT_BINARY_DIR}/${name}_include.cmake)
-  else()
-    gtest_discover_tests(${name} PROPERTIES ENVIRONMENT "${TREELOD_TEST_ENV}" LABELS ${label} DISCOVERY_TIMEOUT 60)
-  endif()
+  # One ctest test per gtest suite (cmake/TreeLodSuiteTests.cmake, after each link): a suite's tests
+  # share one process, so one Ogre start-up and one bake of each tree a suite keeps (a static in
+  # the test source, OgreEnvironment::keep). `ctest -R Suite\.` still selects a suite.
+  set(suites ${CMAKE_CURRENT_BINARY_DIR}/${name}_suites.cmake)
+  string(REPLACE ";" "|" environment "${TREELOD_TEST_ENV}")
+  add_custom_command(TARGET ${name} POST_BUILD
+    COMMAND ${CMAKE_COMMAND} -D TEST_EXECUTABLE=$<TARGET_FILE:${name}> -D CTEST_FILE=${suites}
+            -D LABEL=${label} -D WORKING_DIRECTORY=${CMAKE_CURRENT_BINARY_DIR} -D ENVIRONMENT=${environment}
+            -P ${PROJECT_SOURCE_DIR}/cmake/TreeLodSuiteTests.cmake
+    BYPRODUCTS ${suites} VERBATIM)
+  file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/${name}_include.cmake
+    "if(EXISTS \"${suites}\")\n  include(\"${suites}\")\nelse()\n  add_test(${name}_NOT_BUILT ${name}_NOT_BUILT)\nendif()\n")
+  set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES ${CMAKE_CURRENT_BINARY_DIR}/${name}_include.cmake)
   set_property(GLOBAL APPEND PROPERTY TREELOD_TEST_TARGETS ${name})
 endfunction()
 

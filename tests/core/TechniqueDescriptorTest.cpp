@@ -42,10 +42,18 @@ namespace TreeLod
     TEST(TechniqueDescriptor, inspectReadsWhatEachBakerWrote)
     {
         const TreeModel& tree = test::generatedOak(300);
-        // The volume octree's default reconstruction (24 photographs of 256 px, 7 levels) is a minute
-        // of this test under the sanitizers; its chunk has the same layout at any size.
+        // Smaller bakes than the defaults where those cost seconds (the volume octree's default
+        // reconstruction alone, 24 photographs of 256 px and 7 levels, is a minute of this test under
+        // the sanitizers): a chunk has the same layout at any size.
         const std::map<std::string, BakeOptions> smaller = {
-            {"volume-octree", {{"cameras", "8"}, {"resolution", "64"}, {"levels", "4"}}}};
+            {"volume-octree", {{"cameras", "8"}, {"resolution", "64"}, {"levels", "4"}}},
+            {"ellipsoids", {{"tries", "1"}, {"viewResolution", "32"}}},
+            {"ellipsoid-lines", {{"viewResolution", "32"}}},
+            {"billboard-cloud", {{"clusteringTries", "1"}, {"aoRays", "4"}}},
+            {"classic-billboard-cloud", {{"clusteringTries", "1"}, {"aoRays", "4"}}},
+            {"octahedral-impostor", {{"framesPerSide", "4"}, {"frameResolution", "32"}, {"samplesPerPixel", "1"}}},
+            {"crossed-quads", {{"resolution", "64"}}},
+            {"impostor", {{"resolution", "64"}}}};
         for (const BakeTechnique& baker : bakeTechniques())
         {
             PackageWriter writer;

@@ -1,9 +1,7 @@
 // main() of the Ogre test binaries: registers OgreEnvironment, whose TearDown destroys the
 // kept assets and the headless Root before main() returns (OgreTestSupport.h).
 #include "OgreTestSupport.h"
-
-#include <cstdlib>
-#include <string>
+#include "TestFilter.h"
 
 // ASan trees (tests/run.sh): no LeakSanitizer in these binaries. OGRE unloads its render system
 // and libGL unloads Mesa's driver before the leak check at exit, so the few one-time allocations
@@ -16,15 +14,7 @@ extern "C" __attribute__((used, visibility("default"))) const char* __asan_defau
 int main(int argc, char** argv)
 {
     ::testing::InitGoogleTest(&argc, argv);
-    // TREELOD_GTEST_SKIP: gtest patterns (A.b:C.*) left out of the run, whatever --gtest_filter
-    // selects. ctest runs these binaries a suite at a time, so the sanitizer trees name the tests
-    // they leave out here (tests/run.sh), not with ctest -E.
-    if (const char* skip = std::getenv("TREELOD_GTEST_SKIP"); skip && *skip)
-    {
-        std::string filter = ::testing::GTEST_FLAG(filter);
-        filter += (filter.find('-') == std::string::npos ? "-" : ":") + std::string(skip);
-        ::testing::GTEST_FLAG(filter) = filter;
-    }
+    TreeLod::test::skipTestsNamedInEnvironment();
     ::testing::AddGlobalTestEnvironment(new TreeLod::OgreEnvironment);
     return RUN_ALL_TESTS();
 }

@@ -152,9 +152,21 @@ namespace TreeLod
     /// stamp the test binary's modification time: read when there, else made by `bake` and
     /// written (through a per-process temp file: ctest -j), the packages of older builds of the
     /// binary removed. Empty bytes from `bake` are returned and not cached.
+    /// $TREELOD_TEST_PACKAGES, when set, is another tree's test-out folder whose packages were
+    /// baked from these sources (tests/run.sh: the ASan stage reads the Release stage's, so its
+    /// Ogre tests check the Ogre half and not the bakers again, which its core tests run); a
+    /// package found there is used and not copied.
     inline std::vector<std::uint8_t> cachedPackage(const std::string& folder, const std::string& name,
                                                    const std::function<std::vector<std::uint8_t>()>& bake)
     {
+        if (const char* shared = std::getenv("TREELOD_TEST_PACKAGES"); shared && *shared)
+        {
+            std::error_code error;
+            for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(shared) / folder, error))
+                if (entry.path().filename().string().rfind(name + "@", 0) == 0 && entry.path().extension() == ".treelod")
+                    if (std::ifstream in{entry.path(), std::ios::binary})
+                        return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        }
         const char* out = std::getenv("TREELOD_TEST_OUT");
         const std::filesystem::path dir =
             (out && *out ? std::string(out) : std::string(TREELOD_BINARY_DIR) + "/test-out") + "/" + folder;

@@ -11,6 +11,7 @@
 #include "TreeLod/EllipsoidTree.h"
 #include "TreeLod/EllipsoidTreeBaker.h"
 #include "TreeLod/Forest.h"
+#include "TreeLod/Package.h"
 #include "TreeLod/PackageWriter.h"
 #include "TreeLod/TreeAssetManager.h"
 #include "TreeLod/TreeGenerator.h"
@@ -34,7 +35,8 @@ namespace TreeLod
             TreeAssetPtr asset;
         };
 
-        /// A generated oak of 1000 leaves with the reference and ellipsoids chunks.
+        /// A generated oak of 1000 leaves with the reference, ellipsoids and lines chunks (the
+        /// package cached on disk: cachedPackage); `data` is its ellipsoids chunk as the asset reads it.
         const BakedOak& oak()
         {
             return OgreEnvironment::keep<BakedOak>("ellipsoids.oak", [] {
@@ -45,16 +47,27 @@ namespace TreeLod
                 Result<TreeModel> model = generateTree(generator);
                 EXPECT_TRUE(model.ok());
                 t.model = std::move(model.value());
-                EllipsoidTreeOptions options;
-                options.viewResolution = 64;
-                Result<EllipsoidTreeData> data = bakeEllipsoidTree(t.model, options, "oak");
+                const std::vector<std::uint8_t> bytes = cachedPackage("ellipsoids", "oak", [&] {
+                    EllipsoidTreeOptions options;
+                    options.viewResolution = 64;
+                    PackageWriter writer;
+                    Result<void> added = addEllipsoidTreeChunk(writer, t.model, options, "oak");
+                    EXPECT_TRUE(added.ok()) << (added.ok() ? "" : added.error().message());
+                    return added.ok() ? writer.toBytes() : std::vector<std::uint8_t>();
+                });
+                Result<PackageReader> reader = PackageReader::fromMemory(bytes, "oak.treelod");
+                EXPECT_TRUE(reader.ok()) << (reader.ok() ? "" : reader.error().message());
+                const int chunk = reader.ok() ? reader->findChunk(ELLIPSOID_TREE_CHUNK, 0) : -1;
+                EXPECT_GE(chunk, 0) << "the package has no ellipsoids chunk";
+                if (chunk < 0)
+                    return t;
+                Result<std::vector<std::uint8_t>> chunkBytes = reader->readChunk(std::size_t(chunk));
+                Result<EllipsoidTreeData> data =
+                    chunkBytes.ok() ? decodeEllipsoidTreeChunk(chunkBytes.value(), "oak") : Result<EllipsoidTreeData>(chunkBytes.error());
                 EXPECT_TRUE(data.ok()) << (data.ok() ? "" : data.error().message());
-                t.data = std::move(data.value());
-                PackageWriter writer;
-                Result<void> added = addEllipsoidTreeChunk(writer, t.model, options, "oak");
-                EXPECT_TRUE(added.ok()) << (added.ok() ? "" : added.error().message());
-                t.asset = TreeAssetManager::getSingleton().loadFromBytes("oak.ellipsoid-test", Ogre::RGN_DEFAULT,
-                                                                         writer.toBytes());
+                if (data.ok())
+                    t.data = std::move(data.value());
+                t.asset = TreeAssetManager::getSingleton().loadFromBytes("oak.ellipsoid-test", Ogre::RGN_DEFAULT, bytes);
                 return t;
             });
         }
