@@ -13,6 +13,8 @@ asan=${TREELOD_ASAN_BUILD_DIR:-$root/build-asan}
 tsan=${TREELOD_TSAN_BUILD_DIR:-$root/build-tsan}
 jobs=$(nproc)
 "$root/.ci/deps.sh" --with-fuzzers
+# step NAME: the time since the start, then NAME (the stages' times in the log).
+step() { echo "==== ${SECONDS} s: $1"; }
 
 # Core dumps of crashing tests: kept where the kernel writes them into the test's folder.
 ulimit -c unlimited 2>/dev/null || true
@@ -63,8 +65,10 @@ configure() {
 }
 
 # ---- 1. Release ------------------------------------------------------------------------
+step "Release: build"
 configure "$build" -DCMAKE_BUILD_TYPE=Release -DTREELOD_BUILD_TESTS=ON
 cmake --build "$build" -j"$jobs"
+step "Release: tests"
 run_ctest "$build"
 [ "${TREELOD_SANITIZE:-1}" = 0 ] && { echo "all tests passed (sanitizer trees skipped)"; exit 0; }
 
@@ -80,6 +84,7 @@ run_ctest "$build"
 export TREELOD_TEST_PACKAGES=$build/test-out
 export ASAN_OPTIONS=abort_on_error=1:alloc_dealloc_mismatch=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+step "ASan: build"
 CXX=clang++ configure "$asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
   -DTREELOD_SANITIZERS=address,undefined -DTREELOD_BUILD_FUZZERS=ON -DTREELOD_BUILD_TESTS=ON \
   -DTREELOD_BUILD_BENCHMARKS=OFF -DTREELOD_BUILD_SAMPLES=OFF
@@ -103,12 +108,15 @@ asan_skip='^(install|cli|bench|shaders|rendersystem)\.'
 export TREELOD_GTEST_SKIP='BillboardCloudBaker.twoHundredThousandLeaves*:EllipsoidTreeBake.twoHundredThousandLeaves:BakeCacheProcesses.HitsWhilePackagesAreReplacedAreNotDiscarded:EllipsoidLineBake.scaleFree:EllipsoidLineBake.deterministicForSeedAndThreads:EllipsoidLineBake.levelCountsWeightsAndTargets:EllipsoidLineBake.registeredAndErrorsNamed:EllipsoidLineBake.extractedSkeletonFollowsTheGenerator:BillboardCloudTree.goldenFiftyThousandLeaves:Forest.errorCurvesRankTheLevelsAgainstTheCpuReference:Forest.calibrationTimesEveryLevelAndIsCachedPerRenderer:Forest.anErrorBudgetChoosesTheCheapestLevelWithinIt:Forest.budgetedSpeciesReplanInPlaceForAnErrorAFrameAndAShadowBudget:EllipsoidTree.halfAMetreAndFiveHundredMetresLookTheSame'
 if [ "${TREELOD_ASAN_OGRE:-1}" = 1 ]; then
   cmake --build "$asan" -j"$jobs" --target treelod_tests treelod_fuzzers
+  step "ASan: tests"
   run_ctest "$asan" -E "$asan_skip"
 else
   cmake --build "$asan" -j"$jobs" --target treelod_core_tests treelod_fuzzers
+  step "ASan: tests"
   run_ctest "$asan" -L core -E "$asan_skip"
 fi
 
+step "ASan: fuzzers"
 fuzzers=(FuzzGltfImporter:gltf FuzzPackageReader:package FuzzSceneScript:scene FuzzInstanceFile:instances FuzzOgreMeshImport:ogremesh)
 # fuzz BINARY:CORPUS: one fuzzer on a copy of its corpus; its last lines, or its whole report when
 # it fails (a crash, a leak, a timeout).
@@ -146,9 +154,11 @@ export LP_NUM_THREADS=0
 # Mesa's shader disk cache writes from threads of its own, whose barriers TSan cannot see in the
 # uninstrumented driver (a race report at teardown on a cold cache): off here.
 export MESA_SHADER_CACHE_DISABLE=true
+step "TSan: build"
 CXX=clang++ configure "$tsan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
   -DTREELOD_SANITIZERS=thread \
   -DTREELOD_BUILD_TESTS=ON -DTREELOD_BUILD_BENCHMARKS=OFF -DTREELOD_BUILD_SAMPLES=OFF
 cmake --build "$tsan" -j"$jobs" --target test_bakecache test_async_bake
+step "TSan: tests"
 launch="taskset -c 0" run_ctest "$tsan" -R '^(BakeCache|BakeCacheProcesses|TreeAssetManager|ForestScene)\.'
-echo "all tests passed"
+step "all tests passed"
