@@ -19,22 +19,28 @@ namespace TreeLod
         constexpr std::uint32_t LEAF_SIZE = 8;
 
         /// A static k-d tree over the component means, for the truncated E-step: the `k` nearest
-        /// means of a point, ties by index, so the set does not depend on the traversal.
+        /// means of a point, ties by index, so the set does not depend on the traversal. A subtree
+        /// is skipped when the distance from the query to its cell (Arya and Mount's incremental
+        /// distance: the per-axis offsets to the cells on the way down) exceeds the k-th nearest
+        /// so far; the points are stored in leaf order.
         class KdTree
         {
         public:
-            explicit KdTree(const std::vector<glm::dvec3>& points) : mPoints(points), mOrder(points.size())
+            explicit KdTree(const std::vector<glm::dvec3>& points) : mOrder(points.size())
             {
                 std::iota(mOrder.begin(), mOrder.end(), 0u);
                 mNodes.reserve(2 * points.size() / LEAF_SIZE + 2);
-                build(0, std::uint32_t(points.size()));
+                build(points, 0, std::uint32_t(points.size()));
+                mSorted.reserve(points.size());
+                for (std::uint32_t i : mOrder)
+                    mSorted.push_back(points[i]);
             }
 
             /// The k nearest (squared distance, index), ascending, into `out` (resized to k).
             void nearest(const glm::dvec3& q, std::uint32_t k, std::vector<std::pair<double, std::uint32_t>>& out) const
             {
                 out.clear();
-                visit(0, q, k, out);
+                visit(0, q, k, glm::dvec3(0.0), out);
             }
 
         private:
@@ -46,7 +52,7 @@ namespace TreeLod
                 double split = 0.0;
             };
 
-            std::int32_t build(std::uint32_t lo, std::uint32_t hi)
+            std::int32_t build(const std::vector<glm::dvec3>& points, std::uint32_t lo, std::uint32_t hi)
             {
                 const std::int32_t id = std::int32_t(mNodes.size());
                 mNodes.push_back(Node{lo, hi});
@@ -55,26 +61,29 @@ namespace TreeLod
                 glm::dvec3 mn(std::numeric_limits<double>::max()), mx(-std::numeric_limits<double>::max());
                 for (std::uint32_t i = lo; i < hi; ++i)
                 {
-                    mn = glm::min(mn, mPoints[mOrder[i]]);
-                    mx = glm::max(mx, mPoints[mOrder[i]]);
+                    mn = glm::min(mn, points[mOrder[i]]);
+                    mx = glm::max(mx, points[mOrder[i]]);
                 }
                 const glm::dvec3 extent = mx - mn;
                 const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
                 const std::uint32_t mid = (lo + hi) / 2;
                 std::nth_element(mOrder.begin() + lo, mOrder.begin() + mid, mOrder.begin() + hi,
                                  [&](std::uint32_t a, std::uint32_t b) {
-                                     return std::make_pair(mPoints[a][axis], a) < std::make_pair(mPoints[b][axis], b);
+                                     return std::make_pair(points[a][axis], a) < std::make_pair(points[b][axis], b);
                                  });
-                const std::int32_t left = build(lo, mid);
-                const std::int32_t right = build(mid, hi);
+                // The median's coordinate, read before the children's builds reorder their ranges.
+                const double split = points[mOrder[mid]][axis];
+                const std::int32_t left = build(points, lo, mid);
+                const std::int32_t right = build(points, mid, hi);
                 mNodes[std::size_t(id)].left = left;
                 mNodes[std::size_t(id)].right = right;
                 mNodes[std::size_t(id)].axis = axis;
-                mNodes[std::size_t(id)].split = mPoints[mOrder[mid]][axis];
+                mNodes[std::size_t(id)].split = split;
                 return id;
             }
 
-            void visit(std::int32_t id, const glm::dvec3& q, std::uint32_t k,
+            /// `offset`: per axis, the distance from `q` to node `id`'s cell (0 where q is inside it).
+            void visit(std::int32_t id, const glm::dvec3& q, std::uint32_t k, const glm::dvec3& offset,
                        std::vector<std::pair<double, std::uint32_t>>& out) const
             {
                 const Node& n = mNodes[std::size_t(id)];
@@ -82,7 +91,7 @@ namespace TreeLod
                 {
                     for (std::uint32_t i = n.lo; i < n.hi; ++i)
                     {
-                        const glm::dvec3 d = mPoints[mOrder[i]] - q;
+                        const glm::dvec3 d = mSorted[i] - q;
                         const std::pair<double, std::uint32_t> c(glm::dot(d, d), mOrder[i]);
                         if (out.size() < k)
                             out.insert(std::upper_bound(out.begin(), out.end(), c), c);
@@ -94,14 +103,20 @@ namespace TreeLod
                     }
                     return;
                 }
+                // The left cell's coordinates on the axis are <= split, the right one's >= split.
                 const double diff = q[n.axis] - n.split;
-                visit(diff < 0.0 ? n.left : n.right, q, k, out);
-                if (out.size() < k || diff * diff <= out.back().first)
-                    visit(diff < 0.0 ? n.right : n.left, q, k, out);
+                visit(diff < 0.0 ? n.left : n.right, q, k, offset, out);
+                glm::dvec3 farOffset = offset;
+                farOffset[n.axis] = diff;
+                // A lower bound of every distance computed in the far cell (rounding is monotone);
+                // shrunk by 1e-9 so that no contraction of the arithmetic can lift it above one.
+                const double farDistance = glm::dot(farOffset, farOffset) * (1.0 - 1e-9);
+                if (out.size() < k || farDistance <= out.back().first)
+                    visit(diff < 0.0 ? n.right : n.left, q, k, farOffset, out);
             }
 
-            const std::vector<glm::dvec3>& mPoints;
             std::vector<std::uint32_t> mOrder;
+            std::vector<glm::dvec3> mSorted; ///< the points in mOrder's order
             std::vector<Node> mNodes;
         };
 
