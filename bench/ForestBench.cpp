@@ -47,10 +47,10 @@ namespace
             std::pair<ForestInstances, std::string> out;
             ForestInstances& forest = out.first;
             for (const ForestKind& k :
-                 {kind("oak/lodf", 18.0f, ForestLodMode::PixelCount, {1e5f, 1e4f, 1e3f}),
-                  kind("pine/billboard-cloud", 25.0f, ForestLodMode::PixelCount, {5e4f, 2e3f, 200.0f}),
-                  kind("birch/mesh", 12.0f, ForestLodMode::PixelCount, {2e4f, 500.0f}),
-                  kind("beech/distance", 20.0f, ForestLodMode::Distance, {2500.0f, 4e4f, 1e6f})})
+                 {kind("oak", 18.0f, ForestLodMode::PixelCount, {1e5f, 1e4f, 1e3f}),
+                  kind("pine", 25.0f, ForestLodMode::PixelCount, {5e4f, 2e3f, 200.0f}),
+                  kind("birch", 12.0f, ForestLodMode::PixelCount, {2e4f, 500.0f}),
+                  kind("beech", 20.0f, ForestLodMode::Distance, {2500.0f, 4e4f, 1e6f})})
                 if (Result<std::uint32_t> r = forest.addKind(k); !r)
                 {
                     out.second = r.error().message();

@@ -193,15 +193,15 @@ finish)
 import json, sys
 s = json.load(open(sys.argv[1]))
 print(f"{s['scene']} {s['resolution'][0]}x{s['resolution'][1]}, {s['frames']} frames")
-print("run | trees | median ms | p95/median | worst ms | x entities | x merged | x quad | x billboard-set | FLIP | RSS MiB")
+floor_names = sorted({name for r in s["results"] for name in r.get("ratioToFloors", {})})
+print(" | ".join(["run", "trees", "median ms", "p95/median", "worst ms"] + ["x " + n for n in floor_names]
+                 + ["FLIP", "RSS MiB"]))
 for r in s["results"]:
     ms, floors, flip = r.get("frameMs", {}), r.get("ratioToFloors", {}), r.get("flip", {})
     f = lambda v, d=2: "-" if v is None else f"{v:.{d}f}"
     print(" | ".join([r["technique"], str(r["trees"]), f(ms.get("median")), f(r.get("p95OverMedian")),
-                      f(r.get("worstFrame", {}).get("frameMs")), f(floors.get("entities")),
-                      f(floors.get("merged-quads")), f(floors.get("impostor")), f(floors.get("billboard-set")),
-                      f(flip.get("mean"), 4),
-                      f(r.get("rssMiB"), 0)]))
+                      f(r.get("worstFrame", {}).get("frameMs"))] + [f(floors.get(n)) for n in floor_names]
+                     + [f(flip.get("mean"), 4), f(r.get("rssMiB"), 0)]))
 EOF
   done
   if [ -f "$from/rss-flythrough-10k/timings.json" ]; then

@@ -4,7 +4,8 @@
 #   runs once per gtest suite ("Suite.*"). OGRE: a headless Ogre test binary, whose main()
 #   (tests/ogre/OgreTestMain.cpp) tears the Root down before returning; the others' main() is
 #   tests/core/TestMain.cpp. Both OGRE and USES_OGRE label the tests "ogre" (ctest -L ogre / -LE ogre),
-#   the others "core".
+#   the others "core". SUITE_COSTS Suite=seconds...: ctest's COST of a suite whose few tests take
+#   long, so that ctest starts it early on a tree without timings of its own.
 # treelod_add_ogre_tests(SOURCES... [RENDER_SYSTEM_TESTS Suite.test...]): a technique's Ogre tests
 #   join test_ogre (tests/ogre/CMakeLists.txt: one executable, one Ogre start-up per process); their
 #   goldens are the technique's golden/ folder; RENDER_SYSTEM_TESTS run again under GL and GLES2.
@@ -24,7 +25,7 @@ set(TREELOD_TEST_ENV
   "TREELOD_TEST_OUT=${CMAKE_BINARY_DIR}/test-out")
 
 function(treelod_add_test name)
-  cmake_parse_arguments(T "OGRE;USES_OGRE" "" "SOURCES;LIBS" ${ARGN})
+  cmake_parse_arguments(T "OGRE;USES_OGRE" "" "SOURCES;LIBS;SUITE_COSTS" ${ARGN})
   if(T_OGRE)
     add_executable(${name} ${T_SOURCES} ${PROJECT_SOURCE_DIR}/tests/ogre/OgreTestMain.cpp)
     target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/ogre)
@@ -47,10 +48,11 @@ function(treelod_add_test name)
   # the test source, OgreEnvironment::keep). `ctest -R Suite\.` still selects a suite.
   set(suites ${CMAKE_CURRENT_BINARY_DIR}/${name}_suites.cmake)
   string(REPLACE ";" "|" environment "${TREELOD_TEST_ENV}")
+  string(REPLACE ";" "|" suite_costs "${T_SUITE_COSTS}")
   add_custom_command(TARGET ${name} POST_BUILD
     COMMAND ${CMAKE_COMMAND} -D TEST_EXECUTABLE=$<TARGET_FILE:${name}> -D CTEST_FILE=${suites}
             -D LABEL=${label} -D WORKING_DIRECTORY=${CMAKE_CURRENT_BINARY_DIR} -D ENVIRONMENT=${environment}
-            -P ${PROJECT_SOURCE_DIR}/cmake/TreeLodSuiteTests.cmake
+            "-DSUITE_COSTS=${suite_costs}" -P ${PROJECT_SOURCE_DIR}/cmake/TreeLodSuiteTests.cmake
     BYPRODUCTS ${suites} VERBATIM)
   file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/${name}_include.cmake
     "if(EXISTS \"${suites}\")\n  include(\"${suites}\")\nelse()\n  add_test(${name}_NOT_BUILT ${name}_NOT_BUILT)\nendif()\n")

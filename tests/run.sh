@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Build and run every test, once each (a failure is a failure: nothing is retried):
 #  1. the Release tree: unit, headless Ogre, golden-image, CLI and browser tests (under Xvfb);
-#  2. a clang tree with ASan + UBSan: every gtest binary (core and Ogre), then each libFuzzer
-#     target for a few seconds;
-#  3. a clang tree with TSan: TreeLod's own threads (bake cache, async baker).
+#  2. a clang tree with ASan + UBSan: every gtest binary (core and Ogre);
+#  3. a clang tree with TSan: TreeLod's own threads (bake cache, async baker), on one CPU while
+#     each libFuzzer target of stage 2's tree runs for a few seconds on another.
 # A test process that dies leaves its core dump and backtrace in <tree>/test-out/cores/.
 # CI (.ci/run) calls exactly this. TREELOD_SANITIZE=0 runs stage 1 only.
 set -euo pipefail
@@ -116,32 +116,40 @@ else
   run_ctest "$asan" -L core -E "$asan_skip"
 fi
 
-step "ASan: fuzzers"
+# ---- 3. TSan, and the ASan tree's fuzzers beside its tests ----------------------------------
+unset TREELOD_TEST_PACKAGES
+step "TSan: build"
+CXX=clang++ configure "$tsan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
+  -DTREELOD_SANITIZERS=thread \
+  -DTREELOD_BUILD_TESTS=ON -DTREELOD_BUILD_BENCHMARKS=OFF -DTREELOD_BUILD_SAMPLES=OFF
+cmake --build "$tsan" -j"$jobs" --target test_bakecache test_async_bake
+
 fuzzers=(FuzzGltfImporter:gltf FuzzPackageReader:package FuzzSceneScript:scene FuzzInstanceFile:instances FuzzOgreMeshImport:ogremesh)
-# fuzz BINARY:CORPUS: one fuzzer on a copy of its corpus; its last lines, or its whole report when
-# it fails (a crash, a leak, a timeout).
+# fuzz BINARY:CORPUS: one fuzzer (under $fuzz_launch) on a copy of its corpus; its last lines, or
+# its whole report when it fails (a crash, a leak, a timeout).
 fuzz() {
   local bin=${1%%:*} corpus=$root/tests/fuzz/corpus/${1#*:} work rc=0
   work=$(mktemp -d)
   cp -r "$corpus"/. "$work"/ 2>/dev/null || true
-  "$asan/bin/$bin" -max_total_time="${TREELOD_FUZZ_SECONDS:-10}" -max_len=65536 -rss_limit_mb=2048 "$work" \
-    > "$work.log" 2>&1 || rc=$?
+  ${fuzz_launch:-} "$asan/bin/$bin" -max_total_time="${TREELOD_FUZZ_SECONDS:-10}" -max_len=65536 -rss_limit_mb=2048 \
+    "$work" > "$work.log" 2>&1 || rc=$?
   echo "fuzzed $bin for ${TREELOD_FUZZ_SECONDS:-10} s: exit $rc"
   if [ $rc = 0 ]; then tail -n 3 "$work.log"; else tail -n 200 "$work.log"; fi
   rm -rf "$work" "$work.log"
   return $rc
 }
-# $jobs fuzzers at a time.
-pids=(); failed=0
-for target in "${fuzzers[@]}"; do
-  fuzz "$target" & pids+=($!)
-  if [ ${#pids[@]} -ge "$jobs" ]; then wait "${pids[0]}" || failed=1; pids=("${pids[@]:1}"); fi
-done
-for pid in "${pids[@]}"; do wait "$pid" || failed=1; done
-[ $failed = 0 ] || { echo "a fuzzer failed (its report is above)"; exit 1; }
+# The fuzzers one after another on the last CPU, in the background, while the TSan tests run on
+# the first (they take one CPU, below); their reports are printed when both are done.
+step "ASan: fuzzers (CPU $((jobs - 1))), TSan: tests (CPU 0)"
+fuzz_launch="taskset -c $((jobs - 1))"
+reports=$(mktemp -d)
+(
+  failed=0
+  for target in "${fuzzers[@]}"; do fuzz "$target" > "$reports/${target%%:*}.txt" || failed=1; done
+  exit $failed
+) &
+fuzz_pid=$!
 
-# ---- 3. TSan -------------------------------------------------------------------------------
-unset TREELOD_TEST_PACKAGES
 # The bake cache's tests of two processes baking, and of a full disk, are left out: they test no
 # thread of TreeLod's.
 export TREELOD_GTEST_SKIP='BakeCacheProcesses.TwoProcesses*:BakeCacheProcesses.DiskFull*:BakeCacheProcesses.NoSpace*'
@@ -154,11 +162,12 @@ export LP_NUM_THREADS=0
 # Mesa's shader disk cache writes from threads of its own, whose barriers TSan cannot see in the
 # uninstrumented driver (a race report at teardown on a cold cache): off here.
 export MESA_SHADER_CACHE_DISABLE=true
-step "TSan: build"
-CXX=clang++ configure "$tsan" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
-  -DTREELOD_SANITIZERS=thread \
-  -DTREELOD_BUILD_TESTS=ON -DTREELOD_BUILD_BENCHMARKS=OFF -DTREELOD_BUILD_SAMPLES=OFF
-cmake --build "$tsan" -j"$jobs" --target test_bakecache test_async_bake
-step "TSan: tests"
-launch="taskset -c 0" run_ctest "$tsan" -R '^(BakeCache|BakeCacheProcesses|TreeAssetManager|ForestScene)\.'
+tsan_rc=0
+launch="taskset -c 0" run_ctest "$tsan" -R '^(BakeCache|BakeCacheProcesses|TreeAssetManager|ForestScene)\.' || tsan_rc=$?
+fuzz_rc=0
+wait "$fuzz_pid" || fuzz_rc=$?
+cat "$reports"/*.txt
+rm -rf "$reports"
+[ $fuzz_rc = 0 ] || { echo "a fuzzer failed (its report is above)"; exit 1; }
+[ $tsan_rc = 0 ] || exit $tsan_rc
 step "all tests passed"

@@ -226,7 +226,7 @@ namespace TreeLod
         /// "auto", auto with an error budget ("auto@0.02") or a frame budget ("auto~40").
         bool isAutoRun(const std::string& technique) { return technique.rfind("auto", 0) == 0; }
 
-        /// A run as the Pareto line names it: "lodf", or "lodf@0.5" at a bias other than 1.
+        /// A run as the Pareto line names it: "<technique>", or "<technique>@0.5" at a bias other than 1.
         std::string runName(const Run& run)
         {
             return run.technique + (run.lodBias == 1.0f ? "" : "@" + number(run.lodBias, 3));

@@ -235,7 +235,7 @@ namespace TreeLod
             stats.emplace_back("Baking", getTechnique() + " (drawing " + menuLabel(mScene->getPolicy()) + " meanwhile)");
         if (!mBakeError.empty())
             stats.emplace_back("Bake failed", mBakeError);
-        // "oak: budget 0.04: lodf 3000 >= 117 px, ...": how, here; which levels, in the level box.
+        // "oak: budget 0.04: <technique> 3000 >= 117 px, ...": how, here; which levels, in the level box.
         for (const std::string& note : mScene->getLevelNotes())
         {
             const std::size_t colon = note.find(": ");

@@ -44,8 +44,8 @@ namespace TreeLod
         ~SingleTreeView();
 
         /// Bake (through TreeAssetManager::require and the registered baker) the chunks of every
-        /// registered technique and the impostor (so a forest of the same tree finds the package
-        /// complete), load the asset and create the objects. Throws Ogre::Exception.
+        /// registered technique (so a forest of the same tree finds the package complete), load
+        /// the asset and create the objects. Throws Ogre::Exception.
         void build(const ProgressCallback& progress);
         const TreeAssetPtr& getAsset() const { return mAsset; }
         const std::string& getSource() const { return mSource; }

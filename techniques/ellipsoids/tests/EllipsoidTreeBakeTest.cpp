@@ -208,6 +208,51 @@ namespace TreeLod
             }
         }
 
+        // The truncated E-step's candidates are each point's nearest means, ties by index: after one
+        // iteration (the means are the starts) every point's components are the brute-force nearest
+        // 8 of 600 starts, on a grid of equal coordinates (ties on every axis) and off it.
+        TEST(EllipsoidTreeBake, truncatedEStepTakesTheNearestMeans)
+        {
+            std::uint64_t state = 11;
+            const auto next = [&state] {
+                state = state * 6364136223846793005ull + 1442695040888963407ull;
+                return double(state >> 11) / 9007199254740992.0;
+            };
+            for (const bool grid : {true, false})
+            {
+                std::vector<glm::dvec3> starts(600);
+                for (glm::dvec3& m : starts)
+                    m = grid ? glm::floor(glm::dvec3(next(), next(), next()) * 6.0) : glm::dvec3(next(), next(), next()) * 6.0;
+                GaussianMixtureInput input;
+                for (int i = 0; i < 3000; ++i)
+                    input.points.push_back(glm::dvec3(next(), next(), next()) * 6.0);
+                GaussianMixtureOptions options;
+                options.maxIterations = 1;
+                options.candidates = 8;
+                const GaussianMixtureResult r = fitGaussianMixture(input, starts, options);
+                ASSERT_EQ(r.means, starts);
+                int wrong = 0;
+                for (std::size_t i = 0; i < input.points.size(); ++i)
+                {
+                    std::vector<std::pair<double, std::uint32_t>> all;
+                    for (std::uint32_t j = 0; j < starts.size(); ++j)
+                    {
+                        const glm::dvec3 d = starts[j] - input.points[i];
+                        all.emplace_back(glm::dot(d, d), j);
+                    }
+                    std::partial_sort(all.begin(), all.begin() + 8, all.end());
+                    std::vector<std::uint32_t> nearest;
+                    for (int m = 0; m < 8; ++m)
+                        nearest.push_back(all[std::size_t(m)].second);
+                    std::sort(nearest.begin(), nearest.end());
+                    const std::vector<std::uint32_t> taken(r.component.begin() + r.offsets[i],
+                                                           r.component.begin() + r.offsets[i + 1]);
+                    wrong += taken != nearest;
+                }
+                EXPECT_EQ(wrong, 0) << (grid ? "on the grid" : "off the grid");
+            }
+        }
+
         // 256 leaves, divisor 4: targets 64, 16, 4, 1 after the 256 leaves (dropping may only lower
         // them); divisor 8: 32, 4, 1 (the division stops at 4, one ellipsoid is added).
         TEST(EllipsoidTreeBake, levelCountsFollowTheDivisor)

@@ -43,7 +43,7 @@ namespace TreeLod
             return true;
         }
 
-        /// "error-curves level 3 'lodf' 1200 low-res"; the name only when it is valid.
+        /// "error-curves level 3 '<technique>' 1200 low-res"; the name only when it is valid.
         std::string levelElement(std::size_t index, const ErrorCurveLevel& level)
         {
             std::string element = std::string(ERROR_CURVES_CHUNK) + " level " + std::to_string(index);

@@ -108,7 +108,7 @@ namespace TreeLod
         virtual void checkLevel(TreeAsset& asset, const ForestLevel& level, Ogre::AxisAlignedBox& drawnBounds) = 0;
         /// Build what `level` draws (uploading the asset's resources on first use).
         virtual void buildParts(TreeAsset& asset, const ForestLevel& level, ForestPartBuilder& parts) = 0;
-        /// A few words naming `level` for people ("lodf 1200", "cloud 1 low"); by default the
+        /// A few words naming `level` for people ("<technique> 1200", "<technique> 1 low"); by default the
         /// technique's name.
         virtual Ogre::String describeLevel(const ForestLevel& level) const { return level.technique; }
     };

@@ -92,7 +92,7 @@ namespace TreeLod
 
     struct TechniqueInfo
     {
-        Ogre::String name;           ///< "mesh", "lodf", "billboard-cloud", "impostor", ...
+        Ogre::String name;           ///< "mesh" or the name a technique registers
         Ogre::String description;
         Ogre::String chunkTechnique; ///< package chunk it draws from ("reference", ...)
         Ogre::String movableType;    ///< factory type of the object it creates
@@ -133,7 +133,7 @@ namespace TreeLod
         const TechniqueInfo& get(const Ogre::String& name, const Ogre::String& element = "",
                                  const char* source = "TechniqueRegistry::get") const;
         const std::vector<TechniqueInfo>& getTechniques() const { return mTechniques; }
-        /// "mesh, billboard-cloud, ..." for messages.
+        /// "mesh, <technique>, ..." for messages.
         Ogre::String describe() const;
         /// The technique whose roles say floor, or Ogre::ItemIdentityException when none is registered.
         const TechniqueInfo& getFloor() const;

@@ -75,10 +75,10 @@ namespace TreeLod
     std::vector<BenchRun> comparisonBenchRuns();
 
     /// What `treelod bench` and treelod_frames draw without --techniques: "auto" and the techniques
-    /// whose roles say benchDefault ("auto,lodf,billboard-cloud").
+    /// whose roles say benchDefault ("auto,<technique>,...").
     std::string defaultBenchTechniques();
 
-    /// The techniques bakeTechniqueOf knows, for messages: "mesh, lodf, billboard-cloud, ...".
+    /// The techniques bakeTechniqueOf knows, for messages: "mesh, <technique>, ...".
     std::string knownSceneTechniques();
 
     /// The packages that drawing `script` needs: per species source, the sorted bake techniques
@@ -148,7 +148,7 @@ namespace TreeLod
         /// The camera at frame `frame` of `frameCount` (0 = the script's frame count).
         CameraSpec cameraAtFrame(std::uint32_t frame, std::uint32_t frameCount = 0) const;
 
-        /// Per auto species, how its levels are chosen now: "oak: budget 0.04: lodf 0 >= 301 px, ..."
+        /// Per auto species, how its levels are chosen now: "oak: budget 0.04: <technique> 0 >= 301 px, ..."
         /// or why the fixed auto bands were used.
         std::vector<std::string> getLevelNotes() const;
         /// Re-plan the budgeted species for `budget` now (Forest::setErrorBudget; throws as it does);

@@ -3,7 +3,7 @@
 // package list, the JSON file CacheTreeBaker::writePackageList() writes after baking
 // (docs/scene-format.md, "Package lists"):
 //   {"format": "treelod-package-list", "version": 1,
-//    "packages": [{"source": "../media/oak.glb", "techniques": ["impostor", "reference"],
+//    "packages": [{"source": "../media/oak.glb", "techniques": ["<technique>", "reference"],
 //                  "path": "cache/oak-1234.treelod"}]}
 // File sources and package paths are stored relative to the list's folder (absolute when they
 // share no root), so a checkout copied to another machine (a GPU device) still finds them.

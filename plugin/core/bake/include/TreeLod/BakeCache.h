@@ -92,7 +92,7 @@ namespace TreeLod
         std::string discardedReason; ///< why an existing cache file was thrown away, "" if none was
 
         /// One line for the user, e.g.
-        /// "oak.glb: baked billboard-cloud (1.9 s), reused reference, lodf -> /home/u/.cache/treelod/oak-....treelod"
+        /// "oak.glb: baked <technique> (1.9 s), reused reference, <technique> -> /home/u/.cache/treelod/oak-....treelod"
         std::string describe() const;
     };
 
@@ -117,11 +117,11 @@ namespace TreeLod
         /// A package at path() holding the chunks of every technique in `techniques` (names of
         /// BakeTechniques.h; duplicates ignored) for `source` baked with `optionsJson` (a JSON
         /// object; "" means {}; key order and spacing do not matter: "leafMaterials" for the
-        /// importer, and per technique an object of its BakeOptions, {"lodf": {"clusterSize": 32}},
+        /// importer, and per technique an object of its BakeOptions, {"<technique>": {"<option>": 32}},
         /// checked against what the baker declares before anything is read). Chunks already cached are
         /// reused, the others baked from one import of the source. `import` reads file formats
         /// other than glTF. `progress` sees the importer's and bakers' steps, prefixed with the
-        /// source's name and technique ("oak.glb lodf: collapse"); "warning: ..." steps keep
+        /// source's name and technique ("oak.glb <technique>: <step>"); "warning: ..." steps keep
         /// their prefix. Safe to call from several threads, though not during addGenerator() (see the
         /// header comment on races).
         Result<BakeCacheEntry> require(const std::string& source, const std::vector<std::string>& techniques,

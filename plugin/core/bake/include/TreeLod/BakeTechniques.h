@@ -14,7 +14,7 @@
 namespace TreeLod
 {
     /// The values given for one baker's options, by option name, as text (`treelod bake --option
-    /// lodf.clusterSize=32`; in a bake cache's options JSON, {"lodf": {"clusterSize": 32}}).
+    /// TECHNIQUE.NAME=VALUE`; in a bake cache's options JSON, {"TECHNIQUE": {"NAME": VALUE}}).
     using BakeOptions = std::map<std::string, std::string>;
 
     /// Adds a technique's chunks for `model` to the package (and the chunks it needs, such as the
@@ -38,7 +38,7 @@ namespace TreeLod
 
     struct BakeTechnique
     {
-        const char* name; ///< the chunk's technique name ("reference", "lodf", ...)
+        const char* name; ///< the chunk's technique name ("reference", ...)
         const char* description;
         BakeFunction bake;
         std::vector<BakeOptionInfo> options; ///< what `options` may hold
@@ -50,7 +50,7 @@ namespace TreeLod
     /// Every registered baker, "reference" first, then by name.
     const std::vector<BakeTechnique>& bakeTechniques();
     const BakeTechnique* findBakeTechnique(const std::string& name);
-    /// "reference, lodf" for messages.
+    /// "reference, <technique>, ..." for messages.
     std::string knownBakeTechniques();
 
     /// An error naming `label` and "option '<technique>.<name>'" for a name `technique` does not

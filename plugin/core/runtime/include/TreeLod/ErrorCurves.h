@@ -45,7 +45,7 @@ namespace TreeLod
     /// One Forest level's curve: image error against the tree's height on screen.
     struct ErrorCurveLevel
     {
-        std::string technique;            ///< registered technique name ("mesh", "lodf", ...), 1..32 printable ASCII
+        std::string technique;            ///< registered technique name ("mesh", ...), 1..32 printable ASCII
         std::uint32_t techniqueLevel = 0; ///< the technique's own level (as ForestLevel::techniqueLevel)
         bool lowRes = false;              ///< as ForestLevel::lowRes
         std::vector<float> flip;          ///< mean FLIP over the (side) views, one per height, in [0, 1]
@@ -77,7 +77,7 @@ namespace TreeLod
     std::vector<std::uint8_t> encodeErrorCurves(const ErrorCurves& curves);
 
     /// Strict: every count, size and value checked; errors name `label`, the element
-    /// ("error-curves level 3 'lodf' 1200", "error-curves heights[2]") and the reason.
+    /// ("error-curves level 3 '<technique>' 1200", "error-curves heights[2]") and the reason.
     Result<ErrorCurves> decodeErrorCurves(const std::vector<std::uint8_t>& bytes, const std::string& label);
 
     /// The same checks on a value (decode calls it; the measurer calls it before writing): counts

@@ -52,7 +52,7 @@ namespace TreeLod
     /// One (asset, technique) pair: what the Forest draws with one instanced batch per level.
     struct ForestKind
     {
-        std::string name;                  ///< for errors and stats, e.g. "oak.treelod/lodf"
+        std::string name;                  ///< for errors and stats, e.g. "oak.treelod/<technique>"
         glm::vec3 boundsCentre{0.0f};      ///< local bounding sphere (metres, unscaled)
         float boundsRadius = 1.0f;         ///< > 0
         ForestLodMode lodMode = ForestLodMode::PixelCount;

@@ -4,7 +4,7 @@
 // another renderer is never reused. Nothing here assumes a cost from triangle counts.
 //
 // File (JSON, written atomically): {"renderer": "...", "version": 1, "assets": {"<asset key>":
-// [{"technique": "lodf", "level": 1200, "lowRes": false, "heightsPx": [16, 64, 256],
+// [{"technique": "<technique>", "level": 1200, "lowRes": false, "heightsPx": [16, 64, 256],
 // "msPerTree": [0.012, 0.020, 0.151]}, ...]}}. The asset key (assetCostKey) hashes the chunks the
 // levels draw from, so a rebaked tree is calibrated again.
 #pragma once

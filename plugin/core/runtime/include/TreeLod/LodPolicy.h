@@ -40,7 +40,7 @@ namespace TreeLod
         /// number, is an error naming `element`. A fixed technique is not checked here (the
         /// technique registry knows the names).
         static Result<LodPolicy> parse(const std::string& text, const std::string& element = "technique");
-        /// The text parse reads back ("auto@0.05", "lodf", "").
+        /// The text parse reads back ("auto@0.05", "<technique>", "").
         std::string toString() const;
 
         bool isAuto() const { return mode == Mode::Auto; }

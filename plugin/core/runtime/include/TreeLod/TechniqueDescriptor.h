@@ -1,5 +1,5 @@
 // TechniqueDescriptor: the runtime half of a technique's core descriptor, and the registry of
-// them. A technique's package chunks are named after it ("lodf", "billboard-cloud", ...); its
+// them. A technique's package chunks are named after it ("<technique>", ...); its
 // descriptor says which format version this build reads, how to decode and validate a chunk
 // (what `treelod info` prints, as text and JSON) and what the package fuzzer exercises after a
 // successful decode. The bake half (the function that writes the chunks) is BakeTechniques.h.

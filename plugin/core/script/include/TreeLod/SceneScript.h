@@ -66,7 +66,7 @@ namespace TreeLod
     /// The technique a species is drawn with up to a distance or down to a screen size.
     struct TechniqueBand
     {
-        std::string technique; ///< registry name ("mesh", "lodf", "billboard-cloud", ...)
+        std::string technique; ///< registry name ("mesh" or a registered technique)
         float maxDistance = 0.0f; ///< metres; 0 = open-ended (last band) or the band uses minPixels
         float minPixels = 0.0f;   ///< tree height on screen in pixels; 0 = open-ended or maxDistance
     };
