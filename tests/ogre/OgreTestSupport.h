@@ -159,13 +159,22 @@ namespace TreeLod
     inline std::vector<std::uint8_t> cachedPackage(const std::string& folder, const std::string& name,
                                                    const std::function<std::vector<std::uint8_t>()>& bake)
     {
+        const auto isPackageOf = [&name](const std::filesystem::path& file) {
+            return file.filename().string().rfind(name + "@", 0) == 0 && file.extension() == ".treelod";
+        };
+        const auto readAll = [](const std::filesystem::path& file) {
+            std::vector<std::uint8_t> bytes;
+            if (std::ifstream in{file, std::ios::binary})
+                bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+            return bytes;
+        };
         if (const char* shared = std::getenv("TREELOD_TEST_PACKAGES"); shared && *shared)
         {
             std::error_code error;
             for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(shared) / folder, error))
-                if (entry.path().filename().string().rfind(name + "@", 0) == 0 && entry.path().extension() == ".treelod")
-                    if (std::ifstream in{entry.path(), std::ios::binary})
-                        return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+                if (isPackageOf(entry.path()))
+                    if (std::vector<std::uint8_t> bytes = readAll(entry.path()); !bytes.empty())
+                        return bytes;
         }
         const char* out = std::getenv("TREELOD_TEST_OUT");
         const std::filesystem::path dir =
@@ -174,16 +183,14 @@ namespace TreeLod
         std::error_code error;
         const auto stamp = std::filesystem::last_write_time("/proc/self/exe", error).time_since_epoch().count();
         const std::filesystem::path path = dir / (name + "@" + std::to_string(error ? 0 : stamp) + ".treelod");
-        std::vector<std::uint8_t> bytes;
-        if (std::ifstream in{path, std::ios::binary})
-            bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        std::vector<std::uint8_t> bytes = readAll(path);
         if (!bytes.empty())
             return bytes;
         bytes = bake();
         if (bytes.empty())
             return bytes;
         for (const auto& entry : std::filesystem::directory_iterator(dir))
-            if (entry.path().filename().string().rfind(name + "@", 0) == 0 && entry.path().extension() == ".treelod")
+            if (isPackageOf(entry.path()))
                 std::filesystem::remove(entry.path());
         const std::string temp = path.string() + "." + std::to_string(::getpid()) + ".tmp";
         std::ofstream(temp, std::ios::binary)
