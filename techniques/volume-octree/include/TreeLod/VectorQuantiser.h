@@ -8,12 +8,15 @@
 //     (Fig. 5 b).
 //   - Modified GLA (§4.1.2): after the last iteration every codeword is replaced by the training
 //     vector nearest to it among those assigned to it (the paper's fix for GLA's averaging, which
-//     darkens and loses contrast), then every vector is reassigned once.
+//     darkens and loses contrast), then every vector is reassigned once. Deviation: once, after
+//     convergence (the paper does not say when), as GLA's error falls monotonically only while
+//     codewords are means.
 //   - Alpha (§4.1.1) is quantised on its own: 16 grey values in [0, 255].
 //   - Black-pixel heuristic (§4.1.1): a texel with no colour (alpha 0 in the input) would show
 //     black wherever the separately quantised alpha gives it coverage; fillTransparentTexels gives
 //     every such texel the colour of the billboard's brightest (largest L*) covered texel before
-//     colour quantisation.
+//     colour quantisation. Deviation: the paper patches the quantised texture, a codeword that many
+//     billboards share and none can change alone.
 //
 // GLA: codewords start as K training vectors picked by a seeded deterministic draw among the
 // distinct vectors; each iteration assigns every vector to its nearest codeword (ties: lowest
