@@ -67,22 +67,6 @@ namespace TreeLod
             std::vector<RgbaImage> levels;
         };
 
-        /// The mean of a FLIP error map over the pixels that are tree in `reference` or in `test`:
-        /// the error per pixel of the tree, whatever share of the crop the background is. A forest
-        /// that fills the frame with trees shows that error on every pixel.
-        double meanOverTree(const FlipResult& result, const Image& reference, const Image& test)
-        {
-            double sum = 0.0;
-            std::size_t count = 0;
-            for (std::size_t i = 0; i < result.errorMap.size(); ++i)
-                if (isTreePixel(reference.pixels[i]) || isTreePixel(test.pixels[i]))
-                {
-                    sum += result.errorMap[i];
-                    ++count;
-                }
-            return count > 0 ? sum / double(count) : result.mean;
-        }
-
         /// Every level's scores against the reference over one square crop around the tree: the
         /// union of the reference's and every level's tree pixels, so the levels of a view are
         /// compared on the same pixels and the reference is filtered for FLIP once. FLIP is the

@@ -218,9 +218,12 @@ namespace TreeLod
         EXPECT_GT(treeCoverage(fresh, LightingSpec().background), 0.05);
     }
 
-    // Golden images at three distances; bound 0.02 as for the reference goldens
-    // (OgreGoldenTest.cpp). At each, the LoDF picture must also stay close to the polygonal
-    // reference's: mean FLIP < 0.08 (measured 0.01-0.05; a wrong leaf, index or colour costs more).
+    // Golden images at three distances (bound 0.05), and the polygonal reference's picture beside
+    // each, both compared over the tree's own pixels: the far tree covers 0.4 % of the frame, where
+    // a mean over the frame stays below any bound. Near and mid, LoDF draws every leaf and matches
+    // the mesh (measured 0.000); far it keeps 638 of 3000 leaves (measured 0.172). Broken variants
+    // measured against these bounds: half the leaves 0.14-0.28 from the golden and 0.216 from the
+    // mesh far, every leaf at the far view 0.166 from its golden, tree pixels black 0.75-0.81.
     TEST(FoliageLodTree, goldenAtThreeDistances)
     {
         const LodfTree& oak = bundledOak();
@@ -229,9 +232,10 @@ namespace TreeLod
         {
             const char* view;
             const char* golden;
-            double minCoverage;
-        } cases[] = {{"orbit:30,10,1.0", "oak-lodf-near", 0.08}, {"orbit:30,10,2.5", "oak-lodf-mid", 0.015},
-                     {"orbit:30,10,6", "oak-lodf-far", 0.002}};
+            double minCoverage, meshBound;
+        } cases[] = {{"orbit:30,10,1.0", "oak-lodf-near", 0.08, 0.02},
+                     {"orbit:30,10,2.5", "oak-lodf-mid", 0.015, 0.02},
+                     {"orbit:30,10,6", "oak-lodf-far", 0.002, 0.2}};
         std::uint32_t previous = ~0u;
         for (const auto& c : cases)
         {
@@ -241,16 +245,14 @@ namespace TreeLod
             EXPECT_LE(count, previous);
             previous = count;
             EXPECT_GT(treeCoverage(lodf, LightingSpec().background), c.minCoverage) << c.golden;
-            compareWithGolden(lodf, c.golden, 0.02);
+            compareWithGolden(lodf, c.golden, 0.05, FlipOver::Tree);
 
             r.clearContent();
             Ogre::MovableObject* mesh =
                 TechniqueRegistry::getSingleton().createInstance("mesh", r.getSceneManager(), "ref", *oak.asset);
             r.getContentNode().createChildSceneNode()->attachObject(mesh);
             const Image reference = toImage(r.render(camera(oak.model, c.view), 256, 256, 3));
-            Result<FlipResult> error = flip(reference, lodf);
-            ASSERT_TRUE(error.ok());
-            EXPECT_LT(error->mean, 0.08) << c.golden << " with " << count << " leaves";
+            EXPECT_LT(flipMean(reference, lodf, FlipOver::Tree), c.meshBound) << c.golden << " with " << count << " leaves";
         }
         EXPECT_LT(previous, oak.model.leaves.size()) << "the far view must drop leaves";
     }
@@ -312,6 +314,9 @@ namespace TreeLod
         EXPECT_GT(treeCoverage(trunkImage, LightingSpec().background), 0.01);
     }
 
+    // 400,000 leaf vertices: the index ranges are 32-bit. Every leaf drawn is the polygonal tree's
+    // picture (over the tree's pixels, measured 0.000), and half of them stay near it (measured
+    // 0.252); 5,000 leaves measured 0.284, tree pixels black 0.511.
     TEST(FoliageLodTree, hundredThousandLeavesUse32BitRanges)
     {
         GeneratorOptions options;
@@ -320,17 +325,27 @@ namespace TreeLod
         Result<TreeModel> model = generateTree(options);
         ASSERT_TRUE(model.ok());
         TreeAssetPtr asset = loadLodf(model.value(), "oak100k.lodf-test");
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const CameraSpec view = camera(model.value(), "orbit:30,10,1.2");
+        Ogre::MovableObject* mesh =
+            TechniqueRegistry::getSingleton().createInstance("mesh", r.getSceneManager(), "ref100k", *asset);
+        r.clearContent();
+        r.setShadows(false);
+        r.setLodBias(1.0f);
+        r.getContentNode().createChildSceneNode()->attachObject(mesh);
+        const Image reference = toImage(r.render(view, 128, 128, 1));
+        EXPECT_GT(treeCoverage(reference, LightingSpec().background), 0.02); // measured 0.037
+
         FoliageLodTree* tree = place(asset);
         EXPECT_GT(FoliageLodResources::of(*asset).getLeafVertexData()->vertexCount, 65535u);
-        OffscreenRenderer& r = OgreEnvironment::renderer();
-        const Image image = toImage(r.render(camera(model.value(), "orbit:30,10,1.2"), 128, 128, 1));
-        EXPECT_GT(treeCoverage(image, LightingSpec().background), 0.02); // measured 0.037
+        tree->setFixedLeafCount(100000);
+        EXPECT_EQ(tree->getLeafCount(), 100000u);
+        const Image all = toImage(r.render(view, 128, 128, 1));
         tree->setFixedLeafCount(50000);
         EXPECT_EQ(tree->getLeafCount(), 50000u);
-        const Image half = toImage(r.render(camera(model.value(), "orbit:30,10,1.2"), 128, 128, 1));
-        Result<FlipResult> error = flip(image, half);
-        ASSERT_TRUE(error.ok());
-        EXPECT_LT(error->mean, 0.15);
+        const Image half = toImage(r.render(view, 128, 128, 1));
+        EXPECT_LT(flipMean(reference, all, FlipOver::Tree), 0.02);
+        EXPECT_LT(flipMean(reference, half, FlipOver::Tree), 0.27);
     }
 
     TEST(FoliageLodTree, quantisedInstancesShareLevelsAndUploadNothing)

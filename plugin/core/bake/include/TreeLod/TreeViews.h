@@ -7,6 +7,7 @@
 
 #include "TreeLod/Camera.h"
 #include "TreeLod/Image.h"
+#include "TreeLod/ImageMetrics.h"
 #include "TreeLod/ReferenceRenderer.h"
 
 #include <glm/glm.hpp>
@@ -54,6 +55,22 @@ namespace TreeLod
         for (const glm::vec4& p : image.pixels)
             covered += isTreePixel(p, background);
         return image.pixels.empty() ? 0.0 : double(covered) / double(image.pixels.size());
+    }
+
+    /// The mean of a FLIP error map (FlipOptions::keepErrorMap) over the pixels that are tree in
+    /// `reference` or in `test`: the error per pixel of the tree, whatever share of the image the
+    /// background is; `result.mean` where neither has a tree pixel.
+    inline double meanOverTree(const FlipResult& result, const Image& reference, const Image& test)
+    {
+        double sum = 0.0;
+        std::size_t count = 0;
+        for (std::size_t i = 0; i < result.errorMap.size(); ++i)
+            if (isTreePixel(reference.pixels[i]) || isTreePixel(test.pixels[i]))
+            {
+                sum += result.errorMap[i];
+                ++count;
+            }
+        return count > 0 ? sum / double(count) : result.mean;
     }
 
     inline Extent unite(Extent a, const Extent& b)
