@@ -9,9 +9,11 @@
 #include "TreeLod/EllipsoidTreeBaker.h"
 #include "TreeLod/EllipsoidTreeData.h"
 #include "TreeLod/GaussianMixture.h"
+#include "TreeLod/ImageMetrics.h"
 #include "TreeLod/ReferenceRenderer.h"
 #include "TreeLod/TechniqueDescriptor.h"
 #include "TestTrees.h"
+#include "../src/EllipsoidErrorViews.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -83,6 +85,35 @@ namespace TreeLod
             for (float a : images.alpha)
                 sum += a;
             return sum / double(images.alpha.size());
+        }
+
+        /// The baker's image error (mean multi-scale RMSE of flat white coverage) of level `k` of `d`
+        /// against `leaves` (flatColourLeaves), in two perspective side views the baker did not use,
+        /// with the level's stored noise (its footprint at the level's target height) or none.
+        double unseenError(const EllipsoidTreeData& d, std::size_t k, const TreeModel& leaves, bool noise)
+        {
+            const EllipsoidLevel& level = d.levels[k];
+            const std::vector<Ellipsoid> ellipsoids(d.ellipsoids.begin() + level.first,
+                                                    d.ellipsoids.begin() + level.first + level.count);
+            EllipsoidNoiseSetting setting;
+            if (noise)
+            {
+                setting.threshold = level.noiseThreshold;
+                setting.normalBlend = level.normalBlend;
+                setting.pixelSize = (leaves.boundsMax.y - leaves.boundsMin.y) / level.targetHeightPx;
+            }
+            const RenderOptions options = EllipsoidErrorViews::renderOptions(96);
+            const ReferenceRenderer renderer(leaves);
+            double sum = 0.0;
+            for (float azimuth : {45.0f, 200.0f})
+            {
+                const CameraSpec camera = CameraSpec::framing(leaves.boundsMin, leaves.boundsMax, azimuth, 10.0f);
+                Result<MultiScaleRmseResult> e = multiScaleRmse(renderer.render(camera, options).colour,
+                                                                renderEllipsoids(ellipsoids, level.scale, setting, camera, options));
+                EXPECT_TRUE(e.ok());
+                sum += e.ok() ? e->combined : 1.0;
+            }
+            return sum / 2.0;
         }
 
         // One square leaf of 0.2 m: one level of one ellipsoid, a disc on the leaf: the two large
@@ -436,16 +467,20 @@ namespace TreeLod
         }
 
         // Each level's noise is calibrated (the chosen threshold, compensation and blend from the
-        // candidates, stored and round-tripped) and, with the noise on, no level's coverage error is
-        // worse than without it by more than the two renderers differ; "noise=0" bakes none.
-        TEST(EllipsoidTreeBake, calibratedNoiseIsStoredAndNeverWorse)
+        // candidates, stored and round-tripped) and holds beyond the baker's four views: in two views
+        // it did not use, the levels with their noise sum to less error than the levels of a bake
+        // without it (measured 0.351 against 0.370), none worse by more than 10 % (measured at most
+        // +4 %, level 1). A threshold of 0.8 everywhere measured 0.18 a level. "noise=0" bakes none.
+        TEST(EllipsoidTreeBake, calibratedNoiseIsStoredAndHoldsInOtherViews)
         {
             const EllipsoidTreeData& withNoise = oakBake();
             EllipsoidTreeOptions off = fastOptions();
             off.noise = false;
             const EllipsoidTreeData without = bakeOrFail(generatedOak(256), off);
+            const TreeModel leaves = flatColourLeaves(generatedOak(256));
             ASSERT_EQ(withNoise.levels.size(), without.levels.size());
             int noisy = 0;
+            double noisySum = 0.0, plainSum = 0.0;
             for (std::size_t k = 0; k < without.levels.size(); ++k)
             {
                 const EllipsoidLevel& a = withNoise.levels[k];
@@ -455,10 +490,15 @@ namespace TreeLod
                 EXPECT_GE(a.noiseThreshold, 0.0f);
                 EXPECT_LT(a.noiseThreshold, 1.0f);
                 EXPECT_GE(a.scale, b.scale * 0.999f) << "the compensation only grows the ellipsoids";
-                EXPECT_LE(a.imageError, b.imageError + 0.01f) << "level " << k;
+                const double noisyError = unseenError(withNoise, k, leaves, true);
+                const double plainError = unseenError(without, k, leaves, false);
+                EXPECT_LT(noisyError, plainError * 1.1) << "level " << k;
+                noisySum += noisyError;
+                plainSum += plainError;
                 noisy += a.noiseThreshold > 0.0f ? 1 : 0;
             }
             EXPECT_GT(noisy, 0) << "no level of the oak takes holes";
+            EXPECT_LT(noisySum, plainSum);
             Result<EllipsoidTreeData> decoded = decodeEllipsoidTreeChunk(encodeEllipsoidTreeChunk(withNoise), "oak");
             ASSERT_TRUE(decoded.ok()) << decoded.error().message();
             for (std::size_t k = 0; k < withNoise.levels.size(); ++k)
@@ -625,10 +665,12 @@ namespace TreeLod
             EXPECT_NE(encodeEllipsoidTreeChunk(bakeOrFail(oak, other)), reference);
         }
 
-        // Each level's rendered coverage (from two side views the baker did not use) is within 20 %
-        // of the leaves' for one ellipsoid per leaf and within 50 % for the clusters (opaque
-        // ellipsoids against sparse leaves: the calibration minimises image error, not coverage,
-        // and measured 0.9 to 1.4 times the leaves' coverage on this oak).
+        // Each level's rendered coverage (from two side views the baker did not use) against the
+        // leaves': one ellipsoid per leaf measured 1.06 times it, the clusters 1.16 to 1.39 (opaque
+        // ellipsoids against sparse leaves: the calibration minimises image error, not coverage).
+        // The baker's own error of every level is at most 0.6 times that of an empty image in its
+        // views (measured 0.11 to 0.49 times). Ellipsoids at 0.8 times their scale measured 0.75 to
+        // 0.93 times the leaves' coverage.
         TEST(EllipsoidTreeBake, everyLevelCoversWhatTheLeavesCover)
         {
             const TreeModel& oak = generatedOak(256);
@@ -641,19 +683,36 @@ namespace TreeLod
                 for (std::size_t k = 0; k < d.levels.size(); ++k)
                 {
                     const double c = coverage(ellipsoidLevelMesh(d, k), leaves.boundsMin, leaves.boundsMax, azimuth);
-                    EXPECT_NEAR(c / reference, 1.0, k == 0 ? 0.2 : 0.5) << "level " << k << ", azimuth " << azimuth << ": " << c
-                                                          << " vs " << reference;
+                    if (k == 0)
+                        EXPECT_NEAR(c / reference, 1.06, 0.1) << "azimuth " << azimuth << ": " << c << " vs " << reference;
+                    else
+                    {
+                        EXPECT_GT(c / reference, 1.0) << "level " << k << ", azimuth " << azimuth;
+                        EXPECT_LT(c / reference, 1.55) << "level " << k << ", azimuth " << azimuth;
+                    }
                 }
             }
-            // The baker's own error: an empty image against the leaves' is about the RMSE of the
-            // coverage itself; every level must do much better.
-            const TreeModel none = ellipsoidLevelMesh(d, 0, 1e-6f);
-            const double emptyCoverage = coverage(none, leaves.boundsMin, leaves.boundsMax, 45.0f);
-            EXPECT_LT(emptyCoverage, 0.001);
+            // The baker's own error, against an empty image's in the baker's views.
+            const glm::vec3 lo = leaves.boundsMin, hi = leaves.boundsMax;
+            const RenderOptions options = EllipsoidErrorViews::renderOptions(EllipsoidTreeOptions().viewResolution);
+            const ReferenceRenderer renderer(leaves);
+            double empty = 0.0;
+            const std::vector<CameraSpec> views = EllipsoidErrorViews::cameras(0.5f * (lo + hi), 0.5f * glm::length(hi - lo));
+            for (const CameraSpec& c : views)
+            {
+                const Image image = renderer.render(c, options).colour;
+                Image black = image;
+                for (glm::vec4& p : black.pixels)
+                    p = glm::vec4(0, 0, 0, 1);
+                Result<MultiScaleRmseResult> e = multiScaleRmse(image, black);
+                ASSERT_TRUE(e.ok());
+                empty += e->combined;
+            }
+            empty /= double(views.size());
             for (std::size_t k = 0; k < d.levels.size(); ++k)
             {
                 EXPECT_GT(d.levels[k].imageError, 0.0f);
-                EXPECT_LT(d.levels[k].imageError, 0.25f) << "level " << k;
+                EXPECT_LT(d.levels[k].imageError, 0.6 * empty) << "level " << k << ", an empty image: " << empty;
                 EXPECT_GE(d.levels[k].scale, 0.3f); // leaves alpha-tested inside their quads: under 1
                 EXPECT_LE(d.levels[k].scale, 1.5f);
             }
