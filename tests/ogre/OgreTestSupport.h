@@ -131,12 +131,25 @@ namespace TreeLod
         return out;
     }
 
-    /// Mean FLIP error of `b` against `a`; 1 (and a test failure) when FLIP fails.
-    inline double flipMean(const Image& a, const Image& b)
+    /// Which pixels a FLIP mean is over: the whole image, or the tree's own (meanOverTree: tree
+    /// pixels in either image). A mean over the frame is at most the tree's share of it; a small
+    /// tree's images are compared over its pixels, so that a wrong tree can cross the bound.
+    enum class FlipOver
     {
-        Result<FlipResult> error = flip(a, b);
-        EXPECT_TRUE(error.ok());
-        return error.ok() ? error->mean : 1.0;
+        Frame,
+        Tree
+    };
+
+    /// Mean FLIP error of `b` against `a` over `over`'s pixels; 1 (and a test failure) when FLIP fails.
+    inline double flipMean(const Image& a, const Image& b, FlipOver over = FlipOver::Frame)
+    {
+        FlipOptions options;
+        options.keepErrorMap = over == FlipOver::Tree;
+        Result<FlipResult> error = flip(a, b, options);
+        EXPECT_TRUE(error.ok()) << (error.ok() ? "" : error.error().message());
+        if (!error.ok())
+            return 1.0;
+        return over == FlipOver::Tree ? meanOverTree(*error, a, b) : error->mean;
     }
 
     /// Mean Rec. 709 luminance of the stored (sRGB) values.
@@ -235,27 +248,6 @@ namespace TreeLod
             either += inA || inB;
         }
         return either ? double(both) / double(either) : 0.0;
-    }
-
-    /// Which pixels a FLIP mean is over: the whole image, or the tree's own (meanOverTree: tree
-    /// pixels in either image). A mean over the frame is at most the tree's share of it; a small
-    /// tree's images are compared over its pixels, so that a wrong tree can cross the bound.
-    enum class FlipOver
-    {
-        Frame,
-        Tree
-    };
-
-    /// FLIP's mean between `reference` and `test` over `over`'s pixels.
-    inline double flipMean(const Image& reference, const Image& test, FlipOver over)
-    {
-        FlipOptions options;
-        options.keepErrorMap = over == FlipOver::Tree;
-        Result<FlipResult> flipped = flip(reference, test, options);
-        EXPECT_TRUE(flipped.ok()) << (flipped.ok() ? "" : flipped.error().message());
-        if (!flipped.ok())
-            return 1.0;
-        return over == FlipOver::Tree ? meanOverTree(*flipped, reference, test) : flipped->mean;
     }
 
     /// `actual` against the golden image `golden` (a path), FLIP mean over `over`'s pixels below

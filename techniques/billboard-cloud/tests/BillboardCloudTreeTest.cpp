@@ -452,24 +452,25 @@ namespace TreeLod
         place(tree.asset, {}, "mesh");
         const Image reference = toImage(r.render(view, size, size, 2));
         const double coverage = treeCoverage(image, BACKGROUND);
-        const double error = flipMean(reference, image);
-        std::printf("%s: level %u coverage %.3f (reference %.3f), FLIP vs reference %.4f\n", name.c_str(), level,
-                    coverage, treeCoverage(reference, BACKGROUND), error);
+        const double error = flipMean(reference, image, FlipOver::Tree);
+        std::printf("%s: level %u coverage %.3f (reference %.3f), FLIP vs reference %.4f over the tree\n", name.c_str(),
+                    level, coverage, treeCoverage(reference, BACKGROUND), error);
         writePng(OgreEnvironment::outDir() + "/bc-" + name + "-vs-reference.png", sideBySide({reference, image}));
         EXPECT_GT(coverage, c.minCoverage) << name;
         EXPECT_LT(error, c.referenceBound) << name;
-        compareWithGolden(image, name, 0.02);
+        compareWithGolden(image, name, 0.05, FlipOver::Tree);
     }
 
     TEST(BillboardCloudTree, goldenBundledTrees)
     {
-        // FLIP against the reference measured 0.190 / 0.0091 (oak near / far), 0.106 / 0.0060
-        // (conifer), 0.047 / 0.0037 (birch): close up the leaves are where the reference has
-        // them only to the clustering's plane error, and AO darkens the crown (the reference
-        // has none); far away both are a few hundred pixels of foliage.
-        const GoldenCase cases[] = {{"oak", false, 0.3, 0.27},      {"oak", true, 0.02, 0.016},
-                                    {"conifer", false, 0.15, 0.17}, {"conifer", true, 0.01, 0.014},
-                                    {"birch", false, 0.09, 0.07},   {"birch", true, 0.008, 0.006}};
+        // FLIP against the reference over the tree's pixels measured 0.401 / 0.220 (oak near /
+        // far), 0.389 / 0.211 (conifer), 0.321 / 0.215 (birch); bounds about 15 % above. Close up
+        // the leaves are where the reference has them only to the clustering's plane error, and
+        // AO darkens the crown (the reference has none); far away both are a few hundred pixels
+        // of foliage. The low-res level drawn near measured 0.57-0.73, the tree black 0.67-0.88.
+        const GoldenCase cases[] = {{"oak", false, 0.3, 0.46},      {"oak", true, 0.02, 0.25},
+                                    {"conifer", false, 0.15, 0.45}, {"conifer", true, 0.01, 0.24},
+                                    {"birch", false, 0.09, 0.37},   {"birch", true, 0.008, 0.25}};
         for (const GoldenCase& c : cases)
             checkGolden(bundled(c.tree), std::string(c.tree) + "-billboardcloud-" + (c.far ? "far" : "near"), c);
     }
@@ -478,9 +479,9 @@ namespace TreeLod
     {
         const BakedTree& tree = generated50k();
         ASSERT_EQ(tree.model.leaves.size(), 50000u);
-        // FLIP against the reference measured 0.149 near, 0.0101 far.
-        checkGolden(tree, "oak50k-billboardcloud-near", {"oak50k", false, 0.3, 0.23});
-        checkGolden(tree, "oak50k-billboardcloud-far", {"oak50k", true, 0.02, 0.018});
+        // FLIP against the reference over the tree's pixels measured 0.299 near, 0.239 far.
+        checkGolden(tree, "oak50k-billboardcloud-near", {"oak50k", false, 0.3, 0.34});
+        checkGolden(tree, "oak50k-billboardcloud-far", {"oak50k", true, 0.02, 0.27});
     }
 
     TEST(BillboardCloudTree, goldenLeafAtlasAndSixLeafMaterials)
@@ -488,11 +489,11 @@ namespace TreeLod
         const BakedTree& tree = atlasOak();
         ASSERT_EQ(tree.model.materials.size(), 7u);
         // Every leaf shows its own atlas cell under its own material's cutoff. FLIP against the
-        // reference measured 0.202 near and 0.0091 far. Drawing the whole atlas on every leaf
+        // reference over the tree's pixels measured 0.420 near and 0.218 far. Drawing the whole atlas on every leaf
         // doubled the error (treelod_bc_study, tree-box FLIP at a quarter of the view: 0.223
         // against 0.110).
-        checkGolden(tree, "oak-atlas6-billboardcloud-near", {"oak-atlas6", false, 0.3, 0.27});
-        checkGolden(tree, "oak-atlas6-billboardcloud-far", {"oak-atlas6", true, 0.02, 0.016});
+        checkGolden(tree, "oak-atlas6-billboardcloud-near", {"oak-atlas6", false, 0.3, 0.48});
+        checkGolden(tree, "oak-atlas6-billboardcloud-far", {"oak-atlas6", true, 0.02, 0.25});
     }
 
     TEST(BillboardCloudTree, goldenFoldedLeaves)
@@ -500,9 +501,9 @@ namespace TreeLod
         const BakedTree& tree = foldedOak();
         ASSERT_EQ(tree.model.leaves[0].indexCount, 12u);
         // Each wing is a leaf of the cloud, showing its half of the leaf image. FLIP against the
-        // reference measured 0.170 near and 0.0090 far.
-        checkGolden(tree, "oak-folded45-billboardcloud-near", {"oak-folded45", false, 0.3, 0.2});
-        checkGolden(tree, "oak-folded45-billboardcloud-far", {"oak-folded45", true, 0.02, 0.012});
+        // reference over the tree's pixels measured 0.364 near and 0.225 far.
+        checkGolden(tree, "oak-folded45-billboardcloud-near", {"oak-folded45", false, 0.3, 0.42});
+        checkGolden(tree, "oak-folded45-billboardcloud-far", {"oak-folded45", true, 0.02, 0.26});
     }
 
     TEST(BillboardCloudTree, classicCloudRenders)
@@ -525,10 +526,12 @@ namespace TreeLod
         const Image reference = toImage(r.render(view, 256, 256, 2));
         placeCloud(oak.asset);
         const Image layered = toImage(r.render(view, 256, 256, 2));
-        // Measured against the reference: classic 0.225, multi-layered 0.215 (oak, equal memory).
-        const double error = flipMean(reference, image), layeredError = flipMean(reference, layered);
+        // Measured against the reference over the tree's pixels: classic 0.415, multi-layered 0.401
+        // (oak, equal memory).
+        const double error = flipMean(reference, image, FlipOver::Tree),
+                     layeredError = flipMean(reference, layered, FlipOver::Tree);
         std::printf("oak near, FLIP vs reference: classic %.4f, multi-layered %.4f\n", error, layeredError);
-        EXPECT_LT(error, 0.3);
+        EXPECT_LT(error, 0.47);
         writePng(OgreEnvironment::outDir() + "/bc-oak-reference-classic-layered.png",
                  sideBySide({reference, image, layered}));
         compareWithGolden(image, "oak-classicbillboardcloud-near", 0.02);

@@ -115,12 +115,16 @@ namespace TreeLod
             const double error = flipMean(cropImage(reference, crop), cropImage(ellipsoids, crop));
             std::printf("distance %.0f: level %zu of %zu, coverage %.4f (reference %.4f), FLIP %.4f\n", double(distance),
                         level, t.data.levels.size(), coverage, wanted, error);
-            EXPECT_GT(coverage, 0.5 * wanted) << "distance " << distance;
-            EXPECT_LT(coverage, 1.6 * wanted) << "distance " << distance;
-            EXPECT_GT(coveredOverlap(reference, ellipsoids, BACKGROUND), 0.5) << "distance " << distance;
-            // Measured 0.078 near (level 0, 160 px), 0.073 far (level 3), with the noise and the
-            // branches as lines; 2x2 supersampling draws the level of the 160 px output.
-            EXPECT_LT(error, distance > 1.0f ? 0.12 : 0.2) << "distance " << distance;
+            // Measured near (level 0, 160 px): coverage 0.995 times the mesh's, overlap 0.918, FLIP
+            // 0.078; far (level 3): 0.90, 0.809, 0.073; with the noise and the branches as lines,
+            // 2x2 supersampling drawing the level of the 160 px output. Levels forced wrong
+            // measured near 0.86-0.92 times the coverage and FLIP 0.19-0.22 (levels 2-5), far FLIP
+            // 0.107 (level 0) and 0.095 (level 5).
+            const bool near = distance == 1.0f;
+            EXPECT_GT(coverage, (near ? 0.93 : 0.8) * wanted) << "distance " << distance;
+            EXPECT_LT(coverage, (near ? 1.07 : 1.1) * wanted) << "distance " << distance;
+            EXPECT_GT(coveredOverlap(reference, ellipsoids, BACKGROUND), near ? 0.85 : 0.7) << "distance " << distance;
+            EXPECT_LT(error, near ? 0.1 : 0.09) << "distance " << distance;
             row.insert(row.end(), {reference, ellipsoids});
             if (distance == 1.0f)
                 compareWithGolden(ellipsoids, "oak-ellipsoids-near", 0.02);
@@ -180,7 +184,8 @@ namespace TreeLod
                     level, l.count, double(l.noiseThreshold), double(l.normalBlend), holes, holes + filled, holesDrawn,
                     filledDrawn);
         EXPECT_GT(double(holes), 0.01 * double(holes + filled)) << "the holes are not open";
-        EXPECT_GT(double(holesDrawn), 0.6 * double(holes)) << "drawn holes differ from the calibrated ones";
+        // Measured 113 of the twin's 116 hole pixels drawn as sky.
+        EXPECT_GT(double(holesDrawn), 0.9 * double(holes)) << "drawn holes differ from the calibrated ones";
         EXPECT_GT(double(filledDrawn), 0.97 * double(filled));
         compareWithGolden(drawn, "oak-ellipsoids-noise", 0.02);
     }
