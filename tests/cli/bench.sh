@@ -151,6 +151,13 @@ awk -F, 'NR > 1 && ($6 != 1 || $9 < 1 || $8 <= 0) { bad = 1; print } END { exit 
 # Sampled frames carry FLIP for every technique; the floor's error is larger than auto's at bias 1.
 n=$(awk -F, 'NR > 1 && $13 != ""' "$out/single/frames.csv" | wc -l)
 [ "$n" = 14 ] || fail "$n frames with FLIP, expected 2 samples x 7 runs = 14"
+python3 - "$out/single/summary.json" <<'EOF' || fail "the floor's error is not above auto's"
+import json, sys
+flip = {(r["technique"], r["lodBias"]): r["trade"]["meanFlip"] for r in json.load(open(sys.argv[1]))["results"]}
+floor, auto = flip[("impostor", 1)], flip[("auto", 1)]
+print(f"mean FLIP: one-quad floor {floor:.4f}, auto {auto:.4f}")
+sys.exit(0 if floor > 2 * auto else 1)  # measured 0.199 against 0.043
+EOF
 grep -q '"technique": "auto"' "$out/single/summary.json" || fail "summary lacks auto"
 grep -q '"speedupVsReference": [0-9]' "$out/single/summary.json" || fail "summary has no measured speedup"
 grep -q '"ratioToFloor": [0-9]' "$out/single/summary.json" || fail "summary has no ratio to the floor"

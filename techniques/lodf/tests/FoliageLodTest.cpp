@@ -869,12 +869,15 @@ namespace TreeLod
         EXPECT_FALSE(r.ok());
     }
 
-    TEST(LodfBuild, extremeCoordinatesDoNotCrashTheBaker)
+    TEST(LodfBuild, extremeCoordinatesStillCollapseEveryLeaf)
     {
         // Finite positions that validate but overflow float in the baker (leaf areas of 1e40,
         // centres 6e38 apart): every collapse cost of a cluster is NaN or inf; the baker then
-        // collapses the first live pair. Either an error or valid data is fine.
-        std::vector<LeafAt> big = scatter(10, 5), far = scatter(10, 5);
+        // collapses the first live pair. The structure is the one the same leaves give at
+        // ordinary coordinates: every leaf, one entry per leaf and per collapse, the same clusters
+        // and collapse count.
+        const std::vector<LeafAt> plain = scatter(10, 5);
+        std::vector<LeafAt> big = plain, far = plain;
         for (LeafAt& l : big)
         {
             l.centre *= 1e19f;
@@ -882,15 +885,20 @@ namespace TreeLod
         }
         for (std::size_t i = 0; i < far.size(); ++i)
             far[i].centre = glm::vec3(i % 2 ? 3e38f : -3e38f, 0.0f, 0.0f);
+        Result<FoliageLodData> ordinary = buildFoliageLod(quadLeaves(plain));
+        ASSERT_TRUE(ordinary.ok()) << ordinary.error().message();
         for (const std::vector<LeafAt>* leaves : {&big, &far})
         {
             const TreeModel m = quadLeaves(*leaves);
             ASSERT_TRUE(m.validate());
             Result<FoliageLodData> r = buildFoliageLod(m);
-            if (r)
-            {
-                EXPECT_TRUE(r->validate("extreme"));
-            }
+            ASSERT_TRUE(r.ok()) << r.error().message();
+            EXPECT_TRUE(r->validate("extreme"));
+            EXPECT_EQ(r->maxLeafCount(), 10u);
+            EXPECT_EQ(r->minLeafCount(), ordinary->minLeafCount());
+            EXPECT_EQ(r->entries.size(), ordinary->entries.size());
+            EXPECT_EQ(r->changedGroup.size(), ordinary->changedGroup.size());
+            EXPECT_EQ(r->indices.size(), ordinary->indices.size());
         }
     }
 

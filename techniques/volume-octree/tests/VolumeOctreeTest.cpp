@@ -383,7 +383,9 @@ namespace TreeLod
         EXPECT_NE(re.error().message().find("carved away"), std::string::npos) << re.error().message();
 
         // A camera inside the volume looks at leaves from within the crown; it only speaks for
-        // the cells wholly in front of it, and the reconstruction goes on.
+        // the cells wholly in front of it: the outside cameras get their images back as without it
+        // (measured within 0.6 %), with 311 of the 317 finest cells. The same camera seeing nothing
+        // (an empty matte) carves 73 of them, and one view loses 4.3 %.
         CaptureSet inside = full;
         const glm::dvec3 centre = 0.5 * (full.volumeMin + full.volumeMax);
         CameraSpec spec;
@@ -399,6 +401,17 @@ namespace TreeLod
         inside.images.push_back(ReferenceRenderer(generatedOak(400)).render(spec, ro).colour);
         Result<VolumeOctreeReconstruction> ri = reconstructVolumeOctree(inside, options, "inside");
         ASSERT_TRUE(ri) << ri.error().message();
+        Result<VolumeOctreeReconstruction> rf = reconstructVolumeOctree(full, options, "full");
+        ASSERT_TRUE(rf) << rf.error().message();
+        for (std::size_t c : {std::size_t(0), full.cameras.size() / 2})
+        {
+            const double with = coverage(renderTransparent(ri->octree, volumeOctreeRawSource(ri.value()),
+                                                           specOf(full.cameras[c]), full.cameras[c].width, 3));
+            const double without = coverage(renderTransparent(rf->octree, volumeOctreeRawSource(rf.value()),
+                                                              specOf(full.cameras[c]), full.cameras[c].width, 3));
+            EXPECT_NEAR(with / without, 1.0, 0.02) << "camera " << c;
+        }
+        EXPECT_GE(double(ri->levels[3].cells), 0.95 * double(rf->levels[3].cells));
         EXPECT_GT(ri->levels[3].billboards, 0u);
     }
 
