@@ -42,24 +42,10 @@ namespace TreeLod
     TEST(TechniqueDescriptor, inspectReadsWhatEachBakerWrote)
     {
         const TreeModel& tree = test::generatedOak(300);
-        // Smaller bakes than the defaults where those cost seconds (the volume octree's default
-        // reconstruction alone, 24 photographs of 256 px and 7 levels, is a minute of this test under
-        // the sanitizers): a chunk has the same layout at any size.
-        const std::map<std::string, BakeOptions> smaller = {
-            {"volume-octree", {{"cameras", "8"}, {"resolution", "64"}, {"levels", "4"}}},
-            {"ellipsoids", {{"tries", "1"}, {"viewResolution", "32"}}},
-            {"ellipsoid-lines", {{"viewResolution", "32"}}},
-            {"billboard-cloud", {{"clusteringTries", "1"}, {"aoRays", "4"}}},
-            {"classic-billboard-cloud", {{"clusteringTries", "1"}, {"aoRays", "4"}}},
-            {"octahedral-impostor", {{"framesPerSide", "4"}, {"frameResolution", "32"}, {"samplesPerPixel", "1"}}},
-            {"crossed-quads", {{"resolution", "64"}}},
-            {"impostor", {{"resolution", "64"}}}};
         for (const BakeTechnique& baker : bakeTechniques())
         {
             PackageWriter writer;
-            const auto options = smaller.find(baker.name);
-            Result<void> baked =
-                baker.bake(writer, tree, options == smaller.end() ? BakeOptions{} : options->second, "oak", {});
+            Result<void> baked = baker.bake(writer, tree, test::quickBakeOptions(baker.name), "oak", {});
             ASSERT_TRUE(baked.ok()) << baker.name << ": " << baked.error().message();
             Result<PackageReader> reader = PackageReader::fromMemory(writer.toBytes(), "oak.treelod");
             ASSERT_TRUE(reader.ok()) << reader.error().message();

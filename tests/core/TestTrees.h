@@ -98,5 +98,24 @@ namespace TreeLod
             out.updateBounds();
             return out;
         }
+
+        /// Bake options that keep a test's bake of a few hundred leaves within a second or two where
+        /// a technique's defaults cost more (the volume octree's default reconstruction, 24
+        /// photographs of 256 px and 7 levels, is a minute under the sanitizers): the chunk has the
+        /// same layout at any size. Empty for the others.
+        inline std::map<std::string, std::string> quickBakeOptions(const std::string& technique)
+        {
+            static const std::map<std::string, std::map<std::string, std::string>> quick = {
+                {"volume-octree", {{"cameras", "8"}, {"resolution", "64"}, {"levels", "4"}}},
+                {"ellipsoids", {{"tries", "1"}, {"viewResolution", "32"}}},
+                {"ellipsoid-lines", {{"viewResolution", "32"}}},
+                {"billboard-cloud", {{"clusteringTries", "1"}, {"aoRays", "4"}}},
+                {"classic-billboard-cloud", {{"clusteringTries", "1"}, {"aoRays", "4"}}},
+                {"octahedral-impostor", {{"framesPerSide", "4"}, {"frameResolution", "32"}, {"samplesPerPixel", "1"}}},
+                {"crossed-quads", {{"resolution", "64"}}},
+                {"impostor", {{"resolution", "64"}}}};
+            const auto found = quick.find(technique);
+            return found == quick.end() ? std::map<std::string, std::string>{} : found->second;
+        }
     }
 }
