@@ -99,6 +99,22 @@ namespace TreeLod
             return out;
         }
 
+        /// `m` with every vertex and skeleton node moved by `offset` (and its bounds and leaf records).
+        inline TreeModel translated(const TreeModel& m, const glm::vec3& offset)
+        {
+            TreeModel out = m;
+            for (Vertex& v : out.barkVertices)
+                v.position += offset;
+            for (Vertex& v : out.leafVertices)
+                v.position += offset;
+            for (SkeletonNode& n : out.skeleton)
+                n.position += offset;
+            for (std::size_t i = 0; i < out.leaves.size(); ++i)
+                out.updateLeafRecord(i);
+            out.updateBounds();
+            return out;
+        }
+
         /// Bake options that keep a test's bake of a few hundred leaves within a second or two where
         /// a technique's defaults cost more (the volume octree's default reconstruction, 24
         /// photographs of 256 px and 7 levels, is a minute under the sanitizers): the chunk has the

@@ -743,6 +743,52 @@ namespace TreeLod
             }
         }
 
+        // The oak 10 km from the origin (floats step by 1 mm there, a hundredth of a leaf's size):
+        // the same levels, scales and image errors. Level 0 is one ellipsoid per leaf: the same
+        // ones moved by the offset, the two large semi-axes as they were (the third, a leaf's
+        // thickness, is the floor of 2 % of its size, which a millimetre of rounding doubles); the
+        // coarser levels' clusters may settle elsewhere, as good.
+        TEST(EllipsoidTreeBake, farFromTheOriginTheSameEllipsoids)
+        {
+            const glm::vec3 offset(1.0e4f, 0.0f, -1.0e4f);
+            const EllipsoidTreeData a = bakeOrFail(generatedOak(128)), b = bakeOrFail(test::translated(generatedOak(128), offset));
+            ASSERT_EQ(a.levels.size(), b.levels.size());
+            for (std::size_t k = 0; k < a.levels.size(); ++k)
+            {
+                EXPECT_EQ(a.levels[k].count, b.levels[k].count) << "level " << k;
+                EXPECT_NEAR(a.levels[k].scale, b.levels[k].scale, 0.02f) << "level " << k;
+                EXPECT_NEAR(a.levels[k].imageError, b.levels[k].imageError, 2e-3f) << "level " << k;
+            }
+            ASSERT_EQ(a.ellipsoids.size(), b.ellipsoids.size());
+            double worstCentre = 0.0, worstRadius = 0.0;
+            for (std::uint32_t i = a.levels[0].first; i < a.levels[0].first + a.levels[0].count; ++i)
+            {
+                worstCentre = std::max(worstCentre, double(glm::distance(a.ellipsoids[i].centre + offset, b.ellipsoids[i].centre)));
+                glm::vec3 ra = a.ellipsoids[i].radii, rb = b.ellipsoids[i].radii;
+                std::sort(&ra[0], &ra[0] + 3);
+                std::sort(&rb[0], &rb[0] + 3);
+                for (int k = 1; k < 3; ++k)
+                    worstRadius = std::max(worstRadius, double(std::abs(ra[k] / rb[k] - 1.0f)));
+            }
+            EXPECT_LT(worstCentre, 0.005); // measured 1.4 mm
+            EXPECT_LT(worstRadius, 0.01);  // measured 0.1 %
+        }
+
+        // Leaves of zero area (a quad folded onto a line) among the oak's are left out: the bake is
+        // the oak's alone, byte for byte.
+        TEST(EllipsoidTreeBake, zeroAreaLeavesAmongNormalOnesAreLeftOut)
+        {
+            const TreeModel& oak = generatedOak(128);
+            TreeModel withDegenerate = oak;
+            const glm::vec3 centre = 0.5f * (oak.boundsMin + oak.boundsMax);
+            for (int i = 0; i < 16; ++i)
+                test::addQuadLeaf(withDegenerate, centre + glm::vec3(0.1f * float(i), 0.0f, 0.0f), glm::vec3(0.1f, 0, 0),
+                                  glm::vec3(0.0f), glm::vec3(0, 0, 1));
+            withDegenerate.updateBounds();
+            ASSERT_EQ(withDegenerate.leaves.size(), oak.leaves.size() + 16);
+            EXPECT_EQ(encodeEllipsoidTreeChunk(bakeOrFail(withDegenerate)), encodeEllipsoidTreeChunk(bakeOrFail(oak)));
+        }
+
         // §5's AO: none without rays (255); with rays the crown's inside is darker than its rim, the
         // last level's single ellipsoid (only the bark inside it) is open, and the values do not
         // depend on the thread count.
