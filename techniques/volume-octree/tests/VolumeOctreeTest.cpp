@@ -415,6 +415,57 @@ namespace TreeLod
         EXPECT_GT(ri->levels[3].billboards, 0u);
     }
 
+    // The oak at 0.5 m and at 500 m tall, and 10 km from the origin: the cameras frame the tree
+    // wherever it is and whatever its size, so the octree keeps the same cells and billboards at
+    // every level (within rounding at the cells' borders).
+    TEST(VolumeOctreeBake, scaleFreeAndFarFromTheOrigin)
+    {
+        const VolumeOctreeReconstruction& base = oakReconstruction();
+        const TreeModel& oak = generatedOak(400);
+        const TreeModel variants[] = {test::scaled(oak, 0.5f / oak.boundsMax.y), test::scaled(oak, 500.0f / oak.boundsMax.y),
+                                      test::translated(oak, glm::vec3(1.0e4f, 0.0f, -1.0e4f))};
+        const char* names[] = {"0.5 m", "500 m", "10 km away"};
+        for (std::size_t v = 0; v < 3; ++v)
+        {
+            SCOPED_TRACE(names[v]);
+            Result<CaptureSet> capture = synthesiseCaptureSet(variants[v], smallCapture(), names[v]);
+            ASSERT_TRUE(capture) << capture.error().message();
+            Result<VolumeOctreeReconstruction> r = reconstructVolumeOctree(capture.value(), smallOctree(), names[v]);
+            ASSERT_TRUE(r) << r.error().message();
+            ASSERT_EQ(r->levels.size(), base.levels.size());
+            for (std::size_t l = 0; l < base.levels.size(); ++l)
+            {
+                // Measured: the same cells at every level, 1 billboard more at level 3 (0.5 m); 10 km
+                // away 2 cells more and 7 billboards fewer of 15,328 at the finest.
+                EXPECT_NEAR(double(r->levels[l].cells), double(base.levels[l].cells), 0.005 * double(base.levels[l].cells) + 1.0)
+                    << "level " << l;
+                EXPECT_NEAR(double(r->levels[l].billboards), double(base.levels[l].billboards),
+                            0.005 * double(base.levels[l].billboards) + 1.0)
+                    << "level " << l;
+            }
+        }
+    }
+
+    // 200,000 leaves: the capture and the reconstruction do not depend on the leaf count (the
+    // cameras photograph the tree), the octree stays within its bound and gives its views back.
+    TEST(VolumeOctreeBake, twoHundredThousandLeaves)
+    {
+        const TreeModel& oak = generatedOak(200000);
+        Result<CaptureSet> capture = synthesiseCaptureSet(oak, smallCapture(8, 64), "200k");
+        ASSERT_TRUE(capture) << capture.error().message();
+        Result<VolumeOctreeReconstruction> r = reconstructVolumeOctree(capture.value(), smallOctree(4), "200k");
+        ASSERT_TRUE(r) << r.error().message();
+        for (std::size_t c = 0; c < capture->cameras.size(); c += 3)
+        {
+            const Image back = renderTransparent(r->octree, volumeOctreeRawSource(r.value()), specOf(capture->cameras[c]),
+                                                 capture->cameras[c].width, 3);
+            // Measured 0.996, 0.997 and 0.826 (from above) of the photographs' coverage.
+            EXPECT_NEAR(coverage(back) / coverage(capture->images[c]), 1.0, 0.25) << "camera " << c;
+        }
+        EXPECT_GT(r->octree.cells.size(), 100u);
+        EXPECT_LE(r->octree.cells.size(), smallOctree(4).maxCells);
+    }
+
     TEST(VolumeOctreeBake, extremeTrees)
     {
         // One flat leaf is invisible edge-on, and a visual hull cannot hold what a camera does not
