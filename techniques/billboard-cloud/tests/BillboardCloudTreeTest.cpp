@@ -458,7 +458,7 @@ namespace TreeLod
         writePng(OgreEnvironment::outDir() + "/bc-" + name + "-vs-reference.png", sideBySide({reference, image}));
         EXPECT_GT(coverage, c.minCoverage) << name;
         EXPECT_LT(error, c.referenceBound) << name;
-        compareWithGolden(image, name, 0.05, FlipOver::Tree);
+        compareWithGolden(image, name, 0.02);
     }
 
     TEST(BillboardCloudTree, goldenBundledTrees)
