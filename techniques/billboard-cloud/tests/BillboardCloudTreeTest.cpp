@@ -422,9 +422,9 @@ namespace TreeLod
         EXPECT_EQ(low->getMaterialLodIndex(), 1u);
         EXPECT_GT(treeCoverage(layers, BACKGROUND), 0.1);
         EXPECT_GT(treeCoverage(lowRes, BACKGROUND), 0.02);
-        const double difference = flipMean(layers, lowRes);
-        std::printf("every list walked vs low-res only: FLIP %.4f\n", difference); // measured 0.067
-        EXPECT_GT(difference, 0.03) << "the lists must change the picture";
+        const double difference = flipMean(layers, lowRes, FlipOver::Tree);
+        std::printf("every list walked vs low-res only: FLIP %.4f\n", difference); // over the tree, measured 0.370
+        EXPECT_GT(difference, 0.2) << "the lists must change the picture";
         writePng(OgreEnvironment::outDir() + "/bc-shader-lod.png", sideBySide({layers, lowRes}));
     }
 
@@ -647,10 +647,11 @@ namespace TreeLod
         }
         EXPECT_EQ(levels[0], levels[2]);
         EXPECT_EQ(levels[1], levels[3]);
-        const double nearError = flipMean(images[0], images[2]), farError = flipMean(images[1], images[3]);
+        const double nearError = flipMean(images[0], images[2], FlipOver::Tree),
+                     farError = flipMean(images[1], images[3], FlipOver::Tree);
         std::printf("0.5 m vs 500 m: FLIP near %.4f far %.4f\n", nearError, farError);
-        EXPECT_LT(nearError, 0.03);
-        EXPECT_LT(farError, 0.03);
+        EXPECT_LT(nearError, 0.03); // over the tree's pixels, measured 0.012
+        EXPECT_LT(farError, 0.03);  // measured 0.019
         EXPECT_GT(treeCoverage(images[0], BACKGROUND), 0.1);
         writePng(OgreEnvironment::outDir() + "/bc-scales.png", sideBySide(images));
     }

@@ -311,13 +311,13 @@ namespace TreeLod
             const double coverage = treeCoverage(impostors[i], BACKGROUND);
             const double reference = treeCoverage(references[i], BACKGROUND);
             EXPECT_NEAR(coverage, reference, 0.25 * reference) << "view " << i;
-            const double error = flipMean(references[i], impostors[i]);
+            const double error = flipMean(references[i], impostors[i], FlipOver::Tree);
             std::printf("view %zu: impostor width %d px, coverage %.3f (reference %.3f), FLIP %.4f\n", i, widths[i],
                         coverage, reference, error);
-            EXPECT_LT(error, 0.2) << "view " << i;
+            EXPECT_LT(error, 0.62) << "view " << i; // over the tree's pixels, measured 0.357-0.557
         }
         // From the side the bake saw (+Z), the picture is nearly the tree's own.
-        EXPECT_LT(flipMean(references[0], impostors[0]), flipMean(references[1], impostors[1]) + 0.02);
+        EXPECT_LT(flipMean(references[0], impostors[0], FlipOver::Tree), flipMean(references[1], impostors[1], FlipOver::Tree) + 0.02);
         compareWithGolden(impostors[1], "oak-impostor", 0.02); // turned 90 degrees from the bake
     }
 
@@ -353,7 +353,7 @@ namespace TreeLod
         for (std::size_t i = 0; i < trees.size(); ++i)
         {
             EXPECT_GT(treeCoverage(trees[i], BACKGROUND), 0.08) << "view " << i;
-            const double error = flipMean(quads[i], trees[i]);
+            const double error = flipMean(quads[i], trees[i], FlipOver::Tree);
             std::printf("view %zu: ImpostorTree against the instanced quad FLIP %.5f\n", i, error);
             EXPECT_LT(error, 0.002) << "view " << i;
         }
@@ -391,9 +391,9 @@ namespace TreeLod
         TreeAssetManager::getSingleton().remove(dxt);
         writePng(OgreEnvironment::outDir() + "/impostor-rgba8-vs-dxt.png", sideBySide(images));
         EXPECT_GT(treeCoverage(images[1], BACKGROUND), 0.08);
-        const double error = flipMean(images[0], images[1]);
+        const double error = flipMean(images[0], images[1], FlipOver::Tree);
         std::printf("DXT against RGBA8 impostor: FLIP %.4f\n", error);
-        EXPECT_LT(error, 0.03);
+        EXPECT_LT(error, 0.07); // over the tree's pixels, measured 0.058
     }
 
     // A missing asset parameter and an asset without the chunk are named.

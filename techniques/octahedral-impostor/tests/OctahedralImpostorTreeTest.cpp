@@ -92,27 +92,30 @@ namespace TreeLod
             const Image reference = renderObject("Entity", camera);
             const Image octahedral = renderObject(ImpostorTreeFactory::OCTAHEDRAL_TYPE_NAME, camera);
             const Image quad = renderObject(ImpostorTreeFactory::FACTORY_TYPE_NAME, camera);
-            const double errorOctahedral = flipMean(reference, octahedral), errorQuad = flipMean(reference, quad);
+            const double errorOctahedral = flipMean(reference, octahedral, FlipOver::Tree),
+                         errorQuad = flipMean(reference, quad, FlipOver::Tree);
             const double coverage = treeCoverage(octahedral, BACKGROUND), wanted = treeCoverage(reference, BACKGROUND);
             std::printf("azimuth %.0f, elevation %.0f: FLIP octahedral %.4f, quad %.4f; coverage %.3f (reference %.3f)\n",
                         double(views[i].azimuth), double(views[i].elevation), errorOctahedral, errorQuad, coverage,
                         wanted);
             EXPECT_GT(coverage, 0.08) << "view " << i;
             EXPECT_NEAR(coverage, wanted, 0.25 * wanted) << "view " << i;
-            EXPECT_LT(errorOctahedral, 0.15) << "view " << i;
+            EXPECT_LT(errorOctahedral, 0.62) << "view " << i; // over the tree's pixels, measured 0.363-0.556
             if (views[i].elevation < 30.0f)
             {
                 sideOctahedral += errorOctahedral;
                 sideQuad += errorQuad;
             }
             else // from above the cylindrical quad foreshortens; the octahedral frames see the crown
-                EXPECT_LT(errorOctahedral, errorQuad - 0.02) << "view " << i;
+                EXPECT_LT(errorOctahedral, errorQuad - 0.2) << "view " << i; // measured 0.30 and 0.40 less
             row.insert(row.end(), {reference, octahedral, quad});
             if (i == 3)
                 compareWithGolden(octahedral, "oak-octahedral-impostor", 0.02);
         }
-        // From the side, about as good as the quad or better.
-        EXPECT_LT(sideOctahedral, sideQuad + 0.01);
+        // From the side, about as good as the quad, which was baked from the first of these views:
+        // over the tree's pixels, the three side views summed 1.472 against the quad's 1.436 (its
+        // own view 0.440 against 0.357, the others 0.476 and 0.556 against 0.497 and 0.572).
+        EXPECT_LT(sideOctahedral, sideQuad + 0.06);
         writePng(OgreEnvironment::outDir() + "/octahedral-impostor-views.png", sideBySide(row));
     }
 
@@ -170,9 +173,10 @@ namespace TreeLod
             return image;
         };
         const Image turned = forest(false, turn), referenceTurned = reference(turn), referenceStraight = reference(0.0f);
-        const double error = flipMean(referenceTurned, turned), unturned = flipMean(referenceStraight, turned);
+        const double error = flipMean(referenceTurned, turned, FlipOver::Tree),
+                     unturned = flipMean(referenceStraight, turned, FlipOver::Tree);
         std::printf("forest level: FLIP %.4f against the turned meshes, %.4f against unturned ones\n", error, unturned);
-        EXPECT_LT(error, 0.1);
+        EXPECT_LT(error, 0.1); // over the pixels other than sky (the ground too), measured 0.082
         EXPECT_LT(error, unturned); // the rotation shows
 
         const Image shadowed = forest(true, turn);
