@@ -48,14 +48,8 @@ namespace TreeLod
         /// `technique`'s object of the oak at `at`, seen from `camera` moved by `at`, without shadows.
         Image renderTechniqueAt(const std::string& technique, const glm::vec3& at, CameraSpec camera)
         {
-            static int serial = 0;
             OffscreenRenderer& r = OgreEnvironment::renderer();
-            r.clearContent();
-            r.setShadows(false);
-            r.setLodBias(1.0f);
-            Ogre::MovableObject* object = TechniqueRegistry::getSingleton().createInstance(
-                technique, r.getSceneManager(), "every-" + std::to_string(serial++), *everyTechniqueOak().asset);
-            r.getContentNode().createChildSceneNode(Ogre::Vector3(at.x, at.y, at.z))->attachObject(object);
+            placeTechnique(technique, *everyTechniqueOak().asset, {}, Ogre::Vector3(at.x, at.y, at.z));
             camera.position += at;
             camera.target += at;
             Image image = toImage(r.render(camera, 128, 128, 1));

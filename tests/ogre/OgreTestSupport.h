@@ -6,6 +6,7 @@
 #include "TreeLod/ImageMetrics.h"
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/RgbaImageConversion.h"
+#include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeViews.h"
 
 #include <OgreMovableObject.h>
@@ -210,6 +211,23 @@ namespace TreeLod
             .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
         std::filesystem::rename(temp, path);
         return bytes;
+    }
+
+    /// A fresh object of `technique` (TechniqueRegistry) for `asset` in a scene node at `at` under
+    /// the content node; the content is cleared first, shadows off, the LoD bias 1.
+    inline Ogre::MovableObject* placeTechnique(const std::string& technique, TreeAsset& asset,
+                                               const Ogre::NameValuePairList& params = {},
+                                               const Ogre::Vector3& at = Ogre::Vector3::ZERO)
+    {
+        static int serial = 0;
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        r.clearContent();
+        r.setShadows(false);
+        r.setLodBias(1.0f);
+        Ogre::MovableObject* object = TechniqueRegistry::getSingleton().createInstance(
+            technique, r.getSceneManager(), technique + "-" + std::to_string(serial++), asset, params);
+        r.getContentNode().createChildSceneNode(at)->attachObject(object);
+        return object;
     }
 
     /// Query flags: with flags 0x4, `object` is found by a ray query along `ray` with mask 0x4

@@ -134,15 +134,7 @@ namespace TreeLod
         Ogre::MovableObject* place(const TreeAssetPtr& asset, const Ogre::NameValuePairList& params = {},
                                    const char* technique = BILLBOARD_CLOUD_CHUNK)
         {
-            static int serial = 0;
-            OffscreenRenderer& r = OgreEnvironment::renderer();
-            r.clearContent();
-            r.setShadows(false);
-            r.setLodBias(1.0f);
-            Ogre::MovableObject* object = TechniqueRegistry::getSingleton().createInstance(
-                technique, r.getSceneManager(), "bc-" + std::to_string(serial++), *asset, params);
-            r.getContentNode().createChildSceneNode()->attachObject(object);
-            return object;
+            return placeTechnique(technique, *asset, params);
         }
 
         BillboardCloudTree* placeCloud(const TreeAssetPtr& asset, const Ogre::NameValuePairList& params = {})

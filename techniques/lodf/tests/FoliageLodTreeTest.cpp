@@ -54,15 +54,7 @@ namespace TreeLod
         /// A fresh FoliageLodTree for `asset` under the content node (the content is cleared).
         FoliageLodTree* place(const TreeAssetPtr& asset, const Ogre::NameValuePairList& params = {})
         {
-            static int serial = 0;
-            OffscreenRenderer& r = OgreEnvironment::renderer();
-            r.clearContent();
-            r.setShadows(false);
-            r.setLodBias(1.0f);
-            Ogre::MovableObject* object = TechniqueRegistry::getSingleton().createInstance(
-                "lodf", r.getSceneManager(), "lodf-" + std::to_string(serial++), *asset, params);
-            r.getContentNode().createChildSceneNode()->attachObject(object);
-            return static_cast<FoliageLodTree*>(object);
+            return static_cast<FoliageLodTree*>(placeTechnique(FOLIAGE_LOD_CHUNK, *asset, params));
         }
 
         CameraSpec camera(const TreeModel& model, const std::string& text)
