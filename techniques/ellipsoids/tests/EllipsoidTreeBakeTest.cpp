@@ -352,6 +352,13 @@ namespace TreeLod
             return d;
         }
 
+        /// The 128-leaf oak's bake, shared by the tests that compare a variant of it with it.
+        const EllipsoidTreeData& smallOakBake()
+        {
+            static const EllipsoidTreeData d = bakeOrFail(generatedOak(128));
+            return d;
+        }
+
         /// Mean white over an image (flat white on black: the covered share).
         double meanWhite(const Image& image)
         {
@@ -751,7 +758,8 @@ namespace TreeLod
         TEST(EllipsoidTreeBake, farFromTheOriginTheSameEllipsoids)
         {
             const glm::vec3 offset(1.0e4f, 0.0f, -1.0e4f);
-            const EllipsoidTreeData a = bakeOrFail(generatedOak(128)), b = bakeOrFail(test::translated(generatedOak(128), offset));
+            const EllipsoidTreeData& a = smallOakBake();
+            const EllipsoidTreeData b = bakeOrFail(test::translated(generatedOak(128), offset));
             ASSERT_EQ(a.levels.size(), b.levels.size());
             for (std::size_t k = 0; k < a.levels.size(); ++k)
             {
@@ -786,7 +794,7 @@ namespace TreeLod
                                   glm::vec3(0.0f), glm::vec3(0, 0, 1));
             withDegenerate.updateBounds();
             ASSERT_EQ(withDegenerate.leaves.size(), oak.leaves.size() + 16);
-            EXPECT_EQ(encodeEllipsoidTreeChunk(bakeOrFail(withDegenerate)), encodeEllipsoidTreeChunk(bakeOrFail(oak)));
+            EXPECT_EQ(encodeEllipsoidTreeChunk(bakeOrFail(withDegenerate)), encodeEllipsoidTreeChunk(smallOakBake()));
         }
 
         // §5's AO: none without rays (255); with rays the crown's inside is darker than its rim, the
