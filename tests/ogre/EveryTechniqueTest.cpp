@@ -13,7 +13,7 @@
 
 #include <cstdio>
 
-namespace TreeLod
+namespace TreeLod::EveryTechniqueTests
 {
     namespace
     {

@@ -297,15 +297,15 @@ namespace TreeLod
         EXPECT_LT(mean, bound) << name << " (over the tree's pixels): see " << actualPath;
     }
 
-#ifndef TREELOD_GOLDEN_DIR
-#define TREELOD_GOLDEN_DIR "tests/golden" // a technique's tests: its golden/ folder (tests/ogre/CMakeLists.txt)
-#endif
-    /// compareWithGoldenFile with TREELOD_GOLDEN_DIR/NAME.png. Static: the folder is the including
-    /// source's own.
-    static inline void compareWithGolden(const Image& actual, const std::string& name, double bound)
+    /// compareWithGoldenFile with NAME.png in the calling test source's golden folder: `golden/`
+    /// beside the folder the source is in (techniques/<name>/golden for techniques/<name>/tests/,
+    /// tests/golden for tests/ogre/ and tests/browser/).
+    inline void compareWithGolden(const Image& actual, const std::string& name, double bound,
+                                  const char* caller = __builtin_FILE())
     {
-        compareWithGoldenFile(actual, OgreEnvironment::sourcePath(std::string(TREELOD_GOLDEN_DIR) + "/" + name + ".png"),
-                              name, bound);
+        // __builtin_FILE() is relative to the source tree (-fmacro-prefix-map, CMakeLists.txt).
+        const std::filesystem::path folder = std::filesystem::path(caller).parent_path().parent_path() / "golden";
+        compareWithGoldenFile(actual, OgreEnvironment::sourcePath((folder / (name + ".png")).string()), name, bound);
     }
 
     /// A tree object's Entity-style mesh LoD bias, seen through callbacks: set it, read the

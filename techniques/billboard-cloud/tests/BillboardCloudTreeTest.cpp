@@ -31,7 +31,7 @@
 #include <iterator>
 #include <map>
 
-namespace TreeLod
+namespace TreeLod::BillboardCloudTreeTests
 {
     namespace
     {
@@ -649,7 +649,7 @@ namespace TreeLod
     }
 }
 
-namespace TreeLod
+namespace TreeLod::BillboardCloudTreeTests
 {
     TEST(BillboardCloudTree, meshLodBiasActsAsEntitysOnTheCloudLevel)
     {

@@ -24,7 +24,7 @@
 #include <numeric>
 #include <set>
 
-namespace TreeLod
+namespace TreeLod::EllipsoidTreeTests
 {
     namespace
     {
@@ -468,7 +468,7 @@ namespace TreeLod
     }
 }
 
-namespace TreeLod
+namespace TreeLod::EllipsoidTreeTests
 {
     TEST(EllipsoidTree, meshLodBiasActsAsEntitysOnTheEllipsoidLevel)
     {

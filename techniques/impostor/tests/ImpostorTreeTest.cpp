@@ -25,7 +25,7 @@
 
 #include <cmath>
 
-namespace TreeLod
+namespace TreeLod::ImpostorTreeTests
 {
     namespace
     {
@@ -485,7 +485,7 @@ namespace TreeLod
     }
 }
 
-namespace TreeLod
+namespace TreeLod::ImpostorTreeTests
 {
     TEST(Impostor, materialLodBiasActsAsEntitys)
     {

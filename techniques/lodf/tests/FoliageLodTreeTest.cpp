@@ -17,7 +17,7 @@
 
 #include <random>
 
-namespace TreeLod
+namespace TreeLod::FoliageLodTreeTests
 {
     namespace
     {
@@ -375,7 +375,7 @@ namespace TreeLod
     }
 }
 
-namespace TreeLod
+namespace TreeLod::FoliageLodTreeTests
 {
     TEST(FoliageLodTree, meshLodBiasScalesTheCurveAndClampsTheBark)
     {

@@ -20,7 +20,7 @@
 
 #include <cmath>
 
-namespace TreeLod
+namespace TreeLod::OctahedralImpostorTreeTests
 {
     namespace
     {

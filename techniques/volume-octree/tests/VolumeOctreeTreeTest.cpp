@@ -20,7 +20,7 @@
 #include <OgreMeshManager.h>
 #include <OgreSceneManager.h>
 
-namespace TreeLod
+namespace TreeLod::VolumeOctreeTreeTests
 {
     namespace
     {
@@ -589,7 +589,7 @@ namespace TreeLod
     }
 }
 
-namespace TreeLod
+namespace TreeLod::VolumeOctreeTreeTests
 {
     TEST(VolumeOctreeTree, photographedTreeDrawsAsVolumeOctreeOnly)
     {
@@ -664,7 +664,7 @@ namespace TreeLod
     }
 }
 
-namespace TreeLod
+namespace TreeLod::VolumeOctreeTreeTests
 {
     TEST(VolumeOctreeTree, meshLodBiasActsAsEntitysOnTheActiveLevel)
     {
