@@ -44,6 +44,20 @@ namespace TreeLod
             return r.ok() ? std::move(r).value() : EllipsoidTreeData();
         }
 
+        /// The 256-leaf oak's bake (fastOptions), shared by the suite's tests.
+        const EllipsoidTreeData& oakBake()
+        {
+            static const EllipsoidTreeData d = bakeOrFail(generatedOak(256));
+            return d;
+        }
+
+        /// The 128-leaf oak's bake, shared by the tests that compare a variant of it with it.
+        const EllipsoidTreeData& smallOakBake()
+        {
+            static const EllipsoidTreeData d = bakeOrFail(generatedOak(128));
+            return d;
+        }
+
         TreeModel emptyLeafModel()
         {
             TreeModel m;
@@ -289,7 +303,7 @@ namespace TreeLod
         TEST(EllipsoidTreeBake, levelCountsFollowTheDivisor)
         {
             const TreeModel& oak = generatedOak(256);
-            const EllipsoidTreeData d = bakeOrFail(oak);
+            const EllipsoidTreeData& d = oakBake();
             const std::uint32_t targets[] = {256, 64, 16, 4, 1};
             ASSERT_EQ(d.levels.size(), 5u);
             for (std::size_t k = 0; k < 5; ++k)
@@ -344,19 +358,6 @@ namespace TreeLod
             Result<EllipsoidTreeData> back = decodeEllipsoidTreeChunk(bytes, "200k");
             ASSERT_TRUE(back.ok()) << back.error().message();
             EXPECT_EQ(back->ellipsoids.size(), d.ellipsoids.size());
-        }
-
-        const EllipsoidTreeData& oakBake()
-        {
-            static const EllipsoidTreeData d = bakeOrFail(generatedOak(256));
-            return d;
-        }
-
-        /// The 128-leaf oak's bake, shared by the tests that compare a variant of it with it.
-        const EllipsoidTreeData& smallOakBake()
-        {
-            static const EllipsoidTreeData d = bakeOrFail(generatedOak(128));
-            return d;
         }
 
         /// Mean white over an image (flat white on black: the covered share).
