@@ -246,7 +246,7 @@ namespace TreeLod
         sm.destroyQuery(query);
     }
 
-    // Golden images: each render is compared with GOLDEN_DIR/NAME.png by FLIP, its mean over the
+    // Golden images: each render is compared with NAME.png in its golden folder by FLIP, its mean over the
     // tree's own pixels (what differs from the sky in either image, meanOverTree) below the bound
     // stated per test, so that a small tree's picture is judged where it is; with
     // TREELOD_GOLDEN=update the goldens are rewritten
@@ -303,9 +303,11 @@ namespace TreeLod
     inline void compareWithGolden(const Image& actual, const std::string& name, double bound,
                                   const char* caller = __builtin_FILE())
     {
-        // __builtin_FILE() is relative to the source tree (-fmacro-prefix-map, CMakeLists.txt).
+        // __builtin_FILE() is relative to the source tree (-fmacro-prefix-map, CMakeLists.txt) for
+        // the project's sources, absolute for others.
         const std::filesystem::path folder = std::filesystem::path(caller).parent_path().parent_path() / "golden";
-        compareWithGoldenFile(actual, OgreEnvironment::sourcePath((folder / (name + ".png")).string()), name, bound);
+        const std::string golden = (folder / (name + ".png")).string();
+        compareWithGoldenFile(actual, folder.is_absolute() ? golden : OgreEnvironment::sourcePath(golden), name, bound);
     }
 
     /// A tree object's Entity-style mesh LoD bias, seen through callbacks: set it, read the
