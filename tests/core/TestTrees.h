@@ -80,17 +80,18 @@ namespace TreeLod
             m.updateLeafRecord(m.leaves.size() - 1);
         }
 
-        /// `m` with every vertex and skeleton node multiplied by `s` (and its bounds and leaf records).
-        inline TreeModel scaled(const TreeModel& m, float s)
+        /// `m` with every vertex and skeleton node at `s * position + offset`, skeleton radii times
+        /// `s` (and its bounds and leaf records).
+        inline TreeModel transformed(const TreeModel& m, float s, const glm::vec3& offset)
         {
             TreeModel out = m;
             for (Vertex& v : out.barkVertices)
-                v.position *= s;
+                v.position = s * v.position + offset;
             for (Vertex& v : out.leafVertices)
-                v.position *= s;
+                v.position = s * v.position + offset;
             for (SkeletonNode& n : out.skeleton)
             {
-                n.position *= s;
+                n.position = s * n.position + offset;
                 n.radius *= s;
             }
             for (std::size_t i = 0; i < out.leaves.size(); ++i)
@@ -99,21 +100,11 @@ namespace TreeLod
             return out;
         }
 
-        /// `m` with every vertex and skeleton node moved by `offset` (and its bounds and leaf records).
-        inline TreeModel translated(const TreeModel& m, const glm::vec3& offset)
-        {
-            TreeModel out = m;
-            for (Vertex& v : out.barkVertices)
-                v.position += offset;
-            for (Vertex& v : out.leafVertices)
-                v.position += offset;
-            for (SkeletonNode& n : out.skeleton)
-                n.position += offset;
-            for (std::size_t i = 0; i < out.leaves.size(); ++i)
-                out.updateLeafRecord(i);
-            out.updateBounds();
-            return out;
-        }
+        /// `m` scaled by `s` about the origin.
+        inline TreeModel scaled(const TreeModel& m, float s) { return transformed(m, s, glm::vec3(0.0f)); }
+
+        /// `m` moved by `offset`.
+        inline TreeModel translated(const TreeModel& m, const glm::vec3& offset) { return transformed(m, 1.0f, offset); }
 
         /// Bake options that keep a test's bake of a few hundred leaves within a second or two where
         /// a technique's defaults cost more (the volume octree's default reconstruction, 24
