@@ -110,8 +110,10 @@ namespace TreeLod
                     TreeAssetPtr asset = TreeAssetManager::getSingleton().loadFromBytes(
                         input->name, Ogre::RGN_DEFAULT, input->packageBytes);
                     Ogre::NameValuePairList params;
-                    for (const auto& [flag, value] : args.techniqueParams)
+                    for (const auto& flagValue : args.techniqueParams)
                     {
+                        const std::string& flag = flagValue.first;
+                        const std::string& value = flagValue.second;
                         if (value.empty())
                             continue;
                         const auto& declared = technique->roles.parameters;
