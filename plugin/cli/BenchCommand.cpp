@@ -51,6 +51,7 @@
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/OgreBootstrap.h"
 #include "TreeLod/TechniqueRegistry.h"
+#include "TreeLod/TreeViews.h"
 
 #include <cerrno>
 #include <cstring>
@@ -121,8 +122,15 @@ namespace TreeLod
             if (!timings.value("complete", true))
                 std::fprintf(stderr, "treelod: %s: incomplete (the frame timer stopped after %zu runs); reporting those\n",
                              path.c_str(), timings["runs"].size());
-            auto load = [&](const std::string& stem) -> Result<Image> {
-                return readImage(directory + "/images/" + stem + ".png");
+            // A saved frame and the next one: DIR/images/STEM.png and STEM-next.png.
+            auto loadPair = [&](const std::string& stem) -> Result<std::pair<Image, Image>> {
+                Result<Image> image = readImage(directory + "/images/" + stem + ".png");
+                if (!image)
+                    return image.error();
+                Result<Image> next = readImage(directory + "/images/" + stem + "-next.png");
+                if (!next)
+                    return next.error();
+                return std::make_pair(std::move(*image), std::move(*next));
             };
             std::vector<Run> runs;
             for (const nlohmann::json& r : timings["runs"])
@@ -136,6 +144,7 @@ namespace TreeLod
                 run.rssMiB = r.value("rssMiB", NAN);
                 run.peakRssMiB = r.value("peakRssMiB", NAN);
                 run.skipped = r.value("skipped", "");
+                run.motionStepSeconds = timings.value("motionStepSeconds", 0.0);
                 for (const nlohmann::json& f : r["frames"])
                 {
                     FrameRecord record;
@@ -153,18 +162,29 @@ namespace TreeLod
                         record.levels = f.value("levels", std::vector<std::uint32_t>{});
                         record.uploadedBytes = f.value("uploadedBytes", std::uint64_t(0));
                     }
+                    if (f.contains("motionImage"))
+                    {
+                        // Temporal error over the trees' pixels (drawn against the background).
+                        Result<std::pair<Image, Image>> pair = loadPair(f["motionImage"]);
+                        if (!pair)
+                            return pair.error();
+                        const auto& [image, next] = *pair;
+                        FlipOptions options;
+                        options.keepErrorMap = true;
+                        if (Result<FlipResult> m = flip(image, next, options))
+                            record.temporalFlip = meanOverTree(*m, image, next);
+                        record.switches = f.value("motionSwitches", std::int64_t(-1));
+                        record.switchVisible = f.value("motionVisible", std::int64_t(-1));
+                    }
                     std::map<std::uint32_t, ReferenceSample>& refs = references[run.count];
                     if (f.contains("referenceImage"))
                     {
-                        const std::string stem = f["referenceImage"];
-                        Result<Image> image = load(stem), next = load(stem + "-next");
-                        if (!image)
-                            return image.error();
-                        if (!next)
-                            return next.error();
+                        Result<std::pair<Image, Image>> pair = loadPair(f["referenceImage"]);
+                        if (!pair)
+                            return pair.error();
                         ReferenceSample sample;
-                        sample.image = std::move(*image);
-                        if (Result<MultiScaleRmseResult> m = multiScaleRmse(sample.image, *next))
+                        sample.image = std::move(pair->first);
+                        if (Result<MultiScaleRmseResult> m = multiScaleRmse(sample.image, pair->second))
                             sample.temporalNoise = m->combined;
                         refs[record.frame] = std::move(sample);
                     }
@@ -173,16 +193,15 @@ namespace TreeLod
                         const std::string stem = f["image"];
                         if (auto it = refs.find(record.frame); it != refs.end())
                         {
-                            Result<Image> image = load(stem), next = load(stem + "-next");
-                            if (!image)
-                                return image.error();
-                            if (!next)
-                                return next.error();
-                            if (Result<FlipResult> m = flip(it->second.image, *image))
+                            Result<std::pair<Image, Image>> pair = loadPair(stem);
+                            if (!pair)
+                                return pair.error();
+                            const auto& [image, next] = *pair;
+                            if (Result<FlipResult> m = flip(it->second.image, image))
                                 record.flip = m->mean;
-                            if (Result<MultiScaleRmseResult> m = multiScaleRmse(it->second.image, *image))
+                            if (Result<MultiScaleRmseResult> m = multiScaleRmse(it->second.image, image))
                                 record.msRmse = m->combined;
-                            if (Result<MultiScaleRmseResult> m = multiScaleRmse(*image, *next))
+                            if (Result<MultiScaleRmseResult> m = multiScaleRmse(image, next))
                                 record.temporalNoise = m->combined;
                         }
                         else
@@ -306,7 +325,7 @@ namespace TreeLod
                                                 std::to_string(frames), "--upload-budget",
                                                 std::to_string(args.uploadBudget), "--shadow-size",
                                                 std::to_string(args.shadowSize), "--shadow-lod-bias",
-                                                number(args.shadowLodBias, 8)};
+                                                number(args.shadowLodBias, 8), "--motion-frames", args.motionFrames};
             if (!args.counts.empty())
                 command.insert(command.end(), {"--counts", args.counts});
             if (args.quiet)
@@ -384,6 +403,11 @@ namespace TreeLod
             ->capture_default_str();
         cmd->add_option("--upload-budget", args->uploadBudget,
                         "bytes of Forest levels built per frame (0 = no limit); levels waiting draw a coarser one")
+            ->capture_default_str();
+        cmd->add_option("--motion-frames", args->motionFrames,
+                        "frames measured in motion: FLIP between the frame and the next at the script's frame rate "
+                        "over the trees' pixels, and the level switches between them; all, or a count evenly along "
+                        "the path (0: none)")
             ->capture_default_str();
         cmd->add_option("--cache", args->cacheDirectory, "bake cache directory (default: $XDG_CACHE_HOME/treelod)");
         cmd->add_flag("--bake-only", args->bakeOnly,

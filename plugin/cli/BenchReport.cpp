@@ -232,6 +232,58 @@ namespace TreeLod
             return run.technique + (run.lodBias == 1.0f ? "" : "@" + number(run.lodBias, 3));
         }
 
+        /// Mean temporal FLIP of `run` over its motion frames (NaN without any).
+        double meanTemporalFlip(const Run& run)
+        {
+            std::vector<double> values;
+            for (const FrameRecord& r : run.frames)
+                values.push_back(r.temporalFlip);
+            return statsOf(values).mean;
+        }
+
+        /// What `run` does in motion (summary.json's "motion"): its temporal FLIP over the motion
+        /// frames with the worst one; the reference's over the frames both measured, and the
+        /// ratios of the means and of the worst frames there; level switches per visible tree per
+        /// second of the path (null where not counted).
+        nlohmann::json motionJson(const Run& run, const Run* reference)
+        {
+            using nlohmann::json;
+            std::vector<double> all, own, ref;
+            json worst = nullptr;
+            std::int64_t switches = 0, visible = 0;
+            bool counted = false;
+            for (std::size_t f = 0; f < run.frames.size(); ++f)
+            {
+                const FrameRecord& r = run.frames[f];
+                if (!std::isfinite(r.temporalFlip))
+                    continue;
+                all.push_back(r.temporalFlip);
+                if (worst.is_null() || r.temporalFlip > worst["temporalFlip"].get<double>())
+                    worst = {{"frame", r.frame}, {"time", r.time}, {"temporalFlip", r.temporalFlip}};
+                if (r.switches >= 0 && r.switchVisible >= 0)
+                {
+                    switches += r.switches;
+                    visible += r.switchVisible;
+                    counted = true;
+                }
+                if (reference && f < reference->frames.size() && std::isfinite(reference->frames[f].temporalFlip))
+                {
+                    own.push_back(r.temporalFlip);
+                    ref.push_back(reference->frames[f].temporalFlip);
+                }
+            }
+            const Stats stats = statsOf(all), ownShared = statsOf(own), refShared = statsOf(ref);
+            const bool rate = counted && visible > 0 && run.motionStepSeconds > 0.0;
+            return {{"temporalFlip", {{"mean", num(stats.mean)}, {"max", num(stats.max)}, {"frames", stats.count}}},
+                    {"worstFrame", worst},
+                    {"reference", {{"mean", num(refShared.mean)}, {"max", num(refShared.max)}, {"frames", refShared.count}}},
+                    {"meanOverReference", num(ownShared.mean / refShared.mean)},
+                    {"worstOverReference", num(ownShared.max / refShared.max)},
+                    {"levelSwitches", counted ? json(switches) : json(nullptr)},
+                    {"switchesPerTreePerSecond",
+                     rate ? num(double(switches) / double(visible) / run.motionStepSeconds) : json(nullptr)}};
+        }
+
         bool writeOutputs(const BenchArgs& args, const SceneScript& script, std::uint32_t frames, int width, int height,
                           const std::vector<Run>& runs,
                           const std::map<std::uint32_t, std::map<std::uint32_t, ReferenceSample>>& references,
@@ -239,7 +291,8 @@ namespace TreeLod
         {
             // frames.csv: one row per run and frame.
             std::string csv = "trees,technique,lod_bias,frame,time_s,timed,cpu_ms,frame_ms,batches,triangles,visible,"
-                              "instances_per_level,flip,ms_rmse,temporal_noise,skipped,uploaded_bytes\n";
+                              "instances_per_level,flip,ms_rmse,temporal_noise,temporal_flip,level_switches,skipped,"
+                              "uploaded_bytes\n";
             for (const Run& run : runs)
                 for (const FrameRecord& r : run.frames)
                     csv += std::to_string(run.count) + "," + run.technique + "," + number(run.lodBias, 3) + "," +
@@ -249,7 +302,8 @@ namespace TreeLod
                            (r.timed ? std::to_string(r.timing.batches) : "") + "," +
                            (r.timed ? std::to_string(r.timing.triangles) : "") + "," +
                            (r.timed ? std::to_string(r.visible) : "") + "," + levelsText(r.levels) + "," +
-                           number(r.flip) + "," + number(r.msRmse) + "," + number(r.temporalNoise) + ",\"" +
+                           number(r.flip) + "," + number(r.msRmse) + "," + number(r.temporalNoise) + "," +
+                           number(r.temporalFlip) + "," + (r.switches >= 0 ? std::to_string(r.switches) : "") + ",\"" +
                            r.skipped + "\"," + (r.timed ? std::to_string(r.uploadedBytes) : "") + "\n";
             if (Result<void> w = writeText(args.output + "/frames.csv", csv); !w)
                 return printError(w.error()), false;
@@ -289,7 +343,8 @@ namespace TreeLod
                 return json{{"technique", runs[i].technique},
                             {"lodBias", runs[i].lodBias},
                             {"medianFrameMs", num(points[i].medianFrameMs)},
-                            {"meanFlip", num(points[i].meanFlip)}};
+                            {"meanFlip", num(points[i].meanFlip)},
+                            {"meanTemporalFlip", num(meanTemporalFlip(runs[i]))}};
             };
             std::vector<std::uint32_t> counts;
             for (const Run& run : runs)
@@ -323,8 +378,13 @@ namespace TreeLod
                 for (std::size_t i : front)
                 {
                     frontJson.push_back(pointJson(i));
-                    char text[96];
-                    std::snprintf(text, sizeof text, " %.3g ms %.3g", points[i].medianFrameMs, points[i].meanFlip);
+                    char text[128];
+                    const double motion = meanTemporalFlip(runs[i]);
+                    if (std::isfinite(motion))
+                        std::snprintf(text, sizeof text, " %.3g ms %.3g (motion %.3g)", points[i].medianFrameMs,
+                                      points[i].meanFlip, motion);
+                    else
+                        std::snprintf(text, sizeof text, " %.3g ms %.3g", points[i].medianFrameMs, points[i].meanFlip);
                     line += (line.empty() ? "" : ", ") + runName(runs[i]) + text;
                 }
                 if (front.empty())
@@ -422,6 +482,7 @@ namespace TreeLod
                                    {"msRmse", num(statsOf(rmse).mean)},
                                    {"temporalNoise", num(statsOf(noise).mean)},
                                    {"referenceTemporalNoise", num(statsOf(refNoise).mean)},
+                                   {"motion", motionJson(run, reference)},
                                    {"assetBytes", run.assetBytes},
                                    {"bakeSeconds", run.bakeSeconds},
                                    {"trade", {{"medianFrameMs", num(points[i].medianFrameMs)},
@@ -450,6 +511,9 @@ namespace TreeLod
                 // frame-time: per run at bias 1 (and the comparisons), frame ms along the path; empty
                 // where the frame was not timed (a gap in the line).
                 std::string timeCsv = "series,label,time_s,frame_ms\n";
+                // motion: the same runs' temporal FLIP along the path (motion frames only).
+                std::string motionCsv = "series,label,time_s,temporal_flip\n";
+                bool anyMotion = false;
                 // trade: one curve per technique over the biases; the comparisons are single points
                 // drawn with their `marker` (ComparisonRun::marker). on_front: 1 for the runs on the
                 // Pareto front.
@@ -484,8 +548,16 @@ namespace TreeLod
                                          [](const FrameRecord& r) { return r.timed; }))
                             label += ": every frame over the triangle budget, skipped";
                         for (const FrameRecord& r : run.frames)
+                        {
                             timeCsv += csvField(run.technique) + "," + csvField(label) + "," + number(r.time, 6) +
                                        "," + (r.timed ? number(r.timing.frameMilliseconds, 6) : "") + "\n";
+                            if (std::isfinite(r.temporalFlip))
+                            {
+                                motionCsv += csvField(run.technique) + "," + csvField(label) + "," +
+                                             number(r.time, 6) + "," + number(r.temporalFlip, 6) + "\n";
+                                anyMotion = true;
+                            }
+                        }
                     }
                 }
                 // Curves after the markers, by technique name.
@@ -507,6 +579,19 @@ namespace TreeLod
                                               {"markers", false}});
                     !w)
                     return printError(w.error()), false;
+                if (anyMotion)
+                    if (Result<void> w = addPlot("motion" + suffix, motionCsv,
+                                                 {{"title", script.name + ": change between consecutive frames (" +
+                                                                treesText(count) + ", LoD bias 1)"},
+                                                  {"x", "time_s"},
+                                                  {"y", "temporal_flip"},
+                                                  {"xLabel", "path time (s)"},
+                                                  {"yLabel", "FLIP between a frame and the next, over the trees"},
+                                                  {"logX", false},
+                                                  {"logY", false},
+                                                  {"markers", true}});
+                        !w)
+                        return printError(w.error()), false;
                 if (Result<void> w = addPlot("trade" + suffix, tradeCsv,
                                              {{"title", script.name + ": error against frame time (" +
                                                             treesText(count) + ")"},

@@ -42,6 +42,7 @@ namespace TreeLod
             std::uint64_t uploadBudget = 8000000; // bytes of Forest levels built per frame (0 = no limit)
             int shadowSize = -1;                  // -1: the script's; 0: off (applyShadowOptions)
             double shadowLodBias = 0.0;           // 0: the script's
+            std::string motionFrames = "all";     // treelod_frames --motion-frames
             bool bakeOnly = false;    // bake, write packages.json, print the treelod_frames command
             std::string framesFrom;   // "" = run treelod_frames here; else read its output from this directory
             bool json = false;
@@ -72,6 +73,11 @@ namespace TreeLod
             std::vector<std::uint32_t> levels; ///< visible instances per level index, all species summed
             std::uint64_t uploadedBytes = 0;   ///< levels made resident in this frame (Forest upload budget)
             double flip = NAN, msRmse = NAN, temporalNoise = NAN;
+            /// Motion frames: FLIP between this frame and the next at the script's frame rate over
+            /// the trees' pixels; the level switches between them and the trees visible (-1: not
+            /// counted, e.g. a floor that is no Forest).
+            double temporalFlip = NAN;
+            std::int64_t switches = -1, switchVisible = -1;
         };
 
         /// One (technique, bias) run over the path.
@@ -85,6 +91,7 @@ namespace TreeLod
             std::uint64_t instanceBytes = 0; ///< the Forest's instance store on the CPU
             double rssMiB = NAN, peakRssMiB = NAN; ///< treelod_frames' resident memory after the run
             double bakeSeconds = 0.0;
+            double motionStepSeconds = 0.0; ///< between a motion frame and its next (the script's frame rate)
             std::string skipped;   ///< the whole run (e.g. too many entities)
             bool hasPicture = false;
         };

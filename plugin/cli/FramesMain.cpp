@@ -17,7 +17,11 @@
 // CPU ms, frame ms (bounded by a one-pixel read-back), batches, triangles, visible trees, trees per
 // level, bytes uploaded, pending levels; run totals: GPU bytes, instance bytes, resident memory) and,
 // on sampled frames, PNGs under DIR/images: the reference supersampled 2x2 and every run at one
-// sample per pixel, each with the next frame at the script's frame rate (temporal noise).
+// sample per pixel, each with the next frame at the script's frame rate (temporal noise). Motion
+// frames (--motion-frames): after a run's timed frames, for each chosen frame a run-in frame one
+// step of the script's frame rate before it (so the Forest's levels and hysteresis are as motion
+// leaves them), the frame and the next, at one sample per pixel with the ground hidden (the trees
+// against the background), the last two saved as PNGs with the level switches between them.
 #include "CliSupport.h"
 
 #include "TreeLod/AtomicFile.h"
@@ -65,6 +69,7 @@ namespace TreeLod
             double shadowLodBias = 0.0;   // 0: the script's
             bool preload = false;         // every Forest level built before the frames (no uploads timed)
             bool skipComparisons = false; // only the techniques: no reference, no floors (memory of one scene)
+            std::string motionFrames = "all"; // frames measured in motion: "all", or a count evenly along the path
             std::string calibration;      // "" = userCacheDirectory(): where cost calibrations are kept
             bool quiet = false;
         };
@@ -181,6 +186,21 @@ namespace TreeLod
                 sampled.push_back(frames <= 1 ? 0
                                               : std::uint32_t((std::uint64_t(i) * 2 + 1) * (frames - 1) / (2 * samples)));
             auto isSampled = [&](std::uint32_t f) { return std::find(sampled.begin(), sampled.end(), f) != sampled.end(); };
+            // Motion frames: every frame, or a count evenly along the path.
+            std::vector<std::uint32_t> motion;
+            if (args.motionFrames == "all")
+                for (std::uint32_t f = 0; f < frames; ++f)
+                    motion.push_back(f);
+            else
+            {
+                char* end = nullptr;
+                const unsigned long count = std::strtoul(args.motionFrames.c_str(), &end, 10);
+                if (args.motionFrames.empty() || *end != '\0' || args.motionFrames[0] == '-')
+                    return printError(fail("", "--motion-frames", "'" + args.motionFrames + "' is not 'all' or a count >= 0"));
+                const std::uint32_t n = std::uint32_t(std::min<unsigned long>(count, frames));
+                for (std::uint32_t i = 0; i < n; ++i)
+                    motion.push_back(std::uint32_t((std::uint64_t(i) * 2 + 1) * frames / (2 * n)));
+            }
             // The temporal pair: the next frame at the script's own frame rate (not --frames'), so
             // temporal noise does not depend on how much the bench thins the path out.
             const double nativeStep =
@@ -225,6 +245,8 @@ namespace TreeLod
                                   {"resolution", {width, height}},
                                   {"frames", frames},
                                   {"sampled", sampled},
+                                  {"motionFrames", motion},
+                                  {"motionStepSeconds", nativeStep},
                                   {"scale", args.scale},
                                   {"shadowMap", script.shadows.enabled ? script.shadows.textureSize : 0},
                                   {"shadowLodBias", script.shadows.lodBias},
@@ -367,6 +389,31 @@ namespace TreeLod
                                 row["skipped"] = skipped;
                             frameRows.push_back(std::move(row));
                         }
+                        // Motion frames (see the file comment), after the timed ones so that they
+                        // change no timed frame's levels or uploads.
+                        if (!motion.empty() && nativeStep > 0.0)
+                        {
+                            scene->setGroundVisible(false);
+                            for (std::uint32_t f : motion)
+                            {
+                                json& row = frameRows[f];
+                                if (!row.contains("frameMs"))
+                                    continue; // not drawn (over the reference budget)
+                                const double t = frameTime(script, f, frames);
+                                renderer.render(cameraAt(script, t - nativeStep), width, height, 1);
+                                const std::string stem = imageStem(trees, technique, bias, f) + "-motion";
+                                save(renderer.render(cameraAt(script, t), width, height, 1), stem);
+                                save(renderer.render(cameraAt(script, t + nativeStep), width, height, 1), stem + "-next");
+                                row["motionImage"] = stem;
+                                if (!baseline)
+                                {
+                                    const ForestStats& stats = scene->getForest().getStats();
+                                    row["motionSwitches"] = stats.levelSwitches;
+                                    row["motionVisible"] = stats.visibleInstances;
+                                }
+                            }
+                            scene->setGroundVisible(true);
+                        }
                         progress(label, 1.0f);
                         const auto [rss, peak] = residentMemory();
                         run["frames"] = std::move(frameRows);
@@ -420,6 +467,11 @@ int main(int argc, char** argv)
         ->capture_default_str();
     app.add_option("--shadow-lod-bias", args.shadowLodBias,
                    "LoD bias of the Forest's shadow casters over the script's (0: the script's; < 1: coarser)")
+        ->capture_default_str();
+    app.add_option("--motion-frames", args.motionFrames,
+                   "frames measured in motion (the frame and the next at the script's frame rate, after a "
+                   "run-in frame; 1 sample per pixel, ground hidden): all, or a count evenly along the path "
+                   "(0: none)")
         ->capture_default_str();
     app.add_flag("--preload", args.preload,
                  "build every Forest level before the frames (Forest::makeAllResident: nothing uploaded while timing)");

@@ -158,6 +158,38 @@ floor, auto = flip[("impostor", 1)], flip[("auto", 1)]
 print(f"mean FLIP: one-quad floor {floor:.4f}, auto {auto:.4f}")
 sys.exit(0 if floor > 2 * auto else 1)  # measured 0.199 against 0.043
 EOF
+# Motion frames (every frame by default): a temporal FLIP on every timed frame; level switches
+# counted for the runs the Forest draws (the reference, the one-quad floor, auto), not for the
+# floors drawn without it.
+awk -F, 'NR > 1 && $6 == 1 && $16 !~ /^[0-9.e-]+$/ { bad = 1; print } END { exit bad }' "$out/single/frames.csv" \
+  || fail "timed frames without a temporal FLIP above"
+awk -F, 'NR > 1 && ($2 == "mesh" || $2 == "impostor" || $2 == "auto") && $17 !~ /^[0-9]+$/ { bad = 1; print }
+  END { exit bad }' "$out/single/frames.csv" || fail "frames of the Forest's runs without level switches above"
+awk -F, 'NR > 1 && ($2 == "entities" || $2 == "merged-quads" || $2 == "billboard-set") && $17 != "" { bad = 1; print }
+  END { exit bad }' "$out/single/frames.csv" || fail "switches counted for a floor that is no Forest (above)"
+plot "$out/single" motion 36 # the frame-time plot's runs, every frame
+python3 - "$out/single/summary.json" <<'EOF' || fail "motion figures above"
+import json, sys
+results = {(r["technique"], r["lodBias"]): r["motion"] for r in json.load(open(sys.argv[1]))["results"]}
+bad = []
+for key, m in results.items():
+    if m["temporalFlip"]["frames"] != 6 or m["reference"]["frames"] != 6:
+        bad.append(f"{key}: {m['temporalFlip']['frames']} motion frames, {m['reference']['frames']} with the reference's")
+    if not (m["temporalFlip"]["mean"] > 0 and m["temporalFlip"]["max"] >= m["temporalFlip"]["mean"]):
+        bad.append(f"{key}: temporal FLIP {m['temporalFlip']} (the camera moves on every frame)")
+    forest = key[0] in ("mesh", "impostor", "auto")
+    if forest != (m["switchesPerTreePerSecond"] is not None):
+        bad.append(f"{key}: switchesPerTreePerSecond {m['switchesPerTreePerSecond']}")
+mesh = results[("mesh", 1)]
+if abs(mesh["meanOverReference"] - 1) > 1e-9 or abs(mesh["worstOverReference"] - 1) > 1e-9:
+    bad.append(f"the reference against itself: {mesh}")
+auto = results[("auto", 1)]
+print(f"temporal FLIP: mesh {mesh['temporalFlip']['mean']:.4f} (worst {mesh['temporalFlip']['max']:.4f}), "
+      f"auto {auto['temporalFlip']['mean']:.4f} (worst {auto['temporalFlip']['max']:.4f}), "
+      f"auto's switches per tree per second {auto['switchesPerTreePerSecond']}")
+print("\n".join(bad))
+sys.exit(1 if bad else 0)
+EOF
 grep -q '"technique": "auto"' "$out/single/summary.json" || fail "summary lacks auto"
 grep -q '"speedupVsReference": [0-9]' "$out/single/summary.json" || fail "summary has no measured speedup"
 grep -q '"ratioToFloor": [0-9]' "$out/single/summary.json" || fail "summary has no ratio to the floor"
@@ -204,6 +236,8 @@ grep -q "incomplete (the frame timer stopped after 2 runs)" "$out/cut.txt" || { 
   --techniques auto --lod-bias 1,0.5 --samples 2 --cache "$shared" --frames-from "$out/single" \
   > "$out/report.txt" 2> "$out/report-progress.txt"
 grep -q '^Pareto front (1 tree): ' "$out/report.txt" || { cat "$out/report.txt"; fail "no Pareto front printed"; }
+grep -q '^Pareto front (1 tree): .* ms [0-9.e-]* (motion [0-9.e-]*)' "$out/report.txt" \
+  || { cat "$out/report.txt"; fail "the printed front lacks the temporal FLIP"; }
 pareto "$out/single-report" "$out/report.txt" || fail "single-report: Pareto front above"
 python3 -c 'import json, sys; a, b = (json.load(open(f))["pareto"] for f in sys.argv[1:]); sys.exit(a != b)' \
   "$out/single/summary.json" "$out/single-report/summary.json" || fail "the same frames gave another Pareto front"

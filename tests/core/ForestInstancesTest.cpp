@@ -924,6 +924,19 @@ namespace TreeLod
 {
     namespace
     {
+        /// One kind switching at 10 m (value 100 pi: pixelCountIsFourPiProjectedRadiusSquared) from
+        /// cameras of fromSpec(..., 100, 100) at 90 degrees, and a tree of it at each of `zs` on the
+        /// z axis.
+        void addTreesSwitchingAtTenMetres(ForestInstances& forest, const std::vector<float>& zs)
+        {
+            ForestKind kind = pixelKind("tree", {100.0f * glm::pi<float>()});
+            kind.boundsCentre = glm::vec3(0.0f);
+            kind.boundsRadius = 1.0f;
+            ASSERT_TRUE(forest.addKind(kind));
+            for (float z : zs)
+                ASSERT_TRUE(forest.add(ForestInstance{glm::vec3(0.0f, 0.0f, z), 0.0f, 1.0f, 0}));
+        }
+
         /// The level `forest`'s only instance gets in each cull from cameras at `distances`.
         std::vector<std::uint32_t> levelsAlong(const ForestInstances& forest, const std::vector<float>& distances,
                                                float hysteresis)
@@ -947,14 +960,9 @@ namespace TreeLod
 
     TEST(ForestInstances, hysteresisHoldsATreeStillUnderCameraJitter)
     {
-        // Value 100 pi at 10 m (pixelCountIsFourPiProjectedRadiusSquared), the switch at exactly
-        // that: a camera jittering 1 % about 10 m crosses it every frame.
+        // The switch at 10 m: a camera jittering 1 % about 10 m crosses it every frame.
         ForestInstances forest;
-        ForestKind kind = pixelKind("tree", {100.0f * glm::pi<float>()});
-        kind.boundsCentre = glm::vec3(0.0f);
-        kind.boundsRadius = 1.0f;
-        ASSERT_TRUE(forest.addKind(kind));
-        ASSERT_TRUE(forest.add(ForestInstance{glm::vec3(0.0f, 0.0f, -10.0f), 0.0f, 1.0f, 0}));
+        addTreesSwitchingAtTenMetres(forest, {-10.0f});
         std::vector<float> jitter;
         for (int f = 0; f < 20; ++f)
             jitter.push_back(f % 2 ? 10.1f : 9.9f);
@@ -993,6 +1001,34 @@ namespace TreeLod
 
 namespace TreeLod
 {
+    TEST(ForestInstances, switchesCountTheVisibleTreesThatChangedLevel)
+    {
+        // Level 0 nearer than 10 m, 1 farther. One tree at z = -10, another at z = -40 (beyond the
+        // switch from every camera below).
+        ForestInstances forest;
+        addTreesSwitchingAtTenMetres(forest, {-10.0f, -40.0f});
+        ForestVisibility vis;
+        auto switchesFrom = [&](float z, float hysteresis, glm::vec3 target = glm::vec3(0.0f, 0.0f, -50.0f)) {
+            CameraSpec spec;
+            spec.position = glm::vec3(0.0f, 0.0f, z);
+            spec.target = target;
+            spec.fovYDegrees = 90.0f;
+            EXPECT_TRUE(forest.cull(CullCamera::fromSpec(spec, 100.0f, 100.0f), 1.0f, vis, hysteresis));
+            return vis.getSwitchCount();
+        };
+        EXPECT_EQ(switchesFrom(-1.0f, 0.0f), 0u) << "first sight: no switch";
+        EXPECT_EQ(switchesFrom(-0.5f, 0.0f), 0u) << "both keep their levels";
+        EXPECT_EQ(switchesFrom(2.0f, 0.0f), 1u) << "the near tree crossed its switch (9 m to 12 m)";
+        EXPECT_EQ(switchesFrom(2.0f, 0.0f), 0u);
+        // With hysteresis a small step back over the switch holds the level; a large one switches.
+        EXPECT_EQ(switchesFrom(-0.3f, 0.15f), 0u);
+        EXPECT_EQ(switchesFrom(-2.0f, 0.15f), 1u);
+        // Out of view and back at another level: counted when it is seen again.
+        EXPECT_EQ(switchesFrom(30.0f, 0.0f, glm::vec3(0.0f, 0.0f, 100.0f)), 0u);
+        EXPECT_EQ(vis.getVisibleCount(), 0u);
+        EXPECT_EQ(switchesFrom(30.0f, 0.0f), 1u) << "the near tree, last seen at level 0, is at level 1";
+    }
+
     TEST(ForestInstances, replacedTablesMoveTheBucketsAfterThemAndForgetLevelsTheyLack)
     {
         ForestInstances forest;

@@ -158,6 +158,50 @@ namespace TreeLod
         }
     }
 
+    TEST(SceneScript, mixedWalkDriveWalksThenDrivesBesideItsRoad)
+    {
+        // Its trees are generated (tools/ez-tree/corpus.sh): parsed here beside empty stand-ins.
+        const std::filesystem::path root = std::filesystem::path(TREELOD_BINARY_DIR) / "test-out" / "scene" /
+                                           "mixed-walk-drive";
+        std::filesystem::create_directories(root / "media" / "third-party");
+        std::filesystem::create_directories(root / "samples" / "scenes");
+        for (const std::string tree : {"aspen", "oak", "ash", "pine"})
+            std::ofstream(root / "media" / "third-party" / ("ez-tree-" + tree + ".glb"));
+        std::ifstream in(scenePath("mixed-walk-drive.json"), std::ios::binary);
+        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        Result<SceneScript> s = parseSceneScript(text, "mixed-walk-drive.json", (root / "samples" / "scenes").string());
+        ASSERT_TRUE(s.ok()) << s.error().message();
+        const std::vector<PlacedTree> trees = generatePlacements(*s);
+        EXPECT_EQ(trees.size(), 2400u);
+        std::vector<int> perSpecies(s->species.size(), 0);
+        for (const PlacedTree& t : trees)
+        {
+            ++perSpecies[t.species];
+            EXPECT_GE(std::abs(t.position.z), 8.0f) << "a tree in the clearing";
+        }
+        for (int n : perSpecies)
+            EXPECT_GT(n, 400); // four species mixed, about 600 each
+
+        // 30 frames a second, at 1.7 m; within the clearing (the spline overshoots its keyframes by 0.12 m),
+        // at least 2.5 m from every trunk.
+        EXPECT_NEAR(frameTime(*s, 1) - frameTime(*s, 0), 1.0 / 30.0, 1e-9);
+        for (std::uint32_t f = 0; f < s->frames; ++f)
+        {
+            const CameraSpec cam = cameraAt(*s, frameTime(*s, f));
+            EXPECT_NEAR(cam.position.y, 1.7f, 1e-3f) << "frame " << f;
+            EXPECT_LT(std::abs(cam.position.z), 5.5f) << "frame " << f;
+        }
+        // Walking speed, then driving speed: metres per second over windows of the path.
+        const auto speed = [&](double from, double to) {
+            double metres = 0.0;
+            for (double t = from; t < to - 1e-9; t += 0.1)
+                metres += glm::length(cameraAt(*s, std::min(t + 0.1, to)).position - cameraAt(*s, t).position);
+            return metres / (to - from);
+        };
+        EXPECT_NEAR(speed(0.0, 10.0), 1.4, 0.1);
+        EXPECT_NEAR(speed(12.0, 32.0), 14.0, 0.5);
+    }
+
     TEST(SceneScript, singleTreeOrbitSpans1mTo2km)
     {
         Result<SceneScript> s = loadSceneScript(scenePath("single-tree.json"));

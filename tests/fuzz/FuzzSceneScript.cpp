@@ -65,7 +65,9 @@ namespace
             if (!mkdtemp(pattern.data()))
                 std::abort();
             root = pattern;
-            for (const char* asset : {"oak.glb", "conifer.glb", "birch.glb", "third-party/ez-tree-pine.glb"})
+            for (const char* asset : {"oak.glb", "conifer.glb", "birch.glb", "third-party/ez-tree-pine.glb",
+                                      "third-party/ez-tree-aspen.glb", "third-party/ez-tree-oak.glb",
+                                      "third-party/ez-tree-ash.glb"})
                 writeFile(root / "media" / asset, "");
             scenes = (root / "samples" / "scenes").string();
             writeFile(fs::path(scenes) / "trees.csv", "x,z,species,rotation,scale\n1,2,oak,90,1.1\n-3,4,pine,0,0.9\n");

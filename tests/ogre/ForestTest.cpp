@@ -357,15 +357,27 @@ namespace TreeLod
 
         // Frozen LoD: levels stay while the camera moves back (every tree stays in view).
         r.render(mid, 256, 192, 1);
+        EXPECT_GT(forest->getStats().levelSwitches, 0u) << "camera bias 8, then 1";
+        r.render(mid, 256, 192, 1);
+        EXPECT_EQ(forest->getStats().levelSwitches, 0u) << "the same view twice";
         const std::vector<std::uint32_t> before = flatCounts(*forest);
         forest->setLodFrozen(true);
         const CameraSpec back = look(glm::vec3(0.0f, 4.0f * h, 30.0f * h), glm::vec3(0.0f, 0.3f * h, 0.0f));
         r.render(back, 256, 192, 1);
         EXPECT_EQ(flatCounts(*forest), before);
+        EXPECT_EQ(forest->getStats().levelSwitches, 0u) << "frozen";
         forest->setLodFrozen(false);
         r.render(back, 256, 192, 1);
-        EXPECT_NE(flatCounts(*forest), before) << "unfrozen, the far view drops detail";
+        const std::vector<std::uint32_t> after = flatCounts(*forest);
+        EXPECT_NE(after, before) << "unfrozen, the far view drops detail";
         EXPECT_EQ(forest->getStats().visibleInstances, 25u);
+        // The switches are the trees that changed level: at least the change of the histogram.
+        std::uint32_t moved = 0;
+        for (std::size_t l = 0; l < after.size(); ++l)
+            moved += after[l] > before[l] ? after[l] - before[l] : 0u;
+        EXPECT_GE(forest->getStats().levelSwitches, moved);
+        EXPECT_GT(forest->getStats().levelSwitches, 0u);
+        EXPECT_LE(forest->getStats().levelSwitches, 25u);
     }
 
     TEST(Forest, aThousandKilometresAway)

@@ -25,6 +25,7 @@ namespace TreeLod
         mStats.fallbackInstances = 0;
         mStats.instances = std::uint32_t(mInstances.size());
         mStats.visibleInstances = 0;
+        mStats.levelSwitches = 0;
         mStats.batches = 0;
         mStats.triangles = 0;
         mStats.cullMilliseconds = 0.0;
@@ -230,6 +231,7 @@ namespace TreeLod
         {
             mStats.instances = std::uint32_t(mInstances.size());
             mStats.visibleInstances = state.visibility.getVisibleCount();
+            mStats.levelSwitches = state.visibility.getSwitchCount();
             mStats.batches = batches;
             mStats.triangles = triangles;
             mStats.cullMilliseconds = cullMs;

@@ -496,6 +496,12 @@ namespace TreeLod
         return true;
     }
 
+    void ForestScene::setGroundVisible(bool visible)
+    {
+        if (mGround)
+            mGround->setVisible(visible);
+    }
+
     void ForestScene::setShadows(bool enabled)
     {
         SunShadowSettings settings;

@@ -520,7 +520,7 @@ namespace TreeLod
         std::uint8_t* visibleClass = out.mVisibleClass.data();
         std::array<std::uint32_t, ForestVisibility::DISTANCE_CLASSES> classCounts{};
         std::uint32_t* counts = out.mCursor.data();
-        std::uint32_t visibleCount = 0;
+        std::uint32_t visibleCount = 0, switchCount = 0;
         const float* blocks = mBlockBounds.data();
         for (std::size_t block = 0, begin = 0; begin < n; ++block, begin += BLOCK_SIZE)
         {
@@ -569,6 +569,7 @@ namespace TreeLod
                 if (lastLevel[i] >= finest && lastLevel[i] <= coarsest)
                     level = lastLevel[i];
             }
+            switchCount += lastLevel[i] != LEVEL_NONE && lastLevel[i] != level;
             lastLevel[i] = std::uint8_t(level);
             const std::uint32_t bucket = kindFirst[kind] + level;
             // Distance class: the exponent and top two mantissa bits of d^2 (monotonic for d^2 >= 0).
@@ -629,6 +630,7 @@ namespace TreeLod
         }
         out.mVisibleCount = visibleCount;
         out.mCulledCount = std::uint32_t(n - visibleCount);
+        out.mSwitchCount = switchCount;
         return {};
     }
 }

@@ -50,6 +50,9 @@ namespace TreeLod
     {
         std::uint32_t instances = 0;          ///< in the Forest
         std::uint32_t visibleInstances = 0;   ///< after frustum culling
+        /// Visible instances at another level than this camera's previous frame gave them
+        /// (ForestVisibility::getSwitchCount): the pops a user may see.
+        std::uint32_t levelSwitches = 0;
         std::uint32_t batches = 0;            ///< instanced draws queued (all parts)
         std::uint64_t triangles = 0;          ///< submitted, summed over instances
         /// Visible instances per species and level: levelCounts[species][level].

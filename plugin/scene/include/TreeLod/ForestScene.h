@@ -145,6 +145,11 @@ namespace TreeLod
         void setShadows(bool enabled);
         static float getShadowFarDistance();
 
+        /// Show or hide the ground mesh (no effect without one): hidden, the trees stand against
+        /// the background colour, so an image's tree pixels are those of another colour (the
+        /// bench's motion frames).
+        void setGroundVisible(bool visible);
+
         /// The camera at frame `frame` of `frameCount` (0 = the script's frame count).
         CameraSpec cameraAtFrame(std::uint32_t frame, std::uint32_t frameCount = 0) const;
 

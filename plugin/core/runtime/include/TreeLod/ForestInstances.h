@@ -144,6 +144,10 @@ namespace TreeLod
 
         std::uint32_t getVisibleCount() const { return mVisibleCount; }
         std::uint32_t getCulledCount() const { return mCulledCount; }
+        /// Level switches of the last cull: visible instances given another level than this
+        /// visibility's previous cull gave them (instances never seen before do not count; one
+        /// that comes back into view at another level does).
+        std::uint32_t getSwitchCount() const { return mSwitchCount; }
 
         /// Bytes reserved by the arrays (to check that a second cull allocates nothing).
         std::size_t getCapacityBytes() const;
@@ -163,6 +167,7 @@ namespace TreeLod
         std::uint32_t mLastLevelTables = 0;      // the ForestInstances table generation it was made for
         std::uint32_t mVisibleCount = 0;
         std::uint32_t mCulledCount = 0;
+        std::uint32_t mSwitchCount = 0;
     };
 
     /// The instance store. Removal swaps the last instance into the hole, so dense indices
