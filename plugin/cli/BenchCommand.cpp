@@ -173,6 +173,15 @@ namespace TreeLod
                         options.keepErrorMap = true;
                         if (Result<FlipResult> m = flip(image, next, options))
                             record.temporalFlip = meanOverTree(*m, image, next);
+                        if (f.value("motionHeld", false))
+                        {
+                            Result<Image> held = readImage(directory + "/images/" + f["motionImage"].get<std::string>() +
+                                                           "-held.png");
+                            if (!held)
+                                return held.error();
+                            if (Result<FlipResult> m = flip(*held, next, options))
+                                record.popFlip = meanOverTree(*m, *held, next);
+                        }
                         record.switches = f.value("motionSwitches", std::int64_t(-1));
                         record.switchVisible = f.value("motionVisible", std::int64_t(-1));
                     }

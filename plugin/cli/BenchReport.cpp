@@ -232,24 +232,25 @@ namespace TreeLod
             return run.technique + (run.lodBias == 1.0f ? "" : "@" + number(run.lodBias, 3));
         }
 
-        /// Mean temporal FLIP of `run` over its motion frames (NaN without any).
-        double meanTemporalFlip(const Run& run)
+        /// Mean of a per-frame figure of `run` over the frames that have it (NaN without any).
+        double meanOf(const Run& run, double FrameRecord::*figure)
         {
             std::vector<double> values;
             for (const FrameRecord& r : run.frames)
-                values.push_back(r.temporalFlip);
+                values.push_back(r.*figure);
             return statsOf(values).mean;
         }
 
         /// What `run` does in motion (summary.json's "motion"): its temporal FLIP over the motion
         /// frames with the worst one; the reference's over the frames both measured, and the
-        /// ratios of the means and of the worst frames there; level switches per visible tree per
-        /// second of the path (null where not counted).
+        /// ratios of the means and of the worst frames there; the pop FLIP (FrameRecord::popFlip)
+        /// with its worst frame and the reference's; level switches per visible tree per second
+        /// of the path (null where not counted).
         nlohmann::json motionJson(const Run& run, const Run* reference)
         {
             using nlohmann::json;
-            std::vector<double> all, own, ref;
-            json worst = nullptr;
+            std::vector<double> all, own, ref, pops, ownPops, refPops;
+            json worst = nullptr, worstPop = nullptr;
             std::int64_t switches = 0, visible = 0;
             bool counted = false;
             for (std::size_t f = 0; f < run.frames.size(); ++f)
@@ -271,7 +272,18 @@ namespace TreeLod
                     own.push_back(r.temporalFlip);
                     ref.push_back(reference->frames[f].temporalFlip);
                 }
+                if (!std::isfinite(r.popFlip))
+                    continue;
+                pops.push_back(r.popFlip);
+                if (worstPop.is_null() || r.popFlip > worstPop["popFlip"].get<double>())
+                    worstPop = {{"frame", r.frame}, {"time", r.time}, {"popFlip", r.popFlip}};
+                if (reference && f < reference->frames.size() && std::isfinite(reference->frames[f].popFlip))
+                {
+                    ownPops.push_back(r.popFlip);
+                    refPops.push_back(reference->frames[f].popFlip);
+                }
             }
+            const Stats popStats = statsOf(pops), refPopStats = statsOf(refPops);
             const Stats stats = statsOf(all), ownShared = statsOf(own), refShared = statsOf(ref);
             const bool rate = counted && visible > 0 && run.motionStepSeconds > 0.0;
             return {{"temporalFlip", {{"mean", num(stats.mean)}, {"max", num(stats.max)}, {"frames", stats.count}}},
@@ -279,6 +291,10 @@ namespace TreeLod
                     {"reference", {{"mean", num(refShared.mean)}, {"max", num(refShared.max)}, {"frames", refShared.count}}},
                     {"meanOverReference", num(ownShared.mean / refShared.mean)},
                     {"worstOverReference", num(ownShared.max / refShared.max)},
+                    {"popFlip", {{"mean", num(popStats.mean)}, {"max", num(popStats.max)}, {"frames", popStats.count}}},
+                    {"worstPopFrame", worstPop},
+                    {"referencePopFlip",
+                     {{"mean", num(refPopStats.mean)}, {"max", num(refPopStats.max)}, {"frames", refPopStats.count}}},
                     {"levelSwitches", counted ? json(switches) : json(nullptr)},
                     {"switchesPerTreePerSecond",
                      rate ? num(double(switches) / double(visible) / run.motionStepSeconds) : json(nullptr)}};
@@ -291,7 +307,7 @@ namespace TreeLod
         {
             // frames.csv: one row per run and frame.
             std::string csv = "trees,technique,lod_bias,frame,time_s,timed,cpu_ms,frame_ms,batches,triangles,visible,"
-                              "instances_per_level,flip,ms_rmse,temporal_noise,temporal_flip,level_switches,skipped,"
+                              "instances_per_level,flip,ms_rmse,temporal_noise,temporal_flip,pop_flip,level_switches,skipped,"
                               "uploaded_bytes\n";
             for (const Run& run : runs)
                 for (const FrameRecord& r : run.frames)
@@ -303,7 +319,8 @@ namespace TreeLod
                            (r.timed ? std::to_string(r.timing.triangles) : "") + "," +
                            (r.timed ? std::to_string(r.visible) : "") + "," + levelsText(r.levels) + "," +
                            number(r.flip) + "," + number(r.msRmse) + "," + number(r.temporalNoise) + "," +
-                           number(r.temporalFlip) + "," + (r.switches >= 0 ? std::to_string(r.switches) : "") + ",\"" +
+                           number(r.temporalFlip) + "," + number(r.popFlip) + "," +
+                           (r.switches >= 0 ? std::to_string(r.switches) : "") + ",\"" +
                            r.skipped + "\"," + (r.timed ? std::to_string(r.uploadedBytes) : "") + "\n";
             if (Result<void> w = writeText(args.output + "/frames.csv", csv); !w)
                 return printError(w.error()), false;
@@ -344,7 +361,8 @@ namespace TreeLod
                             {"lodBias", runs[i].lodBias},
                             {"medianFrameMs", num(points[i].medianFrameMs)},
                             {"meanFlip", num(points[i].meanFlip)},
-                            {"meanTemporalFlip", num(meanTemporalFlip(runs[i]))}};
+                            {"meanTemporalFlip", num(meanOf(runs[i], &FrameRecord::temporalFlip))},
+                            {"meanPopFlip", num(meanOf(runs[i], &FrameRecord::popFlip))}};
             };
             std::vector<std::uint32_t> counts;
             for (const Run& run : runs)
@@ -379,8 +397,12 @@ namespace TreeLod
                 {
                     frontJson.push_back(pointJson(i));
                     char text[128];
-                    const double motion = meanTemporalFlip(runs[i]);
-                    if (std::isfinite(motion))
+                    const double motion = meanOf(runs[i], &FrameRecord::temporalFlip);
+                    const double pops = meanOf(runs[i], &FrameRecord::popFlip);
+                    if (std::isfinite(motion) && std::isfinite(pops))
+                        std::snprintf(text, sizeof text, " %.3g ms %.3g (motion %.3g pops %.3g)",
+                                      points[i].medianFrameMs, points[i].meanFlip, motion, pops);
+                    else if (std::isfinite(motion))
                         std::snprintf(text, sizeof text, " %.3g ms %.3g (motion %.3g)", points[i].medianFrameMs,
                                       points[i].meanFlip, motion);
                     else
@@ -513,7 +535,8 @@ namespace TreeLod
                 std::string timeCsv = "series,label,time_s,frame_ms\n";
                 // motion: the same runs' temporal FLIP along the path (motion frames only).
                 std::string motionCsv = "series,label,time_s,temporal_flip\n";
-                bool anyMotion = false;
+                std::string popCsv = "series,label,time_s,pop_flip\n";
+                bool anyMotion = false, anyPop = false;
                 // trade: one curve per technique over the biases; the comparisons are single points
                 // drawn with their `marker` (ComparisonRun::marker). on_front: 1 for the runs on the
                 // Pareto front.
@@ -557,6 +580,12 @@ namespace TreeLod
                                              number(r.time, 6) + "," + number(r.temporalFlip, 6) + "\n";
                                 anyMotion = true;
                             }
+                            if (std::isfinite(r.popFlip))
+                            {
+                                popCsv += csvField(run.technique) + "," + csvField(label) + "," + number(r.time, 6) +
+                                          "," + number(r.popFlip, 6) + "\n";
+                                anyPop = true;
+                            }
                         }
                     }
                 }
@@ -587,6 +616,19 @@ namespace TreeLod
                                                   {"y", "temporal_flip"},
                                                   {"xLabel", "path time (s)"},
                                                   {"yLabel", "FLIP between a frame and the next, over the trees"},
+                                                  {"logX", false},
+                                                  {"logY", false},
+                                                  {"markers", true}});
+                        !w)
+                        return printError(w.error()), false;
+                if (anyPop)
+                    if (Result<void> w = addPlot("pops" + suffix, popCsv,
+                                                 {{"title", script.name + ": what level switches change between two "
+                                                                          "frames (" + treesText(count) + ", LoD bias 1)"},
+                                                  {"x", "time_s"},
+                                                  {"y", "pop_flip"},
+                                                  {"xLabel", "path time (s)"},
+                                                  {"yLabel", "FLIP, next frame with levels held vs switched"},
                                                   {"logX", false},
                                                   {"logY", false},
                                                   {"markers", true}});

@@ -77,6 +77,10 @@ namespace TreeLod
             /// the trees' pixels; the level switches between them and the trees visible (-1: not
             /// counted, e.g. a floor that is no Forest).
             double temporalFlip = NAN;
+            /// Motion frames of the Forest's runs: FLIP between the next frame with this frame's
+            /// levels held and the next frame, over the trees' pixels: what the level switches
+            /// alone change (0 without a switch).
+            double popFlip = NAN;
             std::int64_t switches = -1, switchVisible = -1;
         };
 

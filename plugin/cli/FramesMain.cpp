@@ -20,8 +20,9 @@
 // sample per pixel, each with the next frame at the script's frame rate (temporal noise). Motion
 // frames (--motion-frames): after a run's timed frames, for each chosen frame a run-in frame one
 // step of the script's frame rate before it (so the Forest's levels and hysteresis are as motion
-// leaves them), the frame and the next, at one sample per pixel with the ground hidden (the trees
-// against the background), the last two saved as PNGs with the level switches between them.
+// leaves them), the frame, the next with the Forest's levels held (Forest::setLodFrozen) and the
+// next, at one sample per pixel with the ground hidden (the trees against the background), the
+// last three saved as PNGs with the level switches between the frame and the next.
 #include "CliSupport.h"
 
 #include "TreeLod/AtomicFile.h"
@@ -394,15 +395,25 @@ namespace TreeLod
                         if (!motion.empty() && nativeStep > 0.0)
                         {
                             scene->setGroundVisible(false);
+                            const double pathEnd = frameTime(script, frames - 1, frames);
                             for (std::uint32_t f : motion)
                             {
                                 json& row = frameRows[f];
-                                if (!row.contains("frameMs"))
-                                    continue; // not drawn (over the reference budget)
                                 const double t = frameTime(script, f, frames);
+                                if (!row.contains("frameMs") || t + nativeStep > pathEnd + 1e-6)
+                                    continue; // not drawn (over the reference budget), or no next frame
                                 renderer.render(cameraAt(script, t - nativeStep), width, height, 1);
                                 const std::string stem = imageStem(trees, technique, bias, f) + "-motion";
                                 save(renderer.render(cameraAt(script, t), width, height, 1), stem);
+                                if (!baseline)
+                                {
+                                    // The next frame with the levels held (the LoD camera of this
+                                    // one): what it would show without the switches.
+                                    scene->getForest().setLodFrozen(true);
+                                    save(renderer.render(cameraAt(script, t + nativeStep), width, height, 1), stem + "-held");
+                                    scene->getForest().setLodFrozen(false);
+                                    row["motionHeld"] = true;
+                                }
                                 save(renderer.render(cameraAt(script, t + nativeStep), width, height, 1), stem + "-next");
                                 row["motionImage"] = stem;
                                 if (!baseline)
@@ -470,8 +481,8 @@ int main(int argc, char** argv)
         ->capture_default_str();
     app.add_option("--motion-frames", args.motionFrames,
                    "frames measured in motion (the frame and the next at the script's frame rate, after a "
-                   "run-in frame; 1 sample per pixel, ground hidden): all, or a count evenly along the path "
-                   "(0: none)")
+                   "run-in frame, and the next with the levels held; 1 sample per pixel, ground hidden): all, or "
+                   "a count evenly along the path (0: none)")
         ->capture_default_str();
     app.add_flag("--preload", args.preload,
                  "build every Forest level before the frames (Forest::makeAllResident: nothing uploaded while timing)");

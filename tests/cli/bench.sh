@@ -158,35 +158,44 @@ floor, auto = flip[("impostor", 1)], flip[("auto", 1)]
 print(f"mean FLIP: one-quad floor {floor:.4f}, auto {auto:.4f}")
 sys.exit(0 if floor > 2 * auto else 1)  # measured 0.199 against 0.043
 EOF
-# Motion frames (every frame by default): a temporal FLIP on every timed frame; level switches
-# counted for the runs the Forest draws (the reference, the one-quad floor, auto), not for the
-# floors drawn without it.
-awk -F, 'NR > 1 && $6 == 1 && $16 !~ /^[0-9.e-]+$/ { bad = 1; print } END { exit bad }' "$out/single/frames.csv" \
-  || fail "timed frames without a temporal FLIP above"
-awk -F, 'NR > 1 && ($2 == "mesh" || $2 == "impostor" || $2 == "auto") && $17 !~ /^[0-9]+$/ { bad = 1; print }
-  END { exit bad }' "$out/single/frames.csv" || fail "frames of the Forest's runs without level switches above"
-awk -F, 'NR > 1 && ($2 == "entities" || $2 == "merged-quads" || $2 == "billboard-set") && $17 != "" { bad = 1; print }
-  END { exit bad }' "$out/single/frames.csv" || fail "switches counted for a floor that is no Forest (above)"
-plot "$out/single" motion 36 # the frame-time plot's runs, every frame
+# Motion frames (every frame by default, but the last, whose next frame is past the path's end):
+# a temporal FLIP on each; a pop FLIP and level switches for the runs the Forest draws (the
+# reference, the one-quad floor, auto), not for the floors drawn without it.
+awk -F, 'NR > 1 && $6 == 1 && ($4 < 5) != ($16 ~ /^[0-9.e-]+$/) { bad = 1; print } END { exit bad }' \
+  "$out/single/frames.csv" || fail "a temporal FLIP missing on frames 0 to 4, or on the last frame (above)"
+awk -F, 'NR > 1 && $4 < 5 && ($2 == "mesh" || $2 == "impostor" || $2 == "auto") && ($17 !~ /^[0-9.e-]+$/ ||
+  $18 !~ /^[0-9]+$/) { bad = 1; print } END { exit bad }' "$out/single/frames.csv" \
+  || fail "Forest runs' frames without pops or switches above"
+awk -F, 'NR > 1 && ($2 == "entities" || $2 == "merged-quads" || $2 == "billboard-set") && ($17 != "" || $18 != "") {
+  bad = 1; print } END { exit bad }' "$out/single/frames.csv" || fail "pops counted for a floor that is no Forest (above)"
+plot "$out/single" motion 30 # the frame-time plot's runs, 5 motion frames each
+plot "$out/single" pops 15   # the Forest's among them
 python3 - "$out/single/summary.json" <<'EOF' || fail "motion figures above"
 import json, sys
 results = {(r["technique"], r["lodBias"]): r["motion"] for r in json.load(open(sys.argv[1]))["results"]}
 bad = []
 for key, m in results.items():
-    if m["temporalFlip"]["frames"] != 6 or m["reference"]["frames"] != 6:
+    if m["temporalFlip"]["frames"] != 5 or m["reference"]["frames"] != 5:
         bad.append(f"{key}: {m['temporalFlip']['frames']} motion frames, {m['reference']['frames']} with the reference's")
     if not (m["temporalFlip"]["mean"] > 0 and m["temporalFlip"]["max"] >= m["temporalFlip"]["mean"]):
         bad.append(f"{key}: temporal FLIP {m['temporalFlip']} (the camera moves on every frame)")
     forest = key[0] in ("mesh", "impostor", "auto")
     if forest != (m["switchesPerTreePerSecond"] is not None):
         bad.append(f"{key}: switchesPerTreePerSecond {m['switchesPerTreePerSecond']}")
+    if m["popFlip"]["frames"] != (5 if forest else 0) or m["referencePopFlip"]["frames"] != (5 if forest else 0):
+        bad.append(f"{key}: pops on {m['popFlip']['frames']} frames, {m['referencePopFlip']['frames']} with the reference's")
+    if forest and not 0 <= m["popFlip"]["mean"] <= m["popFlip"]["max"]:
+        bad.append(f"{key}: pop FLIP {m['popFlip']}")
+    if forest and m["levelSwitches"] == 0 and m["popFlip"]["max"] != 0:
+        bad.append(f"{key}: no level switched, yet the held levels differ from the next frame: {m['popFlip']}")
 mesh = results[("mesh", 1)]
 if abs(mesh["meanOverReference"] - 1) > 1e-9 or abs(mesh["worstOverReference"] - 1) > 1e-9:
     bad.append(f"the reference against itself: {mesh}")
 auto = results[("auto", 1)]
 print(f"temporal FLIP: mesh {mesh['temporalFlip']['mean']:.4f} (worst {mesh['temporalFlip']['max']:.4f}), "
-      f"auto {auto['temporalFlip']['mean']:.4f} (worst {auto['temporalFlip']['max']:.4f}), "
-      f"auto's switches per tree per second {auto['switchesPerTreePerSecond']}")
+      f"auto {auto['temporalFlip']['mean']:.4f} (worst {auto['temporalFlip']['max']:.4f}); pop FLIP: mesh "
+      f"{mesh['popFlip']['max']:.4f}, auto {auto['popFlip']['max']:.4f} (worst); auto's switches per tree per "
+      f"second {auto['switchesPerTreePerSecond']}")
 print("\n".join(bad))
 sys.exit(1 if bad else 0)
 EOF
@@ -236,7 +245,7 @@ grep -q "incomplete (the frame timer stopped after 2 runs)" "$out/cut.txt" || { 
   --techniques auto --lod-bias 1,0.5 --samples 2 --cache "$shared" --frames-from "$out/single" \
   > "$out/report.txt" 2> "$out/report-progress.txt"
 grep -q '^Pareto front (1 tree): ' "$out/report.txt" || { cat "$out/report.txt"; fail "no Pareto front printed"; }
-grep -q '^Pareto front (1 tree): .* ms [0-9.e-]* (motion [0-9.e-]*)' "$out/report.txt" \
+grep -q '^Pareto front (1 tree): .* ms [0-9.e-]* (motion [0-9.e-]* pops [0-9.e-]*)' "$out/report.txt" \
   || { cat "$out/report.txt"; fail "the printed front lacks the temporal FLIP"; }
 pareto "$out/single-report" "$out/report.txt" || fail "single-report: Pareto front above"
 python3 -c 'import json, sys; a, b = (json.load(open(f))["pareto"] for f in sys.argv[1:]); sys.exit(a != b)' \
@@ -265,6 +274,35 @@ grep -q '"bake"' "$out/table2-again/summary.json" && ! grep -q ': baked' "$out/t
 # A Pareto front per tree count; without auto runs, autoOnFront is null.
 pareto "$out/table2" || fail "table2: Pareto front above"
 [ "$(grep -c '"autoOnFront": null' "$out/table2/summary.json")" = 2 ] || fail "table2: autoOnFront should be null twice"
+
+# A pop, measured: one oak drawn by the mesh within 30 m and by the one-quad impostor beyond, the
+# camera from 20 m to 45 m in one step of the script's frame rate (3 frames in 2 s), then to 46 m.
+# Frame 0's next frame switches the tree; frame 1's switches nothing (pop FLIP 0); frame 2 has no
+# next frame.
+cat > "$out/pop.json" <<EOF
+{
+  "name": "pop",
+  "ground": {"kind": "plane", "size": 200},
+  "species": [{"name": "oak", "source": "$src/media/oak.glb",
+               "techniques": [{"technique": "mesh", "maxDistance": 30}, {"technique": "impostor"}]}],
+  "placements": [{"species": "oak", "positions": [[0, 0, 0]]}],
+  "camera": {"keyframes": [{"time": 0, "position": [0, 6, 20], "target": [0, 6, 0]},
+                           {"time": 1, "position": [0, 6, 45], "target": [0, 6, 0]},
+                           {"time": 2, "position": [0, 6, 46], "target": [0, 6, 0]}]},
+  "resolution": [96, 64],
+  "frames": 3
+}
+EOF
+"$treelod" bench "$out/pop.json" -o "$out/pop" --techniques auto --lod-bias 1 --samples 1 --cache "$shared" -q
+python3 - "$out/pop/frames.csv" <<'EOF' || fail "the pop above"
+import csv, sys
+rows = {(r["technique"], r["frame"]): r for r in csv.DictReader(open(sys.argv[1]))}
+switch, still, last = rows[("auto", "0")], rows[("auto", "1")], rows[("auto", "2")]
+print(f"a pop: {switch['level_switches']} switch, pop FLIP {switch['pop_flip']}; without a switch {still['pop_flip']}")
+ok = switch["level_switches"] == "1" and float(switch["pop_flip"]) > 0.05 and still["level_switches"] == "0" \
+    and float(still["pop_flip"]) == 0 and last["pop_flip"] == "" and last["temporal_flip"] == ""
+sys.exit(0 if ok else 1)
+EOF
 
 # 3. A bad script: exit 2, file:line:column named, nothing written.
 printf '{\n  "name": "bad",\n  "frames": -3\n}\n' > "$out/bad.json"
