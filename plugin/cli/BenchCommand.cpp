@@ -293,6 +293,8 @@ namespace TreeLod
             }
             if (args.samples == 0 || frames == 0)
                 return printError(fail("", "--frames/--samples", "must be >= 1"));
+            if (Result<std::vector<std::uint32_t>> motion = parseMotionFrames(args.motionFrames, frames); !motion)
+                return printError(motion.error());
 
             std::error_code ec;
             std::filesystem::create_directories(args.output, ec);

@@ -1,5 +1,7 @@
 #include "CliSupport.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -108,6 +110,25 @@ namespace TreeLod
         if (biases.empty())
             return fail("", "--lod-bias", "needs at least one value");
         return biases;
+    }
+
+    Result<std::vector<std::uint32_t>> parseMotionFrames(const std::string& text, std::uint32_t frames)
+    {
+        std::vector<std::uint32_t> motion;
+        if (text == "all")
+        {
+            for (std::uint32_t f = 0; f < frames; ++f)
+                motion.push_back(f);
+            return motion;
+        }
+        char* end = nullptr;
+        const unsigned long count = std::strtoul(text.c_str(), &end, 10);
+        if (text.empty() || *end != '\0' || !std::isdigit(static_cast<unsigned char>(text[0])))
+            return fail("", "--motion-frames", "'" + text + "' is not 'all' or a frame count >= 0");
+        const std::uint32_t n = std::uint32_t(std::min<unsigned long>(count, frames));
+        for (std::uint32_t i = 0; i < n; ++i)
+            motion.push_back(std::uint32_t((std::uint64_t(i) * 2 + 1) * frames / (2 * n)));
+        return motion;
     }
 
     Result<void> applyShadowOptions(int size, double lodBias, SceneShadows& shadows)

@@ -33,6 +33,9 @@ namespace TreeLod
 
     /// `--lod-bias`: comma-separated finite numbers > 0, at least one.
     Result<std::vector<float>> parseLodBiases(const std::string& text);
+    /// --motion-frames: the motion frames among `frames` frames, "all" of them or a count spread
+    /// evenly along the path (0: none); an error naming the option for anything else.
+    Result<std::vector<std::uint32_t>> parseMotionFrames(const std::string& text, std::uint32_t frames);
 
     /// `--shadow-size N` and `--shadow-lod-bias B` over a script's shadows. Size: -1 keeps the
     /// script's, 0 turns them off, else a power of two in 256..16384 (scaled-down llvmpipe runs:

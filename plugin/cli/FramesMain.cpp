@@ -165,6 +165,10 @@ namespace TreeLod
             if (counts.empty())
                 counts.push_back(0); // as the script places them
             const double imageBudget = args.referenceImageBudget > 0.0 ? args.referenceImageBudget : args.referenceBudget;
+            Result<std::vector<std::uint32_t>> motionFrames = parseMotionFrames(args.motionFrames, frames);
+            if (!motionFrames)
+                return printError(motionFrames.error());
+            const std::vector<std::uint32_t>& motion = *motionFrames;
 
             std::error_code ec;
             std::filesystem::create_directories(args.output + "/images", ec);
@@ -187,21 +191,6 @@ namespace TreeLod
                 sampled.push_back(frames <= 1 ? 0
                                               : std::uint32_t((std::uint64_t(i) * 2 + 1) * (frames - 1) / (2 * samples)));
             auto isSampled = [&](std::uint32_t f) { return std::find(sampled.begin(), sampled.end(), f) != sampled.end(); };
-            // Motion frames: every frame, or a count evenly along the path.
-            std::vector<std::uint32_t> motion;
-            if (args.motionFrames == "all")
-                for (std::uint32_t f = 0; f < frames; ++f)
-                    motion.push_back(f);
-            else
-            {
-                char* end = nullptr;
-                const unsigned long count = std::strtoul(args.motionFrames.c_str(), &end, 10);
-                if (args.motionFrames.empty() || *end != '\0' || args.motionFrames[0] == '-')
-                    return printError(fail("", "--motion-frames", "'" + args.motionFrames + "' is not 'all' or a count >= 0"));
-                const std::uint32_t n = std::uint32_t(std::min<unsigned long>(count, frames));
-                for (std::uint32_t i = 0; i < n; ++i)
-                    motion.push_back(std::uint32_t((std::uint64_t(i) * 2 + 1) * frames / (2 * n)));
-            }
             // The temporal pair: the next frame at the script's own frame rate (not --frames'), so
             // temporal noise does not depend on how much the bench thins the path out.
             const double nativeStep =

@@ -333,4 +333,11 @@ code=$?
 set -e
 [ "$code" = 2 ] && grep -q -- "--shadow-lod-bias" "$out/badbias.txt" || { cat "$out/badbias.txt"; fail "--shadow-lod-bias -1 accepted"; }
 [ ! -e "$out/badbias" ] || fail "a bad --shadow-lod-bias created its output directory"
+set +e
+"$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/badmotion" --motion-frames -1 -q 2> "$out/badmotion.txt"
+code=$?
+set -e
+[ "$code" = 2 ] && grep -q -- "--motion-frames: '-1' is not" "$out/badmotion.txt" \
+  || { cat "$out/badmotion.txt"; fail "--motion-frames -1 accepted"; }
+[ ! -e "$out/badmotion" ] || fail "a bad --motion-frames created its output directory"
 echo "bench test passed"
