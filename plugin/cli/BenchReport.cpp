@@ -241,6 +241,39 @@ namespace TreeLod
             return statsOf(values).mean;
         }
 
+        /// A per-frame figure of `run` over its frames that have it (`all`, with the worst frame
+        /// named `name`), and over the frames where `reference` has it too, its own and the
+        /// reference's (`own`, `ref`).
+        struct FigureStats
+        {
+            Stats all, own, ref;
+            nlohmann::json worst = nullptr;
+        };
+
+        FigureStats figureStats(const Run& run, const Run* reference, double FrameRecord::*figure, const char* name)
+        {
+            std::vector<double> all, own, ref;
+            FigureStats out;
+            for (std::size_t f = 0; f < run.frames.size(); ++f)
+            {
+                const FrameRecord& r = run.frames[f];
+                if (!std::isfinite(r.*figure))
+                    continue;
+                all.push_back(r.*figure);
+                if (out.worst.is_null() || r.*figure > out.worst[name].get<double>())
+                    out.worst = {{"frame", r.frame}, {"time", r.time}, {name, r.*figure}};
+                if (reference && f < reference->frames.size() && std::isfinite(reference->frames[f].*figure))
+                {
+                    own.push_back(r.*figure);
+                    ref.push_back(reference->frames[f].*figure);
+                }
+            }
+            out.all = statsOf(all);
+            out.own = statsOf(own);
+            out.ref = statsOf(ref);
+            return out;
+        }
+
         /// What `run` does in motion (summary.json's "motion"): its temporal FLIP over the motion
         /// frames with the worst one; the reference's over the frames both measured, and the
         /// ratios of the means and of the worst frames there; the pop FLIP (FrameRecord::popFlip)
@@ -249,52 +282,29 @@ namespace TreeLod
         nlohmann::json motionJson(const Run& run, const Run* reference)
         {
             using nlohmann::json;
-            std::vector<double> all, own, ref, pops, ownPops, refPops;
-            json worst = nullptr, worstPop = nullptr;
+            const FigureStats motion = figureStats(run, reference, &FrameRecord::temporalFlip, "temporalFlip");
+            const FigureStats pops = figureStats(run, reference, &FrameRecord::popFlip, "popFlip");
             std::int64_t switches = 0, visible = 0;
             bool counted = false;
-            for (std::size_t f = 0; f < run.frames.size(); ++f)
-            {
-                const FrameRecord& r = run.frames[f];
-                if (!std::isfinite(r.temporalFlip))
-                    continue;
-                all.push_back(r.temporalFlip);
-                if (worst.is_null() || r.temporalFlip > worst["temporalFlip"].get<double>())
-                    worst = {{"frame", r.frame}, {"time", r.time}, {"temporalFlip", r.temporalFlip}};
-                if (r.switches >= 0 && r.switchVisible >= 0)
+            for (const FrameRecord& r : run.frames)
+                if (std::isfinite(r.temporalFlip) && r.switches >= 0 && r.switchVisible >= 0)
                 {
                     switches += r.switches;
                     visible += r.switchVisible;
                     counted = true;
                 }
-                if (reference && f < reference->frames.size() && std::isfinite(reference->frames[f].temporalFlip))
-                {
-                    own.push_back(r.temporalFlip);
-                    ref.push_back(reference->frames[f].temporalFlip);
-                }
-                if (!std::isfinite(r.popFlip))
-                    continue;
-                pops.push_back(r.popFlip);
-                if (worstPop.is_null() || r.popFlip > worstPop["popFlip"].get<double>())
-                    worstPop = {{"frame", r.frame}, {"time", r.time}, {"popFlip", r.popFlip}};
-                if (reference && f < reference->frames.size() && std::isfinite(reference->frames[f].popFlip))
-                {
-                    ownPops.push_back(r.popFlip);
-                    refPops.push_back(reference->frames[f].popFlip);
-                }
-            }
-            const Stats popStats = statsOf(pops), refPopStats = statsOf(refPops);
-            const Stats stats = statsOf(all), ownShared = statsOf(own), refShared = statsOf(ref);
+            const auto summary = [](const Stats& s) {
+                return json{{"mean", num(s.mean)}, {"max", num(s.max)}, {"frames", s.count}};
+            };
             const bool rate = counted && visible > 0 && run.motionStepSeconds > 0.0;
-            return {{"temporalFlip", {{"mean", num(stats.mean)}, {"max", num(stats.max)}, {"frames", stats.count}}},
-                    {"worstFrame", worst},
-                    {"reference", {{"mean", num(refShared.mean)}, {"max", num(refShared.max)}, {"frames", refShared.count}}},
-                    {"meanOverReference", num(ownShared.mean / refShared.mean)},
-                    {"worstOverReference", num(ownShared.max / refShared.max)},
-                    {"popFlip", {{"mean", num(popStats.mean)}, {"max", num(popStats.max)}, {"frames", popStats.count}}},
-                    {"worstPopFrame", worstPop},
-                    {"referencePopFlip",
-                     {{"mean", num(refPopStats.mean)}, {"max", num(refPopStats.max)}, {"frames", refPopStats.count}}},
+            return {{"temporalFlip", summary(motion.all)},
+                    {"worstFrame", motion.worst},
+                    {"reference", summary(motion.ref)},
+                    {"meanOverReference", num(motion.own.mean / motion.ref.mean)},
+                    {"worstOverReference", num(motion.own.max / motion.ref.max)},
+                    {"popFlip", summary(pops.all)},
+                    {"worstPopFrame", pops.worst},
+                    {"referencePopFlip", summary(pops.ref)},
                     {"levelSwitches", counted ? json(switches) : json(nullptr)},
                     {"switchesPerTreePerSecond",
                      rate ? num(double(switches) / double(visible) / run.motionStepSeconds) : json(nullptr)}};
