@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 #include "TreeLodShadowCaster.glsl"
 // Shadow caster; ALPHA_TEST: leaves cast the shadow of their texture's shape.
 #ifdef ALPHA_TEST
@@ -18,6 +19,7 @@ uniform float alphaMaxLod;
 MAIN_PARAMETERS
     IN(vec2 vClipZW, TEXCOORD0)
     IN(vec2 vUv, TEXCOORD1)
+    TRANSITION_IN(TEXCOORD2)
 MAIN_DECLARATION
 {
 #ifdef ALPHA_TEST
@@ -26,6 +28,7 @@ MAIN_DECLARATION
 #endif
     // The shadow camera's window depth, 0..1 (shadow textures clear to 1); the receiver computes
     // the same from texture_viewproj_matrix.
+    TRANSITION_DISCARD
     float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5;
     fragColour = casterOutput(depth);
 }

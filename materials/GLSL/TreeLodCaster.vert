@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 // Shadow caster: passes clip-space z and w on; the fragment stage writes depth in 0..1.
 // INSTANCED: placed by the Forest's instance data first (TreeLodInstance.glsl).
 uniform mat4 worldViewProj;
@@ -21,8 +22,14 @@ MAIN_PARAMETERS
 #endif
     OUT(vec2 vClipZW, TEXCOORD0)
     OUT(vec2 vUv, TEXCOORD1)
+    TRANSITION_OUT(TEXCOORD2)
 MAIN_DECLARATION
 {
+#ifdef INSTANCED
+    vTransition = transitionOf(uv4, uv5);
+#else
+    vTransition = NO_TRANSITION;
+#endif
 #ifdef INSTANCED
     gl_Position = mul(worldViewProj, instancePosition(uv4, uv5, vertex));
 #else

@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 // colour = albedo * (ambient * ao + sun * max(0, n.l)) in linear space, written as sRGB
 // (LightingSpec in TreeLod/Camera.h; the CPU reference renderer uses the same formula).
 // LEAF: alpha test by discard; two-sided, the back side with backColour instead of baseColour.
@@ -36,6 +37,7 @@ MAIN_PARAMETERS
 #ifdef SHADOW_RECEIVER
     SHADOW_POSITIONS_IN(TEXCOORD4, TEXCOORD5, TEXCOORD6)
 #endif
+    TRANSITION_IN(TEXCOORD7)
 MAIN_DECLARATION
 {
     vec4 texel = TEX2D(diffuseMap, vUv);
@@ -63,5 +65,6 @@ MAIN_DECLARATION
     float ao = 1.0;
 #endif
     vec3 colour = albedo * (ambientColour.rgb * ao + sunColour.rgb * lambert);
+    TRANSITION_DISCARD
     fragColour = vec4(toSrgb(colour), 1.0);
 }

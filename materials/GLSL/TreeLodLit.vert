@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 // Lit tree surfaces (bark and leaves): world-space normal and UV to the fragment stage;
 // SHADOW_RECEIVER: also the position in the sun's shadow texture. AO: the vertex colour's red
 // channel (ambient occlusion) to the fragment stage. INSTANCED: placed by the Forest's
@@ -40,8 +41,14 @@ MAIN_PARAMETERS
 #ifdef SHADOW_RECEIVER
     SHADOW_POSITIONS_OUT(TEXCOORD4, TEXCOORD5, TEXCOORD6)
 #endif
+    TRANSITION_OUT(TEXCOORD7)
 MAIN_DECLARATION
 {
+#ifdef INSTANCED
+    vTransition = transitionOf(uv4, uv5);
+#else
+    vTransition = NO_TRANSITION;
+#endif
 #ifdef INSTANCED
     vec4 position = instancePosition(uv4, uv5, vertex);
     vec3 objectNormal = instanceDirection(uv5, normal);

@@ -389,7 +389,7 @@ namespace TreeLod
         cmd->add_option("--techniques", args->techniques,
                         "comma-separated techniques besides the comparison runs (" + comparisons + "): auto (the "
                         "script's choice), auto@E (budgeted auto at error budget E), auto~MS (under a frame budget of "
-                        "MS milliseconds) or any of " + known)
+                        "MS milliseconds) or any of " + known + "; each may end in +fadeT (level transitions of length T, 0: hard switches)")
             ->capture_default_str();
         cmd->add_option("--lod-bias", args->lodBiases, "comma-separated LoD biases (< 1 = less detail)")
             ->capture_default_str();

@@ -74,6 +74,10 @@ namespace TreeLod
         virtual bool hasErrorBudget() const { return false; }
         virtual float getErrorBudget() const { return 0.0f; }
         virtual void setErrorBudget(float) {}
+        /// Level transitions (Forest::setLodTransition: 0 hard switches), where the sample has them.
+        virtual bool hasLodTransition() const { return false; }
+        virtual float getLodTransition() const { return 0.0f; }
+        virtual void setLodTransition(float) {}
         virtual bool hasCameraPath() const { return false; }
         virtual bool isPlaying() const { return false; }
         virtual void setPlaying(bool) {}

@@ -71,6 +71,7 @@ namespace TreeLod
             return *costs;
         };
         mErrorBudget = mScript.lod.maxError;
+        mLodTransition = mScript.lod.transition;
         prepareSceneOptions(options);
         // The camera first: PSSM shadows split the view of the scene manager's camera.
         mCamera = mSceneManager->createCamera("TreeLod/Browser/ForestCamera");
@@ -120,7 +121,10 @@ namespace TreeLod
         {
             const bool frozen = isLodFrozen();
             if (mScene->update())
+            {
                 mScene->getForest().setLodFrozen(frozen);
+                mScene->getForest().setLodTransition(mLodTransition);
+            }
         }
         catch (const Ogre::Exception& e)
         {
@@ -189,6 +193,12 @@ namespace TreeLod
         requestPolicy(LodPolicy::automatic(budget));
     }
 
+    void ForestSample::setLodTransition(float transition)
+    {
+        mLodTransition = transition;
+        mScene->getForest().setLodTransition(transition);
+    }
+
     void ForestSample::setLodBias(float bias)
     {
         mLodBias = bias;
@@ -223,6 +233,8 @@ namespace TreeLod
         std::snprintf(cull, sizeof cull, "%.2f ms", s.cullMilliseconds);
         std::vector<std::pair<std::string, std::string>> stats;
         stats.emplace_back("Trees shown", formatCount(s.visibleInstances) + " of " + formatCount(s.instances));
+        if (mLodTransition > 0.0f)
+            stats.emplace_back("In a transition", formatCount(s.transitionInstances));
         stats.emplace_back("Batches (frame)", std::to_string(mCamera->_getNumRenderedBatches()));
         stats.emplace_back("Triangles (frame)", formatCount(mCamera->_getNumRenderedFaces()));
         stats.emplace_back("Forest draws", std::to_string(s.batches));

@@ -58,6 +58,10 @@ namespace TreeLod
         bool hasErrorBudget() const override { return true; }
         float getErrorBudget() const override { return mErrorBudget; }
         void setErrorBudget(float budget) override;
+        /// The Forest's transitions (the script's lod.transition at first), kept across technique switches.
+        bool hasLodTransition() const override { return true; }
+        float getLodTransition() const override { return mLodTransition; }
+        void setLodTransition(float transition) override;
         bool isPlaying() const override { return mPlaying; }
         void setPlaying(bool playing) override { mPlaying = playing; }
         void setScreenshotView(unsigned index, unsigned count) override;
@@ -87,6 +91,7 @@ namespace TreeLod
         std::string mBakeError; ///< the last technique switch's failed bake, shown in the stats
         float mLodBias = 1.0f;
         float mErrorBudget = 0.0f; ///< set from the script's lod.maxError when built
+        float mLodTransition = 0.0f; ///< set from the script's lod.transition when built
         bool mShadows = false;
         bool mWireframe = false;
     };

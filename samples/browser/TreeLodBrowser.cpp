@@ -52,13 +52,23 @@ namespace TreeLod
         /// reference's own; 0: the reference itself).
         const std::vector<float>& ERROR_BUDGETS = frameBudgetLadder();
 
-        std::size_t nearestErrorBudget(float budget)
+        /// The slider step of `steps` nearest to `value`.
+        std::size_t nearestStep(const std::vector<float>& steps, float value)
         {
             std::size_t best = 0;
-            for (std::size_t i = 1; i < ERROR_BUDGETS.size(); ++i)
-                if (std::abs(ERROR_BUDGETS[i] - budget) < std::abs(ERROR_BUDGETS[best] - budget))
+            for (std::size_t i = 1; i < steps.size(); ++i)
+                if (std::abs(steps[i] - value) < std::abs(steps[best] - value))
                     best = i;
             return best;
+        }
+
+        /// The transition slider's steps (Forest::setLodTransition; 0: hard switches).
+        const std::vector<float> TRANSITIONS = {0.0f, 0.05f, 0.1f, 0.2f, 0.3f, 0.5f, 1.0f};
+
+
+        std::string transitionCaption(float transition)
+        {
+            return transition > 0.0f ? Ogre::StringConverter::toString(transition) : "hard";
         }
 
         std::string biasCaption(int exponent)
@@ -430,6 +440,7 @@ namespace TreeLod
         mTechniqueMenu = nullptr;
         mLodBiasSlider = nullptr;
         mErrorBudgetSlider = nullptr;
+        mTransitionSlider = nullptr;
         mShadowsBox = mWireframeBox = mFreezeBox = nullptr;
         mPlayButton = nullptr;
         mStatsPanel = nullptr;
@@ -512,6 +523,11 @@ namespace TreeLod
             mErrorBudgetSlider = mTrays->createLongSlider(TL_TOPLEFT, "ErrorBudget", "Error budget (auto)", WIDGET_WIDTH,
                                                           60.0f, 54.0f, 0.0f, float(ERROR_BUDGETS.size() - 1),
                                                           unsigned(ERROR_BUDGETS.size()));
+        mTransitionSlider = nullptr;
+        if (sample.hasLodTransition())
+            mTransitionSlider = mTrays->createLongSlider(TL_TOPLEFT, "Transition", "Level transitions (X)", WIDGET_WIDTH,
+                                                         60.0f, 54.0f, 0.0f, float(TRANSITIONS.size() - 1),
+                                                         unsigned(TRANSITIONS.size()));
         mShadowsBox = mTrays->createCheckBox(TL_TOPLEFT, "Shadows", "Shadows (H)", WIDGET_WIDTH);
         mWireframeBox = mTrays->createCheckBox(TL_TOPLEFT, "Wireframe", "Wireframe (R)", WIDGET_WIDTH);
         mFreezeBox = mTrays->createCheckBox(TL_TOPLEFT, "FreezeLod", "Freeze LoD (L)", WIDGET_WIDTH);
@@ -537,9 +553,15 @@ namespace TreeLod
         mLodBiasSlider->setValueCaption(biasCaption(exponent));
         if (mErrorBudgetSlider)
         {
-            const std::size_t step = nearestErrorBudget(sample.getErrorBudget());
+            const std::size_t step = nearestStep(ERROR_BUDGETS, sample.getErrorBudget());
             mErrorBudgetSlider->setValue(Ogre::Real(step), false);
             mErrorBudgetSlider->setValueCaption(Ogre::StringConverter::toString(ERROR_BUDGETS[step]));
+        }
+        if (mTransitionSlider)
+        {
+            const std::size_t step = nearestStep(TRANSITIONS, sample.getLodTransition());
+            mTransitionSlider->setValue(Ogre::Real(step), false);
+            mTransitionSlider->setValueCaption(transitionCaption(TRANSITIONS[step]));
         }
         mShadowsBox->setChecked(sample.getShadows(), false);
         mWireframeBox->setChecked(sample.getWireframe(), false);
@@ -726,6 +748,13 @@ namespace TreeLod
                     mTechniqueMenu->selectItem((std::size_t(mTechniqueMenu->getSelectionIndex()) + 1) % techniques);
                     settle();
                 }
+                // Level transitions on and off, as the X key does.
+                if (mTransitionSlider && report.switches < switches)
+                {
+                    const std::size_t now = std::size_t(std::lround(mTransitionSlider->getValue()));
+                    mTransitionSlider->setValue(Ogre::Real(now == 0 ? nearestStep(TRANSITIONS, mLastTransition) : 0));
+                    settle();
+                }
             }
             const SoakMemory pass = measureMemory();
             std::fprintf(stderr, "soak: after %u switches %.1f MiB resident, %.1f MiB heap in use\n", report.switches,
@@ -803,6 +832,14 @@ namespace TreeLod
             mWireframeBox->toggle();
         else if (key == 'l')
             mFreezeBox->toggle();
+        else if (key == 'x' && mTransitionSlider)
+        {
+            // Hard switches and back to the last transition length.
+            const float now = sample.getLodTransition();
+            if (now > 0.0f)
+                mLastTransition = now;
+            mTransitionSlider->setValue(Ogre::Real(nearestStep(TRANSITIONS, now > 0.0f ? 0.0f : mLastTransition)));
+        }
         else if (key == OgreBites::SDLK_SPACE && sample.hasCameraPath())
             buttonHit(mPlayButton);
         else
@@ -924,6 +961,12 @@ namespace TreeLod
     {
         if (slider == mLodBiasSlider && mCurrent >= 0)
             setLodBiasExponent(int(std::lround(slider->getValue())));
+        if (slider == mTransitionSlider && mCurrent >= 0)
+        {
+            const float transition = TRANSITIONS[std::min(TRANSITIONS.size() - 1, std::size_t(std::lround(slider->getValue())))];
+            mSamples[std::size_t(mCurrent)]->setLodTransition(transition);
+            slider->setValueCaption(transitionCaption(transition));
+        }
         if (slider == mErrorBudgetSlider && mCurrent >= 0)
         {
             const std::size_t step = std::min(ERROR_BUDGETS.size() - 1, std::size_t(std::lround(slider->getValue())));

@@ -153,6 +153,8 @@ namespace TreeLod
         OgreBites::SelectMenu* mTechniqueMenu = nullptr;
         OgreBites::Slider* mLodBiasSlider = nullptr;
         OgreBites::Slider* mErrorBudgetSlider = nullptr; ///< samples with budgeted auto only
+        OgreBites::Slider* mTransitionSlider = nullptr;  ///< samples with level transitions only
+        float mLastTransition = 0.2f; ///< what the X key turns transitions back on to
         OgreBites::CheckBox* mShadowsBox = nullptr;
         OgreBites::CheckBox* mWireframeBox = nullptr;
         OgreBites::CheckBox* mFreezeBox = nullptr;

@@ -937,6 +937,16 @@ namespace TreeLod
                 ASSERT_TRUE(forest.add(ForestInstance{glm::vec3(0.0f, 0.0f, z), 0.0f, 1.0f, 0}));
         }
 
+        /// A distance kind switching at 10 m (d^2 = 100) and a tree of it at z = -10.
+        void addTreeSwitchingAtTenMetresByDistance(ForestInstances& forest)
+        {
+            ForestKind kind = distanceKind("tree", {100.0f});
+            kind.boundsCentre = glm::vec3(0.0f);
+            kind.boundsRadius = 1.0f;
+            ASSERT_TRUE(forest.addKind(kind));
+            ASSERT_TRUE(forest.add(ForestInstance{glm::vec3(0.0f, 0.0f, -10.0f), 0.0f, 1.0f, 0}));
+        }
+
         /// The level `forest`'s only instance gets in each cull from cameras at `distances`.
         std::vector<std::uint32_t> levelsAlong(const ForestInstances& forest, const std::vector<float>& distances,
                                                float hysteresis)
@@ -979,11 +989,7 @@ namespace TreeLod
 
         // A distance kind: the same hold, from the other side of the key's sign.
         ForestInstances byDistance;
-        ForestKind dk = distanceKind("tree", {100.0f});
-        dk.boundsCentre = glm::vec3(0.0f);
-        dk.boundsRadius = 1.0f;
-        ASSERT_TRUE(byDistance.addKind(dk));
-        ASSERT_TRUE(byDistance.add(ForestInstance{glm::vec3(0.0f, 0.0f, -10.0f), 0.0f, 1.0f, 0}));
+        addTreeSwitchingAtTenMetresByDistance(byDistance);
         const std::vector<std::uint32_t> d0 = levelsAlong(byDistance, jitter, 0.0f);
         EXPECT_EQ(std::count(d0.begin(), d0.end(), 0u), 10);
         const std::vector<std::uint32_t> d1 = levelsAlong(byDistance, jitter, 0.15f);
@@ -1075,5 +1081,163 @@ namespace TreeLod
         ASSERT_FALSE(unknown);
         EXPECT_NE(unknown.error().message().find("kind 9"), std::string::npos) << unknown.error().message();
         EXPECT_EQ(forest.getBucketCount(), 2u + 3u + 1u + 4u);
+    }
+}
+
+namespace TreeLod
+{
+    namespace
+    {
+        /// One draw of a cull: its level and transition code.
+        struct Draw
+        {
+            std::uint32_t level;
+            float code;
+        };
+
+        /// The draws of `forest`'s only instance from a camera `d` metres from z = -10 (as levelsAlong).
+        std::vector<Draw> drawsAt(const ForestInstances& forest, ForestVisibility& vis, float d, float transition,
+                                  float hysteresis = 0.0f)
+        {
+            CameraSpec spec;
+            spec.position = glm::vec3(0.0f, 0.0f, -10.0f + d);
+            spec.target = glm::vec3(0.0f, 0.0f, -10.0f);
+            spec.fovYDegrees = 90.0f;
+            EXPECT_TRUE(forest.cull(CullCamera::fromSpec(spec, 100.0f, 100.0f), 1.0f, vis, hysteresis, transition));
+            std::vector<Draw> draws;
+            for (std::size_t b = 0; b < vis.getBucketCount(); ++b)
+                for (std::uint32_t k = 0; k < vis.getBucket(b).count; ++k)
+                    draws.push_back({vis.getBucket(b).level, vis.getBucketTransitionCodes(b)[k]});
+            EXPECT_EQ(draws.size(), vis.getDrawCount());
+            return draws;
+        }
+
+        /// The share of the 64 screen-door thresholds (TreeLodTransition.glsl) each level keeps.
+        std::vector<double> levelShares(const std::vector<Draw>& draws, std::uint32_t levels)
+        {
+            std::vector<double> share(levels, 0.0);
+            for (int t = 0; t < 64; ++t)
+            {
+                const float dither = (float(t) + 0.5f) / 64.0f;
+                int kept = 0;
+                for (const Draw& draw : draws)
+                    if (transitionKeeps(draw.code, dither))
+                    {
+                        share[draw.level] += 1.0 / 64.0;
+                        ++kept;
+                    }
+                EXPECT_EQ(kept, 1) << "threshold " << dither << ": each pixel drawn by exactly one level";
+            }
+            return share;
+        }
+    }
+
+    TEST(ForestInstances, transitionsDrawATreeNearASwitchAtBothLevelsWithComplementaryMasks)
+    {
+        // The switch at 10 m; transition 0.2: screen sizes within 1.2 times the switch's, 8.33 m to 10 m.
+        ForestInstances forest;
+        addTreesSwitchingAtTenMetres(forest, {-10.0f});
+        ForestVisibility vis;
+        auto expectOne = [&](float d, std::uint32_t level) {
+            const std::vector<Draw> draws = drawsAt(forest, vis, d, 0.2f);
+            ASSERT_EQ(draws.size(), 1u) << d << " m";
+            EXPECT_EQ(draws[0].level, level) << d << " m";
+            EXPECT_EQ(draws[0].code, 0.0f) << d << " m: the whole tree";
+            EXPECT_EQ(vis.getTransitionCount(), 0u);
+        };
+        expectOne(12.0f, 1u);
+        expectOne(10.05f, 1u);
+        expectOne(8.0f, 0u);
+        expectOne(1.0f, 0u);
+
+        // At 9.5 m the screen size is 10 / 9.5 = 1.0526 times the switch's: the coarse level keeps
+        // (1.2 - 1.0526) / 0.2 = 0.737 of the pixels, the fine one the rest.
+        const std::vector<Draw> mid = drawsAt(forest, vis, 9.5f, 0.2f);
+        ASSERT_EQ(mid.size(), 2u);
+        EXPECT_EQ(vis.getVisibleCount(), 1u);
+        EXPECT_EQ(vis.getTransitionCount(), 1u);
+        EXPECT_EQ(mid[0].level, 0u);
+        EXPECT_EQ(mid[1].level, 1u);
+        EXPECT_NEAR(mid[1].code, (1.2f - 10.0f / 9.5f) / 0.2f, 1e-4f);
+        EXPECT_EQ(mid[0].code, -mid[1].code);
+        EXPECT_EQ(vis.getIndices()[0], vis.getIndices()[1]);
+        for (std::size_t k = 0; k < ForestVisibility::TRANSFORM_FLOATS; ++k)
+            EXPECT_EQ(vis.getTransforms()[k], vis.getTransforms()[ForestVisibility::TRANSFORM_FLOATS + k]);
+        const std::vector<double> shares = levelShares(mid, 2);
+        EXPECT_NEAR(shares[1], 0.737, 1.0 / 64.0);
+
+        // Walking through the band in 1 cm steps: the coarse share moves by at most 2/64 a step
+        // (a screen-door step and rounding); a hard switch (transition 0) moves it by all of it at once.
+        double worstSmooth = 0.0, worstHard = 0.0, previousSmooth = 0.0, previousHard = 0.0;
+        for (int step = 0; step <= 500; ++step)
+        {
+            const float d = 7.0f + 0.01f * float(step);
+            const double smooth = levelShares(drawsAt(forest, vis, d, 0.2f), 2)[1];
+            const double hard = levelShares(drawsAt(forest, vis, d, 0.0f), 2)[1];
+            if (step > 0)
+            {
+                worstSmooth = std::max(worstSmooth, std::abs(smooth - previousSmooth));
+                worstHard = std::max(worstHard, std::abs(hard - previousHard));
+            }
+            previousSmooth = smooth;
+            previousHard = hard;
+        }
+        EXPECT_LE(worstSmooth, 2.0 / 64.0);
+        EXPECT_EQ(worstHard, 1.0);
+        EXPECT_EQ(previousSmooth, 1.0);
+
+        // A distance kind switching at 10 m: the same shares at the same distances.
+        ForestInstances byDistance;
+        addTreeSwitchingAtTenMetresByDistance(byDistance);
+        const std::vector<Draw> distanceMid = drawsAt(byDistance, vis, 9.5f, 0.2f);
+        ASSERT_EQ(distanceMid.size(), 2u);
+        EXPECT_NEAR(distanceMid[1].code, mid[1].code, 1e-4f);
+        EXPECT_EQ(drawsAt(byDistance, vis, 10.05f, 0.2f).size(), 1u);
+        EXPECT_EQ(drawsAt(byDistance, vis, 8.0f, 0.2f).size(), 1u);
+
+        // Hysteresis does not hold a level while transitions are on: 9.9 m after 10.1 m is in the band.
+        drawsAt(forest, vis, 10.1f, 0.2f, 0.15f);
+        EXPECT_EQ(drawsAt(forest, vis, 9.9f, 0.2f, 0.15f).size(), 2u);
+
+        // A second cull with transitions allocates nothing.
+        const std::size_t capacity = vis.getCapacityBytes();
+        drawsAt(forest, vis, 9.5f, 0.2f);
+        EXPECT_EQ(vis.getCapacityBytes(), capacity);
+    }
+
+    TEST(ForestInstances, aTransitionTakesAtMostTheLowerHalfOfItsLevel)
+    {
+        // Switches at 10 m and 11 m: level 1 spans screen sizes 1.1 apart, so a transition of 0.5 into
+        // level 2 ends at sqrt(1.1) = 1.0488 times the 11 m switch's (10.49 m), not at 1.5 (7.3 m).
+        ForestInstances forest;
+        ForestKind kind = pixelKind("tree", {100.0f * glm::pi<float>(), 100.0f * glm::pi<float>() / 1.21f});
+        kind.boundsCentre = glm::vec3(0.0f);
+        kind.boundsRadius = 1.0f;
+        ASSERT_TRUE(forest.addKind(kind));
+        ASSERT_TRUE(forest.add(ForestInstance{glm::vec3(0.0f, 0.0f, -10.0f), 0.0f, 1.0f, 0}));
+        ForestVisibility vis;
+        EXPECT_EQ(drawsAt(forest, vis, 10.6f, 0.5f).size(), 2u) << "11 / 10.6 = 1.038: in level 1's band";
+        EXPECT_EQ(drawsAt(forest, vis, 10.4f, 0.5f).size(), 1u) << "11 / 10.4 = 1.058: level 1 alone";
+        // Level 0 has no finer neighbour: its band is the whole 0.5 (10 m to 6.67 m).
+        EXPECT_EQ(drawsAt(forest, vis, 7.0f, 0.5f).size(), 2u);
+        EXPECT_EQ(drawsAt(forest, vis, 6.5f, 0.5f).size(), 1u);
+        // The last level has no coarser neighbour: nothing fades beyond it.
+        EXPECT_EQ(drawsAt(forest, vis, 30.0f, 0.5f).size(), 1u);
+    }
+
+    TEST(ForestInstances, badTransitionsAreRefusedByName)
+    {
+        ForestInstances forest;
+        addTreesSwitchingAtTenMetres(forest, {-10.0f});
+        ForestVisibility vis;
+        drawsAt(forest, vis, 9.5f, 0.2f);
+        const CullCamera camera = CullCamera::fromSpec(CameraSpec(), 100.0f, 100.0f);
+        for (const float bad : {-0.1f, std::nanf(""), 1.5f, std::numeric_limits<float>::infinity()})
+        {
+            const Result<void> culled = forest.cull(camera, 1.0f, vis, 0.0f, bad);
+            ASSERT_FALSE(culled) << bad;
+            EXPECT_NE(culled.error().message().find("LoD transition"), std::string::npos) << culled.error().message();
+            EXPECT_EQ(vis.getDrawCount(), 2u) << "the last cull's result is kept";
+        }
     }
 }

@@ -60,9 +60,31 @@ namespace TreeLod
         }
     }
 
+    TEST(LodPolicy, aTransitionFollowsAnyChoice)
+    {
+        Result<LodPolicy> hard = LodPolicy::parse("auto+fade0");
+        ASSERT_TRUE(hard.ok());
+        EXPECT_TRUE(hard->isAuto());
+        EXPECT_EQ(hard->transition, 0.0f);
+        Result<LodPolicy> fixed = LodPolicy::parse("billboard-cloud+fade0.25");
+        ASSERT_TRUE(fixed.ok());
+        EXPECT_EQ(fixed->technique, "billboard-cloud");
+        EXPECT_EQ(fixed->transition, 0.25f);
+        EXPECT_TRUE(std::isnan(LodPolicy::parse("auto@0.1")->transition)) << "the script's";
+        EXPECT_NE(*LodPolicy::parse("auto+fade0"), *LodPolicy::parse("auto"));
+        for (const char* bad : {"auto+fade", "auto+fade-0.1", "auto+fade1.5", "auto+fadenan", "auto+fade0.2x", "auto@2+fade0"})
+        {
+            Result<LodPolicy> policy = LodPolicy::parse(bad, "--techniques");
+            ASSERT_FALSE(policy.ok()) << bad;
+            EXPECT_NE(policy.error().message().find("--techniques"), std::string::npos) << policy.error().message();
+            EXPECT_NE(policy.error().message().find("[0, 1]"), std::string::npos) << policy.error().message();
+        }
+    }
+
     TEST(LodPolicy, writesBackWhatItParses)
     {
-        for (const char* text : {"", "auto", "auto@0.05", "auto@0", "auto@1", "auto~40", "auto~16.5", "lodf"})
+        for (const char* text : {"", "auto", "auto@0.05", "auto@0", "auto@1", "auto~40", "auto~16.5", "lodf",
+                                 "auto+fade0", "auto@0.05+fade0.2", "impostor+fade1", "+fade0.1"})
         {
             Result<LodPolicy> policy = LodPolicy::parse(text);
             ASSERT_TRUE(policy.ok()) << text;

@@ -378,7 +378,14 @@ namespace TreeLod
         EXPECT_EQ(both.lod.maxError, SceneLod::DEFAULT_MAX_ERROR);
         EXPECT_EQ(parsed(MINIMAL).lod.shadowMaxError, SceneLod::DEFAULT_SHADOW_MAX_ERROR);
         EXPECT_EQ(parsed(MINIMAL).lod.frameBudgetMs, 0.0f);
+        // Level transitions.
+        EXPECT_EQ(parsed(MINIMAL).lod.transition, ForestInstances::DEFAULT_TRANSITION);
+        EXPECT_EQ(parsed(replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"lod\": {\"transition\": 0.3}")).lod.transition,
+                  0.3f);
         for (const auto& [bad, key] : {std::pair<const char*, const char*>{"{\"shadowMaxError\": 2}", "/lod/shadowMaxError"},
+                                      {"{\"transition\": -0.1}", "/lod/transition"},
+                                      {"{\"transition\": 1.5}", "/lod/transition"},
+                                      {"{\"transition\": \"smooth\"}", "/lod/transition"},
                                       {"{\"frameBudgetMs\": -1}", "/lod/frameBudgetMs"},
                                       {"{\"frameBudgetMs\": \"fast\"}", "/lod/frameBudgetMs"}})
         {
@@ -1199,8 +1206,9 @@ namespace TreeLod
             ForestVisibility vis;
             ASSERT_TRUE(forest.cull(camera, 1.0f, vis));
             EXPECT_EQ(vis.getVisibleCount(), MILLION);
-            // per visible tree: transform, indices, distance class; per tree (all visible here): its last level
-            const std::size_t perVisible = ForestVisibility::TRANSFORM_FLOATS * sizeof(float) +
+            // per visible tree: transform, indices, distance class, transition code (and its scratch);
+            // per tree (all visible here): its last level
+            const std::size_t perVisible = (ForestVisibility::TRANSFORM_FLOATS + 2) * sizeof(float) +
                                            4 * sizeof(std::uint32_t) + 2 * sizeof(std::uint8_t);
             const std::size_t visibilityBound = MILLION * perVisible +
                                                 forest.getBucketCount() * (sizeof(ForestBucket) + sizeof(std::uint32_t));

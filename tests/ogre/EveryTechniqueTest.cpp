@@ -1,13 +1,9 @@
 // Every registered technique against the same extremes, through the registries (no technique is
-// named here): a generated oak of 300 leaves baked by every baker (quick options, TestTrees.h) into
-// one package, each technique's object created from it by TechniqueRegistry.
-#include "OgreTestSupport.h"
-#include "TestTrees.h"
+// named here): everyTechniqueOak (ForestTestSupport.h), each technique's object created from it by
+// TechniqueRegistry.
+#include "ForestTestSupport.h"
 
-#include "TreeLod/BakeTechniques.h"
-#include "TreeLod/PackageWriter.h"
 #include "TreeLod/TechniqueRegistry.h"
-#include "TreeLod/TreeAssetManager.h"
 
 #include <gtest/gtest.h>
 
@@ -17,34 +13,6 @@ namespace TreeLod::EveryTechniqueTests
 {
     namespace
     {
-        struct EveryTechniqueTree
-        {
-            TreeModel model;
-            TreeAssetPtr asset;
-        };
-
-        const EveryTechniqueTree& everyTechniqueOak()
-        {
-            return OgreEnvironment::keep<EveryTechniqueTree>("every-technique.oak", [] {
-                EveryTechniqueTree t;
-                t.model = test::generatedOak(300);
-                const std::vector<std::uint8_t> bytes = cachedPackage("every-technique", "oak300", [&] {
-                    PackageWriter writer;
-                    for (const BakeTechnique& baker : bakeTechniques())
-                    {
-                        Result<void> baked = baker.bake(writer, t.model, test::quickBakeOptions(baker.name), "oak300", {});
-                        EXPECT_TRUE(baked.ok()) << baker.name << ": " << baked.error().message();
-                        if (!baked.ok())
-                            return std::vector<std::uint8_t>{};
-                    }
-                    return writer.toBytes();
-                });
-                OgreEnvironment::renderer();
-                t.asset = TreeAssetManager::getSingleton().loadFromBytes("oak300.every-technique", Ogre::RGN_DEFAULT, bytes);
-                return t;
-            });
-        }
-
         /// `technique`'s object of the oak at `at`, seen from `camera` moved by `at`, without shadows.
         Image renderTechniqueAt(const std::string& technique, const glm::vec3& at, CameraSpec camera)
         {

@@ -148,42 +148,15 @@ namespace TreeLod
         compareWithGolden(shadowed, "forest-shadows", 0.02);
     }
 
-    /// Texture shadows for the tests below: Forest trees (mesh level) on a ground (a clone of
-    /// TreeLod/Bark, or of TreeLod/BarkShadowed where `receiving`: the sun's depth shadow), or
+    /// Texture shadows for the tests below: Forest trees (mesh level) on a ground (placeGround), or
     /// none where `groundSize` is 0.
     void placeShadowScene(const std::vector<ForestInstance>& trees, float groundSize, bool receiving)
     {
         OffscreenRenderer& r = OgreEnvironment::renderer();
         Ogre::SceneManager& sm = r.getSceneManager();
-        Ogre::MaterialManager& materials = Ogre::MaterialManager::getSingleton();
-        for (const char* suffix : {"", "Shadowed"})
-        {
-            const Ogre::String name = Ogre::String("ForestTest/ShadowSceneGround") + suffix;
-            if (materials.resourceExists(name, "TreeLod"))
-                continue;
-            Ogre::MaterialPtr material = materials.getByName(Ogre::String("TreeLod/Bark") + suffix, "TreeLod")->clone(name);
-            material->getTechnique(0)->getPass(0)->getFragmentProgramParameters()->setNamedConstant(
-                "baseColour", Ogre::ColourValue(0.45f, 0.5f, 0.3f, 1.0f));
-            material->load();
-        }
         r.clearContent();
         if (groundSize > 0.0f)
-        {
-            Ogre::ManualObject* quad = sm.createManualObject();
-            quad->setCastShadows(false);
-            quad->begin(receiving ? "ForestTest/ShadowSceneGroundShadowed" : "ForestTest/ShadowSceneGround",
-                        Ogre::RenderOperation::OT_TRIANGLE_LIST, "TreeLod");
-            const float s = groundSize;
-            for (const glm::vec2 c : {glm::vec2(-s, -s), glm::vec2(s, -s), glm::vec2(s, s), glm::vec2(-s, s)})
-            {
-                quad->position(c.x, 0.0f, c.y);
-                quad->normal(0.0f, 1.0f, 0.0f);
-                quad->textureCoord(0.0f, 0.0f);
-            }
-            quad->quad(0, 3, 2, 1);
-            quad->end();
-            r.getContentNode().createChildSceneNode()->attachObject(quad);
-        }
+            placeGround(groundSize, receiving);
         static int serial = 0;
         auto* forest = static_cast<Forest*>(sm.createMovableObject("shadowSetup" + std::to_string(serial++), "Forest"));
         forest->addSpecies(oak().asset, {ForestLevel{"mesh", 0, false, 0.0f}});
@@ -530,7 +503,7 @@ namespace TreeLod
                 if (treePixel[i] == trees)
                 {
                     const glm::vec4& p = image.pixels[i];
-                    sum += 0.2126 * p.r + 0.7152 * p.g + 0.0722 * p.b;
+                    sum += pixelLuminance(p);
                     ++n;
                 }
             return n ? sum / double(n) : 0.0;

@@ -1,12 +1,15 @@
 // Helpers of the Forest tests (ForestTest.cpp, ForestShadowTest.cpp, ForestLevelPlanTest.cpp,
-// ForestFloorTest.cpp): the oak package every Forest test draws (reference, lodf, billboard-cloud,
-// impostor of media/oak.glb, baked with the core bakers (few AO rays) and cached in
-// $TREELOD_TEST_OUT/forest, keyed by the test binary's modification time), grids of instances,
-// views and counts.
+// ForestFloorTest.cpp, ForestTransitionTest.cpp, EveryTechniqueTest.cpp): the oak package every
+// Forest test draws (reference, lodf, billboard-cloud, impostor of media/oak.glb, baked with the
+// core bakers (few AO rays) and cached in $TREELOD_TEST_OUT/forest, keyed by the test binary's
+// modification time), the oak of every technique (everyTechniqueOak), a ground, grids of
+// instances, views and counts.
 #pragma once
 
 #include "OgreTestSupport.h"
+#include "TestTrees.h"
 #include "TreeLod/AtomicFile.h"
+#include "TreeLod/BakeTechniques.h"
 
 #include "TreeLod/BillboardCloudResources.h"
 #include "TreeLod/FoliageLodResources.h"
@@ -104,7 +107,71 @@ namespace TreeLod
             });
         }
 
+        struct EveryTechniqueTree
+        {
+            TreeModel model;
+            TreeAssetPtr asset;
+        };
+
+        /// A generated oak of 300 leaves baked by every baker (quick options, TestTrees.h) into one
+        /// package, loaded as "oak300.every-technique".
+        inline const EveryTechniqueTree& everyTechniqueOak()
+        {
+            return OgreEnvironment::keep<EveryTechniqueTree>("every-technique.oak", [] {
+                EveryTechniqueTree t;
+                t.model = test::generatedOak(300);
+                const std::vector<std::uint8_t> bytes = cachedPackage("every-technique", "oak300", [&] {
+                    PackageWriter writer;
+                    for (const BakeTechnique& baker : bakeTechniques())
+                    {
+                        Result<void> baked = baker.bake(writer, t.model, test::quickBakeOptions(baker.name), "oak300", {});
+                        EXPECT_TRUE(baked.ok()) << baker.name << ": " << baked.error().message();
+                        if (!baked.ok())
+                            return std::vector<std::uint8_t>{};
+                    }
+                    return writer.toBytes();
+                });
+                OgreEnvironment::renderer();
+                t.asset = TreeAssetManager::getSingleton().loadFromBytes("oak300.every-technique", Ogre::RGN_DEFAULT, bytes);
+                return t;
+            });
+        }
+
         const glm::vec3 BACKGROUND = LightingSpec().background;
+
+        /// A ground square of half-size `size` at y = 0 under the content node, casting no shadow: a
+        /// clone of TreeLod/Bark in a plain green, or of TreeLod/BarkShadowed where `receiving` (the
+        /// sun's depth shadow).
+        inline void placeGround(float size, bool receiving)
+        {
+            Ogre::MaterialManager& materials = Ogre::MaterialManager::getSingleton();
+            for (const char* suffix : {"", "Shadowed"})
+            {
+                const Ogre::String name = Ogre::String("ForestTest/ShadowSceneGround") + suffix;
+                if (materials.resourceExists(name, "TreeLod"))
+                    continue;
+                Ogre::MaterialPtr material =
+                    materials.getByName(Ogre::String("TreeLod/Bark") + suffix, "TreeLod")->clone(name);
+                material->getTechnique(0)->getPass(0)->getFragmentProgramParameters()->setNamedConstant(
+                    "baseColour", Ogre::ColourValue(0.45f, 0.5f, 0.3f, 1.0f));
+                material->load();
+            }
+            OffscreenRenderer& r = OgreEnvironment::renderer();
+            Ogre::ManualObject* quad = r.getSceneManager().createManualObject();
+            quad->setCastShadows(false);
+            quad->begin(receiving ? "ForestTest/ShadowSceneGroundShadowed" : "ForestTest/ShadowSceneGround",
+                        Ogre::RenderOperation::OT_TRIANGLE_LIST, "TreeLod");
+            for (const glm::vec2 c : {glm::vec2(-size, -size), glm::vec2(size, -size), glm::vec2(size, size),
+                                      glm::vec2(-size, size)})
+            {
+                quad->position(c.x, 0.0f, c.y);
+                quad->normal(0.0f, 1.0f, 0.0f);
+                quad->textureCoord(0.0f, 0.0f);
+            }
+            quad->quad(0, 3, 2, 1); // counter-clockwise seen from above
+            quad->end();
+            r.getContentNode().createChildSceneNode()->attachObject(quad);
+        }
 
         /// A fresh Forest (through its factory) under a child of the content node, content cleared.
         inline Forest* placeForest(const Ogre::NameValuePairList& params = {}, Ogre::SceneNode** node = nullptr)

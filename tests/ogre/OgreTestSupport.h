@@ -153,12 +153,15 @@ namespace TreeLod
         return over == FlipOver::Tree ? meanOverTree(*error, a, b) : error->mean;
     }
 
+    /// Rec. 709 luminance of a pixel's stored (sRGB) values.
+    inline double pixelLuminance(const glm::vec4& p) { return 0.2126 * p.r + 0.7152 * p.g + 0.0722 * p.b; }
+
     /// Mean Rec. 709 luminance of the stored (sRGB) values.
     inline double meanLuminance(const Image& image)
     {
         double sum = 0.0;
         for (const glm::vec4& p : image.pixels)
-            sum += 0.2126 * p.r + 0.7152 * p.g + 0.0722 * p.b;
+            sum += pixelLuminance(p);
         return sum / double(image.pixels.size());
     }
 

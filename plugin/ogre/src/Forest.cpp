@@ -211,6 +211,16 @@ namespace TreeLod
         mLodHysteresis = hysteresis;
     }
 
+    void Forest::setLodTransition(Ogre::Real transition)
+    {
+        if (!(transition >= 0.0f && transition <= ForestInstances::MAX_TRANSITION))
+            invalid("Forest '" + mName + "': LoD transition " + std::to_string(transition) + " is not in [0, " +
+                        std::to_string(ForestInstances::MAX_TRANSITION) +
+                        "] (0: hard switches; at most a doubling of screen size)",
+                    "Forest::setLodTransition");
+        mLodTransition = transition;
+    }
+
     void Forest::setShadowLodBias(Ogre::Real bias)
     {
         if (!std::isfinite(bias) || !(bias > 0.0f))

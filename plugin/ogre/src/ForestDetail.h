@@ -45,10 +45,11 @@ namespace TreeLod
 {
     namespace ForestDetail
     {
-        /// Per instance: uv4 = position xyz + uniform scale, uv5 = cos, sin of the rotation (Forest.h).
-        constexpr std::size_t INSTANCE_FLOATS = 6;
+        /// Per draw of a tree: uv4 = position xyz + uniform scale, uv5 = cos, sin of the rotation and
+        /// the transition code (Forest.h, TreeLodInstance.glsl).
+        constexpr std::size_t INSTANCE_FLOATS = 7;
         constexpr std::size_t INSTANCE_BYTES = INSTANCE_FLOATS * sizeof(float);
-        static_assert(INSTANCE_BYTES == 24, "the instance layout of Forest.h");
+        static_assert(INSTANCE_BYTES == 28, "the instance layout of Forest.h");
         constexpr std::size_t MIN_INSTANCE_CAPACITY = 16;
         constexpr std::size_t MAX_LEVELS = ForestInstances::MAX_THRESHOLDS + 1;
         constexpr Ogre::Real NO_UPPER = ForestLevelSpan::NO_UPPER;
@@ -331,7 +332,7 @@ namespace TreeLod
             Ogre::VertexDeclaration* decl = mVertexData->vertexDeclaration;
             mSource = static_cast<unsigned short>(decl->getMaxSource() + 1);
             decl->addElement(mSource, 0, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 4);
-            decl->addElement(mSource, 4 * sizeof(float), Ogre::VET_FLOAT2, Ogre::VES_TEXTURE_COORDINATES, 5);
+            decl->addElement(mSource, 4 * sizeof(float), Ogre::VET_FLOAT3, Ogre::VES_TEXTURE_COORDINATES, 5);
             for (const auto& [index, value] : part.customParameters)
                 setCustomParameter(index, value);
         }

@@ -26,6 +26,7 @@ namespace TreeLod
         mStats.instances = std::uint32_t(mInstances.size());
         mStats.visibleInstances = 0;
         mStats.levelSwitches = 0;
+        mStats.transitionInstances = 0;
         mStats.batches = 0;
         mStats.triangles = 0;
         mStats.cullMilliseconds = 0.0;
@@ -75,6 +76,7 @@ namespace TreeLod
         }
         // The cull's rows [R*s | t] (ForestInstances.h): t, s = m11, cos = m00 / s, sin = m02 / s.
         const float* transforms = state.visibility.getBucketTransforms(b);
+        const float* codes = state.visibility.getBucketTransitionCodes(b);
         constexpr std::size_t STRIDE = ForestVisibility::TRANSFORM_FLOATS;
         if (slot.backToFront)
         {
@@ -95,7 +97,8 @@ namespace TreeLod
             slot.buffer->lock(0, std::size_t(bucket.count) * INSTANCE_BYTES, Ogre::HardwareBuffer::HBL_DISCARD));
         for (std::uint32_t i = 0; i < bucket.count; ++i, out += INSTANCE_FLOATS)
         {
-            const float* m = transforms + (slot.backToFront ? state.depthOrder[i].second : i) * STRIDE;
+            const std::uint32_t draw = slot.backToFront ? state.depthOrder[i].second : i;
+            const float* m = transforms + draw * STRIDE;
             const float scale = m[5], inverse = 1.0f / scale;
             out[0] = m[3];
             out[1] = m[7];
@@ -103,6 +106,7 @@ namespace TreeLod
             out[3] = scale;
             out[4] = m[0] * inverse;
             out[5] = m[2] * inverse;
+            out[6] = codes[draw];
         }
         slot.buffer->unlock();
     }
@@ -160,7 +164,7 @@ namespace TreeLod
         state.eye = glm::vec3(eye.x, eye.y, eye.z);
 
         const auto start = std::chrono::steady_clock::now();
-        const Result<void> culled = mInstances.cull(state.camera, state.lodBias, state.visibility, mLodHysteresis);
+        const Result<void> culled = mInstances.cull(state.camera, state.lodBias, state.visibility, mLodHysteresis, mLodTransition);
         const double cullMs =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         if (!culled)
@@ -232,6 +236,7 @@ namespace TreeLod
             mStats.instances = std::uint32_t(mInstances.size());
             mStats.visibleInstances = state.visibility.getVisibleCount();
             mStats.levelSwitches = state.visibility.getSwitchCount();
+            mStats.transitionInstances = state.visibility.getTransitionCount();
             mStats.batches = batches;
             mStats.triangles = triangles;
             mStats.cullMilliseconds = cullMs;

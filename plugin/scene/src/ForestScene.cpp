@@ -125,11 +125,17 @@ namespace TreeLod
             Result<LodPolicy> policy = LodPolicy::parse(name, "--techniques");
             if (!policy)
                 return policy.error();
-            if (name == "auto")
-                policy = LodPolicy::scriptChoice(); // the bench's "auto": each species as its script says
-            if (policy->mode == LodPolicy::Mode::Fixed && bakeTechniqueOf(name).empty())
+            if (policy->isAuto() && std::isnan(policy->errorBudget) && std::isnan(policy->frameBudgetMs))
+            {
+                // The bench's "auto": each species as its script says.
+                const float transition = policy->transition;
+                policy = LodPolicy::scriptChoice();
+                policy->transition = transition;
+            }
+            if (policy->mode == LodPolicy::Mode::Fixed && bakeTechniqueOf(policy->technique).empty())
                 return fail("", "--techniques",
-                            "unknown technique '" + name + "' (known: auto, auto@E, auto~MS, " + knownSceneTechniques() + ")");
+                            "unknown technique '" + policy->technique + "' (known: auto, auto@E, auto~MS, " +
+                                knownSceneTechniques() + "; any with +fadeT)");
             runs.push_back({name, *policy});
         }
         return runs;
@@ -337,6 +343,7 @@ namespace TreeLod
         mForest->setUploadBudget(mOptions.uploadBudget);
         mForest->setShadowLodBias(mScript.shadows.lodBias);
         mForest->setFrameBudgetMs(std::isnan(mPolicy.frameBudgetMs) ? mScript.lod.frameBudgetMs : mPolicy.frameBudgetMs);
+        mForest->setLodTransition(std::isnan(mPolicy.transition) ? mScript.lod.transition : mPolicy.transition);
 
         // Bands per species; then one bake request per distinct source with every technique its
         // species draw (two species sharing a file share one package and one asset).

@@ -114,7 +114,8 @@ namespace TreeLod
                 mNearFirst.capacity()) *
                    sizeof(std::uint32_t) +
                mVisibleClass.capacity() + mLastLevel.capacity() +
-               mTransforms.capacity() * sizeof(float);
+               (mTransforms.capacity() + mCodes.capacity() + mVisibleCode.capacity() + mBandEnds.capacity()) *
+                   sizeof(float);
     }
 
     std::size_t ForestInstances::getMemoryBytes() const
@@ -459,28 +460,64 @@ namespace TreeLod
 
     // ---- the per-frame loop ----------------------------------------------------------------------
 
+    void ForestInstances::writeBandEnds(float transition, ForestVisibility& out) const
+    {
+        // Screen-size ratio where threshold i's band ends: 1 + t, at most the square root of level
+        // i's own range of screen sizes (its lower half in ratio; level 0's range is unbounded).
+        out.mBandEnds.assign(mKinds.size() * MAX_THRESHOLDS, 1.0f);
+        for (std::size_t k = 0; k < mKinds.size(); ++k)
+        {
+            const std::vector<float>& t = mKinds[k].thresholds;
+            const bool distance = mKindDistance[k] != 0;
+            for (std::size_t i = 0; i < t.size(); ++i)
+            {
+                if (!(t[i] > 0.0f))
+                    continue; // a switch at value 0 (or distance 0) is never crossed from above
+                float end = 1.0f + transition;
+                if (i > 0)
+                {
+                    const float range = distance ? t[i] / t[i - 1] : t[i - 1] / t[i]; // value ratio, >= 1
+                    end = std::min(end, std::sqrt(std::sqrt(range)));
+                }
+                out.mBandEnds[k * MAX_THRESHOLDS + i] = end;
+            }
+        }
+        out.mBandTransition = transition;
+        out.mBandTables = mTableGeneration;
+    }
+
     Result<void> ForestInstances::cull(const CullCamera& camera, float lodBias, ForestVisibility& out,
-                                       float hysteresis) const
+                                       float hysteresis, float transition) const
     {
         if (!std::isfinite(lodBias) || !(lodBias > 0.0f))
             return fail("", "LoD bias", text(lodBias) + " is not finite and > 0");
         if (!(hysteresis >= 0.0f && hysteresis <= 1.0f))
             return fail("", "LoD hysteresis", text(hysteresis) + " is not in [0, 1]");
+        if (!(transition >= 0.0f && transition <= MAX_TRANSITION))
+            return fail("", "LoD transition", text(transition) + " is not in [0, " + text(MAX_TRANSITION) + "]");
         for (std::size_t p = 0; p < 6; ++p)
             if (!finite(glm::vec3(camera.planes[p])) || !std::isfinite(camera.planes[p].w))
                 return fail("", "camera", "frustum plane " + std::to_string(p) + " is not finite");
         if (!finite(camera.lodPosition) || !std::isfinite(camera.lodPixelScale) || camera.lodPixelScale < 0.0f)
             return fail("", "camera", "LoD position or pixel scale is not finite");
 
-        // Warm-up: arrays grow to the instance and bucket counts, never shrink.
+        // Warm-up: arrays grow to the instance and bucket counts (twice the instances with
+        // transitions: a tree may be drawn at two levels), never shrink.
         const std::size_t n = size();
-        if (out.mVisible.size() < n)
+        const bool transitions = transition > 0.0f;
+        const std::size_t entries = transitions ? 2 * n : n;
+        if (out.mVisible.size() < entries)
         {
-            out.mVisible.resize(n);
-            out.mVisibleBucket.resize(n);
-            out.mVisibleClass.resize(n);
-            out.mNearFirst.resize(n);
+            out.mVisible.resize(entries);
+            out.mVisibleBucket.resize(entries);
+            out.mVisibleClass.resize(entries);
+            out.mVisibleCode.resize(entries);
+            out.mNearFirst.resize(entries);
         }
+        if (transitions && (out.mBandTransition != transition || out.mBandTables != mTableGeneration ||
+                            out.mBandEnds.size() != mKinds.size() * MAX_THRESHOLDS))
+            writeBandEnds(transition, out);
+        const float* bandEnds = out.mBandEnds.data();
         out.mBuckets.resize(mBucketCount);
         out.mCursor.assign(mBucketCount, 0u);
         constexpr std::uint8_t LEVEL_NONE = 0xFF;
@@ -518,9 +555,10 @@ namespace TreeLod
         std::uint32_t* visible = out.mVisible.data();
         std::uint32_t* visibleBucket = out.mVisibleBucket.data();
         std::uint8_t* visibleClass = out.mVisibleClass.data();
+        float* visibleCode = out.mVisibleCode.data();
         std::array<std::uint32_t, ForestVisibility::DISTANCE_CLASSES> classCounts{};
         std::uint32_t* counts = out.mCursor.data();
-        std::uint32_t visibleCount = 0, switchCount = 0;
+        std::uint32_t visibleCount = 0, switchCount = 0, transitionCount = 0, entryCount = 0;
         const float* blocks = mBlockBounds.data();
         for (std::size_t block = 0, begin = 0; begin < n; ++block, begin += BLOCK_SIZE)
         {
@@ -559,7 +597,7 @@ namespace TreeLod
             const float key = lodKey(d2, r, kindDistance[kind] != 0, c);
             const float* table = tables + kind * MAX_THRESHOLDS;
             std::uint32_t level = levelForKey(table, key);
-            if (hysteresis > 0.0f && lastLevel[i] != LEVEL_NONE && lastLevel[i] != level)
+            if (hysteresis > 0.0f && !transitions && lastLevel[i] != LEVEL_NONE && lastLevel[i] != level)
             {
                 // Keys grow toward finer levels (distance keys are negated, so scaling a negative
                 // key by more than 1 makes it coarser): the band [finest, coarsest] of key * (1 +- h).
@@ -577,12 +615,35 @@ namespace TreeLod
             std::memcpy(&bits, &d2, sizeof bits);
             const std::uint8_t distanceClass = std::uint8_t(
                 std::clamp(int(bits >> 21) - 127 * 4, 0, ForestVisibility::DISTANCE_CLASSES - 1));
-            visible[visibleCount] = std::uint32_t(i);
-            visibleBucket[visibleCount] = bucket;
-            visibleClass[visibleCount] = distanceClass;
+            // In a transition band (the file comment): the coarse level's share f of the pixels.
+            float coarseShare = 0.0f;
+            if (transitions && level < MAX_THRESHOLDS)
+            {
+                const float end = bandEnds[kind * MAX_THRESHOLDS + level];
+                const float threshold = table[level];
+                const float ratio = kindDistance[kind] != 0 ? threshold / key : key / threshold; // >= 1 (or NaN)
+                if (end > 1.0f && ratio < end * end)
+                    coarseShare = std::min((end - std::sqrt(ratio)) / (end - 1.0f), 1.0f);
+            }
+            visible[entryCount] = std::uint32_t(i);
+            visibleBucket[entryCount] = bucket;
+            visibleClass[entryCount] = distanceClass;
+            visibleCode[entryCount] = coarseShare > 0.0f ? -coarseShare : 0.0f;
             ++classCounts[distanceClass];
             ++counts[bucket];
+            ++entryCount;
             ++visibleCount;
+            if (coarseShare > 0.0f)
+            {
+                visible[entryCount] = std::uint32_t(i);
+                visibleBucket[entryCount] = bucket + 1;
+                visibleClass[entryCount] = distanceClass;
+                visibleCode[entryCount] = coarseShare;
+                ++classCounts[distanceClass];
+                ++counts[bucket + 1];
+                ++entryCount;
+                ++transitionCount;
+            }
         }
         }
 
@@ -605,23 +666,26 @@ namespace TreeLod
             count = at;
             at += size;
         }
-        for (std::uint32_t j = 0; j < visibleCount; ++j)
+        for (std::uint32_t j = 0; j < entryCount; ++j)
             nearFirst[classCounts[visibleClass[j]]++] = j;
 
-        // Pass 2: fill indices and world matrices, bucket by bucket, near first.
-        if (out.mIndices.size() < visibleCount)
+        // Pass 2: fill indices, world matrices and transition codes, bucket by bucket, near first.
+        if (out.mIndices.size() < entryCount)
         {
-            out.mIndices.resize(visibleCount);
-            out.mTransforms.resize(ForestVisibility::TRANSFORM_FLOATS * visibleCount);
+            out.mIndices.resize(entryCount);
+            out.mCodes.resize(entryCount);
+            out.mTransforms.resize(ForestVisibility::TRANSFORM_FLOATS * entryCount);
         }
         std::uint32_t* indices = out.mIndices.data();
+        float* codes = out.mCodes.data();
         float* transforms = out.mTransforms.data();
-        for (std::uint32_t k = 0; k < visibleCount; ++k)
+        for (std::uint32_t k = 0; k < entryCount; ++k)
         {
             const std::uint32_t j = nearFirst[k];
             const std::uint32_t i = visible[j];
             const std::uint32_t slot = counts[visibleBucket[j]]++;
             indices[slot] = i;
+            codes[slot] = visibleCode[j];
             float* m = transforms + ForestVisibility::TRANSFORM_FLOATS * slot;
             const float cs = cosScale[i], ss = sinScale[i];
             m[0] = cs, m[1] = 0.0f, m[2] = ss, m[3] = px[i];
@@ -631,6 +695,7 @@ namespace TreeLod
         out.mVisibleCount = visibleCount;
         out.mCulledCount = std::uint32_t(n - visibleCount);
         out.mSwitchCount = switchCount;
+        out.mTransitionCount = transitionCount;
         return {};
     }
 }

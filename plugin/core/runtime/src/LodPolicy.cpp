@@ -1,5 +1,7 @@
 #include "TreeLod/LodPolicy.h"
 
+#include "TreeLod/ForestInstances.h"
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -25,6 +27,18 @@ namespace TreeLod
 
     Result<LodPolicy> LodPolicy::parse(const std::string& text, const std::string& element)
     {
+        if (const std::size_t fade = text.rfind("+fade"); fade != std::string::npos)
+        {
+            const std::string number = text.substr(fade + 5);
+            char* end = nullptr;
+            const double value = std::strtod(number.c_str(), &end);
+            if (number.empty() || *end != '\0' || !(value >= 0.0 && value <= ForestInstances::MAX_TRANSITION))
+                return fail("", element, "'" + text + "': the transition after '+fade' must be in [0, 1] (0: hard switches)");
+            Result<LodPolicy> base = parse(text.substr(0, fade), element);
+            if (base)
+                base->transition = float(value);
+            return base;
+        }
         if (text.empty())
             return scriptChoice();
         if (text == "auto")
@@ -49,6 +63,14 @@ namespace TreeLod
 
     std::string LodPolicy::toString() const
     {
+        if (!std::isnan(transition))
+        {
+            LodPolicy base = *this;
+            base.transition = std::numeric_limits<float>::quiet_NaN();
+            char fade[32];
+            std::snprintf(fade, sizeof fade, "+fade%g", double(transition));
+            return base.toString() + fade;
+        }
         char text[48];
         switch (mode)
         {
@@ -72,6 +94,6 @@ namespace TreeLod
     {
         const auto same = [](float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); };
         return mode == other.mode && technique == other.technique && same(errorBudget, other.errorBudget) &&
-               same(frameBudgetMs, other.frameBudgetMs);
+               same(frameBudgetMs, other.frameBudgetMs) && same(transition, other.transition);
     }
 }

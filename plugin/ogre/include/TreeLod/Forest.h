@@ -16,8 +16,11 @@
 // Bark: a level draws the bark mesh LoD of the largest value it covers; levels split where it switches.
 // Materials: instanced clones, vertex programs swapped for "<program>/Instanced" (INSTANCED=1);
 // ForestPartOptions::instancedMaterial parts are used as they are.
-// Per-camera state: instance buffers (24 bytes a visible tree) and Renderables, dropped with the
+// Per-camera state: instance buffers (28 bytes a draw of a tree) and Renderables, dropped with the
 // camera; a warmed-up frame allocates nothing.
+// Transitions (setLodTransition): a tree near a level switch is drawn at both levels with
+// complementary screen-door masks (ForestInstances.h, TreeLodTransition.glsl), in the view and in
+// the shadow textures alike.
 // Residency: driven from the render thread, which uploads. addSpecies builds the last level only;
 // others are built when a camera first needs them, within setUploadBudget's bytes a frame, their
 // trees drawn at the nearest resident level meanwhile; nothing is evicted. Bakes run elsewhere.
@@ -53,9 +56,12 @@ namespace TreeLod
         /// Visible instances at another level than this camera's previous frame gave them
         /// (ForestVisibility::getSwitchCount): the pops a user may see.
         std::uint32_t levelSwitches = 0;
+        /// Visible instances drawn at two levels, in a transition (setLodTransition).
+        std::uint32_t transitionInstances = 0;
         std::uint32_t batches = 0;            ///< instanced draws queued (all parts)
         std::uint64_t triangles = 0;          ///< submitted, summed over instances
-        /// Visible instances per species and level: levelCounts[species][level].
+        /// Instances drawn per species and level: levelCounts[species][level] (a tree in a
+        /// transition counts at both of its levels).
         std::vector<std::vector<std::uint32_t>> levelCounts;
         double cullMilliseconds = 0.0;        ///< ForestInstances::cull of the viewer's camera
         std::uint64_t instanceBufferBytes = 0; ///< instance vertex buffers, all cameras
@@ -193,6 +199,14 @@ namespace TreeLod
         /// that trees at a switch do not flicker under camera jitter.
         void setLodHysteresis(Ogre::Real hysteresis);
         Ogre::Real getLodHysteresis() const { return mLodHysteresis; }
+        /// Transition length t in [0, 1] (ForestInstances::MAX_TRANSITION; default
+        /// DEFAULT_LOD_TRANSITION): a tree whose screen size is within 1 + t times its level's switch
+        /// to the next is drawn at both, cross-faded by complementary screen-door masks, so that no
+        /// level pops. 0: hard switches (with hysteresis, which transitions replace). Each band
+        /// takes at most the lower half of its level's range of screen sizes (in ratio).
+        void setLodTransition(Ogre::Real transition);
+        Ogre::Real getLodTransition() const { return mLodTransition; }
+        static constexpr Ogre::Real DEFAULT_LOD_TRANSITION = ForestInstances::DEFAULT_TRANSITION;
         /// Keep the LoD camera of the last frame (levels stop changing; culling goes on).
         void setLodFrozen(bool frozen);
         bool isLodFrozen() const { return mLodFrozen; }
@@ -283,6 +297,7 @@ namespace TreeLod
         ObjectLodBias mLodBias;
         Ogre::Real mShadowLodBias = 1.0f;
         Ogre::Real mLodHysteresis = 0.15f;
+        Ogre::Real mLodTransition = DEFAULT_LOD_TRANSITION;
         FrameBudgetController mBudget{DEFAULT_ERROR_BUDGET}; ///< the error budget, set or under a frame budget
         float mShadowErrorBudget = DEFAULT_SHADOW_ERROR_BUDGET;
         bool mLodFrozen = false;

@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 #ifdef CASTER
 #include "TreeLodShadowCaster.glsl"
 #endif
@@ -110,6 +111,7 @@ MAIN_PARAMETERS
 #ifdef SHADOW_RECEIVER
     SHADOW_POSITIONS_IN(TEXCOORD7, TEXCOORD8, TEXCOORD9)
 #endif
+    TRANSITION_IN(TEXCOORD10)
 MAIN_DECLARATION
 {
     vec3 N = normalize(vNormal);
@@ -202,6 +204,7 @@ MAIN_DECLARATION
         ao = lowResAo(vLowResUv, lowResDx, lowResDy, texel.a);
 #endif
     }
+    TRANSITION_DISCARD
 #ifdef CASTER
     float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5; // as TreeLodCaster.frag
     fragColour = casterOutput(depth);

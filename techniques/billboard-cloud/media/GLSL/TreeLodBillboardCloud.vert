@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 // Billboard cloud quads (García et al. 2007 §4.2, §6; vertex layout in TreeLod/TreeAsset.h,
 // BillboardCloudGpu): the billboard frame in world space, its (u, v), hash rectangle and
 // low-res rectangle to the fragment stage.
@@ -50,8 +51,14 @@ MAIN_PARAMETERS
 #ifdef SHADOW_RECEIVER
     SHADOW_POSITIONS_OUT(TEXCOORD7, TEXCOORD8, TEXCOORD9)
 #endif
+    TRANSITION_OUT(TEXCOORD10)
 MAIN_DECLARATION
 {
+#ifdef INSTANCED
+    vTransition = transitionOf(uv4, uv5);
+#else
+    vTransition = NO_TRANSITION;
+#endif
 #ifdef INSTANCED
     vec4 local = instancePosition(uv4, uv5, vertex);
     vec3 objectNormal = instanceDirection(uv5, normal);

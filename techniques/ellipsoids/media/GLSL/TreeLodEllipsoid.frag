@@ -10,6 +10,7 @@
 #extension GL_ARB_conservative_depth : enable
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 #ifdef CASTER
 #include "TreeLodShadowCaster.glsl"
 #endif
@@ -68,6 +69,7 @@ MAIN_PARAMETERS
     FLAT_IN(mat3 vToUnit, TEXCOORD3)
     FLAT_IN(vec4 vColour, TEXCOORD6)
     FLAT_IN(vec3 vNoise, TEXCOORD7) // lod, alpha threshold, normal blend
+    TRANSITION_IN(TEXCOORD8)
 MAIN_DECLARATION_DEPTH
 {
     vec3 from = vNear.xyz / vNear.w;
@@ -96,6 +98,7 @@ MAIN_DECLARATION_DEPTH
     float ndcDepth = clip.z / clip.w;
     if (ndcDepth > 1.0)
         discard; // beyond the far plane
+    TRANSITION_DISCARD
     float depth = 0.5 * ndcDepth + 0.5; // the casters' shadow depth (TreeLodShadowCaster.glsl)
     gl_FragDepth = WINDOW_DEPTH(ndcDepth);
 #ifdef CASTER

@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 // Ellipsoids of an EllipsoidTree (EllipsoidTreeData.h), ray cast per fragment (Sigg et al. 2006,
 // as the ellipsoids-and-lines paper (001) §5 renders them): one quad per ellipsoid covering, in
 // normalised device coordinates, the projection of the ellipsoid's box (centre +- the three
@@ -44,8 +45,10 @@ MAIN_PARAMETERS
     FLAT_OUT(mat3 vToUnit, TEXCOORD3) // view space -> the unit-sphere frame (about the centre); HLSL: TEXCOORD3..5
     FLAT_OUT(vec4 vColour, TEXCOORD6)
     FLAT_OUT(vec3 vNoise, TEXCOORD7)  // lod, alpha threshold, normal blend
+    TRANSITION_OUT(TEXCOORD8)
 MAIN_DECLARATION
 {
+    vTransition = transitionOf(uv4, uv5);
     vec3 centre = mul(worldView, instancePosition(uv4, uv5, vec4(vertex.xyz, 1.0))).xyz;
     mat3 toView = toMat3(worldView);
     vec3 axis0 = mul(toView, instanceDirection(uv5, uv4.w * uv1.xyz));

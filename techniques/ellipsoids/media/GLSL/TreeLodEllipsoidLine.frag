@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 #ifdef CASTER
 #include "TreeLodShadowCaster.glsl"
 #endif
@@ -70,6 +71,7 @@ MAIN_PARAMETERS
     FLAT_IN(float vPixel, TEXCOORD4)
     FLAT_IN(vec4 vColour, TEXCOORD5)
     FLAT_IN(vec4 vProjectionCentre, TEXCOORD6) // the eye (w = 1) or a parallel projection's depth direction (w = 0)
+    TRANSITION_IN(TEXCOORD7)
 MAIN_DECLARATION_DEPTH
 {
     // From the eye through the pixel, or along a parallel projection's depth axis (into the scene).
@@ -108,6 +110,7 @@ MAIN_DECLARATION_DEPTH
     float ndcDepth = clip.z / clip.w;
     if (ndcDepth < NDC_NEAR || ndcDepth > 1.0)
         discard;
+    TRANSITION_DISCARD
     float depth = 0.5 * ndcDepth + 0.5; // the casters' shadow depth (TreeLodShadowCaster.glsl)
     gl_FragDepth = WINDOW_DEPTH(ndcDepth);
 #ifdef CASTER

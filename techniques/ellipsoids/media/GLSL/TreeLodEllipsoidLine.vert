@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 // Lines of an EllipsoidTree (EllipsoidLineData.h: capsules, a segment swept by a sphere), ray cast
 // per fragment like the ellipsoids (TreeLodEllipsoid.frag). The paper (001, §5) draws its lines as
 // screen-aligned strips ([MSE*06]); here the strip is a quad along the segment, turned to face the
@@ -43,8 +44,10 @@ MAIN_PARAMETERS
     FLAT_OUT(float vPixel, TEXCOORD4)  // view-space size of a pixel at the line (perspective: at its nearer end)
     FLAT_OUT(vec4 vColour, TEXCOORD5)
     FLAT_OUT(vec4 vProjectionCentre, TEXCOORD6) // projectionCentre(), for the fragment's ray
+    TRANSITION_OUT(TEXCOORD7)
 MAIN_DECLARATION
 {
+    vTransition = transitionOf(uv4, uv5);
     vec3 a = mul(worldView, instancePosition(uv4, uv5, vec4(vertex.xyz, 1.0))).xyz;
     vec3 b = mul(worldView, instancePosition(uv4, uv5, vec4(uv1.xyz, 1.0))).xyz;
     float radius = uv1.w * uv4.w;

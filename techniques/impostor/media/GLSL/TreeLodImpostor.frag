@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 #ifdef CASTER
 #include "TreeLodShadowCaster.glsl"
 #endif
@@ -43,11 +44,13 @@ MAIN_PARAMETERS
 #ifdef SHADOW_RECEIVER
     SHADOW_POSITIONS_IN(TEXCOORD2, TEXCOORD3, TEXCOORD4)
 #endif
+    TRANSITION_IN(TEXCOORD5)
 MAIN_DECLARATION
 {
     vec4 texel = TEX2D(colourMap, vUv);
     if (texel.a < alphaCutoff)
         discard;
+    TRANSITION_DISCARD
 #ifdef CASTER
     float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5;
     fragColour = casterOutput(depth);

@@ -6,9 +6,10 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 // The one-quad impostor (ImpostorData.h), instanced by the Forest (Forest.h): per instance
 // uv4 = position (the Forest's local space) + uniform scale, uv5 = cos, sin of the rotation
-// about +Y, unused: the quad (vertex.xy, metres, facing +Z) turns about the instance's +Y axis
+// about +Y (unused) and the transition code (TreeLodTransition.glsl): the quad (vertex.xy, metres, facing +Z) turns about the instance's +Y axis
 // until its +Z faces the camera (a cylindrical billboard), so the tree's rotation cannot show.
 // The sun's direction goes to the fragment stage in the quad frame (x right, y up, z towards
 // the camera), the frame of the baked normals: one value per quad, so the fragment stage lights
@@ -32,6 +33,7 @@ MAIN_PARAMETERS
     IN(vec4 vertex, POSITION)
     IN(vec2 uv0, TEXCOORD0)
     IN(vec4 uv4, TEXCOORD4)
+    IN(vec3 uv5, TEXCOORD5)
     OUT(vec2 vUv, TEXCOORD0)
 #ifdef CASTER
     OUT(vec2 vClipZW, TEXCOORD1)
@@ -41,8 +43,10 @@ MAIN_PARAMETERS
 #ifdef SHADOW_RECEIVER
     SHADOW_POSITIONS_OUT(TEXCOORD2, TEXCOORD3, TEXCOORD4)
 #endif
+    TRANSITION_OUT(TEXCOORD5)
 MAIN_DECLARATION
 {
+    vTransition = transitionOf(uv4, uv5);
     vec3 centre = uv4.xyz;
 #ifdef CASTER
     // The view's +z axis (towards the shadow camera) in the Forest's local space.

@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 #ifdef CASTER
 #include "TreeLodShadowCaster.glsl"
 #endif
@@ -81,6 +82,7 @@ MAIN_PARAMETERS
 #ifdef SHADOW_RECEIVER
     SHADOW_POSITIONS_IN(TEXCOORD10, TEXCOORD11, TEXCOORD12)
 #endif
+    TRANSITION_IN(TEXCOORD13)
 MAIN_DECLARATION
 {
     vec4 colourSum = vec4_splat(0.0);
@@ -90,6 +92,7 @@ MAIN_DECLARATION
     addFrame(vWeights.z, vFrame2, vUv2, colourSum);
     if (colourSum.a < alphaCutoff)
         discard;
+    TRANSITION_DISCARD
     float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5;
     fragColour = casterOutput(depth);
 #else
@@ -99,6 +102,7 @@ MAIN_DECLARATION
     addFrame(vWeights.z, vFrame2, vUv2, vParallax2, vSun2, colourSum, lightSum);
     if (colourSum.a < alphaCutoff)
         discard;
+    TRANSITION_DISCARD
     vec3 albedo = colourSum.rgb / colourSum.a;
     vec2 light = lightSum / colourSum.a;
     vec3 k = ambientColour.rgb * light.y + sunColour.rgb * (light.x * SUN_VISIBILITY);

@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 // The octahedral impostor (OctahedralImpostorData.h), instanced by the Forest (Forest.h,
 // TreeLodInstance.glsl). Per instance, from the direction v towards the camera (CASTER: towards
 // the light) turned into the tree's own frame:
@@ -64,8 +65,6 @@ float halfHeight(vec3 up) { return 0.5 * (cylinder.z - cylinder.y) * abs(up.y) +
 
 float marginScale() { return atlas.y / (atlas.y - 2.0 * atlas.z); }
 
-/// A direction of the Forest's local space in the tree's own frame (the instance's rotation undone).
-vec3 intoTree(vec2 uv5, vec3 d) { return vec3(uv5.x * d.x - uv5.y * d.z, d.y, uv5.y * d.x + uv5.x * d.z); }
 
 /// Frame `cell`: this corner's frame coordinates (xy) and their shift per unit of encoded depth
 /// (zw); the sun in the frame's axes.
@@ -104,8 +103,10 @@ MAIN_PARAMETERS
 #ifdef SHADOW_RECEIVER
     SHADOW_POSITIONS_OUT(TEXCOORD10, TEXCOORD11, TEXCOORD12)
 #endif
+    TRANSITION_OUT(TEXCOORD13)
 MAIN_DECLARATION
 {
+    vTransition = transitionOf(uv4, uv5);
     float centreY = 0.5 * (cylinder.y + cylinder.z);
     vec3 centre = uv4.xyz + vec3(0.0, uv4.w * centreY, 0.0);
 #ifdef CASTER
@@ -113,7 +114,7 @@ MAIN_DECLARATION
 #else
     vec3 away = cameraPosition.xyz - centre;
 #endif
-    vec3 v = dot(away, away) > 0.0 ? intoTree(uv5, normalize(away)) : vec3(0.0, 0.0, 1.0);
+    vec3 v = dot(away, away) > 0.0 ? instanceLocalDirection(uv5, normalize(away)) : vec3(0.0, 0.0, 1.0);
 
     // The quad, facing v.
     vec3 right, up;
@@ -143,7 +144,7 @@ MAIN_DECLARATION
 #ifdef CASTER
     vec3 sunInTree = vec3_splat(0.0);
 #else
-    vec3 sunInTree = intoTree(uv5, normalize(mul(transpose(toMat3(world)), normalize(sunDirection.xyz))));
+    vec3 sunInTree = instanceLocalDirection(uv5, normalize(mul(transpose(toMat3(world)), normalize(sunDirection.xyz))));
 #endif
     vec3 sun0, sun1, sun2;
     vec4 c0 = frameCoordinates(cell0, v, corner, sunInTree, sun0);

@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 #ifdef CASTER
 #include "TreeLodShadowCaster.glsl"
 #endif
@@ -52,6 +53,7 @@ MAIN_PARAMETERS
     IN(vec2 vClipZW, TEXCOORD4)
     FLAT_IN(float vCell, TEXCOORD5)
 #endif
+    TRANSITION_IN(TEXCOORD6)
 MAIN_DECLARATION
 {
     vec2 texel = clamp(vTexel, vec2_splat(0.5), vec2_splat(3.5));
@@ -61,11 +63,13 @@ MAIN_DECLARATION
     ivec2 cell = ivec2(clamp(floor(vTexel), vec2_splat(0.0), vec2_splat(3.0)));
     if (colour.a <= hash01(uint(vCell + 0.5), uint(cell.y * 4 + cell.x)))
         discard;
+    TRANSITION_DISCARD
     float depth = 0.5 * vClipZW.x / vClipZW.y + 0.5;
     fragColour = casterOutput(depth);
 #else
     if (colour.a < 0.5 / 255.0)
         discard;
+    TRANSITION_DISCARD
     fragColour = colour;
 #endif
 }

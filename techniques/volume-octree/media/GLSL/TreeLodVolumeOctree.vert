@@ -6,6 +6,7 @@
 #version 150
 #endif
 #include "TreeLodShaderSupport.glsl"
+#include "TreeLodTransition.glsl"
 // The volumetric octree tree (VolumeOctreeData.h; Linz et al. 2006): one billboard a cell, facing
 // the viewer (the camera's right and up axes in the model's frame), its corners (+-1, +-1).
 // - Level of detail (§3.1, volumeOctreeDrawsCell): a cell of the active level L draws when its
@@ -115,8 +116,14 @@ MAIN_PARAMETERS
     OUT(vec2 vClipZW, TEXCOORD4)
     FLAT_OUT(float vCell, TEXCOORD5)
 #endif
+    TRANSITION_OUT(TEXCOORD6)
 MAIN_DECLARATION
 {
+#ifdef INSTANCED
+    vTransition = transitionOf(uv4, uv5);
+#else
+    vTransition = NO_TRANSITION;
+#endif
 #ifdef INSTANCED
     int quad = int(vertex + 0.5) / 4, c = int(vertex + 0.5) % 4;
     vec2 corner = vec2(c == 1 || c == 2 ? 1.0 : -1.0, c >= 2 ? 1.0 : -1.0);

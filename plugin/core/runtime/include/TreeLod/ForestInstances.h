@@ -27,6 +27,15 @@
 // P11 = 2 / h for a view window w x h, which gives the same units (4 pi r_px^2). At d^2 <=
 // FLT_EPSILON the value is FLT_MAX (Ogre's base value: finest level).
 // Distance tables instead compare d^2 / bias (DistanceLodStrategy's squared distance).
+//
+// Transitions (cull's `transition` t > 0): a tree whose screen size s is within (1, 1 + t) times
+// that of its level's switch to the next coarser one is drawn at both levels, by complementary
+// screen-door masks: the coarse one keeps the fraction f = (1 + t - s) / t of the pixels, the fine
+// one the rest (ForestVisibility::getTransitionCodes, transitionKeeps; TreeLodTransition.glsl
+// draws the masks). Screen size grows as the
+// square root of the pixel value and falls as the distance, so s = sqrt(value / threshold) or
+// sqrt(threshold / d^2) for distance tables. A band takes at most the lower half of its level's
+// own range of s (in ratio), so bands never meet and each level is drawn whole somewhere.
 #pragma once
 
 #include "TreeLod/Camera.h"
@@ -128,7 +137,7 @@ namespace TreeLod
         const ForestBucket& getBucket(std::size_t bucket) const { return mBuckets[bucket]; }
 
         /// Instance indices (ForestInstances' dense indices), grouped by bucket, near first within
-        /// a bucket: getVisibleCount() of them.
+        /// a bucket: getDrawCount() of them (a tree in a transition is in two buckets).
         const std::uint32_t* getIndices() const { return mIndices.data(); }
         /// 12 floats per visible instance, same order as getIndices(): rows of the world matrix
         /// [R*s | t]: (m00 m01 m02 tx) (m10 m11 m12 ty) (m20 m21 m22 tz).
@@ -141,8 +150,17 @@ namespace TreeLod
         {
             return mTransforms.data() + TRANSFORM_FLOATS * mBuckets[bucket].first;
         }
+        /// Transition code per draw, same order as getIndices() (transitionCode): 0 draws the whole
+        /// tree; f in (0, 1] the coarse level's share f of a transition, -f the fine level's rest.
+        const float* getTransitionCodes() const { return mCodes.data(); }
+        const float* getBucketTransitionCodes(std::size_t bucket) const { return mCodes.data() + mBuckets[bucket].first; }
 
+        /// Visible trees (each once, also when in a transition).
         std::uint32_t getVisibleCount() const { return mVisibleCount; }
+        /// Draws: the visible trees and once more each tree in a transition.
+        std::uint32_t getDrawCount() const { return mVisibleCount + mTransitionCount; }
+        /// Visible trees drawn at two levels (in a transition band).
+        std::uint32_t getTransitionCount() const { return mTransitionCount; }
         std::uint32_t getCulledCount() const { return mCulledCount; }
         /// Level switches of the last cull: visible instances given another level than this
         /// visibility's previous cull gave them (instances never seen before do not count; one
@@ -157,6 +175,11 @@ namespace TreeLod
         std::vector<ForestBucket> mBuckets;
         std::vector<std::uint32_t> mIndices;     // grown to the largest visible count so far
         std::vector<float> mTransforms;          // grown to 12 x the largest visible count so far
+        std::vector<float> mCodes;               // transition code per draw
+        std::vector<float> mVisibleCode;         // scratch: per entry of mVisible
+        std::vector<float> mBandEnds;            // per kind and threshold: 1 + the band's length (1: none)
+        float mBandTransition = -1.0f;           // the transition mBandEnds were made for
+        std::uint32_t mBandTables = 0;           // and the table generation
         std::vector<std::uint32_t> mVisible;     // scratch: visible instances in input order
         std::vector<std::uint32_t> mVisibleBucket; // scratch: their buckets
         std::vector<std::uint8_t> mVisibleClass;   // scratch: their distance classes
@@ -168,7 +191,16 @@ namespace TreeLod
         std::uint32_t mVisibleCount = 0;
         std::uint32_t mCulledCount = 0;
         std::uint32_t mSwitchCount = 0;
+        std::uint32_t mTransitionCount = 0;
     };
+
+    /// What a draw keeps of a tree at screen-door threshold `dither` in [0, 1) (the pattern's
+    /// value at the pixel, TreeLodTransition.glsl): code 0 all, f > 0 where dither < f, -f where
+    /// dither >= f. The two draws of a transition keep complementary pixels.
+    inline bool transitionKeeps(float code, float dither)
+    {
+        return code > 0.0f ? dither < code : dither >= -code;
+    }
 
     /// The instance store. Removal swaps the last instance into the hole, so dense indices
     /// change on remove; handles do not. Not thread-safe for writes; `cull` is const and may run
@@ -181,6 +213,11 @@ namespace TreeLod
         /// Dense instances [k * BLOCK_SIZE, (k + 1) * BLOCK_SIZE) share a conservative world box;
         /// cull skips a block outside the frustum whole and tests no instance of a block inside it.
         static constexpr std::size_t BLOCK_SIZE = 256;
+        /// The longest transition: a screen size doubling.
+        static constexpr float MAX_TRANSITION = 1.0f;
+        /// The transition the Forest and scene scripts use unless told (docs/measurements.md,
+        /// "Transitions").
+        static constexpr float DEFAULT_TRANSITION = 0.0f;
 
         /// An order of `instances` (indices) along a Z-order curve over their x-z extent: added in
         /// that order, blocks are compact patches and culling skips what is out of view (the
@@ -243,14 +280,16 @@ namespace TreeLod
         std::uint32_t levelForValue(std::uint32_t kind, float value) const;
 
         /// Cull and select levels for every instance (see the file comment). Error if the bias is
-        /// not finite and > 0, the hysteresis not in [0, 1] or the camera has a non-finite value;
-        /// `out` is untouched then.
+        /// not finite and > 0, the hysteresis not in [0, 1], the transition not in [0,
+        /// MAX_TRANSITION] or the camera has a non-finite value; `out` is untouched then.
         /// Hysteresis h: an instance keeps the level it had in `out`'s last cull while that level is
         /// one its LoD value times or divided by (1 + h) would give, so trees near a switch do not
         /// flicker between two levels under camera jitter (0: none). `out` remembers the levels
         /// per instance; after instances are added or removed, or a kind's table changes, it
-        /// starts afresh.
-        Result<void> cull(const CullCamera& camera, float lodBias, ForestVisibility& out, float hysteresis = 0.0f) const;
+        /// starts afresh. Transition t (file comment): trees near a switch are drawn at both levels;
+        /// hysteresis is not applied while t > 0 (a fade has nothing to flicker).
+        Result<void> cull(const CullCamera& camera, float lodBias, ForestVisibility& out, float hysteresis = 0.0f,
+                          float transition = 0.0f) const;
 
     private:
         std::string check(const ForestInstance& instance) const; ///< "" or the reason it is refused
@@ -261,6 +300,7 @@ namespace TreeLod
         void write(std::size_t slot, const ForestInstance& instance);
         void push(const ForestInstance& instance, ForestHandle handle);
         void growBlock(std::size_t slot); ///< merge the instance's world sphere into its block's box
+        void writeBandEnds(float transition, ForestVisibility& out) const; ///< out.mBandEnds for t
 
         // kinds
         std::vector<ForestKind> mKinds;

@@ -6,6 +6,8 @@
 //   "auto@E"   Auto     budgeted auto at error budget E, the mean FLIP allowed, in [0, 1]
 //   "auto~MS"  Auto     budgeted auto under a frame budget of MS milliseconds, in (0, 1e6]
 //   any other  Fixed    every species drawn by that one technique or measurement baseline
+// Any of them + "+fadeT": level transitions of length T in [0, 1] (Forest::setLodTransition; 0:
+// hard switches), else the script's ("auto+fade0", "impostor+fade0.2", "+fade0.1").
 #pragma once
 
 #include "TreeLod/Result.h"
@@ -30,6 +32,8 @@ namespace TreeLod
         float errorBudget = std::numeric_limits<float>::quiet_NaN();
         /// Auto: frame time the error budget follows, milliseconds; NaN: none.
         float frameBudgetMs = std::numeric_limits<float>::quiet_NaN();
+        /// Forest::setLodTransition, [0, 1]; NaN: the script's.
+        float transition = std::numeric_limits<float>::quiet_NaN();
 
         static LodPolicy scriptChoice() { return {}; }
         static LodPolicy automatic(float errorBudget = std::numeric_limits<float>::quiet_NaN(),
@@ -40,7 +44,7 @@ namespace TreeLod
         /// number, is an error naming `element`. A fixed technique is not checked here (the
         /// technique registry knows the names).
         static Result<LodPolicy> parse(const std::string& text, const std::string& element = "technique");
-        /// The text parse reads back ("auto@0.05", "<technique>", "").
+        /// The text parse reads back ("auto@0.05", "<technique>", "", "auto+fade0").
         std::string toString() const;
 
         bool isAuto() const { return mode == Mode::Auto; }

@@ -35,6 +35,7 @@
 #pragma once
 
 #include "TreeLod/Camera.h"
+#include "TreeLod/ForestInstances.h"
 #include "TreeLod/GreyImage.h"
 #include "TreeLod/LevelSelection.h"
 #include "TreeLod/Result.h"
@@ -153,6 +154,8 @@ namespace TreeLod
         float shadowMaxError = DEFAULT_SHADOW_MAX_ERROR;
         /// Frame budget of budgeted auto (Forest::setFrameBudgetMs), ms; 0: none.
         float frameBudgetMs = 0.0f;
+        /// Level transitions (Forest::setLodTransition) of every species, in [0, 1]; 0: hard switches.
+        float transition = ForestInstances::DEFAULT_TRANSITION;
     };
 
     struct SceneKeyframe
