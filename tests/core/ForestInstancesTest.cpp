@@ -1223,6 +1223,10 @@ namespace TreeLod
         EXPECT_EQ(drawsAt(forest, vis, 6.5f, 0.5f).size(), 1u);
         // The last level has no coarser neighbour: nothing fades beyond it.
         EXPECT_EQ(drawsAt(forest, vis, 30.0f, 0.5f).size(), 1u);
+        // A hard switch (ForestKind::hardSwitches) does not fade; the others still do.
+        ASSERT_TRUE(forest.setKindThresholds(0, forest.getKind(0).thresholds, 0b01));
+        EXPECT_EQ(drawsAt(forest, vis, 7.0f, 0.5f).size(), 1u);
+        EXPECT_EQ(drawsAt(forest, vis, 10.6f, 0.5f).size(), 2u);
     }
 
     TEST(ForestInstances, badTransitionsAreRefusedByName)

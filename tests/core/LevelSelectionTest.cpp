@@ -198,6 +198,44 @@ namespace TreeLod
         }
     }
 
+    // A transition's double draw: a tree within 1 + t of a run's smallest height also pays for the
+    // next run's level, over the share of each sample's quarter-octave bin the band covers.
+    TEST(LevelSelection, aTransitionAddsTheCoarseLevelsCostOverItsBand)
+    {
+        Fixture f;
+        std::vector<LevelChoice> plan(2);
+        plan[0].curveLevel = 0; // the mesh down to 64 px
+        plan[0].minHeightPx = 64.0f;
+        plan[1].curveLevel = 2; // the impostor below
+        const std::vector<float> hard = planCostPerTree(f.curves, f.costs, plan);
+        EXPECT_EQ(planCostPerTree(f.curves, f.costs, plan, 0.0f), hard);
+        // 2^(1/4) - 1: the band [64, 76.1) px is the upper half of 64's bin and the lower half of 76.1's.
+        const float t = std::exp2(0.25f) - 1.0f;
+        const std::vector<float> faded = planCostPerTree(f.curves, f.costs, plan, t);
+        const std::size_t at64 = selectionSample(64.0f), above = at64 - 1;
+        const auto impostor = [&](float h) { return f.costs[2].msAt(h); };
+        EXPECT_NEAR(faded[at64] - hard[at64], 0.5f * impostor(64.0f), 1e-5f);
+        EXPECT_NEAR(faded[above] - hard[above], 0.5f * impostor(selectionHeight(above)), 1e-5f);
+        for (std::size_t k = 0; k < SELECTION_SAMPLES; ++k)
+            if (k != at64 && k != above)
+                EXPECT_EQ(faded[k], hard[k]) << selectionHeight(k) << " px: outside the band";
+        // A band stops at half of its run's range: the impostor from 64 to 70 px fades into LoDF
+        // over half of log2(70 / 64) octaves (0.26 of the bin at 64 px), not the octave t = 1 asks.
+        std::vector<LevelChoice> three(3);
+        three[0] = LevelChoice{0, 70.0f, 0.0f};
+        three[1] = LevelChoice{2, 64.0f, 0.0f};
+        three[2] = LevelChoice{1, 0.0f, 0.0f};
+        const std::vector<float> long3 = planCostPerTree(f.curves, f.costs, three, 1.0f);
+        const std::vector<float> hard3 = planCostPerTree(f.curves, f.costs, three);
+        EXPECT_NEAR(long3[at64] - hard3[at64], 0.5 * std::log2(70.0 / 64.0) * SELECTION_SAMPLES_PER_OCTAVE * f.costs[1].msAt(64.0f),
+                    1e-4);
+        // Runs below the transitions' smallest height switch hard.
+        EXPECT_EQ(planCostPerTree(f.curves, f.costs, plan, t, 65.0f), hard);
+        // Above 70 px the mesh fades into the impostor for a whole octave: nearly free.
+        for (std::size_t k = 0; k < at64; ++k)
+            EXPECT_LT(long3[k] - hard3[k], 0.05f) << selectionHeight(k) << " px";
+    }
+
     TEST(LevelSelection, aFrameBudgetTakesTheFinestStepPredictedWithinIt)
     {
         Fixture f;

@@ -180,6 +180,20 @@ namespace TreeLod::ForestTransitionTests
         const auto [hard, none] = worstFrame(0.0f);
         EXPECT_GE(framesInBand, 8u);
         EXPECT_EQ(none, 0u);
+        // A switch below the transitions' smallest height on screen stays hard.
+        Forest* forest = placeForest();
+        forest->setLodTransition(TRANSITION, 1e4f);
+        forest->addSpecies(everyTechniqueOak().asset, levels);
+        forest->addInstances({instance(0.0f, 0.0f, 0.0f)});
+        forest->setLodBias(1.2f);
+        OgreEnvironment::renderer().render(oakView(), SIZE, SIZE, 1);
+        EXPECT_EQ(forest->getStats().transitionInstances, 0u);
+        forest->setLodTransition(TRANSITION, 0.0f);
+        OgreEnvironment::renderer().render(oakView(), SIZE, SIZE, 1);
+        EXPECT_EQ(forest->getStats().transitionInstances, 1u);
+        EXPECT_THROW(forest->setLodTransition(TRANSITION, -1.0f), Ogre::InvalidParametersException);
+        EXPECT_THROW(forest->setLodTransition(std::nanf(""), 0.0f), Ogre::InvalidParametersException);
+        EXPECT_THROW(forest->setLodTransition(1.5f), Ogre::InvalidParametersException);
         EXPECT_LT(smooth, 0.2) << "a transition spreads the change over its frames";
         EXPECT_GT(hard, 0.4) << "a hard switch changes the tree at once";
     }

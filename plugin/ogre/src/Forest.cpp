@@ -51,7 +51,7 @@ namespace TreeLod
             Result<std::vector<LevelChoice>> choices = chooseLevels(plan->curves, costs, step, MAX_LEVELS);
             if (!choices)
                 invalid(label + choices.error().message(), source);
-            plan->ladderMsPerTree.push_back(planCostPerTree(plan->curves, costs, *choices));
+            plan->ladderChoices.push_back(std::move(*choices));
         }
         Result<std::vector<LevelChoice>> choices = chooseLevels(plan->curves, costs, mBudget.getErrorBudget(), MAX_LEVELS);
         if (!choices)
@@ -119,6 +119,7 @@ namespace TreeLod
         kind.boundsCentre = glm::vec3(centre.x, centre.y, centre.z);
         kind.boundsRadius = radius;
         kind.thresholds = kindThresholds(*species, levels);
+        kind.hardSwitches = kindHardSwitches(*species, levels);
         Result<std::uint32_t> added = mInstances.addKind(kind);
         if (!added)
             invalid(label + added.error().message(), source);
@@ -186,16 +187,32 @@ namespace TreeLod
         return thresholds;
     }
 
+    std::uint16_t Forest::kindHardSwitches(const Species& species, const std::vector<ForestLevel>& levels) const
+    {
+        // A switch's height on screen: valueForHeight inverted (heightPerRootValue, Species).
+        std::uint16_t hard = 0;
+        for (std::size_t l = 0; l + 1 < levels.size(); ++l)
+            if (species.heightPerRootValue * std::sqrt(double(species.kindValue(levels[l].minPixelCount))) <
+                double(mLodTransitionMinHeight))
+                hard = std::uint16_t(hard | 1u << l);
+        return hard;
+    }
+
+    void Forest::writeKindTables(const char* source)
+    {
+        for (std::uint32_t s = 0; s < mSpecies.size(); ++s)
+            if (Result<void> set = mInstances.setKindThresholds(s, kindThresholds(*mSpecies[s], mSpecies[s]->levels),
+                                                                kindHardSwitches(*mSpecies[s], mSpecies[s]->levels));
+                !set)
+                invalid("Forest '" + mName + "': " + set.error().message(), source);
+    }
+
     void Forest::setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex, unsigned short minDetailIndex)
     {
         const bool limits = maxDetailIndex != mLodBias.maxMeshIndex || minDetailIndex != mLodBias.minMeshIndex;
         mLodBias.setMesh(factor, maxDetailIndex, minDetailIndex, "Forest '" + mName + "'");
-        if (!limits)
-            return;
-        for (std::uint32_t s = 0; s < mSpecies.size(); ++s)
-            if (Result<void> set = mInstances.setKindThresholds(s, kindThresholds(*mSpecies[s], mSpecies[s]->levels));
-                !set)
-                invalid("Forest '" + mName + "': " + set.error().message(), "Forest::setMeshLodBias");
+        if (limits)
+            writeKindTables("Forest::setMeshLodBias");
     }
 
     void Forest::setLodBias(Ogre::Real bias)
@@ -211,14 +228,22 @@ namespace TreeLod
         mLodHysteresis = hysteresis;
     }
 
-    void Forest::setLodTransition(Ogre::Real transition)
+    void Forest::setLodTransition(Ogre::Real transition, Ogre::Real minHeightPx)
     {
         if (!(transition >= 0.0f && transition <= ForestInstances::MAX_TRANSITION))
             invalid("Forest '" + mName + "': LoD transition " + std::to_string(transition) + " is not in [0, " +
                         std::to_string(ForestInstances::MAX_TRANSITION) +
                         "] (0: hard switches; at most a doubling of screen size)",
                     "Forest::setLodTransition");
+        if (!(minHeightPx >= 0.0f && std::isfinite(minHeightPx)))
+            invalid("Forest '" + mName + "': LoD transition minimum height " + std::to_string(minHeightPx) +
+                        " px is not finite and >= 0",
+                    "Forest::setLodTransition");
         mLodTransition = transition;
+        if (minHeightPx == mLodTransitionMinHeight)
+            return;
+        mLodTransitionMinHeight = minHeightPx;
+        writeKindTables("Forest::setLodTransition");
     }
 
     void Forest::setShadowLodBias(Ogre::Real bias)

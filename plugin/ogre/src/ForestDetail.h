@@ -296,8 +296,8 @@ namespace TreeLod
         ErrorCurves curves;                  ///< the auto techniques' levels
         std::vector<LevelCost> costs;        ///< this machine's
         std::vector<LevelChoice> choices;    ///< the plan in use
-        /// Per frameBudgetLadder() step: its plan's cost per tree at each selection sample height.
-        std::vector<std::vector<float>> ladderMsPerTree;
+        /// Per frameBudgetLadder() step: its plan (costed at each measurement, with the transition then).
+        std::vector<std::vector<LevelChoice>> ladderChoices;
         HeightHistogram visible; ///< the viewer's trees at the frame budget's last measurement
     };
 

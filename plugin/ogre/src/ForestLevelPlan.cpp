@@ -248,7 +248,8 @@ namespace TreeLod
         // old parts), the buckets of later species moved with their indices.
         const std::uint32_t first = mInstances.getBucketIndex(s, 0);
         const std::size_t oldCount = species.levels.size();
-        if (Result<void> set = mInstances.setKindThresholds(s, kindThresholds(species, levels)); !set)
+        if (Result<void> set = mInstances.setKindThresholds(s, kindThresholds(species, levels), kindHardSwitches(species, levels));
+            !set)
             invalid(label + set.error().message(), source);
         for (auto& [camera, state] : mCameras)
         {
@@ -364,9 +365,11 @@ namespace TreeLod
         const std::size_t steps = frameBudgetLadder().size();
         std::vector<double> predicted(steps, 0.0);
         for (const std::unique_ptr<Species>& species : mSpecies)
-            if (species->budget)
+            if (const BudgetPlan* plan = species->budget.get())
                 for (std::size_t step = 0; step < steps; ++step)
-                    predicted[step] += species->budget->visible.milliseconds(species->budget->ladderMsPerTree[step]);
+                    predicted[step] += plan->visible.milliseconds(
+                        planCostPerTree(plan->curves, plan->costs, plan->ladderChoices[step], mLodTransition,
+                                        mLodTransitionMinHeight));
         mStats.predictedMilliseconds = mBudget.measure(std::move(predicted)); // scaled by the reported frames
     }
 

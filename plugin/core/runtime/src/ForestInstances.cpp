@@ -192,12 +192,14 @@ namespace TreeLod
         return index;
     }
 
-    Result<void> ForestInstances::setKindThresholds(std::uint32_t kind, const std::vector<float>& thresholds)
+    Result<void> ForestInstances::setKindThresholds(std::uint32_t kind, const std::vector<float>& thresholds,
+                                                    std::uint16_t hardSwitches)
     {
         if (kind >= mKinds.size())
             return fail("", "kind " + std::to_string(kind), "no such kind (" + std::to_string(mKinds.size()) + " kinds)");
         ForestKind changed = mKinds[kind];
         changed.thresholds = thresholds;
+        changed.hardSwitches = hardSwitches;
         if (Result<void> valid = checkThresholds(changed, "kind " + std::to_string(kind) + " '" + changed.name + "'");
             !valid)
             return valid;
@@ -471,8 +473,8 @@ namespace TreeLod
             const bool distance = mKindDistance[k] != 0;
             for (std::size_t i = 0; i < t.size(); ++i)
             {
-                if (!(t[i] > 0.0f))
-                    continue; // a switch at value 0 (or distance 0) is never crossed from above
+                if (!(t[i] > 0.0f) || (mKinds[k].hardSwitches >> i & 1u))
+                    continue; // hard; or at value 0 (or distance 0): never crossed from above
                 float end = 1.0f + transition;
                 if (i > 0)
                 {

@@ -195,17 +195,39 @@ namespace TreeLod
     }
 
     std::vector<float> planCostPerTree(const ErrorCurves& curves, const std::vector<LevelCost>& costs,
-                                       const std::vector<LevelChoice>& choices)
+                                       const std::vector<LevelChoice>& choices, float transition,
+                                       float transitionMinHeightPx)
     {
         const std::vector<const LevelCost*> costOf = costsOf(curves, costs);
+        auto msAt = [&](std::size_t level, float h) {
+            return level < costOf.size() && costOf[level] ? costOf[level]->msAt(h) : 0.0f;
+        };
         std::vector<float> ms(SELECTION_SAMPLES, 0.0f);
         if (choices.empty())
             return ms;
+        constexpr double BIN = 1.0 / SELECTION_SAMPLES_PER_OCTAVE; // a sample's bin, octaves
         for (std::size_t k = 0; k < SELECTION_SAMPLES; ++k)
         {
             const float h = selectionHeight(k);
-            const std::size_t level = choices[choiceAt(choices, h)].curveLevel;
-            ms[k] = level < costOf.size() && costOf[level] ? costOf[level]->msAt(h) : 0.0f;
+            ms[k] = msAt(choices[choiceAt(choices, h)].curveLevel, h);
+            if (!(transition > 0.0f))
+                continue;
+            // The bands above each run's smallest height (at most the lower half of the run's
+            // range, as ForestInstances::cull draws them), in octaves, against this sample's bin.
+            const double lo = std::log2(double(h)) - 0.5 * BIN, hi = lo + BIN;
+            for (std::size_t r = 0; r + 1 < choices.size(); ++r)
+            {
+                if (!(choices[r].minHeightPx > 0.0f) || choices[r].minHeightPx < transitionMinHeightPx)
+                    continue;
+                double length = std::log2(1.0 + double(transition));
+                if (r > 0)
+                    length = std::min(length, 0.5 * std::log2(double(choices[r - 1].minHeightPx) /
+                                                               double(choices[r].minHeightPx)));
+                const double start = std::log2(double(choices[r].minHeightPx));
+                const double overlap = std::min(hi, start + length) - std::max(lo, start);
+                if (overlap > 0.0)
+                    ms[k] += float(overlap / BIN) * msAt(choices[r + 1].curveLevel, h);
+            }
         }
         return ms;
     }

@@ -204,9 +204,14 @@ namespace TreeLod
         /// to the next is drawn at both, cross-faded by complementary screen-door masks, so that no
         /// level pops. 0: hard switches (with hysteresis, which transitions replace). Each band
         /// takes at most the lower half of its level's range of screen sizes (in ratio).
-        void setLodTransition(Ogre::Real transition);
+        /// Switches below `minHeightPx` on screen (at LoD bias 1; default
+        /// DEFAULT_LOD_TRANSITION_MIN_HEIGHT) stay hard: a pop of a small tree is small, where its
+        /// masks are noise that a dense forest's many small trees add up.
+        void setLodTransition(Ogre::Real transition, Ogre::Real minHeightPx = DEFAULT_LOD_TRANSITION_MIN_HEIGHT);
         Ogre::Real getLodTransition() const { return mLodTransition; }
+        Ogre::Real getLodTransitionMinHeight() const { return mLodTransitionMinHeight; }
         static constexpr Ogre::Real DEFAULT_LOD_TRANSITION = ForestInstances::DEFAULT_TRANSITION;
+        static constexpr Ogre::Real DEFAULT_LOD_TRANSITION_MIN_HEIGHT = 32.0f;
         /// Keep the LoD camera of the last frame (levels stop changing; culling goes on).
         void setLodFrozen(bool frozen);
         bool isLodFrozen() const { return mLodFrozen; }
@@ -261,6 +266,9 @@ namespace TreeLod
         void updateShadowLevels(std::uint32_t species);
         /// The kind's table of `levels` of `species`, within setMeshLodBias's limits.
         std::vector<float> kindThresholds(const Species& species, const std::vector<ForestLevel>& levels) const;
+        /// ForestKind::hardSwitches of `levels`: the switches below the transitions' smallest height.
+        std::uint16_t kindHardSwitches(const Species& species, const std::vector<ForestLevel>& levels) const;
+        void writeKindTables(const char* source); ///< every species' thresholds and hard switches again
         /// The frame budget's measurement on the viewer's cull: prediction and the step it wants.
         void measureFrameBudget(const CameraState& state);
 
@@ -298,6 +306,7 @@ namespace TreeLod
         Ogre::Real mShadowLodBias = 1.0f;
         Ogre::Real mLodHysteresis = 0.15f;
         Ogre::Real mLodTransition = DEFAULT_LOD_TRANSITION;
+        Ogre::Real mLodTransitionMinHeight = DEFAULT_LOD_TRANSITION_MIN_HEIGHT;
         FrameBudgetController mBudget{DEFAULT_ERROR_BUDGET}; ///< the error budget, set or under a frame budget
         float mShadowErrorBudget = DEFAULT_SHADOW_ERROR_BUDGET;
         bool mLodFrozen = false;

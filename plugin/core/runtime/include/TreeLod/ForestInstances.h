@@ -69,6 +69,8 @@ namespace TreeLod
         /// camera-facing quad; the Ogre side decides what a level draws). Finite, >= 0, at most
         /// MAX_THRESHOLDS, non-increasing (PixelCount) or non-decreasing (Distance).
         std::vector<float> thresholds;
+        /// Bit i: threshold i switches hard, also while cull draws transitions.
+        std::uint16_t hardSwitches = 0;
     };
 
     /// One tree. Rotation in radians about +Y (right-handed), uniform scale > 0.
@@ -230,7 +232,8 @@ namespace TreeLod
         /// its level count changes, the bucket indices of the kinds after it move (getBucketIndex);
         /// a ForestVisibility culled before holds the old buckets until its next cull, which forgets
         /// the levels it remembered for hysteresis (a level index may mean another level now).
-        Result<void> setKindThresholds(std::uint32_t kind, const std::vector<float>& thresholds);
+        Result<void> setKindThresholds(std::uint32_t kind, const std::vector<float>& thresholds,
+                                       std::uint16_t hardSwitches = 0);
         std::uint32_t getKindCount() const { return std::uint32_t(mKinds.size()); }
         const ForestKind& getKind(std::uint32_t kind) const { return mKinds[kind]; }
         std::uint32_t getLevelCount(std::uint32_t kind) const

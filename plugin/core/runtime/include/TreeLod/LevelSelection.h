@@ -79,9 +79,14 @@ namespace TreeLod
                                                         const std::vector<LevelChoice>& choices, float shadowBudget);
 
     /// Milliseconds per tree a plan costs at each selection sample height: the cost of the level
-    /// `choices` draws there (LevelCost::msAt; 0 for a level without a cost).
+    /// `choices` draws there (LevelCost::msAt; 0 for a level without a cost). With level
+    /// transitions of length `transition` (ForestInstances.h, "Transitions") a tree within 1 + t of
+    /// a run's smallest height also draws the next run's level: each sample adds that level's cost
+    /// times the share of its bin (a quarter octave about it) the band covers; runs whose smallest
+    /// height is below `transitionMinHeightPx` switch hard (Forest::setLodTransition).
     std::vector<float> planCostPerTree(const ErrorCurves& curves, const std::vector<LevelCost>& costs,
-                                       const std::vector<LevelChoice>& choices);
+                                       const std::vector<LevelChoice>& choices, float transition = 0.0f,
+                                       float transitionMinHeightPx = 0.0f);
 
     /// Visible trees of one species counted by height on screen, at the nearest selection sample.
     struct HeightHistogram
