@@ -191,6 +191,16 @@ namespace TreeLod::ForestTransitionTests
         forest->setLodTransition(TRANSITION, 0.0f);
         OgreEnvironment::renderer().render(oakView(), SIZE, SIZE, 1);
         EXPECT_EQ(forest->getStats().transitionInstances, 1u);
+        // LoDF's levels are steps of its leaf collapse from the reference: hard (the pop is small).
+        Forest* collapse = placeForest();
+        collapse->setLodTransition(TRANSITION, 0.0f);
+        collapse->addSpecies(everyTechniqueOak().asset,
+                             pairAt({"mesh", 0, false, 0.0f}, {"lodf", 0, false, 0.0f}, 1.1f));
+        collapse->addInstances({instance(0.0f, 0.0f, 0.0f)});
+        OgreEnvironment::renderer().render(oakView(), SIZE, SIZE, 1);
+        EXPECT_EQ(collapse->getStats().transitionInstances, 0u);
+        EXPECT_EQ(collapse->getStats().levelCounts.at(0), (std::vector<std::uint32_t>{1u, 0u}));
+        forest = collapse;
         EXPECT_THROW(forest->setLodTransition(TRANSITION, -1.0f), Ogre::InvalidParametersException);
         EXPECT_THROW(forest->setLodTransition(std::nanf(""), 0.0f), Ogre::InvalidParametersException);
         EXPECT_THROW(forest->setLodTransition(1.5f), Ogre::InvalidParametersException);

@@ -193,7 +193,8 @@ namespace TreeLod
         std::uint16_t hard = 0;
         for (std::size_t l = 0; l + 1 < levels.size(); ++l)
             if (species.heightPerRootValue * std::sqrt(double(species.kindValue(levels[l].minPixelCount))) <
-                double(mLodTransitionMinHeight))
+                    double(mLodTransitionMinHeight) ||
+                levelProvider(levels[l + 1].technique, "", "Forest").isContinuousStep(levels[l], levels[l + 1]))
                 hard = std::uint16_t(hard | 1u << l);
         return hard;
     }

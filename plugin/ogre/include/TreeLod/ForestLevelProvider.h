@@ -111,5 +111,14 @@ namespace TreeLod
         /// A few words naming `level` for people ("<technique> 1200", "<technique> 1 low"); by default the
         /// technique's name.
         virtual Ogre::String describeLevel(const ForestLevel& level) const { return level.technique; }
+        /// Whether a switch from `finer` to `coarser` (one of this technique's levels) is one step of
+        /// a continuous simplification, whose pop is small: the Forest switches it hard, also with
+        /// transitions (a cross-fade of two nearly equal levels is pixel noise). By default only
+        /// the same drawable again (bark LoD splits, Forest.h "Bark").
+        virtual bool isContinuousStep(const ForestLevel& finer, const ForestLevel& coarser) const
+        {
+            return finer.technique == coarser.technique && finer.techniqueLevel == coarser.techniqueLevel &&
+                   finer.lowRes == coarser.lowRes;
+        }
     };
 }
