@@ -1195,9 +1195,16 @@ namespace TreeLod
         EXPECT_EQ(drawsAt(byDistance, vis, 10.05f, 0.2f).size(), 1u);
         EXPECT_EQ(drawsAt(byDistance, vis, 8.0f, 0.2f).size(), 1u);
 
-        // Hysteresis does not hold a level while transitions are on: 9.9 m after 10.1 m is in the band.
+        // Hysteresis does not hold a level across a fading switch: 9.9 m after 10.1 m is in the band.
         drawsAt(forest, vis, 10.1f, 0.2f, 0.15f);
         EXPECT_EQ(drawsAt(forest, vis, 9.9f, 0.2f, 0.15f).size(), 2u);
+        // It still holds a hard one (ForestKind::hardSwitches), transitions on or off.
+        ASSERT_TRUE(forest.setKindThresholds(0, forest.getKind(0).thresholds, 1));
+        drawsAt(forest, vis, 10.1f, 0.2f, 0.15f);
+        const std::vector<Draw> held = drawsAt(forest, vis, 9.9f, 0.2f, 0.15f);
+        ASSERT_EQ(held.size(), 1u);
+        EXPECT_EQ(held[0].level, 1u) << "held at the coarse level";
+        ASSERT_TRUE(forest.setKindThresholds(0, forest.getKind(0).thresholds, 0));
 
         // A second cull with transitions allocates nothing.
         const std::size_t capacity = vis.getCapacityBytes();

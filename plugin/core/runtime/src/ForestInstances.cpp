@@ -599,7 +599,14 @@ namespace TreeLod
             const float key = lodKey(d2, r, kindDistance[kind] != 0, c);
             const float* table = tables + kind * MAX_THRESHOLDS;
             std::uint32_t level = levelForKey(table, key);
-            if (hysteresis > 0.0f && !transitions && lastLevel[i] != LEVEL_NONE && lastLevel[i] != level)
+            // Hysteresis holds hard switches only: a switch through a fading threshold has a band.
+            auto fades = [&](std::uint32_t from, std::uint32_t to) {
+                for (std::uint32_t t = std::min(from, to); transitions && t < std::max(from, to) && t < MAX_THRESHOLDS; ++t)
+                    if (bandEnds[kind * MAX_THRESHOLDS + t] > 1.0f)
+                        return true;
+                return false;
+            };
+            if (hysteresis > 0.0f && lastLevel[i] != LEVEL_NONE && lastLevel[i] != level && !fades(lastLevel[i], level))
             {
                 // Keys grow toward finer levels (distance keys are negated, so scaling a negative
                 // key by more than 1 makes it coarser): the band [finest, coarsest] of key * (1 +- h).

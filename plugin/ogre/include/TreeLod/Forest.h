@@ -202,11 +202,11 @@ namespace TreeLod
         /// Transition length t in [0, 1] (ForestInstances::MAX_TRANSITION; default
         /// DEFAULT_LOD_TRANSITION): a tree whose screen size is within 1 + t times its level's switch
         /// to the next is drawn at both, cross-faded by complementary screen-door masks, so that no
-        /// level pops. 0: hard switches (with hysteresis, which transitions replace). Each band
-        /// takes at most the lower half of its level's range of screen sizes (in ratio).
-        /// Switches below `minHeightPx` on screen (at LoD bias 1; default
-        /// DEFAULT_LOD_TRANSITION_MIN_HEIGHT) stay hard: a pop of a small tree is small, where its
-        /// masks are noise that a dense forest's many small trees add up.
+        /// level pops. 0: hard switches. Each band takes at most the lower half of its level's range
+        /// of screen sizes (in ratio). Some switches stay hard, held by hysteresis: those below
+        /// `minHeightPx` on screen (at LoD bias 1; default DEFAULT_LOD_TRANSITION_MIN_HEIGHT: a small
+        /// tree's pop is small, where its masks are noise that a dense forest's many small trees add
+        /// up) and the steps of a continuous simplification (ForestLevelProvider::isContinuousStep).
         void setLodTransition(Ogre::Real transition, Ogre::Real minHeightPx = DEFAULT_LOD_TRANSITION_MIN_HEIGHT);
         Ogre::Real getLodTransition() const { return mLodTransition; }
         Ogre::Real getLodTransitionMinHeight() const { return mLodTransitionMinHeight; }

@@ -290,7 +290,7 @@ namespace TreeLod
         /// flicker between two levels under camera jitter (0: none). `out` remembers the levels
         /// per instance; after instances are added or removed, or a kind's table changes, it
         /// starts afresh. Transition t (file comment): trees near a switch are drawn at both levels;
-        /// hysteresis is not applied while t > 0 (a fade has nothing to flicker).
+        /// hysteresis holds only the switches that do not fade (a fade has nothing to flicker).
         Result<void> cull(const CullCamera& camera, float lodBias, ForestVisibility& out, float hysteresis = 0.0f,
                           float transition = 0.0f) const;
 
