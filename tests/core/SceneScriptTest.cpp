@@ -185,6 +185,7 @@ namespace TreeLod
         // 30 frames a second, at 1.7 m; within the clearing (the spline overshoots its keyframes by 0.12 m),
         // at least 2.5 m from every trunk.
         EXPECT_NEAR(frameTime(*s, 1) - frameTime(*s, 0), 1.0 / 30.0, 1e-9);
+        EXPECT_EQ(s->lod.transition, 0.2f) << "levels cross-fade on the flythrough";
         for (std::uint32_t f = 0; f < s->frames; ++f)
         {
             const CameraSpec cam = cameraAt(*s, frameTime(*s, f));

@@ -221,15 +221,17 @@ namespace TreeLod
         const ForestStats& stats = forest->getStats();
 
         ForestVisibility visibility;
-        ASSERT_TRUE(forest->getInstances().cull(CullCamera::fromSpec(view, float(width), float(height)), 1.0f,
-                                                visibility).ok());
+        ASSERT_TRUE(forest->getInstances()
+                        .cull(CullCamera::fromSpec(view, float(width), float(height)), 1.0f, visibility,
+                              forest->getLodHysteresis(), forest->getLodTransition())
+                        .ok());
         EXPECT_EQ(stats.instances, 144u);
         EXPECT_EQ(stats.visibleInstances, visibility.getVisibleCount());
         EXPECT_GT(stats.visibleInstances, 10u);
         EXPECT_LT(stats.visibleInstances, 100u) << "about half the forest is behind the camera";
         for (const ForestBucket& bucket : visibility.getBuckets())
             EXPECT_EQ(stats.levelCounts.at(bucket.kind).at(bucket.level), bucket.count) << "level " << bucket.level;
-        for (std::uint32_t v = 0; v < visibility.getVisibleCount(); ++v)
+        for (std::uint32_t v = 0; v < visibility.getDrawCount(); ++v)
         {
             const glm::vec4 sphere = forest->getInstances().getWorldSphere(visibility.getIndices()[v]);
             EXPECT_LT(sphere.z - sphere.w, eye.z) << "an instance behind the camera counted visible";

@@ -79,13 +79,6 @@ namespace TreeLod
                     parts.addMesh(asset.getBarkMesh(), materials, shadowed);
             }
 
-            /// LoDF's levels are steps of one leaf collapse (Rebollo et al. 2006) from the reference
-            /// (every leaf) down: they switch hard, and fade only into other techniques' levels.
-            bool isContinuousStep(const ForestLevel& finer, const ForestLevel& coarser) const override
-            {
-                return finer.technique == coarser.technique || finer.technique == REFERENCE_TECHNIQUE;
-            }
-
             Ogre::String describeLevel(const ForestLevel& level) const override
             {
                 return level.technique + " " + (level.techniqueLevel ? std::to_string(level.techniqueLevel) : "all");

@@ -211,7 +211,7 @@ namespace TreeLod
         Ogre::Real getLodTransition() const { return mLodTransition; }
         Ogre::Real getLodTransitionMinHeight() const { return mLodTransitionMinHeight; }
         static constexpr Ogre::Real DEFAULT_LOD_TRANSITION = ForestInstances::DEFAULT_TRANSITION;
-        static constexpr Ogre::Real DEFAULT_LOD_TRANSITION_MIN_HEIGHT = 32.0f;
+        static constexpr Ogre::Real DEFAULT_LOD_TRANSITION_MIN_HEIGHT = 64.0f;
         /// Keep the LoD camera of the last frame (levels stop changing; culling goes on).
         void setLodFrozen(bool frozen);
         bool isLodFrozen() const { return mLodFrozen; }
