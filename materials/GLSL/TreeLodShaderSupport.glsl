@@ -61,6 +61,7 @@
 #define vec3_splat(x) ((float3)(x))
 #define vec4_splat(x) ((float4)(x))
 #define ivec2_splat(x) ((int2)(x))
+#define ivec3_splat(x) ((int3)(x))
 #define row3(m, i) ((m)[i].xyz)
 #define toMat3(m) ((float3x3)(m))
 #define mtxFromCols(a, b, c) transpose(float3x3(a, b, c))
@@ -118,6 +119,7 @@ precision highp samplerCube;
 #define vec3_splat vec3
 #define vec4_splat vec4
 #define ivec2_splat ivec2
+#define ivec3_splat ivec3
 #define row3(m, i) vec3((m)[0][i], (m)[1][i], (m)[2][i])
 #define toMat3 mat3
 #define mtxFromCols mat3

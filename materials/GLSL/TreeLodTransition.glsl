@@ -15,11 +15,14 @@
 #define NO_TRANSITION vec2_splat(0.0)
 #define TRANSITION_DISCARD if (transitionDrops(gl_FragCoord.xy, vTransition)) discard;
 
-/// (code, pattern shift) of an instance: the code is uv5.z (0 where the data has no third value).
+/// (code, pattern shift) of an instance: the code is uv5.z (0 where the data has no third value);
+/// the shift hashes the instance's quarter-metre cell in integers, so that the two programs of a
+/// transition (each compiled on its own, with its own float contractions) get the same shift.
 vec2 transitionOf(vec4 uv4, vec3 uv5)
 {
-    float hash = fract(sin(dot(floor(uv4.xyz * 4.0), vec3(12.9898, 78.233, 37.719))) * 43758.547);
-    return vec2(uv5.z, floor(hash * 64.0) / 64.0);
+    ivec3 cell = ivec3(floor(uv4.xyz * 4.0)) + ivec3_splat(16777216); // positive within 4000 km
+    uint hash = (uint(cell.x) * 73856093u) ^ (uint(cell.y) * 19349663u) ^ (uint(cell.z) * 83492791u);
+    return vec2(uv5.z, float(hash & 63u) / 64.0);
 }
 
 /// The 8x8 Bayer threshold of a window pixel, in (0, 1): M8 = 16 M2(p) + 4 M2(p / 2) + M2(p / 4),
