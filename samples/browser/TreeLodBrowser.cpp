@@ -65,7 +65,6 @@ namespace TreeLod
         /// The transition slider's steps (Forest::setLodTransition; 0: hard switches).
         const std::vector<float> TRANSITIONS = {0.0f, 0.05f, 0.1f, 0.2f, 0.3f, 0.5f, 1.0f};
 
-
         std::string transitionCaption(float transition)
         {
             return transition > 0.0f ? Ogre::StringConverter::toString(transition) : "hard";
