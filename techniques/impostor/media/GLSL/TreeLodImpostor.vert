@@ -9,8 +9,9 @@
 #include "TreeLodTransition.glsl"
 // The one-quad impostor (ImpostorData.h), instanced by the Forest (Forest.h): per instance
 // uv4 = position (the Forest's local space) + uniform scale, uv5 = cos, sin of the rotation
-// about +Y (unused) and the transition code (TreeLodTransition.glsl): the quad (vertex.xy, metres, facing +Z) turns about the instance's +Y axis
-// until its +Z faces the camera (a cylindrical billboard), so the tree's rotation cannot show.
+// about +Y (unused) and the transition code (TreeLodTransition.glsl): the quad (vertex.xy,
+// metres, facing +Z) turns about the instance's +Y axis until its +Z faces the camera (a
+// cylindrical billboard), so the tree's rotation cannot show.
 // The sun's direction goes to the fragment stage in the quad frame (x right, y up, z towards
 // the camera), the frame of the baked normals: one value per quad, so the fragment stage lights
 // without turning or normalising anything.
