@@ -7,7 +7,9 @@
 // of its position (a multiple of 1/64, so the shares stay exact) so that trees one behind another
 // in a transition do not drop the same pixels.
 // Vertex programs: TRANSITION_OUT(semantic) last among their outputs, and vTransition =
-// transitionOf(uv4, uv5) (the instance data, TreeLodInstance.glsl) or NO_TRANSITION.
+// transitionOf(uv4, uv5) (the instance data, TreeLodInstance.glsl), objectTransition.xy (a tree
+// object's draw: `uniform vec4 objectTransition`, the Renderable's custom parameter 7,
+// TreeLod/ObjectTransition.h), drawTransition (either) or NO_TRANSITION.
 // Fragment programs: TRANSITION_IN(semantic) last among their inputs, and TRANSITION_DISCARD
 // before their output, after their derivatives and implicit-LOD samples.
 #define TRANSITION_OUT(semantic) FLAT_OUT(vec2 vTransition, semantic)
@@ -17,12 +19,27 @@
 
 /// (code, pattern shift) of an instance: the code is uv5.z (0 where the data has no third value);
 /// the shift hashes the instance's quarter-metre cell in integers, so that the two programs of a
-/// transition (each compiled on its own, with its own float contractions) get the same shift.
+/// transition (each compiled on its own, with its own float contractions) get the same shift
+/// (TreeLod::transitionPatternShift computes it for tree objects).
 vec2 transitionOf(vec4 uv4, vec3 uv5)
 {
     ivec3 cell = ivec3(floor(uv4.xyz * 4.0)) + ivec3_splat(16777216); // positive within 4000 km
     uint hash = (uint(cell.x) * 73856093u) ^ (uint(cell.y) * 19349663u) ^ (uint(cell.z) * 83492791u);
     return vec2(uv5.z, float(hash & 63u) / 64.0);
+}
+
+/// The code and shift of a draw by a program that the Forest's batches and the tree objects share:
+/// the instance's where it carries a code, else the Renderable's (both set it, (0, 0) by default).
+vec2 drawTransition(vec4 uv4, vec3 uv5, vec4 objectTransition)
+{
+    return uv5.z != 0.0 ? transitionOf(uv4, uv5) : objectTransition.xy;
+}
+
+/// The coarse level's share at `sizeRatio` (screen size over the switch's) in a band ending at
+/// `end`; 0 outside it (TreeLod::transitionCoarseShare).
+float transitionCoarseShare(float sizeRatio, float end)
+{
+    return end > 1.0 && sizeRatio < end ? min((end - sizeRatio) / (end - 1.0), 1.0) : 0.0;
 }
 
 /// The 8x8 Bayer threshold of a window pixel, in (0, 1): M8 = 16 M2(p) + 4 M2(p / 2) + M2(p / 4),

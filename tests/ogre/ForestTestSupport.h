@@ -139,6 +139,69 @@ namespace TreeLod
 
         const glm::vec3 BACKGROUND = LightingSpec().background;
 
+        /// everyTechniqueOak (at the origin) framed from 30 degrees around, 10 up.
+        inline CameraSpec everyTechniqueOakView()
+        {
+            const TreeModel& model = everyTechniqueOak().model;
+            return CameraSpec::framing(model.boundsMin, model.boundsMax, 30.0f, 10.0f);
+        }
+
+        /// Per pixel, whether `image` differs from the background there (isTreePixel).
+        inline std::vector<bool> treePixelMask(const Image& image)
+        {
+            std::vector<bool> covered(image.pixels.size());
+            for (std::size_t i = 0; i < covered.size(); ++i)
+                covered[i] = isTreePixel(image.pixels[i], BACKGROUND);
+            return covered;
+        }
+
+        /// What a picture mid-transition keeps of its two levels' pictures: the share of the pixels
+        /// both cover (1: no hole), and of those each covers alone (about the level's share: no
+        /// double density).
+        struct TransitionCoverage
+        {
+            std::size_t both = 0, fineOnly = 0, coarseOnly = 0;
+            double bothKept = 0.0, fineKept = 0.0, coarseKept = 0.0;
+        };
+        /// The largest share of the tree's pixels (tree in either frame) that a frame of `frames`
+        /// changes from the one before.
+        inline double worstFrameChange(const std::vector<Image>& frames)
+        {
+            double worst = 0.0;
+            for (std::size_t f = 1; f < frames.size(); ++f)
+            {
+                std::size_t changed = 0, tree = 0;
+                for (std::size_t i = 0; i < frames[f].pixels.size(); ++i)
+                {
+                    const glm::vec4 &a = frames[f - 1].pixels[i], &b = frames[f].pixels[i];
+                    tree += isTreePixel(a, BACKGROUND) || isTreePixel(b, BACKGROUND);
+                    changed += glm::length(glm::vec3(a) - glm::vec3(b)) > 0.02f;
+                }
+                worst = std::max(worst, double(changed) / double(std::max<std::size_t>(tree, 1)));
+            }
+            return worst;
+        }
+
+        inline TransitionCoverage transitionCoverage(const Image& fine, const Image& mid, const Image& coarse)
+        {
+            const std::vector<bool> inFine = treePixelMask(fine), inCoarse = treePixelMask(coarse), inMid = treePixelMask(mid);
+            TransitionCoverage c;
+            std::size_t bothKept = 0, fineKept = 0, coarseKept = 0;
+            for (std::size_t i = 0; i < inMid.size(); ++i)
+            {
+                if (inFine[i] && inCoarse[i])
+                    ++c.both, bothKept += inMid[i];
+                else if (inFine[i])
+                    ++c.fineOnly, fineKept += inMid[i];
+                else if (inCoarse[i])
+                    ++c.coarseOnly, coarseKept += inMid[i];
+            }
+            c.bothKept = double(bothKept) / double(std::max<std::size_t>(c.both, 1));
+            c.fineKept = double(fineKept) / double(std::max<std::size_t>(c.fineOnly, 1));
+            c.coarseKept = double(coarseKept) / double(std::max<std::size_t>(c.coarseOnly, 1));
+            return c;
+        }
+
         /// A ground square of half-size `size` at y = 0 under the content node, casting no shadow: a
         /// clone of TreeLod/Bark in a plain green, or of TreeLod/BarkShadowed where `receiving` (the
         /// sun's depth shadow).

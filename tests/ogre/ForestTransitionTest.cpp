@@ -17,11 +17,7 @@ namespace TreeLod::ForestTransitionTests
         constexpr float TRANSITION = 0.2f;
 
         /// The view of the oak (at the origin) every test here renders.
-        CameraSpec oakView()
-        {
-            const TreeModel& model = everyTechniqueOak().model;
-            return CameraSpec::framing(model.boundsMin, model.boundsMax, 30.0f, 10.0f);
-        }
+        CameraSpec oakView() { return everyTechniqueOakView(); }
 
         /// The Forest's LoD value (Forest.h units: 4 pi r_px^2 of the asset's reference sphere) of a
         /// tree at the origin seen from `view` in a SIZE x SIZE viewport.
@@ -54,15 +50,6 @@ namespace TreeLod::ForestTransitionTests
             ForestLevel far = coarse;
             far.minPixelCount = 0.0f;
             return {near, far};
-        }
-
-        /// Pixels where `image` differs from the background.
-        std::vector<bool> coverage(const Image& image)
-        {
-            std::vector<bool> covered(image.pixels.size());
-            for (std::size_t i = 0; i < covered.size(); ++i)
-                covered[i] = isTreePixel(image.pixels[i], BACKGROUND);
-            return covered;
         }
     }
 
@@ -104,27 +91,14 @@ namespace TreeLod::ForestTransitionTests
             EXPECT_EQ(forest->getStats().levelCounts.at(0), (std::vector<std::uint32_t>{1u, 1u}));
             const Image hard = renderOak(pairAt(pair.fine, pair.coarse, 1.1f), 0.0f);
 
-            const std::vector<bool> inFine = coverage(fine), inCoarse = coverage(coarse), inMid = coverage(mid);
-            std::size_t both = 0, bothKept = 0, fineOnly = 0, fineOnlyKept = 0, coarseOnly = 0, coarseOnlyKept = 0;
-            for (std::size_t i = 0; i < inMid.size(); ++i)
-            {
-                if (inFine[i] && inCoarse[i])
-                    ++both, bothKept += inMid[i];
-                else if (inFine[i])
-                    ++fineOnly, fineOnlyKept += inMid[i];
-                else if (inCoarse[i])
-                    ++coarseOnly, coarseOnlyKept += inMid[i];
-            }
-            const double bothShare = double(bothKept) / double(both);
-            const double fineShare = double(fineOnlyKept) / double(std::max<std::size_t>(fineOnly, 1));
-            const double coarseShare = double(coarseOnlyKept) / double(std::max<std::size_t>(coarseOnly, 1));
+            const TransitionCoverage c = transitionCoverage(fine, mid, coarse);
             std::printf("%s: covered by both %zu px, %.3f kept; fine alone %zu px, %.3f kept; coarse alone %zu px, "
                         "%.3f kept; hard switch vs fine FLIP %.4f\n",
-                        name.c_str(), both, bothShare, fineOnly, fineShare, coarseOnly, coarseShare,
+                        name.c_str(), c.both, c.bothKept, c.fineOnly, c.fineKept, c.coarseOnly, c.coarseKept,
                         flipMean(fine, hard, FlipOver::Tree));
-            ASSERT_GT(both, 500u) << "the levels overlap";
-            EXPECT_GT(bothShare, 0.97) << "no hole where both levels cover";
-            for (const auto& [alone, share] : {std::make_pair(fineOnly, fineShare), std::make_pair(coarseOnly, coarseShare)})
+            ASSERT_GT(c.both, 500u) << "the levels overlap";
+            EXPECT_GT(c.bothKept, 0.97) << "no hole where both levels cover";
+            for (const auto& [alone, share] : {std::make_pair(c.fineOnly, c.fineKept), std::make_pair(c.coarseOnly, c.coarseKept)})
                 if (alone >= 100)
                 {
                     EXPECT_GT(share, 0.3) << "each level draws its share";
@@ -160,18 +134,7 @@ namespace TreeLod::ForestTransitionTests
                 frames.push_back(toImage(r.render(oakView(), SIZE, SIZE, 1)));
                 inBand += forest->getStats().transitionInstances;
             }
-            double worst = 0.0;
-            for (std::size_t f = 1; f < frames.size(); ++f)
-            {
-                std::size_t changed = 0, tree = 0;
-                for (std::size_t i = 0; i < frames[f].pixels.size(); ++i)
-                {
-                    const glm::vec4 &a = frames[f - 1].pixels[i], &b = frames[f].pixels[i];
-                    tree += isTreePixel(a, BACKGROUND) || isTreePixel(b, BACKGROUND);
-                    changed += glm::length(glm::vec3(a) - glm::vec3(b)) > 0.02f;
-                }
-                worst = std::max(worst, double(changed) / double(std::max<std::size_t>(tree, 1)));
-            }
+            const double worst = worstFrameChange(frames);
             std::printf("transition %.2f: %u frames in the band, worst frame changes %.3f of the tree's pixels\n",
                         double(transition), inBand, worst);
             return std::make_pair(worst, inBand);

@@ -9,6 +9,7 @@
 #include "TreeLod/ErrorCurves.h"
 #include "TreeLod/LevelSelection.h"
 #include "TreeLod/ObjectParams.h"
+#include "TreeLod/ObjectTransition.h"
 #include "TreeLod/ScreenSizeLodStrategy.h"
 #include "TreeLod/ShadowSetup.h"
 
@@ -333,6 +334,7 @@ namespace TreeLod
             mSource = static_cast<unsigned short>(decl->getMaxSource() + 1);
             decl->addElement(mSource, 0, Ogre::VET_FLOAT4, Ogre::VES_TEXTURE_COORDINATES, 4);
             decl->addElement(mSource, 4 * sizeof(float), Ogre::VET_FLOAT3, Ogre::VES_TEXTURE_COORDINATES, 5);
+            ObjectTransition::apply(*this, 0.0f, Ogre::Vector3::ZERO); // the code comes per instance
             for (const auto& [index, value] : part.customParameters)
                 setCustomParameter(index, value);
         }

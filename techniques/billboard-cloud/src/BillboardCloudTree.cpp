@@ -66,6 +66,7 @@ namespace TreeLod
                         "BillboardCloudTree '" + name + "'");
         mLodBias.setMesh(mOptions.lodBias, 0, 99, "BillboardCloudTree '" + name + "'");
         mLodBias.strategy = mOptions.lodStrategy;
+        mTransition.set(mOptions.lodTransition, "BillboardCloudTree '" + name + "'");
         mListFactor = mOptions.listFactor >= 0.0f ? mOptions.listFactor : mGpu->listFactor;
         updateSwitchValues();
 
@@ -149,6 +150,11 @@ namespace TreeLod
         applyLevel();
     }
 
+    void BillboardCloudTree::setLodTransition(Ogre::Real length)
+    {
+        mTransition.set(length, "BillboardCloudTree '" + mName + "'");
+    }
+
     void BillboardCloudTree::setForcedLevel(int level)
     {
         mOptions.level = level < 0 ? -1 : std::min(level, int(std::max<std::uint32_t>(getLevelCount(), 1)) - 1);
@@ -224,6 +230,25 @@ namespace TreeLod
         if (mOptions.level < 0)
             mLevel = mLodBias.clampMesh(Ogre::ushort(std::min<std::uint32_t>(levelForPixelCount(mPixelCountValue), 0xffff)));
         mLevel = std::min(mLevel, std::max<std::uint32_t>(getLevelCount(), 1) - 1);
+        // A transition to the next level (ObjectTransition.h), where the strategy chose this one and
+        // the next is allowed: screen sizes are square roots of pixel counts.
+        mTransitionShare = 0.0f;
+        if (mOptions.level < 0 && mLevel + 1 < mLevelParts.size() && mLevel < mSwitchPixelCounts.size() &&
+            levelForPixelCount(mPixelCountValue) == mLevel && mLodBias.clampMesh(Ogre::ushort(mLevel + 1)) == mLevel + 1 &&
+            mSwitchPixelCounts[mLevel] > 0.0f && mLevelParts[mLevel + 1]->mIndexData.indexCount > 0)
+        {
+            const Ogre::Real threshold = mSwitchPixelCounts[mLevel];
+            const float range = mLevel == 0 ? std::numeric_limits<float>::infinity()
+                                            : std::sqrt(float(mSwitchPixelCounts[mLevel - 1] / threshold));
+            mTransitionShare = mTransition.coarseShare(std::sqrt(float(mPixelCountValue / threshold)), range);
+        }
+        if (mLevel < mLevelParts.size())
+        {
+            const Ogre::Vector3& position = mParentNode->_getDerivedPosition();
+            ObjectTransition::apply(*mLevelParts[mLevel], mTransitionShare > 0.0f ? -mTransitionShare : 0.0f, position);
+            if (mTransitionShare > 0.0f)
+                ObjectTransition::apply(*mLevelParts[mLevel + 1], mTransitionShare, position);
+        }
         if (mBarkMesh)
             mBarkLodIndex = mLodBias.meshLodIndex(*mBarkMesh, *this, camera);
         for (const std::unique_ptr<Part>& part : mBarkParts)
@@ -244,6 +269,8 @@ namespace TreeLod
             queue->addRenderable(part.get(), mRenderQueueID, mRenderQueuePriority);
         if (mLevel < mLevelParts.size() && mLevelParts[mLevel]->mIndexData.indexCount > 0)
             queue->addRenderable(mLevelParts[mLevel].get(), mRenderQueueID, mRenderQueuePriority);
+        if (mTransitionShare > 0.0f)
+            queue->addRenderable(mLevelParts[mLevel + 1].get(), mRenderQueueID, mRenderQueuePriority);
     }
 
     void BillboardCloudTree::visitRenderables(Ogre::Renderable::Visitor* visitor, bool)
@@ -268,6 +295,7 @@ namespace TreeLod
         }
         options.lodStrategy = ObjectLodBias::strategyParam(p);
         p.flag("ambientOcclusion", options.ambientOcclusion);
+        ObjectTransition::param(p, options.lodTransition);
         if (p.number("listFactor", 0.0, 1e6, v))
             options.listFactor = float(v);
         if (p.number("lodBias", 1e-6, 1e6, v))

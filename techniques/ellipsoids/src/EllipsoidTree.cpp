@@ -51,6 +51,7 @@ namespace TreeLod
     {
         mLodBias.setMesh(mOptions.lodBias, 0, 99, "EllipsoidTree '" + name + "'");
         mLodBias.strategy = mOptions.lodStrategy;
+        mTransition.set(mOptions.lodTransition, "EllipsoidTree '" + name + "'");
         if (mOptions.level >= 0 && std::size_t(mOptions.level) >= mGpu->levels.size())
             OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
                         "parameter 'level': " + std::to_string(mOptions.level) + " is not a level of the ellipsoids (" +
@@ -68,9 +69,12 @@ namespace TreeLod
                         Ogre::String("material '") + ELLIPSOID_MATERIAL +
                             "' not found: add TreeLod's materials/ to a resource group",
                         "EllipsoidTree '" + name + "'");
-        mEllipsoids = std::make_unique<Part>(*this, material->getGroup(), mVertexData.get(), ELLIPSOID_MATERIAL,
-                                             ELLIPSOID_SHADOWED_MATERIAL);
-        mEllipsoids->mIndexData.indexBuffer = mGpu->indexBuffer;
+        for (std::unique_ptr<Part>* part : {&mEllipsoids.fine, &mEllipsoids.coarse})
+        {
+            *part = std::make_unique<Part>(*this, material->getGroup(), mVertexData.get(), ELLIPSOID_MATERIAL,
+                                           ELLIPSOID_SHADOWED_MATERIAL);
+            (*part)->mIndexData.indexBuffer = mGpu->indexBuffer;
+        }
 
         const TreeModel& model = mAsset->getReference().model;
         mTreeHeight = model.boundsMax.y - model.boundsMin.y;
@@ -82,9 +86,12 @@ namespace TreeLod
         {
             mLineVertexData.reset(mLines->vertexData->clone(false));
             addOriginInstance(*mLineVertexData);
-            mLineParts = std::make_unique<Part>(*this, material->getGroup(), mLineVertexData.get(),
-                                                ELLIPSOID_LINE_MATERIAL, ELLIPSOID_LINE_SHADOWED_MATERIAL);
-            mLineParts->mIndexData.indexBuffer = mLines->indexBuffer;
+            for (std::unique_ptr<Part>* part : {&mLineParts.fine, &mLineParts.coarse})
+            {
+                *part = std::make_unique<Part>(*this, material->getGroup(), mLineVertexData.get(),
+                                               ELLIPSOID_LINE_MATERIAL, ELLIPSOID_LINE_SHADOWED_MATERIAL);
+                (*part)->mIndexData.indexBuffer = mLines->indexBuffer;
+            }
         }
         else if (!model.barkIndices.empty())
         {
@@ -111,6 +118,8 @@ namespace TreeLod
 
     void EllipsoidTree::setLevels(float heightPx)
     {
+        mHeightPx = heightPx;
+        bool natural = mOptions.level < 0; // the level the height selects: transitions allowed
         if (mOptions.level >= 0)
             mLevel = std::size_t(mOptions.level);
         else
@@ -120,17 +129,44 @@ namespace TreeLod
                 mLodBias.clampMesh(Ogre::ushort(std::min<std::size_t>(mLevel, 0xffff))), mGpu->levels.size() - 1);
             if (clamped != mLevel) // a clamped level: the lines made for its target height
                 heightPx = mGpu->levels[clamped].targetHeightPx;
+            natural = clamped == mLevel && mLodBias.clampMesh(Ogre::ushort(std::min<std::size_t>(mLevel + 1, 0xffff))) ==
+                                               mLevel + 1;
             mLevel = clamped;
         }
-        mEllipsoids->mIndexData.indexStart = mGpu->levels[mLevel].indexStart;
-        mEllipsoids->mIndexData.indexCount = mGpu->levels[mLevel].indexCount;
+        setLevelDraw(mEllipsoids, mGpu->levels, mLevel, natural ? transitionShare(mGpu->levels, mLevel, heightPx) : 0.0f);
         if (mLines)
         {
             // A forced level: the lines made for its target height.
             mLineLevel = TreeLod::levelForHeight(mLines->levels, mOptions.level >= 0 ? mGpu->levels[mLevel].targetHeightPx
                                                                             : heightPx);
-            mLineParts->mIndexData.indexStart = mLines->levels[mLineLevel].indexStart;
-            mLineParts->mIndexData.indexCount = mLines->levels[mLineLevel].indexCount;
+            setLevelDraw(mLineParts, mLines->levels, mLineLevel,
+                         mOptions.level < 0 ? transitionShare(mLines->levels, mLineLevel, heightPx) : 0.0f);
+        }
+    }
+
+    float EllipsoidTree::transitionShare(const std::vector<EllipsoidGpuLevel>& levels, std::size_t level, float heightPx) const
+    {
+        // Level l is drawn down to the next one's target height, from its own (level 0: any height).
+        if (level + 1 >= levels.size() || !(levels[level + 1].targetHeightPx > 0.0f) ||
+            levels[level + 1].indexCount == 0)
+            return 0.0f;
+        const float next = levels[level + 1].targetHeightPx;
+        const float range = level == 0 ? std::numeric_limits<float>::infinity() : levels[level].targetHeightPx / next;
+        return mTransition.coarseShare(heightPx / next, range);
+    }
+
+    void EllipsoidTree::setLevelDraw(LevelDraw& draw, const std::vector<EllipsoidGpuLevel>& levels, std::size_t level, float share)
+    {
+        draw.share = share;
+        draw.fine->mIndexData.indexStart = levels[level].indexStart;
+        draw.fine->mIndexData.indexCount = levels[level].indexCount;
+        const Ogre::Vector3 position = mParentNode ? mParentNode->_getDerivedPosition() : Ogre::Vector3::ZERO;
+        ObjectTransition::apply(*draw.fine, share > 0.0f ? -share : 0.0f, position);
+        if (share > 0.0f)
+        {
+            draw.coarse->mIndexData.indexStart = levels[level + 1].indexStart;
+            draw.coarse->mIndexData.indexCount = levels[level + 1].indexCount;
+            ObjectTransition::apply(*draw.coarse, share, position);
         }
     }
 
@@ -159,11 +195,16 @@ namespace TreeLod
         setLevels(float(heightPx));
         if (mBarkMesh)
             mBarkLodIndex = mLodBias.meshLodIndex(*mBarkMesh, *this, camera);
-        for (Part* part : {mEllipsoids.get(), mLineParts.get()})
+        for (Part* part : {mEllipsoids.fine.get(), mEllipsoids.coarse.get(), mLineParts.fine.get(), mLineParts.coarse.get()})
             if (part)
                 part->updateMaterialLod(mLodBias, camera);
         for (const std::unique_ptr<Part>& part : mBarkParts)
             part->updateMaterialLod(mLodBias, camera);
+    }
+
+    void EllipsoidTree::setLodTransition(Ogre::Real length)
+    {
+        mTransition.set(length, "EllipsoidTree '" + mName + "'");
     }
 
     void EllipsoidTree::setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex, unsigned short minDetailIndex)
@@ -186,18 +227,25 @@ namespace TreeLod
     {
         if (mManager)
             notifyShadowTechnique(*mManager);
-        queue->addRenderable(mEllipsoids.get(), mRenderQueueID, mRenderQueuePriority);
-        if (mLineParts)
-            queue->addRenderable(mLineParts.get(), mRenderQueueID, mRenderQueuePriority);
+        for (const LevelDraw* draw : {&mEllipsoids, &mLineParts})
+            if (draw->fine)
+            {
+                queue->addRenderable(draw->fine.get(), mRenderQueueID, mRenderQueuePriority);
+                if (draw->share > 0.0f)
+                    queue->addRenderable(draw->coarse.get(), mRenderQueueID, mRenderQueuePriority);
+            }
         for (const std::unique_ptr<Part>& part : mBarkParts)
             queue->addRenderable(part.get(), mRenderQueueID, mRenderQueuePriority);
     }
 
     void EllipsoidTree::visitRenderables(Ogre::Renderable::Visitor* visitor, bool)
     {
-        visitor->visit(mEllipsoids.get(), 0, false);
-        if (mLineParts)
-            visitor->visit(mLineParts.get(), 0, false);
+        for (const LevelDraw* draw : {&mEllipsoids, &mLineParts})
+            if (draw->fine)
+            {
+                visitor->visit(draw->fine.get(), 0, false);
+                visitor->visit(draw->coarse.get(), 1, false);
+            }
         for (const std::unique_ptr<Part>& part : mBarkParts)
             visitor->visit(part.get(), 0, false);
     }
@@ -218,6 +266,7 @@ namespace TreeLod
             options.lodBias = float(value);
         p.flag("lines", options.lines);
         options.lodStrategy = ObjectLodBias::strategyParam(p);
+        ObjectTransition::param(p, options.lodTransition);
         return new EllipsoidTree(name, p.loadAsset(name, "EllipsoidTree"), options);
     }
 }

@@ -43,6 +43,7 @@ namespace TreeLod
     {
         mLodBias.setMesh(mOptions.lodBias, 0, 99, "VolumeOctreeTree '" + name + "'");
         mLodBias.strategy = mOptions.lodStrategy;
+        mTransition.set(mOptions.lodTransition, "VolumeOctreeTree '" + name + "'");
         if (mOptions.level >= 0 && std::uint32_t(mOptions.level) >= mData->levelCount)
             OGRE_EXCEPT(Ogre::Exception::ERR_INVALIDPARAMS,
                         "parameter 'level': " + std::to_string(mOptions.level) + " is not a level of the octree (" +
@@ -104,13 +105,18 @@ namespace TreeLod
             towards = -(toModel.linear() * camera->getDerivedDirection());
         towards.normalise();
         mPair = volumeOctreeCameraPair(mData->cameraDirections, glm::vec3(towards.x, towards.y, towards.z));
+        // Transitions per cell (the vertex program): a cell is drawn from the plane to half its depth,
+        // where its children take over, a range of 2 in screen size.
+        const float bandEnd = mOptions.level < 0 ? transitionBandEnd(mTransition.length, 2.0f) : 1.0f;
+        const Ogre::Vector3 position = mParentNode->_getDerivedPosition();
+        const float shift = transitionPatternShift({position.x, position.y, position.z});
         if (mManager && mManager->_getCurrentRenderStage() == Ogre::SceneManager::IRS_RENDER_TO_TEXTURE)
         {
             // A shadow camera: the cameras nearest the light; the viewer's levels and order stay (a
             // depth caster needs no order), the active level everywhere (no plane).
             mPart->setCustomParameter(0, Ogre::Vector4(float(mOrderedActive), std::numeric_limits<float>::max(),
                                                        mPair.firstWeight, 1.0f - mPair.firstWeight));
-            mPart->setCustomParameter(1, Ogre::Vector4(float(mPair.first), float(mPair.second), 0.0f, 0.0f));
+            mPart->setCustomParameter(1, Ogre::Vector4(float(mPair.first), float(mPair.second), bandEnd, shift));
             return;
         }
         const std::uint32_t octant = volumeOctreeOctant(glm::vec3(-towards.x, -towards.y, -towards.z));
@@ -150,10 +156,16 @@ namespace TreeLod
         const float plane = perspective && focal < std::numeric_limits<float>::max()
                                 ? volumeOctreePlaneDepth(mData->cellEdge(mActive) * s, focal, mOptions.lodPixels)
                                 : std::numeric_limits<float>::max();
+        mPlaneDepth = plane;
         mPart->updateMaterialLod(mLodBias, camera);
         order(octant, mActive);
         mPart->setCustomParameter(0, Ogre::Vector4(float(mActive), plane, mPair.firstWeight, 1.0f - mPair.firstWeight));
-        mPart->setCustomParameter(1, Ogre::Vector4(float(mPair.first), float(mPair.second), 0.0f, 0.0f));
+        mPart->setCustomParameter(1, Ogre::Vector4(float(mPair.first), float(mPair.second), bandEnd, shift));
+    }
+
+    void VolumeOctreeTree::setLodTransition(Ogre::Real length)
+    {
+        mTransition.set(length, "VolumeOctreeTree '" + mName + "'");
     }
 
     void VolumeOctreeTree::setMeshLodBias(Ogre::Real factor, unsigned short maxDetailIndex,
@@ -198,6 +210,7 @@ namespace TreeLod
         options.lodStrategy = ObjectLodBias::strategyParam(p);
         if (p.number("lodPixels", 1e-3, 1e6, value))
             options.lodPixels = float(value);
+        ObjectTransition::param(p, options.lodTransition);
         return new VolumeOctreeTree(name, p.loadAsset(name, "VolumeOctreeTree"), options);
     }
 }

@@ -475,13 +475,10 @@ namespace TreeLod
             {
                 if (!(t[i] > 0.0f) || (mKinds[k].hardSwitches >> i & 1u))
                     continue; // hard; or at value 0 (or distance 0): never crossed from above
-                float end = 1.0f + transition;
-                if (i > 0)
-                {
-                    const float range = distance ? t[i] / t[i - 1] : t[i - 1] / t[i]; // value ratio, >= 1
-                    end = std::min(end, std::sqrt(std::sqrt(range)));
-                }
-                out.mBandEnds[k * MAX_THRESHOLDS + i] = end;
+                // Level i's range of screen sizes: the square root of its range of values.
+                const float range = i == 0 ? std::numeric_limits<float>::infinity()
+                                           : std::sqrt(distance ? t[i] / t[i - 1] : t[i - 1] / t[i]);
+                out.mBandEnds[k * MAX_THRESHOLDS + i] = transitionBandEnd(transition, range);
             }
         }
         out.mBandTransition = transition;
@@ -632,7 +629,7 @@ namespace TreeLod
                 const float threshold = table[level];
                 const float ratio = kindDistance[kind] != 0 ? threshold / key : key / threshold; // >= 1 (or NaN)
                 if (end > 1.0f && ratio < end * end)
-                    coarseShare = std::min((end - std::sqrt(ratio)) / (end - 1.0f), 1.0f);
+                    coarseShare = transitionCoarseShare(std::sqrt(ratio), end);
             }
             visible[entryCount] = std::uint32_t(i);
             visibleBucket[entryCount] = bucket;

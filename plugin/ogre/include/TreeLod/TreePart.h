@@ -5,6 +5,7 @@
 #pragma once
 
 #include "TreeLod/ObjectLodBias.h"
+#include "TreeLod/ObjectTransition.h"
 
 #include <OgreMaterialManager.h>
 #include <OgreTechnique.h>
@@ -33,6 +34,7 @@ namespace TreeLod
             for (Ogre::MaterialPtr* m : {&mMaterial, &mShadowedMaterial})
                 if (*m)
                     (*m)->load();
+            ObjectTransition::apply(*this, 0.0f, Ogre::Vector3::ZERO); // the whole tree
         }
 
         Ogre::IndexData mIndexData;            ///< ranged parts: start and count in a shared buffer

@@ -28,16 +28,22 @@
 // The shader's list factor is listFactor * sqrt(bias): supersampling by s with bias 1 / s^2
 // (OffscreenRenderer) walks the entries of the output image's pixels.
 //
+// Transitions (ObjectTransition.h; setLodTransition, the `lodTransition` parameter, default 0:
+// hard): within 1 + t of a switch in screen size (the square root of the pixel-count value) both
+// clouds are drawn with complementary screen-door masks, the coarser one keeping the share
+// getTransitionShare of the pixels. Not past a clamped or forced level.
+//
 // Parameters (createMovableObject params, or the registry): asset (required with the factory),
 // group, classic (true | false: draw chunk "classic-billboard-cloud"), level (force level 0,
 // 1, 2...), lodStrategy (treelod_screen_size, the default, or another: ObjectLodBias.h), listFactor (overrides the
 // chunk's shader LoD factor; 0 = low-res texture only), lodBias (> 0, setMeshLodBias's factor),
 // ambientOcclusion (true, the default | false: light like the polygonal reference, which has
-// no AO; the image-error study compares that way).
+// no AO; the image-error study compares that way), lodTransition (in [0, 1]).
 #pragma once
 
 #include "TreeLod/BillboardCloudResources.h"
 #include "TreeLod/ObjectLodBias.h"
+#include "TreeLod/ObjectTransition.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreMovableObject.h>
@@ -59,6 +65,7 @@ namespace TreeLod
             float listFactor = -1.0f; ///< < 0: the chunk's
             float lodBias = 1.0f;     ///< the initial setMeshLodBias factor
             bool ambientOcclusion = true; ///< false: no AO on leaves or bark (the polygonal reference's lighting)
+            float lodTransition = ForestInstances::DEFAULT_TRANSITION; ///< ObjectTransition::length
         };
 
         /// List entries a layered level's shader walks where the next layered level takes over.
@@ -91,6 +98,12 @@ namespace TreeLod
         void setMaterialLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0,
                                 unsigned short minDetailIndex = 99);
         const ObjectLodBias& getLodBias() const { return mLodBias; }
+
+        /// Transition length t (ObjectTransition.h) in [0, 1]; throws naming the object otherwise.
+        void setLodTransition(Ogre::Real length);
+        Ogre::Real getLodTransition() const { return mTransition.length; }
+        /// The share of the pixels level getLevel() + 1 draws now (0: getLevel() alone).
+        Ogre::Real getTransitionShare() const { return mTransitionShare; }
 
         /// Shader LoD factor in use (the chunk's unless overridden); >= 0.
         float getListFactor() const { return mListFactor; }
@@ -146,6 +159,8 @@ namespace TreeLod
         Ogre::Real mPixelCountValue = 0.0f;
         Ogre::Real mBias = 1.0f; ///< the camera's LoD bias times the mesh factor
         ObjectLodBias mLodBias;
+        ObjectTransition mTransition;
+        Ogre::Real mTransitionShare = 0.0f;
         const Ogre::Camera* mLastCamera = nullptr; ///< the last camera seen, for levelForValue
     };
 

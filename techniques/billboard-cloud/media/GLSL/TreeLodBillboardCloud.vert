@@ -22,6 +22,7 @@ uniform mat4 view;
 uniform mat4 normalMatrix;
 uniform vec4 cameraPosition;
 #endif
+uniform vec4 objectTransition; // custom 7 (TreeLod/ObjectTransition.h)
 #ifdef SHADOW_RECEIVER
 #include "TreeLodShadowReceiver.glsl"
 #endif
@@ -55,9 +56,9 @@ MAIN_PARAMETERS
 MAIN_DECLARATION
 {
 #ifdef INSTANCED
-    vTransition = transitionOf(uv4, uv5);
+    vTransition = drawTransition(uv4, uv5, objectTransition);
 #else
-    vTransition = NO_TRANSITION;
+    vTransition = objectTransition.xy;
 #endif
 #ifdef INSTANCED
     vec4 local = instancePosition(uv4, uv5, vertex);

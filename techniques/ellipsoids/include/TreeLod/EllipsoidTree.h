@@ -33,14 +33,20 @@
 // AO (§5): the ambient term is scaled by each primitive's baked AO (none unless baked with
 // ellipsoids.aoRays).
 //
+// Transitions (ObjectTransition.h; setLodTransition, the `lodTransition` parameter, default 0:
+// hard): within 1 + t of a switch in height on screen (a level's target height) the ellipsoids, and
+// the lines at their own switches, are drawn at both levels with complementary screen-door masks.
+// Not past a clamped or forced level.
+//
 // Parameters (createMovableObject params, or the registry): asset (required), group, level
 // (force an ellipsoid level: 0 finest; the lines follow its target height), lodBias (> 0,
 // setMeshLodBias's factor), lines (true: the baked lines when the package has them), lodStrategy
-// (treelod_screen_size, the default, or another: ObjectLodBias.h).
+// (treelod_screen_size, the default, or another: ObjectLodBias.h), lodTransition (in [0, 1]).
 #pragma once
 
 #include "TreeLod/EllipsoidTreeResources.h"
 #include "TreeLod/ObjectLodBias.h"
+#include "TreeLod/ObjectTransition.h"
 #include "TreeLod/TreeAsset.h"
 
 #include <OgreMovableObject.h>
@@ -59,6 +65,7 @@ namespace TreeLod
             float lodBias = 1.0f; ///< > 0, the initial setMeshLodBias factor
             const Ogre::LodStrategy* lodStrategy = nullptr; ///< null: treelod_screen_size (ObjectLodBias::strategy)
             bool lines = true;    ///< the baked lines when the package has them, else the bark mesh
+            float lodTransition = ForestInstances::DEFAULT_TRANSITION; ///< ObjectTransition::length
         };
 
         EllipsoidTree(const Ogre::String& name, const TreeAssetPtr& asset, const Options& options);
@@ -68,6 +75,8 @@ namespace TreeLod
         std::size_t getLevelCount() const { return mGpu->levels.size(); }
         /// The level drawn for the last camera.
         std::size_t getLevel() const { return mLevel; }
+        /// The tree's height on screen for the last camera (bias applied), what the levels follow.
+        float getHeightOnScreen() const { return mHeightPx; }
         /// Ellipsoids of the level drawn.
         std::size_t getEllipsoidCount() const { return mGpu->levels[mLevel].indexCount / 6; }
         /// Whether the branches are lines (else the bark mesh).
@@ -81,6 +90,12 @@ namespace TreeLod
         void setMaterialLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0,
                                 unsigned short minDetailIndex = 99);
         const ObjectLodBias& getLodBias() const { return mLodBias; }
+        /// Transition length t (ObjectTransition.h) in [0, 1]; throws naming the object otherwise.
+        void setLodTransition(Ogre::Real length);
+        Ogre::Real getLodTransition() const { return mTransition.length; }
+        /// The share of the pixels level getLevel() + 1 (getLineLevel() + 1) draws now (0: one level).
+        Ogre::Real getTransitionShare() const { return mEllipsoids.share; }
+        Ogre::Real getLineTransitionShare() const { return mLineParts.share; }
         /// The level for a tree `heightPx` tall on screen (bias applied), as §6 above.
         static std::size_t levelForHeight(const EllipsoidTreeGpu& gpu, float heightPx);
 
@@ -94,6 +109,16 @@ namespace TreeLod
 
     private:
         class Part;
+        /// A level's draw and, in a transition, the next coarser level's (its share of the pixels).
+        struct LevelDraw
+        {
+            std::unique_ptr<Part> fine, coarse;
+            float share = 0.0f;
+        };
+        /// Point `draw` at `level` of `levels` and, with `share` > 0, at the next one in a transition.
+        void setLevelDraw(LevelDraw& draw, const std::vector<EllipsoidGpuLevel>& levels, std::size_t level, float share);
+        /// The next coarser level's share at `heightPx` for `level` of `levels` (ObjectTransition.h).
+        float transitionShare(const std::vector<EllipsoidGpuLevel>& levels, std::size_t level, float heightPx) const;
         bool useShadowedMaterials() const;
         /// The ellipsoid and line levels for a tree `heightPx` tall on screen (or the forced level).
         void setLevels(float heightPx);
@@ -102,19 +127,21 @@ namespace TreeLod
         const EllipsoidTreeGpu* mGpu;
         Options mOptions;
         std::unique_ptr<Ogre::VertexData> mVertexData; ///< the asset's ellipsoids + one instance at the origin
-        std::unique_ptr<Part> mEllipsoids;
+        LevelDraw mEllipsoids;
         const EllipsoidLineGpu* mLines = nullptr;
         std::unique_ptr<Ogre::VertexData> mLineVertexData; ///< the asset's lines + one instance at the origin
-        std::unique_ptr<Part> mLineParts;
+        LevelDraw mLineParts; ///< no parts without lines
         std::size_t mLineLevel = 0;
         std::vector<std::unique_ptr<Part>> mBarkParts;
         Ogre::MeshPtr mBarkMesh;
         unsigned short mBarkLodIndex = 0;
         std::size_t mLevel = 0;
         float mTreeHeight = 0.0f; ///< the reference's box height, metres
+        float mHeightPx = 0.0f;
         Ogre::AxisAlignedBox mBounds;
         Ogre::Real mRadius = 0.0f;
         ObjectLodBias mLodBias;
+        ObjectTransition mTransition;
     };
 
     class EllipsoidTreeFactory : public Ogre::MovableObjectFactory

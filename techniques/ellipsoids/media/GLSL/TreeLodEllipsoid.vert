@@ -25,6 +25,7 @@ uniform mat4 worldView;
 uniform mat4 projection;
 uniform mat4 inverseProjection;
 uniform vec4 viewportSize; // pixels: width, height, 1 / width, 1 / height
+uniform vec4 objectTransition; // custom 7 (TreeLod/ObjectTransition.h)
 
 #include "TreeLodInstance.glsl"
 
@@ -48,7 +49,7 @@ MAIN_PARAMETERS
     TRANSITION_OUT(TEXCOORD8)
 MAIN_DECLARATION
 {
-    vTransition = transitionOf(uv4, uv5);
+    vTransition = drawTransition(uv4, uv5, objectTransition);
     vec3 centre = mul(worldView, instancePosition(uv4, uv5, vec4(vertex.xyz, 1.0))).xyz;
     mat3 toView = toMat3(worldView);
     vec3 axis0 = mul(toView, instanceDirection(uv5, uv4.w * uv1.xyz));

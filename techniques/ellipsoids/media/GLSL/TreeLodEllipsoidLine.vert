@@ -21,6 +21,7 @@ uniform mat4 worldView;
 uniform mat4 projection;
 uniform mat4 inverseProjection;
 uniform vec4 viewportSize; // width, height, 1 / width, 1 / height
+uniform vec4 objectTransition; // custom 7 (TreeLod/ObjectTransition.h)
 
 #include "TreeLodInstance.glsl"
 
@@ -47,7 +48,7 @@ MAIN_PARAMETERS
     TRANSITION_OUT(TEXCOORD7)
 MAIN_DECLARATION
 {
-    vTransition = transitionOf(uv4, uv5);
+    vTransition = drawTransition(uv4, uv5, objectTransition);
     vec3 a = mul(worldView, instancePosition(uv4, uv5, vec4(vertex.xyz, 1.0))).xyz;
     vec3 b = mul(worldView, instancePosition(uv4, uv5, vec4(uv1.xyz, 1.0))).xyz;
     float radius = uv1.w * uv4.w;

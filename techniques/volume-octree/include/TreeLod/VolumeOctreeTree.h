@@ -26,12 +26,20 @@
 // kept by a hashed alpha test, so a light ray is blocked with the probability the reconstruction
 // gives (techniques/volume-octree/media/GLSL/TreeLodVolumeOctree.frag, CASTER). Shadow cameras keep the viewer's levels.
 //
+// Transitions (ObjectTransition.h; setLodTransition, the `lodTransition` parameter, default 0:
+// hard), per cell as the switches are: a cell of the level above whose centre is in front of the
+// plane by less than 1 + t in screen size draws with its children, complementary screen-door masks
+// sharing its pixels (a cell's own range, plane to half the plane's depth, caps the band at
+// sqrt(2)). The active level's own change (cells beyond twice the nearest point's depth) stays hard,
+// as do shadow casters (the active level everywhere).
+//
 // Parameters (createMovableObject params, or the registry): asset (required), group, level (force
 // the active level), lodBias (> 0), lodPixels (> 0), lodStrategy (treelod_screen_size, the
-// default, or another: ObjectLodBias.h).
+// default, or another: ObjectLodBias.h), lodTransition (in [0, 1]).
 #pragma once
 
 #include "TreeLod/ObjectLodBias.h"
+#include "TreeLod/ObjectTransition.h"
 #include "TreeLod/TreeAsset.h"
 #include "TreeLod/VolumeOctreeResources.h"
 
@@ -51,6 +59,7 @@ namespace TreeLod
             float lodBias = 1.0f;    ///< > 0, the initial setMeshLodBias factor
             const Ogre::LodStrategy* lodStrategy = nullptr; ///< null: treelod_screen_size (ObjectLodBias::strategy)
             float lodPixels = 4.0f;  ///< > 0
+            float lodTransition = ForestInstances::DEFAULT_TRANSITION; ///< ObjectTransition::length
         };
 
         VolumeOctreeTree(const Ogre::String& name, const TreeAssetPtr& asset, const Options& options);
@@ -60,6 +69,9 @@ namespace TreeLod
         std::uint32_t getLevelCount() const { return mData->levelCount; }
         /// The active level for the last camera.
         std::uint32_t getActiveLevel() const { return mActive; }
+        /// Its distance plane's view depth for the last camera (metres; FLT_MAX: none, as for an
+        /// orthographic camera).
+        float getPlaneDepth() const { return mPlaneDepth; }
         /// Billboards the last camera's draw may show (cells of both drawn levels).
         std::size_t getDrawnCellCount() const;
         /// The two input cameras blended for the last camera.
@@ -71,6 +83,9 @@ namespace TreeLod
         void setMaterialLodBias(Ogre::Real factor, unsigned short maxDetailIndex = 0,
                                 unsigned short minDetailIndex = 99);
         const ObjectLodBias& getLodBias() const { return mLodBias; }
+        /// Transition length t (ObjectTransition.h) in [0, 1]; throws naming the object otherwise.
+        void setLodTransition(Ogre::Real length);
+        Ogre::Real getLodTransition() const { return mTransition.length; }
 
         // MovableObject
         const Ogre::String& getMovableType() const override;
@@ -94,8 +109,10 @@ namespace TreeLod
         Ogre::HardwareIndexBufferSharedPtr mIndexBuffer;
         std::uint32_t mOctant = 8, mActive = 0, mOrderedActive = ~0u;
         VolumeCameraPair mPair;
+        float mPlaneDepth = 0.0f;
         Ogre::Real mRadius = 0.0f;
         ObjectLodBias mLodBias;
+        ObjectTransition mTransition;
     };
 
     class VolumeOctreeTreeFactory : public Ogre::MovableObjectFactory

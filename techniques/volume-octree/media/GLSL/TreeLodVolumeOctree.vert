@@ -15,7 +15,10 @@
 // - Texture (§2.1): the two input cameras nearest the view; each one's slot gives a colour and an
 //   alpha codeword (§4.1), a 4x4 block of the atlas; a pruned slot (§3.2) gives weight 0.
 // Single tree (VolumeOctreeTree): the vertices are the cells in the object's back-to-front order;
-// the camera pair, active level and plane come per object from the CPU.
+// the camera pair, active level and plane come per object from the CPU. With a transition band
+// (TreeLod/ObjectTransition.h) a cell of the level above in front of the plane, within the band's
+// end of it in screen size (plane depth over its centre's), draws too, and it and its children
+// keep complementary screen-door shares (TreeLodTransition.glsl).
 // INSTANCED (a Forest level, VolumeOctreeForestGpu): the corners of quad q fetch the cell of entry
 // q of its tree's view octant in the level's orders, so each tree of one draw has its own order;
 // the camera pair (volumeOctreeCameraPair) is chosen here from each tree's view of the camera,
@@ -40,7 +43,7 @@ SAMPLER2D(cells, 2);          // RGBA8: x | y << 9 | z << 18 | level << 27
 SAMPLER2D(orders, 3);         // RGBA8: cell indices
 #else
 uniform vec4 lodState;   // active level, plane depth (view metres), weight of camera 0, of camera 1
-uniform vec4 cameraPair; // input camera 0, input camera 1
+uniform vec4 cameraPair; // input camera 0, input camera 1, transition band's end (1: none), pattern shift
 #endif
 
 // The codewords of the slot of `cell` for `camera`: (colour, alpha), -1 when pruned.
@@ -121,8 +124,6 @@ MAIN_DECLARATION
 {
 #ifdef INSTANCED
     vTransition = transitionOf(uv4, uv5);
-#else
-    vTransition = NO_TRANSITION;
 #endif
 #ifdef INSTANCED
     int quad = int(vertex + 0.5) / 4, c = int(vertex + 0.5) % 4;
@@ -169,6 +170,19 @@ MAIN_DECLARATION
     bool drawn = activeLevel < 0.5 ? level < 0.5
                               : (abs(level - activeLevel) < 0.5 ? parentDepth < lodState.y
                                                            : abs(level + 1.0 - activeLevel) < 0.5 && depth >= lodState.y);
+#ifndef INSTANCED
+    // The band: both a cell of the level above and its children draw while the cell's centre is
+    // within cameraPair.z of the plane (in screen size), each keeping its share.
+    float share = 0.0;
+    if (activeLevel >= 0.5 && abs(level - activeLevel) < 0.5 && drawn)
+        share = -transitionCoarseShare(lodState.y / max(parentDepth, 1e-6), cameraPair.z);
+    else if (activeLevel >= 0.5 && abs(level + 1.0 - activeLevel) < 0.5 && depth < lodState.y)
+    {
+        share = transitionCoarseShare(lodState.y / max(depth, 1e-6), cameraPair.z);
+        drawn = share > 0.0;
+    }
+    vTransition = vec2(share, cameraPair.w);
+#endif
     ivec2 first = codewords(int(cellIndex + 0.5), int(cameraPair.x + 0.5));
     ivec2 second = codewords(int(cellIndex + 0.5), int(cameraPair.y + 0.5));
     vWeights = vec2(first.x >= 0 ? lodState.z : 0.0, second.x >= 0 ? lodState.w : 0.0);

@@ -31,7 +31,7 @@
 // Transitions (cull's `transition` t > 0): a tree whose screen size s is within (1, 1 + t) times
 // that of its level's switch to the next coarser one is drawn at both levels, by complementary
 // screen-door masks: the coarse one keeps the fraction f = (1 + t - s) / t of the pixels, the fine
-// one the rest (ForestVisibility::getTransitionCodes, transitionKeeps; TreeLodTransition.glsl
+// one the rest (ForestVisibility::getTransitionCodes; LevelTransition.h; TreeLodTransition.glsl
 // draws the masks). Screen size grows as the
 // square root of the pixel value and falls as the distance, so s = sqrt(value / threshold) or
 // sqrt(threshold / d^2) for distance tables. A band takes at most the lower half of its level's
@@ -39,6 +39,7 @@
 #pragma once
 
 #include "TreeLod/Camera.h"
+#include "TreeLod/LevelTransition.h"
 #include "TreeLod/Result.h"
 
 #include <glm/glm.hpp>
@@ -195,14 +196,6 @@ namespace TreeLod
         std::uint32_t mSwitchCount = 0;
         std::uint32_t mTransitionCount = 0;
     };
-
-    /// What a draw keeps of a tree at screen-door threshold `dither` in [0, 1) (the pattern's
-    /// value at the pixel, TreeLodTransition.glsl): code 0 all, f > 0 where dither < f, -f where
-    /// dither >= f. The two draws of a transition keep complementary pixels.
-    inline bool transitionKeeps(float code, float dither)
-    {
-        return code > 0.0f ? dither < code : dither >= -code;
-    }
 
     /// The instance store. Removal swaps the last instance into the hole, so dense indices
     /// change on remove; handles do not. Not thread-safe for writes; `cull` is const and may run
