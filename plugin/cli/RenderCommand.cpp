@@ -11,6 +11,7 @@
 #include "TreeLod/ReferenceRenderer.h"
 
 #include <algorithm>
+#include <vector>
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -170,13 +171,27 @@ namespace TreeLod
         cmd->add_option("--technique", args->technique,
                         "LoD technique: " + techniques + " (mesh: the polygonal reference); a .glb is baked in memory");
 #ifdef TREELOD_WITH_OGRE
-        // Each technique's object parameters (TechniqueRoles::parameters), one option per flag.
-        std::map<std::string, std::string> help;
+        // Each technique's object parameters (TechniqueRoles::parameters), one option per flag; the
+        // techniques that describe it alike share one description.
+        std::map<std::string, std::vector<std::pair<std::string, std::string>>> help; // flag: (description, names)
         for (const TechniqueInfo& info : TechniqueRegistry::getSingleton().getTechniques())
             for (const TechniqueParameter& p : info.roles.parameters)
-                help[p.flag] += (help[p.flag].empty() ? "" : "; ") + info.name + ": " + p.description;
-        for (const auto& [flag, text] : help)
+            {
+                auto& described = help[p.flag];
+                auto same = std::find_if(described.begin(), described.end(),
+                                         [&](const auto& d) { return d.first == p.description; });
+                if (same == described.end())
+                    described.push_back({p.description, info.name});
+                else
+                    same->second += ", " + info.name;
+            }
+        for (const auto& [flag, described] : help)
+        {
+            std::string text;
+            for (const auto& [description, names] : described)
+                text += (text.empty() ? "" : "; ") + names + ": " + description;
             cmd->add_option("--" + flag, args->techniqueParams[flag], text)->type_name("VALUE");
+        }
 #endif
         cmd->add_option("--lod-bias", args->lodBias, "camera LoD bias (> 1 = more detail)");
         cmd->add_flag("--shadows", args->shadows, "texture shadows from the sun (2048^2 float depth)");

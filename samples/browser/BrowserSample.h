@@ -74,7 +74,8 @@ namespace TreeLod
         virtual bool hasErrorBudget() const { return false; }
         virtual float getErrorBudget() const { return 0.0f; }
         virtual void setErrorBudget(float) {}
-        /// Level transitions (Forest::setLodTransition: 0 hard switches), where the sample has them.
+        /// Level transitions (Forest::setLodTransition, the tree objects' setLodTransition: 0 hard
+        /// switches), where the sample has them.
         virtual bool hasLodTransition() const { return false; }
         virtual float getLodTransition() const { return 0.0f; }
         virtual void setLodTransition(float) {}

@@ -464,6 +464,14 @@ namespace TreeLod
             mLodCamera->setLodBias(bias);
     }
 
+    void SingleTreeView::setLodTransition(float length)
+    {
+        mLodTransition = length;
+        for (const auto& [name, object] : mTechniques)
+            if (const TechniqueInfo* info = TechniqueRegistry::getSingleton().find(name); info && info->setLodTransition)
+                info->setLodTransition(*object, length);
+    }
+
     void SingleTreeView::setShadows(bool enabled)
     {
         mShadows = enabled;

@@ -74,6 +74,9 @@ namespace TreeLod
         void setShadows(bool enabled);
         bool getWireframe() const { return mWireframe; }
         void setWireframe(bool enabled);
+        /// Level transitions of the objects that have them (TechniqueInfo::setLodTransition; 0: hard).
+        float getLodTransition() const { return mLodTransition; }
+        void setLodTransition(float length);
         bool isLodFrozen() const { return mLodFrozen; }
         void setLodFrozen(bool frozen);
 
@@ -136,6 +139,7 @@ namespace TreeLod
         double mFlipMilliseconds = 0.0, mRenderMilliseconds = 0.0; ///< last recompute: FLIP, and the two offscreen renders
 
         float mLodBias = 1.0f;
+        float mLodTransition = 0.0f;
         bool mShadows = false;
         bool mWireframe = false;
         bool mLodFrozen = false;

@@ -38,6 +38,9 @@ namespace TreeLod
         void setShadows(bool enabled) override { mView->setShadows(enabled); }
         bool getWireframe() const override { return mView->getWireframe(); }
         void setWireframe(bool enabled) override { mView->setWireframe(enabled); }
+        bool hasLodTransition() const override { return true; }
+        float getLodTransition() const override { return mView->getLodTransition(); }
+        void setLodTransition(float length) override { mView->setLodTransition(length); }
         bool isLodFrozen() const override { return mView->isLodFrozen(); }
         void setLodFrozen(bool frozen) override { mView->setLodFrozen(frozen); }
         void setScreenshotView(unsigned index, unsigned count) override;

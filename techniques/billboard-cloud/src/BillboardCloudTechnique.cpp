@@ -110,8 +110,16 @@ namespace TreeLod
                                                                           : " low-res";
                 lines.push_back({"cloud " + std::to_string(level) + "  ", drawn ? 1.0 : 0.0, drawn ? material : ""});
             }
+            if (cloud.getTransitionShare() > 0.0f)
+                lines.push_back({"fading to cloud " + std::to_string(cloud.getLevel() + 1) + "  ",
+                                 double(cloud.getTransitionShare()), ""});
             lines.push_back({"bark LoD " + std::to_string(cloud.getBarkLodIndex()), -1.0, ""});
             return lines;
+        }
+
+        void setLodTransition(Ogre::MovableObject& object, float length)
+        {
+            static_cast<BillboardCloudTree&>(object).setLodTransition(length);
         }
 
         void registerBillboardClouds(TechniqueRegistry& registry)
@@ -126,24 +134,27 @@ namespace TreeLod
             roles.parameters = {{"level", "level", "draw this cloud (0 finest; 2: low-res only) instead of the LoD strategy's"},
                                 {"listFactor", "list-factor",
                                  "shader LoD, list entries walked per pixel of projected hash-cell diagonal (0 = low-res "
-                                 "texture only; default from the package)"}};
+                                 "texture only; default from the package)"},
+                                {"lodTransition", "lod-transition", "level transition length t in [0, 1]: both levels drawn, screen-door blended, within 1 + t of a switch (0: hard)"}};
             registry.add({BILLBOARD_CLOUD_CHUNK,
                           "billboard clouds with multi-layered indirect texturing and shader LoD (García et al. 2007)",
                           BILLBOARD_CLOUD_CHUNK, BillboardCloudTreeFactory::FACTORY_TYPE_NAME,
                           TechniqueRegistry::byFactory(BillboardCloudTreeFactory::FACTORY_TYPE_NAME,
                                                        {{"classic", "false"}}),
-                          factory, std::make_shared<BillboardCloudLevels>(false), &describeState, roles});
+                          factory, std::make_shared<BillboardCloudLevels>(false), &describeState, roles, &setLodTransition});
             TechniqueRoles classicRoles;
             classicRoles.autoCandidate = true;
             classicRoles.referenceShadingParams = roles.referenceShadingParams;
-            classicRoles.parameters = {{"level", "level", "draw this cloud (0 finest) instead of the LoD strategy's"}};
+            classicRoles.parameters = {{"level", "level", "draw this cloud (0 finest) instead of the LoD strategy's"},
+                                       roles.parameters.back()};
             registry.add({CLASSIC_BILLBOARD_CLOUD_CHUNK,
                           "classic billboard cloud: one RGBA texture per billboard, the baseline of García et al. "
                           "2007 Fig. 13",
                           CLASSIC_BILLBOARD_CLOUD_CHUNK, BillboardCloudTreeFactory::FACTORY_TYPE_NAME,
                           TechniqueRegistry::byFactory(BillboardCloudTreeFactory::FACTORY_TYPE_NAME,
                                                        {{"classic", "true"}}),
-                          factory, std::make_shared<BillboardCloudLevels>(true), &describeState, classicRoles});
+                          factory, std::make_shared<BillboardCloudLevels>(true), &describeState, classicRoles,
+                          &setLodTransition});
         }
 
         const TechniqueRegistry::Registration registration(&registerBillboardClouds);

@@ -122,7 +122,8 @@ namespace TreeLod
             const Ogre::String& type = EllipsoidTreeFactory::FACTORY_TYPE_NAME;
             TechniqueRoles roles;
             roles.autoCandidate = true;
-            roles.parameters = {{"level", "level", "draw this level (0 finest) instead of the LoD strategy's"}};
+            roles.parameters = {{"level", "level", "draw this level (0 finest) instead of the LoD strategy's"},
+                                {"lodTransition", "lod-transition", "level transition length t in [0, 1]: both levels drawn, screen-door blended, within 1 + t of a switch (0: hard)"}};
             registry.add({ELLIPSOID_TREE_CHUNK, "leaves as EM/GMM-clustered ellipsoids, ray cast per pixel",
                           ELLIPSOID_TREE_CHUNK, type, TechniqueRegistry::byFactory(type),
                           std::make_shared<EllipsoidTreeFactory>(), std::make_shared<EllipsoidLevels>(),
@@ -133,12 +134,18 @@ namespace TreeLod
                                   {"level ", levels > 1 ? 1.0 - double(tree.getLevel()) / double(levels - 1) : 1.0,
                                    " " + std::to_string(tree.getLevel()) + " of " + std::to_string(levels) + ", " +
                                        std::to_string(tree.getEllipsoidCount()) + " ellipsoids"}};
+                              if (tree.getTransitionShare() > 0.0f)
+                                  state.push_back({"fading to level " + std::to_string(tree.getLevel() + 1) + " ",
+                                                   double(tree.getTransitionShare()), ""});
                               if (tree.drawsLines())
                                   state.push_back({"lines: level " + std::to_string(tree.getLineLevel()) + ", " +
                                                        std::to_string(tree.getLineCount()) + " lines",
                                                    -1.0, ""});
                               return state;
-                          }, roles});
+                          }, roles,
+                          [](Ogre::MovableObject& object, float length) {
+                              static_cast<EllipsoidTree&>(object).setLodTransition(length);
+                          }});
         }
 
         const TechniqueRegistry::Registration registration(&registerEllipsoids);

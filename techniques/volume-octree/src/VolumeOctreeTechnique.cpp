@@ -87,6 +87,8 @@ namespace TreeLod
         void registerVolumeOctree(TechniqueRegistry& registry)
         {
             const Ogre::String& type = VolumeOctreeTreeFactory::FACTORY_TYPE_NAME;
+            TechniqueRoles roles;
+            roles.parameters = {{"lodTransition", "lod-transition", "level transition length t in [0, 1]: cells fade into their children within 1 + t of the plane (0: hard)"}};
             registry.add({VOLUME_OCTREE_CHUNK,
                           "an octree of per-camera billboards from matted images, VQ-compressed (Linz et al. 2006)",
                           VOLUME_OCTREE_CHUNK, type, TechniqueRegistry::byFactory(type),
@@ -101,7 +103,10 @@ namespace TreeLod
                                       {"cameras " + std::to_string(pair.first) + " and " + std::to_string(pair.second) +
                                            " blended",
                                        -1.0, ""}};
-                          }, TechniqueRoles{}});
+                          },
+                          roles, [](Ogre::MovableObject& object, float length) {
+                              static_cast<VolumeOctreeTree&>(object).setLodTransition(length);
+                          }});
         }
 
         const TechniqueRegistry::Registration registration(&registerVolumeOctree);

@@ -109,6 +109,9 @@ namespace TreeLod
         /// level panel; may be empty.
         std::function<std::vector<TechniqueStateLine>(Ogre::MovableObject& object)> describeState;
         TechniqueRoles roles; ///< what it is in the trade (auto candidate, default band, floor, ...)
+        /// Set the level transition length of an object `create` made (ObjectTransition.h; throws
+        /// as its setLodTransition); null where the object has one level or a continuous one.
+        std::function<void(Ogre::MovableObject& object, float length)> setLodTransition;
     };
 
     class TechniqueRegistry
