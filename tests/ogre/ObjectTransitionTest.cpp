@@ -1,7 +1,8 @@
 // Level transitions of the tree objects (ObjectTransition.h: BillboardCloudTree, EllipsoidTree,
 // VolumeOctreeTree), on everyTechniqueOak: mid-transition each object covers what its two levels
 // cover alone (no hole, no double density); a sweep through a band changes a small share of the
-// pixels a frame where a hard switch changes them at once; bad lengths are refused by name.
+// pixels a frame where a hard switch changes them at once; a cloud mid-transition casts one shadow;
+// bad lengths are refused by name.
 #include "ForestTestSupport.h"
 
 #include "TreeLod/BillboardCloudTree.h"
@@ -160,6 +161,80 @@ namespace TreeLod::ObjectTransitionTests
         EXPECT_GE(framesInBand, 8);
         EXPECT_EQ(none, 0);
         EXPECT_LT(smooth, 0.5 * hard) << "a transition spreads the change over its frames";
+    }
+
+    // A billboard cloud mid-transition casts one shadow: the ground darkens about as much as under
+    // either cloud alone, well below both clouds drawn whole at once.
+    TEST(ObjectTransition, aCloudMidTransitionCastsOneShadow)
+    {
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const TreeModel& model = everyTechniqueOak().model;
+        const float h = model.boundsMax.y - model.boundsMin.y;
+        // The sun's default direction shades the ground beside the tree: seen from above.
+        const CameraSpec view = look(glm::vec3(0.3f * h, 2.6f * h, 1.6f * h), glm::vec3(0.0f, 0.0f, 0.0f), 60.0f);
+        // Clouds at the origin over a ground: `levels` (-1: the strategy's, mid-transition), shadows
+        // on or off; returns the picture and the transition share of the last cloud.
+        Ogre::Real factor = 1.0f;
+        BillboardCloudTree* lastCloud = nullptr;
+        auto render = [&](const std::vector<int>& levels, bool shadows) {
+            r.clearContent();
+            r.setShadows(false);
+            r.setLodBias(1.0f);
+            placeGround(3.0f * h, shadows);
+            static int serial = 0;
+            BillboardCloudTree* cloud = nullptr;
+            for (int level : levels)
+            {
+                cloud = static_cast<BillboardCloudTree*>(TechniqueRegistry::getSingleton().createInstance(
+                    "billboard-cloud", r.getSceneManager(), "transitionShadow" + std::to_string(serial++),
+                    *everyTechniqueOak().asset, {{"lodTransition", "0.2"}}));
+                cloud->setMeshLodBias(factor);
+                cloud->setForcedLevel(level);
+                r.getContentNode().createChildSceneNode()->attachObject(cloud);
+            }
+            r.setShadows(shadows, 1024);
+            Image image = toImage(r.render(view, 160, 160, 1));
+            r.setShadows(false);
+            lastCloud = cloud;
+            return std::make_pair(image, cloud ? cloud->getTransitionShare() : 0.0f);
+        };
+        // The factor that puts the cloud's screen size at 1.1 times its switch from this view.
+        render({-1}, false);
+        factor = lastCloud->getSwitchPixelCount(0) * 1.21f / lastCloud->getPixelCountValue();
+        const std::vector<std::vector<int>> cases = {{0}, {1}, {-1}, {0, 1}};
+        const char* names[] = {"cloud 0", "cloud 1", "mid-transition", "clouds 0 and 1 whole"};
+        std::vector<Image> lit, shadowed;
+        for (const std::vector<int>& levels : cases)
+        {
+            lit.push_back(render(levels, false).first);
+            const auto [image, share] = render(levels, true);
+            shadowed.push_back(image);
+            if (&levels == &cases[2])
+                EXPECT_NEAR(share, 0.5f, 1e-3f) << "mid-transition";
+        }
+        const Image groundOnly = render({}, false).first;
+        std::vector<double> darkening;
+        for (std::size_t c = 0; c < cases.size(); ++c)
+        {
+            double sum = 0.0;
+            for (std::size_t i = 0; i < groundOnly.pixels.size(); ++i)
+            {
+                bool ground = true;
+                for (const Image& image : lit)
+                    ground = ground && glm::length(glm::vec3(image.pixels[i]) - glm::vec3(groundOnly.pixels[i])) < 0.02f;
+                if (ground)
+                    sum += pixelLuminance(lit[c].pixels[i]) - pixelLuminance(shadowed[c].pixels[i]);
+            }
+            darkening.push_back(sum);
+            std::printf("%s: ground darkened by %.2f (luminance summed over the ground's pixels)\n", names[c], sum);
+        }
+        writePng(OgreEnvironment::outDir() + "/object-transition-shadows.png", sideBySide(shadowed));
+        // The clouds' shadows overlap much more than a mesh's and a quad's (measured: 1.26 times
+        // either for both whole), so the bounds are tighter than the Forest's test.
+        const double mean = 0.5 * (darkening[0] + darkening[1]);
+        ASSERT_GT(darkening[0], 20.0) << "the cloud casts a shadow on the ground in view";
+        ASSERT_GT(darkening[3], 1.15 * mean) << "two casters whole cast more than either";
+        EXPECT_NEAR(darkening[2], mean, 0.08 * mean) << "mid-transition: one shadow, between the levels'";
     }
 
     // Lengths outside [0, 1] and NaN are refused naming the parameter, as parameters and setters.
