@@ -13,7 +13,8 @@
 // path over the samples (the Viterbi algorithm: Viterbi 1967, IEEE Trans. Inf. Theory 13(2));
 // with a slack of 0 the cheapest allowed level at each sample, as before switches were measured.
 // The result is merged into runs of one level: near to far, each with the smallest height it is
-// drawn at. A budget of 0 draws the reference itself; a budget of 1 a cheapest level everywhere.
+// drawn at. A budget of 0 draws the reference itself; a budget of 1 the cheapest level (within
+// the slack) everywhere.
 // A level without a cost is not a candidate.
 // Shadow casters (chooseShadowLevels) get their own, coarser budget: each run's casters draw the
 // cheapest of its level and the coarser runs' levels within that budget over the run's heights.
@@ -58,7 +59,8 @@ namespace TreeLod
     /// differ by up to 20 % in median frame time (docs/measurements.md, "Transitions").
     constexpr float LEVEL_SWITCH_COST_SLACK = 0.1f;
     /// What a switch counts besides the FLIP it shows: between plans whose switches show as much,
-    /// the one with fewer switches wins; small against a switch between different levels.
+    /// the one with fewer switches wins; small against a switch between different levels (0.07 and
+    /// more between two levels of the test oak, docs/measurements.md "Error curves at bake time").
     constexpr float LEVEL_SWITCH_PENALTY = 0.01f;
 
     /// The heights the selection samples: 4 per octave from 8192 px (sample 0) down to 1 px.
