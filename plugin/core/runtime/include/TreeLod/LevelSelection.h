@@ -11,7 +11,7 @@
 // (ErrorCurves::switchFlipAt; flip(a) + flip(b) where the curves have none) plus
 // LEVEL_SWITCH_PENALTY, so fewer switches win; ties go to the smaller summed cost. A shortest
 // path over the samples (the Viterbi algorithm: Viterbi 1967, IEEE Trans. Inf. Theory 13(2));
-// with a slack of 0 the cheapest allowed level at each sample, as before switches were measured.
+// with a slack of 0, the cheapest allowed level at each sample.
 // The result is merged into runs of one level: near to far, each with the smallest height it is
 // drawn at. A budget of 0 draws the reference itself; a budget of 1 the cheapest level (within
 // the slack) everywhere.
