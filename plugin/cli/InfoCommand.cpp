@@ -157,7 +157,7 @@ namespace TreeLod
                     if (!firstError)
                         firstError = fail(reader.label(), c.element(),
                                           "unsupported format version " + std::to_string(c.formatVersion) +
-                                              ", this build reads " + std::to_string(technique->formatVersion));
+                                              ", this build reads " + readFormatVersions(*technique));
                     continue;
                 }
                 Result<ChunkSummary> summary = inspectChunk(*technique, bytes.value(), reader.label(), c.formatVersion);

@@ -176,6 +176,8 @@ namespace TreeLod
         ASSERT_NE(reference, nullptr);
         EXPECT_TRUE(readsFormatVersion(*reference, reference->formatVersion));
         EXPECT_FALSE(readsFormatVersion(*reference, reference->formatVersion - 1));
+        EXPECT_EQ(readFormatVersions(*d), "1..2");
+        EXPECT_EQ(readFormatVersions(*reference), std::to_string(reference->formatVersion));
     }
 
     TEST(ErrorCurves, switchFlipAtInterpolatesEitherOrder)

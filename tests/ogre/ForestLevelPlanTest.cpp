@@ -264,6 +264,23 @@ namespace TreeLod
                                             asset->getPackage().readChunk(info.technique, info.level).value()));
             }
         }
+        // A version this build does not read: refused, naming both.
+        ASSERT_TRUE(writer.addChunk(ERROR_CURVES_CHUNK, 0, 3, v1));
+        Result<std::vector<std::uint8_t>> newer = writer.toBytes();
+        ASSERT_TRUE(newer) << newer.error().message();
+        TreeAssetPtr future = TreeAssetManager::getSingleton().loadFromBytes("oak.v3-curves", Ogre::RGN_DEFAULT, *newer);
+        try
+        {
+            future->readChunk(ERROR_CURVES_CHUNK);
+            ADD_FAILURE() << "a chunk of version 3 was read";
+        }
+        catch (const Ogre::InvalidParametersException& e)
+        {
+            EXPECT_NE(e.getDescription().find("format version 3, this build reads 1..2"), std::string::npos)
+                << e.getDescription();
+        }
+        TreeAssetManager::getSingleton().remove(future);
+
         ASSERT_TRUE(writer.addChunk(ERROR_CURVES_CHUNK, 0, 1, v1));
         Result<std::vector<std::uint8_t>> bytes = writer.toBytes();
         ASSERT_TRUE(bytes) << bytes.error().message();

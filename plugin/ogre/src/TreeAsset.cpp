@@ -134,7 +134,7 @@ namespace TreeLod
         if (descriptor && !readsFormatVersion(*descriptor, version))
             raise(fail(mName, chunkElement(technique, level),
                        "format version " + std::to_string(version) + ", this build reads " +
-                           std::to_string(descriptor->formatVersion) + ": bake the package again"));
+                           readFormatVersions(*descriptor) + ": bake the package again"));
         Result<std::vector<std::uint8_t>> bytes = package.readChunk(std::size_t(index));
         if (!bytes)
             raise(bytes.error());

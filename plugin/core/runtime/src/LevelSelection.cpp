@@ -102,8 +102,9 @@ namespace TreeLod
         // The path near to far through the candidates whose switches show least (Viterbi): at a
         // switch between samples k - 1 and k, at the height halfway between them (the run
         // boundary), the switch FLIP of the two levels plus LEVEL_SWITCH_PENALTY; without
-        // measured switch FLIP, flip(a) + flip(b) (an upper bound of what the switch can show
-        // when each image is that far from the reference's). Ties: the smaller summed cost.
+        // measured switch FLIP, flip(a) + flip(b), a conservative stand-in (each image is that far
+        // from the reference's; every measured switch FLIP of the test oak is below it). Ties:
+        // the smaller summed cost.
         auto switchCost = [&](std::size_t a, std::size_t b, float h) {
             const float shown = curves.hasSwitchFlip() ? curves.switchFlipAt(a, b, h)
                                                        : curves.flipAt(a, h) + curves.flipAt(b, h);
@@ -113,6 +114,10 @@ namespace TreeLod
         {
             double switches = 0.0, ms = 0.0;
             std::size_t from = 0; ///< index into the previous sample's candidates
+            bool better(const Step& other) const
+            {
+                return switches < other.switches || (switches == other.switches && ms < other.ms);
+            }
         };
         std::vector<std::vector<Step>> steps(SELECTION_SAMPLES);
         constexpr int SAMPLES_PER_OCTAVE = SELECTION_SAMPLES_PER_OCTAVE;
@@ -130,10 +135,10 @@ namespace TreeLod
                     {
                         const std::size_t a = candidates[k - 1][i];
                         const Step& before = steps[k - 1][i];
-                        const double switches = before.switches + (a == b ? 0.0 : switchCost(a, b, boundary));
-                        const double ms = before.ms + double(msOf(b, h));
-                        if (switches < step.switches || (switches == step.switches && ms < step.ms))
-                            step = Step{switches, ms, i};
+                        const Step through{before.switches + (a == b ? 0.0 : switchCost(a, b, boundary)),
+                                           before.ms + double(msOf(b, h)), i};
+                        if (through.better(step))
+                            step = through;
                     }
                 }
                 steps[k].push_back(step);
@@ -142,12 +147,8 @@ namespace TreeLod
         std::vector<std::size_t> path(SELECTION_SAMPLES);
         std::size_t at = 0;
         for (std::size_t i = 1; i < steps.back().size(); ++i)
-        {
-            const Step& s = steps.back()[i];
-            const Step& best = steps.back()[at];
-            if (s.switches < best.switches || (s.switches == best.switches && s.ms < best.ms))
+            if (steps.back()[i].better(steps.back()[at]))
                 at = i;
-        }
         for (std::size_t k = SELECTION_SAMPLES; k-- > 0;)
         {
             path[k] = candidates[k][at];

@@ -47,6 +47,8 @@ namespace TreeLod
 
     /// Whether this build reads chunks of `formatVersion` of `descriptor`'s technique.
     bool readsFormatVersion(const TechniqueDescriptor& descriptor, std::uint32_t formatVersion);
+    /// The versions it reads, for messages: "2", or "1..2".
+    std::string readFormatVersions(const TechniqueDescriptor& descriptor);
     /// `descriptor`'s inspect of a chunk of `formatVersion`; an error naming `label` and the
     /// technique when this build does not read that version.
     Result<ChunkSummary> inspectChunk(const TechniqueDescriptor& descriptor, const std::vector<std::uint8_t>& bytes,
