@@ -688,8 +688,10 @@ namespace TreeLod
                 Result<PackageReader> package = PackageReader::open(entry.path);
                 if (!package || package->findChunk(ERROR_CURVES_CHUNK, 0) < 0)
                     continue;
-                Result<std::vector<std::uint8_t>> bytes = package->readChunk(ERROR_CURVES_CHUNK, 0);
-                Result<ErrorCurves> curves = bytes ? decodeErrorCurves(*bytes, entry.path) : Result<ErrorCurves>(bytes.error());
+                const std::size_t chunk = std::size_t(package->findChunk(ERROR_CURVES_CHUNK, 0));
+                Result<std::vector<std::uint8_t>> bytes = package->readChunk(chunk);
+                Result<ErrorCurves> curves = bytes ? decodeErrorCurves(*bytes, entry.path, package->chunks()[chunk].formatVersion)
+                                                   : Result<ErrorCurves>(bytes.error());
                 if (!curves)
                     return printError(curves.error()), false;
                 std::string csv = "series,label,height_px,flip,flip_max,ms_rmse\n";

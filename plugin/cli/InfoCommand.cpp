@@ -152,15 +152,15 @@ namespace TreeLod
                 const TechniqueDescriptor* technique = findTechniqueDescriptor(c.technique);
                 if (!technique)
                     continue; // a chunk of a technique this build does not know: listed only
-                if (c.formatVersion != technique->formatVersion)
+                if (!readsFormatVersion(*technique, c.formatVersion))
                 {
                     if (!firstError)
                         firstError = fail(reader.label(), c.element(),
                                           "unsupported format version " + std::to_string(c.formatVersion) +
-                                              ", this build reads " + std::to_string(technique->formatVersion));
+                                              ", this build reads " + readFormatVersions(*technique));
                     continue;
                 }
-                Result<ChunkSummary> summary = technique->inspect(bytes.value(), reader.label());
+                Result<ChunkSummary> summary = inspectChunk(*technique, bytes.value(), reader.label(), c.formatVersion);
                 if (!summary)
                 {
                     if (!firstError)

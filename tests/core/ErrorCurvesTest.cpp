@@ -1,5 +1,6 @@
-// The "error-curves" chunk: what is encoded decodes to the same values, flipAt interpolates in
-// log2(height) and clamps, and every broken value or byte is refused naming the element. The
+// The "error-curves" chunk: what is encoded decodes to the same values, flipAt and switchFlipAt
+// interpolate in log2(height) and clamp, version 1 still decodes (switch data unknown), and every
+// broken value or byte is refused naming the element. The
 // descriptor is registered by TreeLodRuntime itself, whatever the program references.
 #include "TreeLod/ErrorCurves.h"
 #include "TreeLod/TechniqueDescriptor.h"
@@ -46,12 +47,27 @@ namespace TreeLod
                         level("lodf", 1200, false, {0.75f, 0.5f, 0.25f}),
                         level("billboard-cloud", 1, true, {1.0f, 0.875f, 0.5f}),
                         level("impostor", 0, false, {0.875f, 0.75f, 0.625f})};
+            // Pair p: p / 16 at 8 px, p / 32 at 32 px, p / 64 at 128 px.
+            for (std::size_t p = 0; p < ErrorCurves::switchPairs(c.levels.size()); ++p)
+                c.switchFlip.push_back({float(p) / 16.0f, float(p) / 32.0f, float(p) / 64.0f});
             return c;
         }
 
-        std::string decodeError(const std::vector<std::uint8_t>& bytes)
+        /// The bytes of `c` as version 1 wrote them: the version 2 layout ends with the switch
+        /// section, which for curves without switch data is one u32 of 0.
+        std::vector<std::uint8_t> versionOneBytes(ErrorCurves c)
         {
-            Result<ErrorCurves> decoded = decodeErrorCurves(bytes, "tree.treelod");
+            c.switchFlip.clear();
+            std::vector<std::uint8_t> bytes = encodeErrorCurves(c);
+            EXPECT_EQ(std::vector<std::uint8_t>(bytes.end() - 4, bytes.end()), std::vector<std::uint8_t>(4, 0));
+            bytes.resize(bytes.size() - 4);
+            return bytes;
+        }
+
+        std::string decodeError(const std::vector<std::uint8_t>& bytes,
+                                std::uint32_t formatVersion = ERROR_CURVES_FORMAT_VERSION)
+        {
+            Result<ErrorCurves> decoded = decodeErrorCurves(bytes, "tree.treelod", formatVersion);
             return decoded ? std::string() : decoded.error().message();
         }
 
@@ -82,8 +98,8 @@ namespace TreeLod
         const ErrorCurves c = sample();
         ASSERT_TRUE(validateErrorCurves(c, "tree").ok()) << validateError(c);
         const std::vector<std::uint8_t> bytes = encodeErrorCurves(c);
-        // 16 header + 12 heights + per level: 4 + name + 8 + 36.
-        EXPECT_EQ(bytes.size(), 16u + 12u + 5u * 48u + 4u + 4u + 4u + 15u + 8u);
+        // 16 header + 12 heights + per level: 4 + name + 8 + 36; the pair count, 10 pairs of 3 heights.
+        EXPECT_EQ(bytes.size(), 16u + 12u + 5u * 48u + 4u + 4u + 4u + 15u + 8u + 4u + 10u * 12u);
         Result<ErrorCurves> decoded = decodeErrorCurves(bytes, "tree");
         ASSERT_TRUE(decoded.ok()) << decoded.error().message();
         EXPECT_EQ(decoded->heightsPx, c.heightsPx);
@@ -99,7 +115,98 @@ namespace TreeLod
             EXPECT_EQ(decoded->levels[i].flipMax, c.levels[i].flipMax);
             EXPECT_EQ(decoded->levels[i].rmse, c.levels[i].rmse);
         }
+        EXPECT_EQ(decoded->switchFlip, c.switchFlip);
+        EXPECT_TRUE(decoded->hasSwitchFlip());
         EXPECT_EQ(encodeErrorCurves(decoded.value()), bytes); // deterministic
+
+        // Curves without switch data (as decoded from version 1) encode as version 2 with 0 pairs.
+        ErrorCurves none = c;
+        none.switchFlip.clear();
+        Result<ErrorCurves> noneDecoded = decodeErrorCurves(encodeErrorCurves(none), "tree");
+        ASSERT_TRUE(noneDecoded.ok()) << noneDecoded.error().message();
+        EXPECT_TRUE(noneDecoded->switchFlip.empty());
+        EXPECT_FALSE(noneDecoded->hasSwitchFlip());
+    }
+
+    TEST(ErrorCurves, versionOneStillDecodesWithSwitchDataUnknown)
+    {
+        const ErrorCurves c = sample();
+        const std::vector<std::uint8_t> v1 = versionOneBytes(c);
+        EXPECT_EQ(v1.size(), 16u + 12u + 5u * 48u + 4u + 4u + 4u + 15u + 8u); // version 1's size
+        Result<ErrorCurves> decoded = decodeErrorCurves(v1, "old.treelod", 1);
+        ASSERT_TRUE(decoded.ok()) << decoded.error().message();
+        ASSERT_EQ(decoded->levels.size(), c.levels.size());
+        for (std::size_t i = 0; i < c.levels.size(); ++i)
+            EXPECT_EQ(decoded->levels[i].flip, c.levels[i].flip);
+        EXPECT_TRUE(decoded->switchFlip.empty());
+        EXPECT_FALSE(decoded->hasSwitchFlip());
+        EXPECT_EQ(decoded->switchFlipAt(1, 3, 32.0f), SWITCH_FLIP_UNKNOWN);
+        EXPECT_EQ(decoded->switchFlipAt(3, 1, 32.0f), SWITCH_FLIP_UNKNOWN);
+        EXPECT_EQ(decoded->switchFlipAt(2, 2, 32.0f), 0.0f); // no switch at all
+
+        // Each version's bytes read as the other are refused; other versions are refused.
+        std::string e = decodeError(encodeErrorCurves(c), 1);
+        EXPECT_TRUE(contains(e, "tree.treelod: error-curves: 124 trailing bytes")) << e;
+        e = decodeError(v1, 2);
+        EXPECT_TRUE(contains(e, "tree.treelod: error-curves switchFlip: truncated")) << e;
+        for (std::uint32_t version : {0u, 3u})
+        {
+            e = decodeError(encodeErrorCurves(c), version);
+            EXPECT_TRUE(contains(e, "error-curves: format version " + std::to_string(version) +
+                                        ", this build reads 1..2"))
+                << e;
+        }
+
+        // The descriptor reads both (treelod info, TreeAsset::readChunk); "reference" its one version.
+        const TechniqueDescriptor* d = findTechniqueDescriptor(ERROR_CURVES_CHUNK);
+        ASSERT_NE(d, nullptr);
+        EXPECT_TRUE(readsFormatVersion(*d, 1));
+        EXPECT_TRUE(readsFormatVersion(*d, 2));
+        EXPECT_FALSE(readsFormatVersion(*d, 3));
+        EXPECT_FALSE(readsFormatVersion(*d, 0));
+        Result<ChunkSummary> summary = inspectChunk(*d, v1, "old.treelod", 1);
+        ASSERT_TRUE(summary.ok()) << summary.error().message();
+        EXPECT_TRUE(contains(summary->text, "6 views; FLIP at")) << summary->text; // no switch pairs
+        Result<ChunkSummary> refused = inspectChunk(*d, v1, "old.treelod", 3);
+        ASSERT_FALSE(refused.ok());
+        EXPECT_TRUE(contains(refused.error().message(), "old.treelod: error-curves: unsupported format version 3, "
+                                                        "this build reads 1..2"))
+            << refused.error().message();
+        const TechniqueDescriptor* reference = findTechniqueDescriptor("reference");
+        ASSERT_NE(reference, nullptr);
+        EXPECT_TRUE(readsFormatVersion(*reference, reference->formatVersion));
+        EXPECT_FALSE(readsFormatVersion(*reference, reference->formatVersion - 1));
+        EXPECT_EQ(readFormatVersions(*d), "1..2");
+        EXPECT_EQ(readFormatVersions(*reference), std::to_string(reference->formatVersion));
+    }
+
+    TEST(ErrorCurves, switchFlipAtInterpolatesEitherOrder)
+    {
+        const ErrorCurves c = sample();
+        // Pair (1, 3) is index 4 + 1 = 5 (pairs of 0 come first: (0, 1) .. (0, 4)).
+        EXPECT_EQ(c.switchPair(0, 1), 0u);
+        EXPECT_EQ(c.switchPair(0, 4), 3u);
+        EXPECT_EQ(c.switchPair(1, 3), 5u);
+        EXPECT_EQ(c.switchPair(3, 4), 9u);
+        EXPECT_EQ(c.switchFlipAt(1, 3, 8.0f), 5.0f / 16.0f);
+        EXPECT_EQ(c.switchFlipAt(3, 1, 8.0f), 5.0f / 16.0f);
+        EXPECT_EQ(c.switchFlipAt(1, 3, 16.0f), 0.5f * (5.0f / 16.0f + 5.0f / 32.0f)); // halfway in log2
+        EXPECT_EQ(c.switchFlipAt(1, 3, 4096.0f), 5.0f / 64.0f);                     // clamped
+        EXPECT_EQ(c.switchFlipAt(4, 4, 16.0f), 0.0f);
+        EXPECT_EQ(c.switchFlipAt(1, 5, 16.0f), SWITCH_FLIP_UNKNOWN); // no level 5
+
+        // Keeping some levels keeps their pairs: levels 1, 3, 4 of the five.
+        ErrorCurves kept = c;
+        kept.keepLevels({false, true, false, true, true});
+        ASSERT_EQ(kept.levels.size(), 3u);
+        EXPECT_EQ(kept.levels[1].technique, "billboard-cloud");
+        EXPECT_TRUE(kept.hasSwitchFlip());
+        EXPECT_TRUE(validateErrorCurves(kept, "kept").ok());
+        for (const auto& [a, b] : {std::pair<std::size_t, std::size_t>{0, 1}, {0, 2}, {1, 2}})
+        {
+            const std::size_t original[] = {1, 3, 4};
+            EXPECT_EQ(kept.switchFlipAt(a, b, 16.0f), c.switchFlipAt(original[a], original[b], 16.0f)) << a << b;
+        }
     }
 
     TEST(ErrorCurves, flipAtInterpolatesInLog2HeightAndClamps)
@@ -159,6 +266,7 @@ namespace TreeLod
         EXPECT_TRUE(contains(validateError(c), "heights[0]: 0.5 px outside [1, 16384]")) << validateError(c);
 
         c = sample();
+        c.switchFlip.clear(); // 5 levels' pairs
         c.levels.push_back(c.levels[2]);
         e = validateError(c);
         EXPECT_TRUE(contains(e, "level 5 'lodf' 1200: the same level as level 2")) << e;
@@ -193,6 +301,26 @@ namespace TreeLod
         c = sample();
         c.heightsPx.assign(65, 1.0f);
         EXPECT_TRUE(contains(validateError(c), "heights: 65 heights (1..64 allowed)")) << validateError(c);
+
+        // Switch data: every value in [0, 1], one per height, one curve per pair (or none).
+        c = sample();
+        c.switchFlip[c.switchPair(1, 3)][2] = 1.5f;
+        e = validateError(c);
+        EXPECT_TRUE(contains(e, "tree.treelod: error-curves level 1 'lodf' 0 to level 3 'billboard-cloud' 1 low-res "
+                                "switchFlip[2]: 1.5 outside [0, 1]"))
+            << e;
+        c.switchFlip[c.switchPair(1, 3)][2] = std::numeric_limits<float>::infinity();
+        EXPECT_TRUE(contains(validateError(c), "switchFlip[2]: inf outside [0, 1]")) << validateError(c);
+        c = sample();
+        c.switchFlip[c.switchPair(0, 4)].pop_back();
+        e = validateError(c);
+        EXPECT_TRUE(contains(e, "level 0 'mesh' 0 to level 4 'impostor' 0 switchFlip: 2 values for 3 heights")) << e;
+        c = sample();
+        c.switchFlip.pop_back();
+        e = validateError(c);
+        EXPECT_TRUE(contains(e, "error-curves switchFlip: 9 pairs of levels for 5 levels (0 or 10 needed)")) << e;
+        c.switchFlip.clear(); // not measured: fine
+        EXPECT_EQ(validateError(c), "");
     }
 
     TEST(ErrorCurves, decodeRefusesBrokenBytes)
@@ -204,6 +332,9 @@ namespace TreeLod
         for (std::size_t size = 0; size < good.size(); ++size)
             EXPECT_NE(decodeError({good.begin(), good.begin() + std::ptrdiff_t(size)}), "") << size;
         std::string e = decodeError({good.begin(), good.end() - 1});
+        EXPECT_TRUE(contains(e, "tree.treelod: error-curves switchFlip: truncated")) << e;
+        const std::size_t levelsEnd = good.size() - 4 - 10 * 12; // where the switch section starts
+        e = decodeError({good.begin(), good.begin() + std::ptrdiff_t(levelsEnd) - 1});
         EXPECT_TRUE(contains(e, "tree.treelod: error-curves level 4 'impostor' 0: truncated")) << e;
 
         std::vector<std::uint8_t> bytes = good;
@@ -243,6 +374,19 @@ namespace TreeLod
         bytes = good;
         putF32(bytes, 44, 1.5f);
         EXPECT_TRUE(contains(decodeError(bytes), "level 0 'mesh' 0 flip[0]: 1.5 outside [0, 1]")) << decodeError(bytes);
+
+        // The switch section: a pair count other than 0 or 10, a NaN (pair (0, 2)'s second value).
+        bytes = good;
+        putU32(bytes, levelsEnd, 9);
+        e = decodeError(bytes);
+        EXPECT_TRUE(contains(e, "error-curves switchFlip: 9 pairs of levels for 5 levels (0 or 10 needed)")) << e;
+        bytes = good;
+        putU32(bytes, levelsEnd, 0xFFFFFFFFu);
+        EXPECT_NE(decodeError(bytes), "");
+        bytes = good;
+        putF32(bytes, levelsEnd + 4 + 12 + 4, std::numeric_limits<float>::quiet_NaN());
+        e = decodeError(bytes);
+        EXPECT_TRUE(contains(e, "error-curves level 0 'mesh' 0 to level 2 'lodf' 1200 switchFlip[1]: nan outside")) << e;
     }
 
     TEST(ErrorCurves, descriptorIsRegisteredAndInspects)
@@ -260,7 +404,8 @@ namespace TreeLod
         const std::vector<std::uint8_t> bytes = encodeErrorCurves(sample());
         Result<ChunkSummary> summary = d->inspect(bytes, "tree.treelod");
         ASSERT_TRUE(summary.ok()) << summary.error().message();
-        EXPECT_EQ(summary->text, "5 levels x 3 heights (8-128 px), 6 views; FLIP at 8/128 px: mesh 0.062/0.016, "
+        EXPECT_EQ(summary->text, "5 levels x 3 heights (8-128 px), 6 views, switch FLIP of 10 pairs; FLIP at 8/128 "
+                                 "px: mesh 0.062/0.016, "
                                  "lodf 0 0.500/0.125, lodf 1200 0.750/0.250, billboard-cloud low-res 1.000/0.500, "
                                  "impostor 0.875/0.625");
         const nlohmann::json json = nlohmann::json::parse(summary->json, nullptr, false);
@@ -276,6 +421,9 @@ namespace TreeLod
         EXPECT_EQ(json["curves"][1]["flip"], nlohmann::json({0.5, 0.25, 0.125}));
         EXPECT_EQ(json["curves"][1]["flipMax"], nlohmann::json({0.625, 0.375, 0.25}));
         EXPECT_EQ(json["curves"][1]["rmse"], nlohmann::json({0.25, 0.125, 0.0625}));
+        ASSERT_EQ(json["switchFlip"].size(), 10u);
+        EXPECT_EQ(json["switchFlip"][5]["levels"], nlohmann::json({1, 3}));
+        EXPECT_EQ(json["switchFlip"][5]["flip"], nlohmann::json({0.3125, 0.15625, 0.078125}));
 
         // Broken: refused naming the package; the fuzz hook never traps on valid or broken bytes.
         Result<ChunkSummary> refused = d->inspect({bytes.begin(), bytes.begin() + 10}, "broken.treelod");

@@ -664,3 +664,34 @@ TEST(Flip, APreparedReferenceGivesTheSameResultForEveryTest)
     EXPECT_FALSE(FlipReference::make(a, options).ok());
     EXPECT_FALSE(flip(FlipReference{}, a).ok());
 }
+
+TEST(Flip, TwoPreparedImagesGiveTheSameResultAsTheImages)
+{
+    FlipOptions options;
+    options.pixelsPerDegree = 30.0;
+    const Image a = randomImage(33, 21, 8), b = randomImage(33, 21, 9);
+    Result<FlipReference> preparedA = FlipReference::make(a, options), preparedB = FlipReference::make(b, options);
+    ASSERT_TRUE(preparedA.ok() && preparedB.ok());
+    options.keepErrorMap = true;
+    Result<FlipResult> once = flip(a, b, options), prepared = flip(*preparedA, *preparedB, true),
+                       swapped = flip(*preparedB, *preparedA, true);
+    ASSERT_TRUE(once.ok() && prepared.ok() && swapped.ok()) << (prepared.ok() ? "" : prepared.error().message());
+    EXPECT_GT(once->mean, 0.0);
+    EXPECT_EQ(once->mean, prepared->mean);
+    EXPECT_EQ(once->max, prepared->max);
+    EXPECT_EQ(once->weightedMedian, prepared->weightedMedian);
+    EXPECT_EQ(once->errorMap, prepared->errorMap);
+    EXPECT_EQ(swapped->errorMap, prepared->errorMap); // FLIP is symmetric per pixel
+
+    // Another size or another pixels per degree: refused.
+    Result<FlipReference> other = FlipReference::make(randomImage(21, 33, 8), options);
+    ASSERT_TRUE(other.ok());
+    Result<FlipResult> mismatch = flip(*preparedA, *other);
+    ASSERT_FALSE(mismatch.ok());
+    EXPECT_NE(mismatch.error().reason.find("33x21 vs 21x33"), std::string::npos) << mismatch.error().reason;
+    options.pixelsPerDegree = 60.0;
+    Result<FlipReference> finer = FlipReference::make(b, options);
+    ASSERT_TRUE(finer.ok());
+    EXPECT_FALSE(flip(*preparedA, *finer).ok());
+    EXPECT_FALSE(flip(*preparedA, FlipReference{}).ok());
+}

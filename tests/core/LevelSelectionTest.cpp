@@ -1,7 +1,8 @@
 // Budgeted level selection (LevelSelection.h) and the cost calibration file (LevelCosts.h):
 // budget 0 draws the reference, budget 1 the cheapest level, a level's worst view bounds it too,
 // bad budgets are refused, runs are
-// merged to the Forest's level limit; costs interpolate in log-log and a calibration made on
+// merged to the Forest's level limit; within the cost slack the plan draws fewer and smaller
+// switches, and without slack the cheapest level at every sample; costs interpolate in log-log and a calibration made on
 // another renderer is not reused.
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/LevelSelection.h"
@@ -10,6 +11,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
+#include <random>
 #include <string>
 #include <unistd.h>
 
@@ -170,6 +173,207 @@ namespace TreeLod
         r = chooseLevels(f.curves, {}, 0.02f);
         ASSERT_FALSE(r);
         EXPECT_NE(r.error().message().find("cost"), std::string::npos) << r.error().message();
+    }
+
+    namespace
+    {
+        /// The levels of `choices` at each selection sample.
+        std::vector<std::size_t> perSample(const std::vector<LevelChoice>& choices)
+        {
+            std::vector<std::size_t> levels;
+            for (std::size_t k = 0; k < SELECTION_SAMPLES; ++k)
+                levels.push_back(choices[choiceAt(choices, selectionHeight(k))].curveLevel);
+            return levels;
+        }
+
+        /// LevelSelection.h's rule without switches, written from its comment: at each sample the
+        /// cheapest allowed level (ties: the smaller FLIP; the reference "mesh", level 0 here, always
+        /// allowed).
+        std::vector<std::size_t> cheapestAllowed(const ErrorCurves& curves, const std::vector<LevelCost>& costs,
+                                                 float budget)
+        {
+            std::vector<std::size_t> levels;
+            for (std::size_t k = 0; k < SELECTION_SAMPLES; ++k)
+            {
+                const float h = selectionHeight(k);
+                std::size_t best = 0;
+                for (std::size_t l = 1; l < curves.levels.size() && budget > 0.0f; ++l)
+                {
+                    const bool allowed = curves.flipAt(l, h) <= curves.flipAt(0, h) + budget &&
+                                         curves.flipMaxAt(l, h) <= curves.flipMaxAt(0, h) + WORST_VIEW_BUDGET_FACTOR * budget;
+                    const float cost = costs[l].msAt(h), bestCost = costs[best].msAt(h);
+                    if (allowed && (cost < bestCost || (cost == bestCost && curves.flipAt(l, h) < curves.flipAt(best, h))))
+                        best = l;
+                }
+                levels.push_back(best);
+            }
+            return levels;
+        }
+
+        /// What the switches of a plan (levels per sample) show: switch FLIP plus the penalty each.
+        double switchesShown(const ErrorCurves& curves, const std::vector<std::size_t>& levels)
+        {
+            double shown = 0.0;
+            for (std::size_t k = 1; k < levels.size(); ++k)
+                if (levels[k] != levels[k - 1])
+                    shown += double(curves.switchFlipAt(levels[k - 1], levels[k],
+                                                        selectionHeight(k) * std::exp2(0.5f / SELECTION_SAMPLES_PER_OCTAVE))) +
+                             double(LEVEL_SWITCH_PENALTY);
+            return shown;
+        }
+
+        std::size_t switchCount(const std::vector<std::size_t>& levels)
+        {
+            std::size_t n = 0;
+            for (std::size_t k = 1; k < levels.size(); ++k)
+                n += levels[k] != levels[k - 1];
+            return n;
+        }
+
+        /// Heights 8..512 px (one an octave); the mesh (0.05, dear) and two levels "lodf" 1 and 2.
+        struct SwitchFixture
+        {
+            ErrorCurves curves;
+            std::vector<LevelCost> costs;
+            SwitchFixture(std::vector<float> flip1, std::vector<float> flip2, std::vector<float> ms1,
+                          std::vector<float> ms2)
+            {
+                curves.heightsPx = {8.0f, 16.0f, 32.0f, 64.0f, 128.0f, 256.0f, 512.0f};
+                curves.views = 1;
+                curves.referenceSamples = 4;
+                curves.levels = {curve("mesh", 0, std::vector<float>(7, 0.05f)), curve("lodf", 1, flip1),
+                                 curve("lodf", 2, flip2)};
+                costs = {cost("mesh", 0, {}), cost("lodf", 1, {}), cost("lodf", 2, {})};
+                for (LevelCost& c : costs)
+                    c.heightsPx = curves.heightsPx;
+                costs[0].msPerTree.assign(7, 4.0f);
+                costs[1].msPerTree = std::move(ms1);
+                costs[2].msPerTree = std::move(ms2);
+            }
+            /// Switch FLIP mesh-lodf 1, mesh-lodf 2, lodf 1-lodf 2, the same at every height.
+            void setSwitches(float mesh1, float mesh2, float between)
+            {
+                curves.switchFlip = {std::vector<float>(7, mesh1), std::vector<float>(7, mesh2),
+                                     std::vector<float>(7, between)};
+            }
+        };
+    }
+
+    TEST(LevelSelection, withoutSlackTheCheapestAllowedLevelAtEverySample)
+    {
+        // Random curves and costs: slack 0 gives the plan of the cheapest allowed level at every
+        // sample; the default slack a plan whose switches show no more, within the slack's cost.
+        std::mt19937 random(7);
+        std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+        std::size_t fewer = 0;
+        for (int trial = 0; trial < 40; ++trial)
+        {
+            ErrorCurves curves;
+            curves.heightsPx = {8.0f, 16.0f, 32.0f, 64.0f, 128.0f, 256.0f, 512.0f};
+            curves.views = 1;
+            curves.referenceSamples = 4;
+            std::vector<LevelCost> costs;
+            for (std::uint32_t l = 0; l < 5; ++l)
+            {
+                std::vector<float> flip;
+                for (std::size_t h = 0; h < 7; ++h)
+                    flip.push_back(0.02f + 0.2f * unit(random));
+                ErrorCurveLevel c = curve(l == 0 ? "mesh" : "lodf", l, flip);
+                for (float& v : c.flipMax)
+                    v = std::min(1.0f, v + 0.1f * unit(random));
+                curves.levels.push_back(c);
+                costs.push_back(cost(l == 0 ? "mesh" : "lodf", l, {0.2f + unit(random), 0.2f + unit(random), 0.2f + unit(random)}));
+            }
+            for (std::size_t p = 0; p < ErrorCurves::switchPairs(5); ++p)
+            {
+                curves.switchFlip.emplace_back();
+                for (std::size_t h = 0; h < 7; ++h)
+                    curves.switchFlip.back().push_back(0.3f * unit(random));
+            }
+            for (const float budget : {0.0f, 0.01f, 0.04f, 0.1f, 1.0f})
+            {
+                Result<std::vector<LevelChoice>> exact = chooseLevels(curves, costs, budget, SELECTION_SAMPLES, 0.0f);
+                ASSERT_TRUE(exact) << exact.error().message();
+                const std::vector<std::size_t> cheapest = cheapestAllowed(curves, costs, budget);
+                ASSERT_EQ(perSample(*exact), cheapest) << "trial " << trial << " budget " << budget;
+
+                Result<std::vector<LevelChoice>> slack = chooseLevels(curves, costs, budget, SELECTION_SAMPLES);
+                ASSERT_TRUE(slack) << slack.error().message();
+                const std::vector<std::size_t> levels = perSample(*slack);
+                EXPECT_LE(switchesShown(curves, levels), switchesShown(curves, cheapest) + 1e-9)
+                    << "trial " << trial << " budget " << budget;
+                for (std::size_t k = 0; k < SELECTION_SAMPLES; ++k)
+                {
+                    const float h = selectionHeight(k);
+                    EXPECT_LE(costs[levels[k]].msAt(h), (1.0f + LEVEL_SWITCH_COST_SLACK) * costs[cheapest[k]].msAt(h))
+                        << "trial " << trial << " budget " << budget << " sample " << k;
+                }
+                fewer += switchCount(levels) < switchCount(cheapest);
+            }
+        }
+        EXPECT_GT(fewer, 0u) << "the slack never saved a switch";
+    }
+
+    TEST(LevelSelection, aCheapestLevelThatAlternatesWithinTheSlackBecomesOneRun)
+    {
+        // lodf 1 and 2 both within the budget everywhere; lodf 2 costs 4 % less, then 4 % more,
+        // octave by octave, than lodf 1.
+        SwitchFixture f({0.06f, 0.06f, 0.06f, 0.06f, 0.06f, 0.06f, 0.06f}, {0.065f, 0.065f, 0.065f, 0.065f, 0.065f, 0.065f, 0.065f},
+                        std::vector<float>(7, 1.0f), {0.96f, 1.04f, 0.96f, 1.04f, 0.96f, 1.04f, 0.96f});
+        f.setSwitches(0.2f, 0.2f, 0.1f);
+        Result<std::vector<LevelChoice>> exact = chooseLevels(f.curves, f.costs, 0.02f, 16, 0.0f);
+        ASSERT_TRUE(exact) << exact.error().message();
+        EXPECT_GE(exact->size(), 6u) << "the cheapest alternates";
+
+        Result<std::vector<LevelChoice>> plan = chooseLevels(f.curves, f.costs, 0.02f);
+        ASSERT_TRUE(plan) << plan.error().message();
+        ASSERT_EQ(plan->size(), 1u);
+        // No switch either way: the one of the smaller summed cost.
+        double ms1 = 0.0, ms2 = 0.0;
+        for (std::size_t k = 0; k < SELECTION_SAMPLES; ++k)
+        {
+            ms1 += f.costs[1].msAt(selectionHeight(k));
+            ms2 += f.costs[2].msAt(selectionHeight(k));
+        }
+        ASSERT_NE(ms1, ms2);
+        EXPECT_EQ(plan->front().curveLevel, ms1 < ms2 ? 1u : 2u) << ms1 << " " << ms2;
+    }
+
+    TEST(LevelSelection, withinTheSlackTheLevelWithTheSmallerSwitchToItsNeighbour)
+    {
+        // Near (above 64 px) only the mesh is within the budget; far, lodf 1 and lodf 2 are, lodf 2
+        // 5 % dearer (within the slack).
+        const std::vector<float> farOnly{0.06f, 0.06f, 0.06f, 0.06f, 0.5f, 0.5f, 0.5f};
+        SwitchFixture f(farOnly, farOnly, std::vector<float>(7, 1.0f), std::vector<float>(7, 1.05f));
+        auto farLevel = [&](float slack) {
+            Result<std::vector<LevelChoice>> plan = chooseLevels(f.curves, f.costs, 0.02f, 16, slack);
+            EXPECT_TRUE(plan) << plan.error().message();
+            EXPECT_EQ(plan->size(), 2u);
+            EXPECT_EQ(plan->front().curveLevel, 0u);
+            return plan->back().curveLevel;
+        };
+        f.setSwitches(0.3f, 0.05f, 0.4f); // the mesh to lodf 2 shows least
+        EXPECT_EQ(farLevel(LEVEL_SWITCH_COST_SLACK), 2u);
+        EXPECT_EQ(farLevel(0.0f), 1u); // the cheapest
+        f.setSwitches(0.05f, 0.3f, 0.4f); // the mesh to lodf 1
+        EXPECT_EQ(farLevel(LEVEL_SWITCH_COST_SLACK), 1u);
+        // 2 % dearer than lodf 1 is not within a slack of 1 %.
+        f.setSwitches(0.3f, 0.05f, 0.4f);
+        EXPECT_EQ(farLevel(0.01f), 1u);
+
+        // Without switch FLIP (curves of version 1): flip(mesh) + flip(level) stands in, so the
+        // level nearer the reference wins within the slack.
+        f.curves.switchFlip.clear();
+        f.curves.levels[2].flip = {0.055f, 0.055f, 0.055f, 0.055f, 0.5f, 0.5f, 0.5f};
+        EXPECT_EQ(farLevel(LEVEL_SWITCH_COST_SLACK), 2u);
+        EXPECT_EQ(farLevel(0.0f), 1u);
+
+        for (const float bad : {-0.1f, std::nanf(""), INFINITY})
+        {
+            Result<std::vector<LevelChoice>> r = chooseLevels(f.curves, f.costs, 0.02f, 16, bad);
+            ASSERT_FALSE(r) << bad;
+            EXPECT_NE(r.error().message().find("cost slack"), std::string::npos) << r.error().message();
+        }
     }
 
     TEST(LevelSelection, shadowCastersTakeTheCheapestCoarserLevelWithinTheirBudget)

@@ -78,7 +78,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             TreeLod::findTechniqueDescriptor(reader->chunks()[i].technique);
         if (!technique)
             continue;
-        technique->inspect(chunk.value(), "fuzz");
+        TreeLod::inspectChunk(*technique, chunk.value(), "fuzz", reader->chunks()[i].formatVersion);
         if (technique->fuzz)
             technique->fuzz(chunk.value());
     }

@@ -1,5 +1,6 @@
 // The Forest's level plans through Plugin_TreeLod: levels from bands along the techniques' curves,
-// error curves against the CPU reference, calibration per renderer, the cheapest level within an
+// error curves against the CPU reference (and the switch FLIP between levels; curves of version 1
+// read and measured again), calibration per renderer, the cheapest level within an
 // error budget, and budgeted species replanned in place for an error, a frame and a shadow budget.
 #include "ForestTestSupport.h"
 
@@ -186,6 +187,32 @@ namespace TreeLod
             for (std::size_t h = 0; h < level.flip.size(); ++h)
                 EXPECT_GE(level.flipMax[h], level.flip[h]);
 
+        // What a switch shows: from the mesh to LoDF with every leaf (which draws what the mesh
+        // draws) about nothing, from the mesh to one quad much, at every height.
+        ASSERT_TRUE(curves->hasSwitchFlip());
+        for (const float h : curves->heightsPx)
+        {
+            const float same = curves->switchFlipAt(std::size_t(mesh), std::size_t(fullLodf), h);
+            const float quadSwitch = curves->switchFlipAt(std::size_t(mesh), std::size_t(quad), h);
+            std::printf("%5.0f px: switch mesh-lodf (all leaves) %.4f, mesh-impostor %.4f\n", double(h), double(same),
+                        double(quadSwitch));
+            EXPECT_LT(same, 0.01f) << h;
+            EXPECT_GT(quadSwitch, 0.1f) << h;
+        }
+        // Along LoDF's ladder a halving shows less than going from every leaf to the fewest.
+        std::vector<std::size_t> lodf; // finest first
+        for (std::size_t l = 0; l < curves->levels.size(); ++l)
+            if (curves->levels[l].technique == "lodf")
+                lodf.push_back(l);
+        std::sort(lodf.begin(), lodf.end(), [&](std::size_t a, std::size_t b) {
+            return curves->levels[a].techniqueLevel > curves->levels[b].techniqueLevel;
+        });
+        ASSERT_GE(lodf.size(), 3u);
+        for (const float h : curves->heightsPx)
+            EXPECT_LT(curves->switchFlipAt(lodf[lodf.size() - 2], lodf.back(), h),
+                      curves->switchFlipAt(lodf.front(), lodf.back(), h))
+                << h;
+
         // The chunk is added once: a package that holds curves covering its levels is not measured again.
         const std::string path = OgreEnvironment::outDir() + "/oak-curves.treelod";
         const std::vector<std::uint8_t> bytes = cachedPackage("forest", "oak-curves", [] {
@@ -216,6 +243,75 @@ namespace TreeLod
         Result<ErrorCurves> remeasured = decodeErrorCurves(rewritten->readChunk(ERROR_CURVES_CHUNK, 0).value(), path);
         ASSERT_TRUE(remeasured);
         EXPECT_EQ(remeasured->heightsPx, other.heightsPx);
+    }
+
+    TEST(Forest, errorCurvesOfVersionOneAreReadAndMeasuredAgain)
+    {
+        // The oak's package with its curves written as version 1 wrote them: without switch FLIP
+        // (version 2's layout less its last u32, 0 pairs).
+        const TreeAssetPtr asset = oakWithCurves();
+        Result<ErrorCurves> curves = decodeErrorCurves(asset->readChunk(ERROR_CURVES_CHUNK), "oak");
+        ASSERT_TRUE(curves) << curves.error().message();
+        curves->switchFlip.clear();
+        std::vector<std::uint8_t> v1 = encodeErrorCurves(*curves);
+        v1.resize(v1.size() - 4);
+        PackageWriter writer;
+        for (const ChunkInfo& info : asset->getPackage().chunks())
+        {
+            if (info.technique != ERROR_CURVES_CHUNK)
+            {
+                ASSERT_TRUE(writer.addChunk(info.technique, info.level, info.formatVersion,
+                                            asset->getPackage().readChunk(info.technique, info.level).value()));
+            }
+        }
+        // A version this build does not read: refused, naming both.
+        ASSERT_TRUE(writer.addChunk(ERROR_CURVES_CHUNK, 0, 3, v1));
+        Result<std::vector<std::uint8_t>> newer = writer.toBytes();
+        ASSERT_TRUE(newer) << newer.error().message();
+        TreeAssetPtr future = TreeAssetManager::getSingleton().loadFromBytes("oak.v3-curves", Ogre::RGN_DEFAULT, *newer);
+        try
+        {
+            future->readChunk(ERROR_CURVES_CHUNK);
+            ADD_FAILURE() << "a chunk of version 3 was read";
+        }
+        catch (const Ogre::InvalidParametersException& e)
+        {
+            EXPECT_NE(e.getDescription().find("format version 3, this build reads 1..2"), std::string::npos)
+                << e.getDescription();
+        }
+        TreeAssetManager::getSingleton().remove(future);
+
+        ASSERT_TRUE(writer.addChunk(ERROR_CURVES_CHUNK, 0, 1, v1));
+        Result<std::vector<std::uint8_t>> bytes = writer.toBytes();
+        ASSERT_TRUE(bytes) << bytes.error().message();
+
+        // Loaded: the chunk is read, the curves have no switch FLIP, and they do not cover the levels.
+        TreeAssetPtr old = TreeAssetManager::getSingleton().loadFromBytes("oak.v1-curves", Ogre::RGN_DEFAULT, *bytes);
+        EXPECT_EQ(old->getChunkFormatVersion(ERROR_CURVES_CHUNK), 1u);
+        Result<ErrorCurves> read =
+            decodeErrorCurves(old->readChunk(ERROR_CURVES_CHUNK), "oak", old->getChunkFormatVersion(ERROR_CURVES_CHUNK));
+        ASSERT_TRUE(read) << read.error().message();
+        EXPECT_EQ(read->levels.size(), curves->levels.size());
+        EXPECT_FALSE(read->hasSwitchFlip());
+        EXPECT_FALSE(coversCandidateLevels(*read, *old, smallCurveOptions()));
+        // Budgeted auto still plans with them (flip(a) + flip(b) standing in for the switches).
+        EXPECT_FALSE(Forest::levelsForErrorBudget(*old, fixedCosts(*old), DEFAULT_ERROR_BUDGET).empty());
+        TreeAssetManager::getSingleton().remove(old);
+
+        // The package is measured again, to version 2 with switch FLIP.
+        const std::string path = OgreEnvironment::outDir() + "/oak-v1-curves.treelod";
+        ASSERT_TRUE(writeFileAtomic(path, *bytes));
+        Result<bool> measured = ensureErrorCurves(OgreEnvironment::renderer(), path, smallCurveOptions());
+        ASSERT_TRUE(measured) << measured.error().message();
+        EXPECT_TRUE(*measured);
+        Result<PackageReader> rewritten = PackageReader::open(path);
+        ASSERT_TRUE(rewritten);
+        const int chunk = rewritten->findChunk(ERROR_CURVES_CHUNK, 0);
+        ASSERT_GE(chunk, 0);
+        EXPECT_EQ(rewritten->chunks()[std::size_t(chunk)].formatVersion, ERROR_CURVES_FORMAT_VERSION);
+        Result<ErrorCurves> again = decodeErrorCurves(rewritten->readChunk(std::size_t(chunk)).value(), path);
+        ASSERT_TRUE(again) << again.error().message();
+        EXPECT_TRUE(again->hasSwitchFlip());
     }
 
     TEST(Forest, calibrationTimesEveryLevelAndIsCachedPerRenderer)

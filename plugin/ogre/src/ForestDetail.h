@@ -147,15 +147,16 @@ namespace TreeLod
         {
             if (!asset.hasChunk(ERROR_CURVES_CHUNK))
                 invalid(label + "no error curves (bake them: treelod bake, or the bench's cache)", source);
-            Result<ErrorCurves> curves = decodeErrorCurves(asset.readChunk(ERROR_CURVES_CHUNK), asset.getName());
+            Result<ErrorCurves> curves = decodeErrorCurves(asset.readChunk(ERROR_CURVES_CHUNK), asset.getName(),
+                                                          asset.getChunkFormatVersion(ERROR_CURVES_CHUNK));
             if (!curves)
                 invalid(curves.error().message(), source);
             const std::vector<Ogre::String> autoTechniques = Forest::getAutoTechniques();
-            std::vector<ErrorCurveLevel> kept;
-            for (ErrorCurveLevel& level : curves->levels)
-                if (std::find(autoTechniques.begin(), autoTechniques.end(), level.technique) != autoTechniques.end())
-                    kept.push_back(std::move(level));
-            curves->levels = std::move(kept);
+            std::vector<bool> keep;
+            for (const ErrorCurveLevel& level : curves->levels)
+                keep.push_back(std::find(autoTechniques.begin(), autoTechniques.end(), level.technique) !=
+                               autoTechniques.end());
+            curves->keepLevels(keep);
             return std::move(*curves);
         }
 

@@ -116,18 +116,25 @@ namespace TreeLod
         return getPackage().findChunk(technique, level) >= 0;
     }
 
+    std::uint32_t TreeAsset::getChunkFormatVersion(const Ogre::String& technique, std::uint32_t level) const
+    {
+        const PackageReader& package = getPackage();
+        const int index = package.findChunk(technique, level);
+        if (index < 0)
+            raise(fail(mName, chunkElement(technique, level), "missing: bake the package with --technique " + technique));
+        return package.chunks()[std::size_t(index)].formatVersion;
+    }
+
     std::vector<std::uint8_t> TreeAsset::readChunk(const Ogre::String& technique, std::uint32_t level) const
     {
         const PackageReader& package = getPackage();
-        int index = package.findChunk(technique, level);
-        if (index < 0)
-            raise(fail(mName, chunkElement(technique, level), "missing: bake the package with --technique " + technique));
-        const std::uint32_t version = package.chunks()[std::size_t(index)].formatVersion;
+        const std::uint32_t version = getChunkFormatVersion(technique, level);
+        const int index = package.findChunk(technique, level);
         const TechniqueDescriptor* descriptor = findTechniqueDescriptor(technique);
-        if (descriptor && version != descriptor->formatVersion)
+        if (descriptor && !readsFormatVersion(*descriptor, version))
             raise(fail(mName, chunkElement(technique, level),
                        "format version " + std::to_string(version) + ", this build reads " +
-                           std::to_string(descriptor->formatVersion) + ": bake the package again"));
+                           readFormatVersions(*descriptor) + ": bake the package again"));
         Result<std::vector<std::uint8_t>> bytes = package.readChunk(std::size_t(index));
         if (!bytes)
             raise(bytes.error());

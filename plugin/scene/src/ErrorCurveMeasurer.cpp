@@ -67,12 +67,22 @@ namespace TreeLod
             std::vector<RgbaImage> levels;
         };
 
+        /// One view's scores: each level's against the reference, and (where the view counts in the
+        /// mean) each pair's FLIP, at ErrorCurves::switchPair.
+        struct ViewScores
+        {
+            std::vector<Scores> levels;
+            std::vector<double> switches;
+        };
+
         /// Every level's scores against the reference over one square crop around the tree: the
         /// union of the reference's and every level's tree pixels, so the levels of a view are
-        /// compared on the same pixels and the reference is filtered for FLIP once. FLIP is the
-        /// mean over the tree's own pixels (meanOverTree), multi-scale RMSE the crop's. A level
-        /// drawn byte for byte as an earlier one gets its scores. Errors name the level.
-        Result<std::vector<Scores>> scoreView(const ViewShots& shots, const std::vector<ForestLevel>& levels)
+        /// compared on the same pixels. FLIP is the mean over the tree's own pixels (meanOverTree),
+        /// multi-scale RMSE the crop's. With `switches`, the FLIP between every two levels too,
+        /// over the pixels that are tree in either. Each image is filtered for FLIP once
+        /// (FlipReference), so a pair costs only the per-pixel comparison; a level drawn byte for
+        /// byte as an earlier one gets its scores. Errors name the level.
+        Result<ViewScores> scoreView(const ViewShots& shots, const std::vector<ForestLevel>& levels, bool switches)
         {
             Extent extent = treeExtent(shots.reference);
             for (const RgbaImage& shot : shots.levels)
@@ -82,26 +92,54 @@ namespace TreeLod
             Result<FlipReference> prepared = FlipReference::make(reference);
             if (!prepared)
                 return fail("", "reference", "FLIP: " + prepared.error().message());
-            std::vector<Scores> scores(shots.levels.size());
-            for (std::size_t l = 0; l < shots.levels.size(); ++l)
+            const std::size_t n = shots.levels.size();
+            std::vector<std::size_t> first(n); // the first level drawn byte for byte as this one
+            std::vector<Image> images(n);
+            std::vector<FlipReference> analysed(n);
+            ViewScores scores;
+            scores.levels.resize(n);
+            for (std::size_t l = 0; l < n; ++l)
             {
-                const auto same = std::find_if(shots.levels.begin(), shots.levels.begin() + std::ptrdiff_t(l),
-                                               [&](const RgbaImage& earlier) { return earlier.pixels == shots.levels[l].pixels; });
-                if (same != shots.levels.begin() + std::ptrdiff_t(l))
+                first[l] = std::size_t(std::find_if(shots.levels.begin(), shots.levels.begin() + std::ptrdiff_t(l),
+                                                    [&](const RgbaImage& earlier) {
+                                                        return earlier.pixels == shots.levels[l].pixels;
+                                                    }) -
+                                       shots.levels.begin());
+                if (first[l] != l)
                 {
-                    scores[l] = scores[std::size_t(same - shots.levels.begin())];
+                    scores.levels[l] = scores.levels[first[l]];
                     continue;
                 }
                 const std::string element = "level " + Forest::describeLevel(levels[l]);
-                const Image test = cropImage(toImage(shots.levels[l]), crop);
-                Result<FlipResult> f = flip(*prepared, test, true);
+                images[l] = cropImage(toImage(shots.levels[l]), crop);
+                Result<FlipReference> image = FlipReference::make(images[l]);
+                Result<FlipResult> f = image ? flip(*prepared, *image, true) : Result<FlipResult>(image.error());
                 if (!f)
                     return fail("", element, "FLIP: " + f.error().message());
-                Result<MultiScaleRmseResult> m = multiScaleRmse(reference, test);
+                analysed[l] = std::move(*image);
+                Result<MultiScaleRmseResult> m = multiScaleRmse(reference, images[l]);
                 if (!m)
                     return fail("", element, "multi-scale RMSE: " + m.error().message());
-                scores[l] = Scores{meanOverTree(*f, reference, test), m->combined};
+                scores.levels[l] = Scores{meanOverTree(*f, reference, images[l]), m->combined};
             }
+            if (!switches)
+                return scores;
+            for (std::size_t a = 0; a < n; ++a)
+                for (std::size_t b = a + 1; b < n; ++b)
+                {
+                    const std::size_t i = first[a], j = first[b];
+                    if (i == j)
+                    {
+                        scores.switches.push_back(0.0);
+                        continue;
+                    }
+                    Result<FlipResult> f = flip(analysed[i], analysed[j], true);
+                    if (!f)
+                        return fail("", "levels " + Forest::describeLevel(levels[a]) + " and " +
+                                            Forest::describeLevel(levels[b]),
+                                    "FLIP: " + f.error().message());
+                    scores.switches.push_back(meanOverTree(*f, images[i], images[j]));
+                }
             return scores;
         }
     }
@@ -145,6 +183,7 @@ namespace TreeLod
             c.flipMax.assign(options.heightsPx.size(), 0.0f);
             c.rmse.assign(options.heightsPx.size(), 0.0f);
         }
+        curves.switchFlip.assign(ErrorCurves::switchPairs(levels.size()), std::vector<float>(options.heightsPx.size(), 0.0f));
 
         renderer.setLighting(LightingSpec()); // the CPU reference's (RenderOptions' default)
         renderer.setShadows(false);
@@ -163,7 +202,7 @@ namespace TreeLod
         // scores do not depend on the thread count (ImageMetrics.h).
         struct Pending
         {
-            std::future<Result<std::vector<Scores>>> scores;
+            std::future<Result<ViewScores>> scores;
             std::size_t height = 0;
             bool inMean = false;
         };
@@ -171,15 +210,17 @@ namespace TreeLod
         auto collect = [&]() -> Result<void> {
             if (!pending)
                 return {};
-            Result<std::vector<Scores>> s = pending->scores.get();
+            Result<ViewScores> s = pending->scores.get();
             const Pending view = std::move(*pending);
             pending.reset();
             if (!s)
                 return s.error();
+            for (std::size_t p = 0; p < s->switches.size(); ++p)
+                curves.switchFlip[p][view.height] += float(s->switches[p]) / float(meanViews);
             for (std::size_t l = 0; l < levels.size(); ++l)
             {
                 ErrorCurveLevel& c = curves.levels[l];
-                const Scores& score = (*s)[l];
+                const Scores& score = s->levels[l];
                 if (view.inMean)
                 {
                     c.flip[view.height] += float(score.flip) / float(meanViews);
@@ -237,8 +278,10 @@ namespace TreeLod
                 }
                 if (Result<void> collected = collect(); !collected)
                     return abandon(collected.error());
-                pending = Pending{std::async(std::launch::async, [shots, &levels] { return scoreView(*shots, levels); }),
-                                  h, meanView(viewAngles)};
+                const bool inMean = meanView(viewAngles);
+                pending = Pending{std::async(std::launch::async,
+                                             [shots, &levels, inMean] { return scoreView(*shots, levels, inMean); }),
+                                  h, inMean};
             }
         }
         if (Result<void> collected = collect(); !collected)
@@ -252,6 +295,9 @@ namespace TreeLod
                 c.rmse[h] = std::clamp(c.rmse[h], 0.0f, 1.0f);
                 c.flipMax[h] = std::max(c.flipMax[h], c.flip[h]);
             }
+        for (std::vector<float>& pair : curves.switchFlip)
+            for (float& v : pair)
+                v = std::clamp(v, 0.0f, 1.0f);
         if (Result<void> valid = validateErrorCurves(curves, label); !valid)
             return valid.error();
         return curves;
@@ -259,7 +305,7 @@ namespace TreeLod
 
     bool coversCandidateLevels(const ErrorCurves& curves, TreeAsset& asset, const ErrorCurveOptions& options)
     {
-        if (curves.heightsPx != options.heightsPx || curves.views != options.views.size())
+        if (curves.heightsPx != options.heightsPx || curves.views != options.views.size() || !curves.hasSwitchFlip())
             return false;
         for (const ForestLevel& level : Forest::getCandidateLevels(asset))
             if (curves.find(level.technique, level.techniqueLevel, level.lowRes) < 0)
@@ -344,7 +390,8 @@ namespace TreeLod
             TemporaryAsset asset(std::move(bytes.value()), path);
             if (asset.get().hasChunk(ERROR_CURVES_CHUNK))
             {
-                Result<ErrorCurves> held = decodeErrorCurves(asset.get().readChunk(ERROR_CURVES_CHUNK), path);
+                Result<ErrorCurves> held = decodeErrorCurves(asset.get().readChunk(ERROR_CURVES_CHUNK), path,
+                                                             asset.get().getChunkFormatVersion(ERROR_CURVES_CHUNK));
                 if (held && coversCandidateLevels(*held, asset.get(), options))
                     return false;
             }

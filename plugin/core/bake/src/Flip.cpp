@@ -380,10 +380,74 @@ namespace TreeLod
         return distance * (pixels / width) * (kPi / 180.0);
     }
 
+    namespace
+    {
+        /// The per-pixel FLIP of two analysed images of one size and kernels.
+        FlipResult compare(const Analysis& ref, const Analysis& tst, bool keepErrorMap)
+        {
+            const int w = ref.L.width, h = ref.L.height;
+            const float cmax = maxColourDifference();
+            const float breakpoint = kPc * cmax;
+            std::vector<float> errors(std::size_t(w) * h);
+            std::vector<double> rowSums(static_cast<std::size_t>(h));
+            std::vector<float> rowMax(static_cast<std::size_t>(h));
+            forRows(h, [&](int y0, int y1) {
+                for (int y = y0; y < y1; ++y)
+                {
+                    double rowSum = 0.0;
+                    float rowPeak = 0.0f;
+                    for (int x = 0; x < w; ++x)
+                    {
+                        const std::size_t i = std::size_t(y) * w + x;
+                        // Colour: compressed HyAB, remapped so that [0, pc cmax] -> [0, pt] and
+                        // [pc cmax, cmax] -> [pt, 1].
+                        const float d = std::pow(hyab(ref.L.v[i], ref.A.v[i], ref.B.v[i], tst.L.v[i], tst.A.v[i], tst.B.v[i]), kQc);
+                        float colour = d < breakpoint ? (kPt / breakpoint) * d
+                                                      : kPt + (d - breakpoint) / (cmax - breakpoint) * (1.0f - kPt);
+                        colour = std::min(colour, 1.0f);
+                        // Features: largest edge or point magnitude difference, normalised by sqrt 2.
+                        const float fd = std::max(std::fabs(ref.edge.v[i] - tst.edge.v[i]), std::fabs(ref.point.v[i] - tst.point.v[i]));
+                        const float feature = std::min(std::sqrt(fd / std::sqrt(2.0f)), 1.0f); // ^qf, qf = 0.5
+                        const float e = colour > 0.0f ? std::pow(colour, 1.0f - feature) : 0.0f;
+                        errors[i] = e;
+                        rowSum += e;
+                        rowPeak = std::max(rowPeak, e);
+                    }
+                    rowSums[std::size_t(y)] = rowSum;
+                    rowMax[std::size_t(y)] = rowPeak;
+                }
+            });
+
+            FlipResult result;
+            result.width = w;
+            result.height = h;
+            double total = 0.0;
+            for (int y = 0; y < h; ++y)
+            {
+                total += rowSums[std::size_t(y)];
+                result.max = std::max(result.max, double(rowMax[std::size_t(y)]));
+            }
+            result.mean = total / double(errors.size());
+
+            std::vector<float> sorted = errors;
+            const std::size_t mid = sorted.size() / 2;
+            std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(mid), sorted.end());
+            double median = sorted[mid];
+            if (sorted.size() % 2 == 0)
+                median = 0.5 * (median + *std::max_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(mid)));
+            result.weightedMedian = median;
+
+            if (keepErrorMap)
+                result.errorMap = std::move(errors);
+            return result;
+        }
+    }
+
     struct FlipReference::Analysed
     {
         Kernels kernels;
         Analysis analysis;
+        double pixelsPerDegree = 0.0;
     };
 
     int FlipReference::width() const { return analysed ? analysed->analysis.L.width : 0; }
@@ -396,7 +460,8 @@ namespace TreeLod
         const double ppd = options.pixelsPerDegree == 0.0 ? flipDefaultPixelsPerDegree() : options.pixelsPerDegree;
         if (!(ppd > 0.0) || !(ppd <= 10000.0))
             return fail("", "FLIP", "pixels per degree must be in (0, 10000], got " + std::to_string(ppd));
-        auto analysed = std::make_shared<Analysed>(Analysed{makeKernels(ppd), Analysis(reference.width, reference.height)});
+        auto analysed =
+            std::make_shared<Analysed>(Analysed{makeKernels(ppd), Analysis(reference.width, reference.height), ppd});
         analyse(reference, analysed->kernels, analysed->analysis);
         FlipReference prepared;
         prepared.analysed = std::move(analysed);
@@ -420,64 +485,23 @@ namespace TreeLod
         const int w = reference.width(), h = reference.height();
         if (auto error = checkComparable("FLIP", w, h, test))
             return *error;
-        const Analysis& ref = reference.analysed->analysis;
         Analysis tst(w, h);
         analyse(test, reference.analysed->kernels, tst);
+        return compare(reference.analysed->analysis, tst, keepErrorMap);
+    }
 
-        const float cmax = maxColourDifference();
-        const float breakpoint = kPc * cmax;
-        std::vector<float> errors(std::size_t(w) * h);
-        std::vector<double> rowSums(static_cast<std::size_t>(h));
-        std::vector<float> rowMax(static_cast<std::size_t>(h));
-        forRows(h, [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y)
-            {
-                double rowSum = 0.0;
-                float rowPeak = 0.0f;
-                for (int x = 0; x < w; ++x)
-                {
-                    const std::size_t i = std::size_t(y) * w + x;
-                    // Colour: compressed HyAB, remapped so that [0, pc cmax] -> [0, pt] and
-                    // [pc cmax, cmax] -> [pt, 1].
-                    const float d = std::pow(hyab(ref.L.v[i], ref.A.v[i], ref.B.v[i], tst.L.v[i], tst.A.v[i], tst.B.v[i]), kQc);
-                    float colour = d < breakpoint ? (kPt / breakpoint) * d
-                                                  : kPt + (d - breakpoint) / (cmax - breakpoint) * (1.0f - kPt);
-                    colour = std::min(colour, 1.0f);
-                    // Features: largest edge or point magnitude difference, normalised by sqrt 2.
-                    const float fd = std::max(std::fabs(ref.edge.v[i] - tst.edge.v[i]), std::fabs(ref.point.v[i] - tst.point.v[i]));
-                    const float feature = std::min(std::sqrt(fd / std::sqrt(2.0f)), 1.0f); // ^qf, qf = 0.5
-                    const float e = colour > 0.0f ? std::pow(colour, 1.0f - feature) : 0.0f;
-                    errors[i] = e;
-                    rowSum += e;
-                    rowPeak = std::max(rowPeak, e);
-                }
-                rowSums[std::size_t(y)] = rowSum;
-                rowMax[std::size_t(y)] = rowPeak;
-            }
-        });
-
-        FlipResult result;
-        result.width = w;
-        result.height = h;
-        double total = 0.0;
-        for (int y = 0; y < h; ++y)
-        {
-            total += rowSums[std::size_t(y)];
-            result.max = std::max(result.max, double(rowMax[std::size_t(y)]));
-        }
-        result.mean = total / double(errors.size());
-
-        std::vector<float> sorted = errors;
-        const std::size_t mid = sorted.size() / 2;
-        std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(mid), sorted.end());
-        double median = sorted[mid];
-        if (sorted.size() % 2 == 0)
-            median = 0.5 * (median + *std::max_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(mid)));
-        result.weightedMedian = median;
-
-        if (keepErrorMap)
-            result.errorMap = std::move(errors);
-        return result;
+    Result<FlipResult> flip(const FlipReference& reference, const FlipReference& test, bool keepErrorMap)
+    {
+        if (!reference.analysed || !test.analysed)
+            return fail("", "FLIP", "the reference or the test image was not prepared");
+        if (reference.width() != test.width() || reference.height() != test.height())
+            return fail("", "FLIP",
+                        "images differ in size: " + std::to_string(reference.width()) + "x" +
+                            std::to_string(reference.height()) + " vs " + std::to_string(test.width()) + "x" +
+                            std::to_string(test.height()));
+        if (reference.analysed->pixelsPerDegree != test.analysed->pixelsPerDegree)
+            return fail("", "FLIP", "the two images were prepared for different pixels per degree");
+        return compare(reference.analysed->analysis, test.analysed->analysis, keepErrorMap);
     }
 
     Image flipHeatmap(const FlipResult& result)

@@ -55,6 +55,34 @@ namespace TreeLod
 
         std::string element(const std::string& what) { return std::string(ERROR_CURVES_CHUNK) + " " + what; }
 
+        /// "error-curves switch level 1 'lodf' 0 to level 3 'impostor' 0".
+        std::string switchElement(const ErrorCurves& curves, std::size_t a, std::size_t b)
+        {
+            return levelElement(a, curves.levels[a]) + " to" +
+                   levelElement(b, curves.levels[b]).substr(std::string(ERROR_CURVES_CHUNK).size());
+        }
+
+        /// What is wrong with `values` (one per height, in [0, 1]), "" when nothing; `at` names the value.
+        std::string valuesProblem(const char* name, const std::vector<float>& values, std::size_t heights,
+                                  std::string& at)
+        {
+            if (values.size() != heights)
+            {
+                at = name;
+                return std::to_string(values.size()) + " values for " + std::to_string(heights) + " heights";
+            }
+            for (std::size_t i = 0; i < heights; ++i)
+            {
+                const float v = values[i];
+                if (!std::isfinite(v) || v < 0.0f || v > 1.0f)
+                {
+                    at = std::string(name) + "[" + std::to_string(i) + "]";
+                    return number(v) + " outside [0, 1]";
+                }
+            }
+            return {};
+        }
+
         /// What is wrong with one level, "" when nothing; `at` names the value at fault.
         std::string levelProblem(const ErrorCurveLevel& level, std::size_t heights, std::string& at)
         {
@@ -64,22 +92,8 @@ namespace TreeLod
             const std::pair<const char*, const std::vector<float>*> curves[] = {
                 {"flip", &level.flip}, {"flipMax", &level.flipMax}, {"rmse", &level.rmse}};
             for (const auto& [name, values] : curves)
-            {
-                if (values->size() != heights)
-                {
-                    at = name;
-                    return std::to_string(values->size()) + " values for " + std::to_string(heights) + " heights";
-                }
-                for (std::size_t i = 0; i < heights; ++i)
-                {
-                    const float v = (*values)[i];
-                    if (!std::isfinite(v) || v < 0.0f || v > 1.0f)
-                    {
-                        at = std::string(name) + "[" + std::to_string(i) + "]";
-                        return number(v) + " outside [0, 1]";
-                    }
-                }
-            }
+                if (std::string problem = valuesProblem(name, *values, heights, at); !problem.empty())
+                    return problem;
             for (std::size_t i = 0; i < heights; ++i)
                 if (level.flipMax[i] < level.flip[i] - FLIP_MAX_TOLERANCE)
                 {
@@ -111,9 +125,10 @@ namespace TreeLod
             return out;
         }
 
-        Result<ChunkSummary> inspect(const std::vector<std::uint8_t>& bytes, const std::string& label)
+        Result<ChunkSummary> inspectVersion(const std::vector<std::uint8_t>& bytes, const std::string& label,
+                                            std::uint32_t formatVersion)
         {
-            Result<ErrorCurves> decoded = decodeErrorCurves(bytes, label);
+            Result<ErrorCurves> decoded = decodeErrorCurves(bytes, label, formatVersion);
             if (!decoded)
                 return decoded.error();
             const ErrorCurves& c = decoded.value();
@@ -126,7 +141,10 @@ namespace TreeLod
             std::string text = std::to_string(c.levels.size()) + (c.levels.size() == 1 ? " level x " : " levels x ") +
                                std::to_string(n) + (n == 1 ? " height (" : " heights (") + number(c.heightsPx[0]) +
                                (n == 1 ? "" : "-" + number(c.heightsPx.back())) + " px), " + std::to_string(c.views) +
-                               (c.views == 1 ? " view; FLIP at " : " views; FLIP at ");
+                               (c.views == 1 ? " view" : " views") +
+                               (c.switchFlip.empty() ? "" : ", switch FLIP of " + std::to_string(c.switchFlip.size()) +
+                                                                (c.switchFlip.size() == 1 ? " pair" : " pairs")) +
+                               "; FLIP at ";
             for (std::size_t k = 0; k < shown.size(); ++k)
                 text += (k ? "/" : "") + number(c.heightsPx[shown[k]]);
             text += " px:";
@@ -162,15 +180,25 @@ namespace TreeLod
                                   {"flip", floats(level.flip)},
                                   {"flipMax", floats(level.flipMax)},
                                   {"rmse", floats(level.rmse)}});
+            nlohmann::json switches = nlohmann::json::array();
+            for (std::size_t a = 0; a < c.levels.size() && !c.switchFlip.empty(); ++a)
+                for (std::size_t b = a + 1; b < c.levels.size(); ++b)
+                    switches.push_back({{"levels", {a, b}}, {"flip", floats(c.switchFlip[c.switchPair(a, b)])}});
             ChunkSummary summary;
             summary.text = text;
             summary.json = nlohmann::json{{"levels", c.levels.size()},
                                           {"heightsPx", floats(c.heightsPx)},
                                           {"views", c.views},
                                           {"referenceSamples", c.referenceSamples},
-                                          {"curves", curves}}
+                                          {"curves", curves},
+                                          {"switchFlip", switches}}
                                .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
             return summary;
+        }
+
+        Result<ChunkSummary> inspect(const std::vector<std::uint8_t>& bytes, const std::string& label)
+        {
+            return inspectVersion(bytes, label, ERROR_CURVES_FORMAT_VERSION);
         }
 
         void fuzz(const std::vector<std::uint8_t>& bytes)
@@ -199,6 +227,14 @@ namespace TreeLod
                     const float v = c.flipAt(l, h);
                     if (!std::isfinite(v) || v < 0.0f || v > 1.0f)
                         __builtin_trap();
+                    // What the selection reads at a switch: a FLIP, or unknown without switch data.
+                    for (std::size_t other = 0; other < c.levels.size(); other += 1 + c.levels.size() / 8)
+                    {
+                        const float s = c.switchFlipAt(l, other, h);
+                        if (s != c.switchFlipAt(other, l, h) ||
+                            !(c.hasSwitchFlip() || l == other ? s >= 0.0f && s <= 1.0f : s == SWITCH_FLIP_UNKNOWN))
+                            __builtin_trap();
+                    }
                 }
             }
         }
@@ -249,6 +285,34 @@ namespace TreeLod
         return level < levels.size() ? interpolateAt(heightsPx, levels[level].flipMax, heightPx) : 0.0f;
     }
 
+    float ErrorCurves::switchFlipAt(std::size_t a, std::size_t b, float heightPx) const
+    {
+        if (a >= levels.size() || b >= levels.size())
+            return SWITCH_FLIP_UNKNOWN;
+        if (a == b)
+            return 0.0f;
+        if (!hasSwitchFlip())
+            return SWITCH_FLIP_UNKNOWN;
+        return interpolateAt(heightsPx, switchFlip[switchPair(std::min(a, b), std::max(a, b))], heightPx);
+    }
+
+    void ErrorCurves::keepLevels(const std::vector<bool>& keep)
+    {
+        std::vector<std::size_t> kept;
+        for (std::size_t l = 0; l < levels.size() && l < keep.size(); ++l)
+            if (keep[l])
+                kept.push_back(l);
+        std::vector<std::vector<float>> switches;
+        for (std::size_t a = 0; a < kept.size() && hasSwitchFlip(); ++a)
+            for (std::size_t b = a + 1; b < kept.size(); ++b)
+                switches.push_back(std::move(switchFlip[switchPair(kept[a], kept[b])]));
+        std::vector<ErrorCurveLevel> keptLevels;
+        for (std::size_t l : kept)
+            keptLevels.push_back(std::move(levels[l]));
+        levels = std::move(keptLevels);
+        switchFlip = std::move(switches);
+    }
+
     Result<void> validateErrorCurves(const ErrorCurves& curves, const std::string& label)
     {
         const std::size_t n = curves.heightsPx.size();
@@ -289,6 +353,21 @@ namespace TreeLod
                             "the same level as level " +
                                 std::to_string(curves.find(level.technique, level.techniqueLevel, level.lowRes)));
         }
+        const std::size_t pairs = ErrorCurves::switchPairs(curves.levels.size());
+        if (!curves.switchFlip.empty() && curves.switchFlip.size() != pairs)
+            return fail(label, element("switchFlip"),
+                        std::to_string(curves.switchFlip.size()) + " pairs of levels for " +
+                            std::to_string(curves.levels.size()) + " levels (0 or " + std::to_string(pairs) +
+                            " needed)");
+        for (std::size_t a = 0; a < curves.levels.size() && !curves.switchFlip.empty(); ++a)
+            for (std::size_t b = a + 1; b < curves.levels.size(); ++b)
+            {
+                std::string at;
+                const std::string problem =
+                    valuesProblem("switchFlip", curves.switchFlip[curves.switchPair(a, b)], n, at);
+                if (!problem.empty())
+                    return fail(label, switchElement(curves, a, b) + " " + at, problem);
+            }
         return {};
     }
 
@@ -296,7 +375,8 @@ namespace TreeLod
     {
         ByteWriter w;
         const std::size_t n = curves.heightsPx.size();
-        w.reserve(16 + 4 * n + curves.levels.size() * (MIN_LEVEL_BYTES + 32 + 12 * n));
+        w.reserve(20 + 4 * n + curves.levels.size() * (MIN_LEVEL_BYTES + 32 + 12 * n) +
+                  curves.switchFlip.size() * 4 * n);
         w.u32(std::uint32_t(n));
         w.u32(std::uint32_t(curves.levels.size()));
         w.u32(curves.views);
@@ -312,11 +392,21 @@ namespace TreeLod
                 for (float v : *values)
                     w.f32(v);
         }
+        w.u32(std::uint32_t(curves.switchFlip.size()));
+        for (const std::vector<float>& values : curves.switchFlip)
+            for (float v : values)
+                w.f32(v);
         return w.take();
     }
 
-    Result<ErrorCurves> decodeErrorCurves(const std::vector<std::uint8_t>& bytes, const std::string& label)
+    Result<ErrorCurves> decodeErrorCurves(const std::vector<std::uint8_t>& bytes, const std::string& label,
+                                          std::uint32_t formatVersion)
     {
+        if (formatVersion < ERROR_CURVES_OLDEST_FORMAT_VERSION || formatVersion > ERROR_CURVES_FORMAT_VERSION)
+            return fail(label, ERROR_CURVES_CHUNK,
+                        "format version " + std::to_string(formatVersion) + ", this build reads " +
+                            std::to_string(ERROR_CURVES_OLDEST_FORMAT_VERSION) + ".." +
+                            std::to_string(ERROR_CURVES_FORMAT_VERSION));
         ByteReader r(bytes.data(), bytes.size(), label, element("header"));
         const std::uint32_t heightCount = r.u32();
         const std::uint32_t levelCount = r.u32();
@@ -367,6 +457,30 @@ namespace TreeLod
         }
         if (!r.ok())
             return r.error();
+        if (formatVersion >= 2)
+        {
+            r.setElement(element("switchFlip"));
+            const std::uint32_t pairs = r.u32();
+            const std::size_t expected = ErrorCurves::switchPairs(levelCount);
+            if (r.ok() && pairs != 0 && pairs != expected)
+                return fail(label, element("switchFlip"),
+                            std::to_string(pairs) + " pairs of levels for " + std::to_string(levelCount) +
+                                " levels (0 or " + std::to_string(expected) + " needed)");
+            if (r.ok() && 4 * std::size_t(heightCount) * pairs > r.remaining())
+                return fail(label, element("switchFlip"),
+                            "truncated: " + std::to_string(pairs) + " pairs of " + std::to_string(heightCount) +
+                                " heights need " + std::to_string(4 * std::size_t(heightCount) * pairs) +
+                                " bytes, chunk has " + std::to_string(r.remaining()) + " left");
+            curves.switchFlip.resize(r.ok() ? pairs : 0);
+            for (std::vector<float>& values : curves.switchFlip)
+            {
+                values.resize(heightCount);
+                for (float& v : values)
+                    v = r.f32();
+            }
+            if (!r.ok())
+                return r.error();
+        }
         if (r.remaining() != 0)
             return fail(label, ERROR_CURVES_CHUNK, std::to_string(r.remaining()) + " trailing bytes");
         Result<void> valid = validateErrorCurves(curves, label);
@@ -380,6 +494,6 @@ namespace TreeLod
         return {ERROR_CURVES_CHUNK,
                 "image error against screen height of every Forest level (FLIP, multi-scale RMSE), measured at bake "
                 "time",
-                ERROR_CURVES_FORMAT_VERSION, &inspect, &fuzz};
+                ERROR_CURVES_FORMAT_VERSION, &inspect, &fuzz, ERROR_CURVES_OLDEST_FORMAT_VERSION, &inspectVersion};
     }
 }

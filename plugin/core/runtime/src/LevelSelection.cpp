@@ -47,18 +47,113 @@ namespace TreeLod
     }
 
     Result<std::vector<LevelChoice>> chooseLevels(const ErrorCurves& curves, const std::vector<LevelCost>& costs,
-                                                  float errorBudget, std::size_t maxRuns)
+                                                  float errorBudget, std::size_t maxRuns, float costSlack)
     {
         Result<int> reference = checkBudget(curves, errorBudget, "error budget");
         if (!reference)
             return reference.error();
         if (maxRuns == 0)
             return fail("", "error budget", "no level may be used (maxRuns 0)");
+        if (!(std::isfinite(costSlack) && costSlack >= 0.0f))
+            return fail("", "cost slack", std::to_string(costSlack) + " is not a finite number >= 0");
 
         // Each curve level's cost, or null (not a candidate; the reference stays allowed).
         const std::vector<const LevelCost*> costOf = costsOf(curves, costs);
         if (std::find_if(costOf.begin(), costOf.end(), [](const LevelCost* c) { return c != nullptr; }) == costOf.end())
             return fail("", "level costs", "no level of the error curves has a calibrated cost");
+
+        // Per sample, the candidates: the cheapest allowed level (ties: the smaller FLIP) first,
+        // then the other allowed levels that cost less than (1 + costSlack) times it.
+        const std::size_t ref = std::size_t(*reference);
+        auto msOf = [&](std::size_t l, float h) { return costOf[l] ? costOf[l]->msAt(h) : 0.0f; };
+        std::vector<std::vector<std::size_t>> candidates(SELECTION_SAMPLES);
+        for (std::size_t k = 0; k < SELECTION_SAMPLES; ++k)
+        {
+            const float h = selectionHeight(k);
+            const float allowed = curves.flipAt(ref, h) + errorBudget;
+            const float allowedWorst = curves.flipMaxAt(ref, h) + WORST_VIEW_BUDGET_FACTOR * errorBudget;
+            auto isAllowed = [&](std::size_t l) {
+                return l == ref || (costOf[l] && curves.flipAt(l, h) <= allowed && curves.flipMaxAt(l, h) <= allowedWorst);
+            };
+            std::size_t best = ref;
+            float bestCost = costOf[best] ? costOf[best]->msAt(h) : std::numeric_limits<float>::infinity();
+            float bestFlip = curves.flipAt(best, h);
+            if (errorBudget > 0.0f)
+                for (std::size_t l = 0; l < curves.levels.size(); ++l)
+                {
+                    if (l == ref || !isAllowed(l))
+                        continue;
+                    const float flip = curves.flipAt(l, h);
+                    const float cost = costOf[l]->msAt(h);
+                    if (cost < bestCost || (cost == bestCost && flip < bestFlip))
+                    {
+                        best = l;
+                        bestCost = cost;
+                        bestFlip = flip;
+                    }
+                }
+            candidates[k].push_back(best);
+            if (errorBudget > 0.0f && costSlack > 0.0f && std::isfinite(bestCost))
+                for (std::size_t l = 0; l < curves.levels.size(); ++l)
+                    if (l != best && costOf[l] && isAllowed(l) && costOf[l]->msAt(h) < (1.0f + costSlack) * bestCost)
+                        candidates[k].push_back(l);
+        }
+
+        // The path near to far through the candidates whose switches show least (Viterbi): at a
+        // switch between samples k - 1 and k, at the height halfway between them (the run
+        // boundary), the switch FLIP of the two levels plus LEVEL_SWITCH_PENALTY; without
+        // measured switch FLIP, flip(a) + flip(b), a conservative stand-in (each image is that far
+        // from the reference's; every measured switch FLIP of the test oak is below it). Ties:
+        // the smaller summed cost.
+        auto switchCost = [&](std::size_t a, std::size_t b, float h) {
+            const float shown = curves.hasSwitchFlip() ? curves.switchFlipAt(a, b, h)
+                                                       : curves.flipAt(a, h) + curves.flipAt(b, h);
+            return double(shown) + double(LEVEL_SWITCH_PENALTY);
+        };
+        struct Step
+        {
+            double switches = 0.0, ms = 0.0;
+            std::size_t from = 0; ///< index into the previous sample's candidates
+            bool better(const Step& other) const
+            {
+                return switches < other.switches || (switches == other.switches && ms < other.ms);
+            }
+        };
+        std::vector<std::vector<Step>> steps(SELECTION_SAMPLES);
+        constexpr int SAMPLES_PER_OCTAVE = SELECTION_SAMPLES_PER_OCTAVE;
+        for (std::size_t k = 0; k < SELECTION_SAMPLES; ++k)
+        {
+            const float h = selectionHeight(k);
+            const float boundary = h * std::exp2(0.5f / SAMPLES_PER_OCTAVE);
+            for (const std::size_t b : candidates[k])
+            {
+                Step step{0.0, double(msOf(b, h)), 0};
+                if (k > 0)
+                {
+                    step.switches = std::numeric_limits<double>::infinity();
+                    for (std::size_t i = 0; i < candidates[k - 1].size(); ++i)
+                    {
+                        const std::size_t a = candidates[k - 1][i];
+                        const Step& before = steps[k - 1][i];
+                        const Step through{before.switches + (a == b ? 0.0 : switchCost(a, b, boundary)),
+                                           before.ms + double(msOf(b, h)), i};
+                        if (through.better(step))
+                            step = through;
+                    }
+                }
+                steps[k].push_back(step);
+            }
+        }
+        std::vector<std::size_t> path(SELECTION_SAMPLES);
+        std::size_t at = 0;
+        for (std::size_t i = 1; i < steps.back().size(); ++i)
+            if (steps.back()[i].better(steps.back()[at]))
+                at = i;
+        for (std::size_t k = SELECTION_SAMPLES; k-- > 0;)
+        {
+            path[k] = candidates[k][at];
+            at = steps[k][at].from;
+        }
 
         struct Run
         {
@@ -68,37 +163,15 @@ namespace TreeLod
             float flip = 0.0f;
         };
         std::vector<Run> runs;
-        constexpr int SAMPLES_PER_OCTAVE = SELECTION_SAMPLES_PER_OCTAVE;
         for (std::size_t k = 0; k < SELECTION_SAMPLES; ++k)
         {
             const float h = selectionHeight(k);
-            const float allowed = curves.flipAt(std::size_t(*reference), h) + errorBudget;
-            const float allowedWorst =
-                curves.flipMaxAt(std::size_t(*reference), h) + WORST_VIEW_BUDGET_FACTOR * errorBudget;
-            std::size_t best = std::size_t(*reference);
-            float bestCost = costOf[best] ? costOf[best]->msAt(h) : std::numeric_limits<float>::infinity();
-            float bestFlip = curves.flipAt(best, h);
-            if (errorBudget > 0.0f)
-                for (std::size_t l = 0; l < curves.levels.size(); ++l)
-                {
-                    if (!costOf[l] || l == std::size_t(*reference))
-                        continue;
-                    const float flip = curves.flipAt(l, h);
-                    const float cost = costOf[l]->msAt(h);
-                    if (flip <= allowed && curves.flipMaxAt(l, h) <= allowedWorst &&
-                        (cost < bestCost || (cost == bestCost && flip < bestFlip)))
-                    {
-                        best = l;
-                        bestCost = cost;
-                        bestFlip = flip;
-                    }
-                }
-            if (runs.empty() || runs.back().level != best)
-                runs.push_back(Run{best, 0, h, 0.0f});
+            if (runs.empty() || runs.back().level != path[k])
+                runs.push_back(Run{path[k], 0, h, 0.0f});
             Run& run = runs.back();
             ++run.samples;
             run.lowestHeight = h;
-            run.flip = std::max(run.flip, bestFlip);
+            run.flip = std::max(run.flip, curves.flipAt(path[k], h));
         }
 
         // Too many runs: the shortest joins its finer (nearer) neighbour.

@@ -78,6 +78,34 @@ namespace TreeLod
 
     const std::vector<TechniqueDescriptor>& techniqueDescriptors() { return registry(); }
 
+    bool readsFormatVersion(const TechniqueDescriptor& descriptor, std::uint32_t formatVersion)
+    {
+        if (formatVersion == descriptor.formatVersion)
+            return true;
+        return descriptor.inspectVersion && descriptor.oldestFormatVersion != 0 &&
+               formatVersion >= descriptor.oldestFormatVersion && formatVersion < descriptor.formatVersion;
+    }
+
+    std::string readFormatVersions(const TechniqueDescriptor& descriptor)
+    {
+        const bool older = descriptor.inspectVersion && descriptor.oldestFormatVersion != 0 &&
+                           descriptor.oldestFormatVersion < descriptor.formatVersion;
+        return (older ? std::to_string(descriptor.oldestFormatVersion) + ".." : std::string()) +
+               std::to_string(descriptor.formatVersion);
+    }
+
+    Result<ChunkSummary> inspectChunk(const TechniqueDescriptor& descriptor, const std::vector<std::uint8_t>& bytes,
+                                      const std::string& label, std::uint32_t formatVersion)
+    {
+        if (!readsFormatVersion(descriptor, formatVersion))
+            return fail(label, descriptor.name,
+                        "unsupported format version " + std::to_string(formatVersion) + ", this build reads " +
+                            readFormatVersions(descriptor));
+        if (descriptor.inspectVersion)
+            return descriptor.inspectVersion(bytes, label, formatVersion);
+        return descriptor.inspect(bytes, label);
+    }
+
     const TechniqueDescriptor* findTechniqueDescriptor(const std::string& name)
     {
         for (const TechniqueDescriptor& d : registry())

@@ -76,9 +76,13 @@ namespace TreeLod
         const std::vector<Ogre::String>& getShadowedMaterialNames();
 
         // ---- for techniques building their resources ----
-        /// Level `level` of chunk `technique`, CRC-checked, its format version checked against the
-        /// registered TechniqueDescriptor; throws naming the asset, the chunk and what to do.
+        /// Level `level` of chunk `technique`, CRC-checked, its format version one the registered
+        /// TechniqueDescriptor reads (readsFormatVersion); throws naming the asset, the chunk and
+        /// what to do.
         std::vector<std::uint8_t> readChunk(const Ogre::String& technique, std::uint32_t level = 0) const;
+        /// The format version of that chunk (for a technique that reads older versions too); throws
+        /// as readChunk when it is missing.
+        std::uint32_t getChunkFormatVersion(const Ogre::String& technique, std::uint32_t level = 0) const;
         /// Throw Ogre::InvalidParametersException with `error`'s message, from this asset.
         [[noreturn]] void raise(const Error& error) const;
         /// Clones of `barkBase` and `leafBase`, one per model material, named

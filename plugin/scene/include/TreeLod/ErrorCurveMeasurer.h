@@ -12,6 +12,9 @@
 // crown thinned from above is not what a camera near the ground sees of it. The view is sized so the tree's box height spans `heightPx`
 // pixels at the distance the Forest's LoD would see it at (the units of ForestBand).
 // The "mesh" curve is the rasteriser's own error at that size: the floor no level can beat.
+// The switch FLIP of two levels (switchFlip, what a hard switch between them shows) compares the
+// two levels' images of the same views as flip with each other, over the pixels that are tree in
+// either: no extra frame, each image filtered for FLIP once (FlipReference).
 //
 // Deviation: a level is measured with its bark at full detail (a Forest draws a level's bark at
 // the mesh LoD of the largest value the level is used at), so curves of coarse levels used near
@@ -51,7 +54,8 @@ namespace TreeLod
     Result<ErrorCurves> measureErrorCurves(OffscreenRenderer& renderer, TreeAsset& asset,
                                            const ErrorCurveOptions& options = {}, const ProgressCallback& progress = {});
 
-    /// Whether `curves` hold every candidate level of `asset` at the heights of `options`.
+    /// Whether `curves` hold every candidate level of `asset` at the heights of `options`, with the
+    /// switch FLIP between them (not so for curves of version 1).
     bool coversCandidateLevels(const ErrorCurves& curves, TreeAsset& asset, const ErrorCurveOptions& options = {});
 
     /// The package `bytes` with its error-curves chunk measured and added (replaced), every other

@@ -74,6 +74,9 @@ namespace TreeLod
 
     /// FLIP error between the prepared reference and `test` (its options; `keepErrorMap` here).
     Result<FlipResult> flip(const FlipReference& reference, const Image& test, bool keepErrorMap = false);
+    /// FLIP error between two prepared images (one size, one pixels per degree), neither filtered
+    /// again: equals flip(reference's image, test's image) exactly.
+    Result<FlipResult> flip(const FlipReference& reference, const FlipReference& test, bool keepErrorMap = false);
 
     /// The error map as an opaque colour image (magma-like: black -> purple -> orange ->
     /// pale yellow as the error goes 0 -> 1), for difference views. Needs a result made

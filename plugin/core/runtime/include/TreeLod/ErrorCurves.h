@@ -11,17 +11,25 @@
 // rmse the mean multi-scale RMSE (ImageMetrics.h) over the same views as flip. A view's FLIP is
 // the mean over the tree's own pixels (tree in the reference or in the level), its RMSE over a
 // square crop around the tree.
+// switchFlip (version 2) is what a hard switch between two levels shows: for each pair of levels
+// and height, the mean over the same views as flip of the FLIP between the two levels' images,
+// over the pixels that are tree in either.
 // A level is named as ForestLevel names it: (technique, techniqueLevel, lowRes).
 //
-// ---- Chunk layout, level 0, formatVersion 1 (ERROR_CURVES_FORMAT_VERSION) -----------------
-// Little-endian; H = heightCount:
-//   u32 heightCount H (1..64), u32 levelCount (1..256), u32 views (>= 1), u32 referenceSamples (>= 1)
+// ---- Chunk layout, level 0, formatVersion 2 (ERROR_CURVES_FORMAT_VERSION) -----------------
+// Little-endian; H = heightCount, n = levelCount:
+//   u32 heightCount H (1..64), u32 levelCount n (1..256), u32 views (>= 1), u32 referenceSamples (>= 1)
 //   f32 heightsPx[H]
-//   levelCount levels:
+//   n levels:
 //       u32 nameLength (1..32), char technique[nameLength] (printable ASCII, no terminator)
 //       u32 techniqueLevel, u32 flags (bit 0: lowRes; others are an error)
 //       f32 flip[H], f32 flipMax[H], f32 rmse[H]
+//   u32 switchPairs (0: not measured, or n (n - 1) / 2)
+//   switchPairs pairs (a, b), a < b, in the order (0, 1), (0, 2), ..., (0, n - 1), (1, 2), ...:
+//       f32 switchFlip[H]
 //   (end of chunk: trailing bytes are an error)
+// Version 1 is the same without switchPairs and the pairs (the chunk ends after the levels); it
+// still decodes, with switchFlip empty.
 #pragma once
 
 #include "TreeLod/Result.h"
@@ -36,11 +44,15 @@ namespace TreeLod
     struct TechniqueDescriptor;
 
     constexpr const char* ERROR_CURVES_CHUNK = "error-curves";
-    constexpr std::uint32_t ERROR_CURVES_FORMAT_VERSION = 1;
+    constexpr std::uint32_t ERROR_CURVES_FORMAT_VERSION = 2;
+    /// The oldest version decodeErrorCurves reads (its curves have no switchFlip).
+    constexpr std::uint32_t ERROR_CURVES_OLDEST_FORMAT_VERSION = 1;
     constexpr std::size_t ERROR_CURVES_MAX_HEIGHTS = 64;
     constexpr std::size_t ERROR_CURVES_MAX_LEVELS = 256;
     constexpr float ERROR_CURVES_MIN_HEIGHT_PX = 1.0f;
     constexpr float ERROR_CURVES_MAX_HEIGHT_PX = 16384.0f;
+    /// ErrorCurves::switchFlipAt of curves without switchFlip (version 1): below every FLIP.
+    constexpr float SWITCH_FLIP_UNKNOWN = -1.0f;
 
     /// One Forest level's curve: image error against the tree's height on screen.
     struct ErrorCurveLevel
@@ -59,6 +71,9 @@ namespace TreeLod
         std::uint32_t views = 0;             ///< views averaged per height (>= 1)
         std::uint32_t referenceSamples = 0;  ///< reference supersampling per pixel (>= 1)
         std::vector<ErrorCurveLevel> levels; ///< 1..256 levels; (technique, techniqueLevel, lowRes) unique
+        /// FLIP between two levels' images, one vector of one value per height (in [0, 1]) per pair
+        /// of levels (a, b), a < b, at switchPair(a, b); empty when not measured (version 1).
+        std::vector<std::vector<float>> switchFlip;
 
         /// The index of the level (technique, techniqueLevel, lowRes), or -1.
         int find(const std::string& technique, std::uint32_t techniqueLevel, bool lowRes) const;
@@ -70,19 +85,41 @@ namespace TreeLod
         float flipAt(std::size_t level, float heightPx) const;
         /// The worst view's FLIP (flipMax) of `level` at `heightPx`, interpolated as flipAt.
         float flipMaxAt(std::size_t level, float heightPx) const;
+
+        /// Whether switchFlip holds every pair of levels (one level: no pair, nothing unknown).
+        bool hasSwitchFlip() const { return switchFlip.size() == switchPairs(levels.size()); }
+        /// FLIP between levels `a` and `b` at `heightPx` (either order), interpolated as flipAt; 0
+        /// when a == b. SWITCH_FLIP_UNKNOWN when the curves have no switchFlip or a level is out
+        /// of range.
+        float switchFlipAt(std::size_t a, std::size_t b, float heightPx) const;
+        /// Keep the levels whose flag in `keep` (one per level) is set, their switchFlip with them.
+        void keepLevels(const std::vector<bool>& keep);
+        /// The number of pairs of `levelCount` levels, and the index of pair (a, b), a < b.
+        static std::size_t switchPairs(std::size_t levelCount)
+        {
+            return levelCount < 2 ? 0 : levelCount * (levelCount - 1) / 2;
+        }
+        std::size_t switchPair(std::size_t a, std::size_t b) const
+        {
+            return a * (2 * levels.size() - a - 1) / 2 + (b - a - 1);
+        }
     };
 
-    /// Serialise in the layout above. Deterministic; does not validate (decode does, and the
-    /// measurer should call validateErrorCurves before writing).
+    /// Serialise in the layout above, version ERROR_CURVES_FORMAT_VERSION. Deterministic; does not
+    /// validate (decode does, and the measurer should call validateErrorCurves before writing).
     std::vector<std::uint8_t> encodeErrorCurves(const ErrorCurves& curves);
 
     /// Strict: every count, size and value checked; errors name `label`, the element
     /// ("error-curves level 3 '<technique>' 1200", "error-curves heights[2]") and the reason.
-    Result<ErrorCurves> decodeErrorCurves(const std::vector<std::uint8_t>& bytes, const std::string& label);
+    /// `formatVersion`: the chunk's (PackageReader's ChunkInfo, TreeAsset::getChunkFormatVersion),
+    /// ERROR_CURVES_OLDEST_FORMAT_VERSION..ERROR_CURVES_FORMAT_VERSION; others are an error.
+    Result<ErrorCurves> decodeErrorCurves(const std::vector<std::uint8_t>& bytes, const std::string& label,
+                                          std::uint32_t formatVersion = ERROR_CURVES_FORMAT_VERSION);
 
     /// The same checks on a value (decode calls it; the measurer calls it before writing): counts
     /// within the limits, every curve one value per height, values finite and in range, heights
-    /// strictly increasing, flipMax >= flip - 1e-6, names valid, levels unique.
+    /// strictly increasing, flipMax >= flip - 1e-6, names valid, levels unique, switchFlip empty
+    /// or one curve per pair.
     Result<void> validateErrorCurves(const ErrorCurves& curves, const std::string& label);
 
     /// The chunk's descriptor (inspect, fuzz); TechniqueDescriptor.cpp registers it.

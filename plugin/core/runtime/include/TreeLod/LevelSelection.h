@@ -1,13 +1,21 @@
 // LevelSelection: each tree's level chosen from two measured things (docs/forest.md, "Budgeted
 // levels"): the asset's error curves (ErrorCurves.h, baked) and the levels' costs on this
-// machine (LevelCosts.h, calibrated). For an error budget e, at each screen height h the
-// cheapest level whose error is within e of the polygonal reference's own error at h:
+// machine (LevelCosts.h, calibrated). For an error budget e, at each screen height h the levels
+// whose error is within e of the polygonal reference's own error at h are allowed:
 //     allowed(L, h)  <=>  flip(L, h) <= flip(mesh, h) + e        (mesh always allowed)
 //                    and  flipMax(L, h) <= flipMax(mesh, h) + WORST_VIEW_BUDGET_FACTOR e
-// and the result, sampled at 4 heights per octave from 1 to 8192 px, is merged into runs of one
-// level: near to far, each with the smallest height it is drawn at. A budget of 0 draws the
-// reference itself; a budget of 1 the cheapest level everywhere. A level without a cost is not a
-// candidate.
+// at 4 heights per octave from 1 to 8192 px. Each run boundary of the plan is a switch a
+// moving tree shows (a pop), so among the allowed levels that cost less than (1 + costSlack)
+// times the cheapest at each sample, the plan is the sequence near to far whose switches show
+// least: the sum over switches of the measured FLIP between the two levels at the switch height
+// (ErrorCurves::switchFlipAt; flip(a) + flip(b) where the curves have none) plus
+// LEVEL_SWITCH_PENALTY, so fewer switches win; ties go to the smaller summed cost. A shortest
+// path over the samples (the Viterbi algorithm: Viterbi 1967, IEEE Trans. Inf. Theory 13(2));
+// with a slack of 0, the cheapest allowed level at each sample.
+// The result is merged into runs of one level: near to far, each with the smallest height it is
+// drawn at. A budget of 0 draws the reference itself; a budget of 1 the cheapest level (within
+// the slack) everywhere.
+// A level without a cost is not a candidate.
 // Shadow casters (chooseShadowLevels) get their own, coarser budget: each run's casters draw the
 // cheapest of its level and the coarser runs' levels within that budget over the run's heights.
 // A frame budget (chooseFrameBudgetStep) picks the finest error budget of a ladder whose plans'
@@ -45,6 +53,16 @@ namespace TreeLod
     /// as when both were measured over a square about half background).
     constexpr float DEFAULT_SHADOW_ERROR_BUDGET = 0.16f;
 
+    /// The cost a plan may add at a height to draw fewer or smaller switches (chooseLevels): a tenth
+    /// of the cheapest allowed level's. Within what the costs can tell apart: they are a model
+    /// (on llvmpipe it predicts 2.2x the measured time, docs/forest.md) and two runs of one bench
+    /// differ by up to 20 % in median frame time (docs/measurements.md, "Transitions").
+    constexpr float LEVEL_SWITCH_COST_SLACK = 0.1f;
+    /// What a switch counts besides the FLIP it shows: between plans whose switches show as much,
+    /// the one with fewer switches wins; small against a switch between different levels (0.07 and
+    /// more between two levels of the test oak, docs/measurements.md "Error curves at bake time").
+    constexpr float LEVEL_SWITCH_PENALTY = 0.01f;
+
     /// The heights the selection samples: 4 per octave from 8192 px (sample 0) down to 1 px.
     constexpr int SELECTION_SAMPLES_PER_OCTAVE = 4;
     constexpr int SELECTION_OCTAVES = 13;
@@ -63,10 +81,12 @@ namespace TreeLod
     };
 
     /// Runs near to far, at most `maxRuns` (the shortest runs, counted in samples, are merged into
-    /// the finer neighbour until they fit). Errors: a budget that is not finite or not in [0, 1];
-    /// curves without the reference level or with no level that has a cost.
+    /// the finer neighbour until they fit); `costSlack` as above (0: the cheapest level at each
+    /// sample). Errors: a budget that is not finite or not in [0, 1]; a slack that is not finite
+    /// or below 0; curves without the reference level or with no level that has a cost.
     Result<std::vector<LevelChoice>> chooseLevels(const ErrorCurves& curves, const std::vector<LevelCost>& costs,
-                                                  float errorBudget, std::size_t maxRuns = 16);
+                                                  float errorBudget, std::size_t maxRuns = 16,
+                                                  float costSlack = LEVEL_SWITCH_COST_SLACK);
 
     /// The run of `choices` drawn at `heightPx` (the first whose minHeightPx it reaches).
     std::size_t choiceAt(const std::vector<LevelChoice>& choices, float heightPx);

@@ -38,7 +38,21 @@ namespace TreeLod
         /// trapping (__builtin_trap) where an invariant of the validated data does not hold. Null
         /// when inspect() alone covers what a renderer reads.
         void (*fuzz)(const std::vector<std::uint8_t>& bytes) = nullptr;
+        /// The oldest version of its chunks this build still reads (0: formatVersion only), with
+        /// inspectVersion, inspect of a chunk of the version given (from the package's chunk table).
+        std::uint32_t oldestFormatVersion = 0;
+        Result<ChunkSummary> (*inspectVersion)(const std::vector<std::uint8_t>& bytes, const std::string& label,
+                                               std::uint32_t formatVersion) = nullptr;
     };
+
+    /// Whether this build reads chunks of `formatVersion` of `descriptor`'s technique.
+    bool readsFormatVersion(const TechniqueDescriptor& descriptor, std::uint32_t formatVersion);
+    /// The versions it reads, for messages: "2", or "1..2".
+    std::string readFormatVersions(const TechniqueDescriptor& descriptor);
+    /// `descriptor`'s inspect of a chunk of `formatVersion`; an error naming `label` and the
+    /// technique when this build does not read that version.
+    Result<ChunkSummary> inspectChunk(const TechniqueDescriptor& descriptor, const std::vector<std::uint8_t>& bytes,
+                                      const std::string& label, std::uint32_t formatVersion);
 
     /// Add (or replace, by name) a descriptor. Not thread-safe: registration happens during static
     /// initialisation or before any lookup.
