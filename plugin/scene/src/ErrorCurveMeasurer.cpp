@@ -183,7 +183,8 @@ namespace TreeLod
             c.flipMax.assign(options.heightsPx.size(), 0.0f);
             c.rmse.assign(options.heightsPx.size(), 0.0f);
         }
-        curves.switchFlip.assign(ErrorCurves::switchPairs(levels.size()), std::vector<float>(options.heightsPx.size(), 0.0f));
+        curves.switchFlip.assign(ErrorCurves::switchPairs(levels.size()),
+                                 std::vector<float>(options.heightsPx.size(), 0.0f));
 
         renderer.setLighting(LightingSpec()); // the CPU reference's (RenderOptions' default)
         renderer.setShadows(false);
