@@ -690,8 +690,9 @@ namespace TreeLod
                     continue;
                 const std::size_t chunk = std::size_t(package->findChunk(ERROR_CURVES_CHUNK, 0));
                 Result<std::vector<std::uint8_t>> bytes = package->readChunk(chunk);
-                Result<ErrorCurves> curves = bytes ? decodeErrorCurves(*bytes, entry.path, package->chunks()[chunk].formatVersion)
-                                                   : Result<ErrorCurves>(bytes.error());
+                Result<ErrorCurves> curves =
+                    bytes ? decodeErrorCurves(*bytes, entry.path, package->chunks()[chunk].formatVersion)
+                          : Result<ErrorCurves>(bytes.error());
                 if (!curves)
                     return printError(curves.error()), false;
                 std::string csv = "series,label,height_px,flip,flip_max,ms_rmse\n";

@@ -386,7 +386,8 @@ namespace TreeLod
         bytes = good;
         putF32(bytes, levelsEnd + 4 + 12 + 4, std::numeric_limits<float>::quiet_NaN());
         e = decodeError(bytes);
-        EXPECT_TRUE(contains(e, "error-curves level 0 'mesh' 0 to level 2 'lodf' 1200 switchFlip[1]: nan outside")) << e;
+        EXPECT_TRUE(contains(e, "error-curves level 0 'mesh' 0 to level 2 'lodf' 1200 switchFlip[1]: nan outside"))
+            << e;
     }
 
     TEST(ErrorCurves, descriptorIsRegisteredAndInspects)

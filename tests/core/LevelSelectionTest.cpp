@@ -1,9 +1,8 @@
 // Budgeted level selection (LevelSelection.h) and the cost calibration file (LevelCosts.h):
 // budget 0 draws the reference, budget 1 the cheapest level, a level's worst view bounds it too,
-// bad budgets are refused, runs are
-// merged to the Forest's level limit; within the cost slack the plan draws fewer and smaller
-// switches, and without slack the cheapest level at every sample; costs interpolate in log-log and a calibration made on
-// another renderer is not reused.
+// bad budgets are refused, runs are merged to the Forest's level limit; within the cost slack the
+// plan draws fewer and smaller switches, and without slack the cheapest level at every sample;
+// costs interpolate in log-log and a calibration made on another renderer is not reused.
 #include "TreeLod/AtomicFile.h"
 #include "TreeLod/LevelSelection.h"
 
@@ -199,10 +198,12 @@ namespace TreeLod
                 std::size_t best = 0;
                 for (std::size_t l = 1; l < curves.levels.size() && budget > 0.0f; ++l)
                 {
-                    const bool allowed = curves.flipAt(l, h) <= curves.flipAt(0, h) + budget &&
-                                         curves.flipMaxAt(l, h) <= curves.flipMaxAt(0, h) + WORST_VIEW_BUDGET_FACTOR * budget;
+                    const bool allowed =
+                        curves.flipAt(l, h) <= curves.flipAt(0, h) + budget &&
+                        curves.flipMaxAt(l, h) <= curves.flipMaxAt(0, h) + WORST_VIEW_BUDGET_FACTOR * budget;
                     const float cost = costs[l].msAt(h), bestCost = costs[best].msAt(h);
-                    if (allowed && (cost < bestCost || (cost == bestCost && curves.flipAt(l, h) < curves.flipAt(best, h))))
+                    const bool finer = cost == bestCost && curves.flipAt(l, h) < curves.flipAt(best, h);
+                    if (allowed && (cost < bestCost || finer))
                         best = l;
                 }
                 levels.push_back(best);
@@ -216,9 +217,11 @@ namespace TreeLod
             double shown = 0.0;
             for (std::size_t k = 1; k < levels.size(); ++k)
                 if (levels[k] != levels[k - 1])
-                    shown += double(curves.switchFlipAt(levels[k - 1], levels[k],
-                                                        selectionHeight(k) * std::exp2(0.5f / SELECTION_SAMPLES_PER_OCTAVE))) +
+                {
+                    const float boundary = selectionHeight(k) * std::exp2(0.5f / SELECTION_SAMPLES_PER_OCTAVE);
+                    shown += double(curves.switchFlipAt(levels[k - 1], levels[k], boundary)) +
                              double(LEVEL_SWITCH_PENALTY);
+                }
             return shown;
         }
 
@@ -282,7 +285,10 @@ namespace TreeLod
                 for (float& v : c.flipMax)
                     v = std::min(1.0f, v + 0.1f * unit(random));
                 curves.levels.push_back(c);
-                costs.push_back(cost(l == 0 ? "mesh" : "lodf", l, {0.2f + unit(random), 0.2f + unit(random), 0.2f + unit(random)}));
+                std::vector<float> ms;
+                for (int h = 0; h < 3; ++h)
+                    ms.push_back(0.2f + unit(random));
+                costs.push_back(cost(l == 0 ? "mesh" : "lodf", l, ms));
             }
             for (std::size_t p = 0; p < ErrorCurves::switchPairs(5); ++p)
             {
@@ -318,8 +324,8 @@ namespace TreeLod
     {
         // lodf 1 and 2 both within the budget everywhere; lodf 2 costs 4 % less, then 4 % more,
         // octave by octave, than lodf 1.
-        SwitchFixture f({0.06f, 0.06f, 0.06f, 0.06f, 0.06f, 0.06f, 0.06f}, {0.065f, 0.065f, 0.065f, 0.065f, 0.065f, 0.065f, 0.065f},
-                        std::vector<float>(7, 1.0f), {0.96f, 1.04f, 0.96f, 1.04f, 0.96f, 1.04f, 0.96f});
+        SwitchFixture f(std::vector<float>(7, 0.06f), std::vector<float>(7, 0.065f), std::vector<float>(7, 1.0f),
+                        {0.96f, 1.04f, 0.96f, 1.04f, 0.96f, 1.04f, 0.96f});
         f.setSwitches(0.2f, 0.2f, 0.1f);
         Result<std::vector<LevelChoice>> exact = chooseLevels(f.curves, f.costs, 0.02f, 16, 0.0f);
         ASSERT_TRUE(exact) << exact.error().message();

@@ -268,7 +268,8 @@ namespace TreeLod
         ASSERT_TRUE(writer.addChunk(ERROR_CURVES_CHUNK, 0, 3, v1));
         Result<std::vector<std::uint8_t>> newer = writer.toBytes();
         ASSERT_TRUE(newer) << newer.error().message();
-        TreeAssetPtr future = TreeAssetManager::getSingleton().loadFromBytes("oak.v3-curves", Ogre::RGN_DEFAULT, *newer);
+        TreeAssetPtr future =
+            TreeAssetManager::getSingleton().loadFromBytes("oak.v3-curves", Ogre::RGN_DEFAULT, *newer);
         try
         {
             future->readChunk(ERROR_CURVES_CHUNK);
@@ -288,8 +289,8 @@ namespace TreeLod
         // Loaded: the chunk is read, the curves have no switch FLIP, and they do not cover the levels.
         TreeAssetPtr old = TreeAssetManager::getSingleton().loadFromBytes("oak.v1-curves", Ogre::RGN_DEFAULT, *bytes);
         EXPECT_EQ(old->getChunkFormatVersion(ERROR_CURVES_CHUNK), 1u);
-        Result<ErrorCurves> read =
-            decodeErrorCurves(old->readChunk(ERROR_CURVES_CHUNK), "oak", old->getChunkFormatVersion(ERROR_CURVES_CHUNK));
+        Result<ErrorCurves> read = decodeErrorCurves(old->readChunk(ERROR_CURVES_CHUNK), "oak",
+                                                     old->getChunkFormatVersion(ERROR_CURVES_CHUNK));
         ASSERT_TRUE(read) << read.error().message();
         EXPECT_EQ(read->levels.size(), curves->levels.size());
         EXPECT_FALSE(read->hasSwitchFlip());

@@ -93,8 +93,9 @@ namespace TreeLod
             if (!prepared)
                 return fail("", "reference", "FLIP: " + prepared.error().message());
             const std::size_t n = shots.levels.size();
+            const std::vector<std::uint8_t> referenceTree = treeMask(reference);
             std::vector<std::size_t> first(n); // the first level drawn byte for byte as this one
-            std::vector<Image> images(n);
+            std::vector<std::vector<std::uint8_t>> trees(n); // each level's tree pixels
             std::vector<FlipReference> analysed(n);
             ViewScores scores;
             scores.levels.resize(n);
@@ -111,16 +112,17 @@ namespace TreeLod
                     continue;
                 }
                 const std::string element = "level " + Forest::describeLevel(levels[l]);
-                images[l] = cropImage(toImage(shots.levels[l]), crop);
-                Result<FlipReference> image = FlipReference::make(images[l]);
+                const Image test = cropImage(toImage(shots.levels[l]), crop);
+                trees[l] = treeMask(test);
+                Result<FlipReference> image = FlipReference::make(test);
                 Result<FlipResult> f = image ? flip(*prepared, *image, true) : Result<FlipResult>(image.error());
                 if (!f)
                     return fail("", element, "FLIP: " + f.error().message());
                 analysed[l] = std::move(*image);
-                Result<MultiScaleRmseResult> m = multiScaleRmse(reference, images[l]);
+                Result<MultiScaleRmseResult> m = multiScaleRmse(reference, test);
                 if (!m)
                     return fail("", element, "multi-scale RMSE: " + m.error().message());
-                scores.levels[l] = Scores{meanOverTree(*f, reference, images[l]), m->combined};
+                scores.levels[l] = Scores{meanOverTree(*f, referenceTree, trees[l]), m->combined};
             }
             if (!switches)
                 return scores;
@@ -138,7 +140,7 @@ namespace TreeLod
                         return fail("", "levels " + Forest::describeLevel(levels[a]) + " and " +
                                             Forest::describeLevel(levels[b]),
                                     "FLIP: " + f.error().message());
-                    scores.switches.push_back(meanOverTree(*f, images[i], images[j]));
+                    scores.switches.push_back(meanOverTree(*f, trees[i], trees[j]));
                 }
             return scores;
         }
@@ -183,7 +185,8 @@ namespace TreeLod
             c.flipMax.assign(options.heightsPx.size(), 0.0f);
             c.rmse.assign(options.heightsPx.size(), 0.0f);
         }
-        curves.switchFlip.assign(ErrorCurves::switchPairs(levels.size()), std::vector<float>(options.heightsPx.size(), 0.0f));
+        curves.switchFlip.assign(ErrorCurves::switchPairs(levels.size()),
+                                 std::vector<float>(options.heightsPx.size(), 0.0f));
 
         renderer.setLighting(LightingSpec()); // the CPU reference's (RenderOptions' default)
         renderer.setShadows(false);

@@ -55,7 +55,7 @@ namespace TreeLod
 
         std::string element(const std::string& what) { return std::string(ERROR_CURVES_CHUNK) + " " + what; }
 
-        /// "error-curves switch level 1 'lodf' 0 to level 3 'impostor' 0".
+        /// "error-curves level 1 'lodf' 0 to level 3 'impostor' 0": the pair of levels (a, b).
         std::string switchElement(const ErrorCurves& curves, std::size_t a, std::size_t b)
         {
             return levelElement(a, curves.levels[a]) + " to" +
@@ -457,7 +457,7 @@ namespace TreeLod
         }
         if (!r.ok())
             return r.error();
-        if (formatVersion >= 2)
+        if (formatVersion >= 2) // the switch section
         {
             r.setElement(element("switchFlip"));
             const std::uint32_t pairs = r.u32();

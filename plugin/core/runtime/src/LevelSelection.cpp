@@ -73,7 +73,8 @@ namespace TreeLod
             const float allowed = curves.flipAt(ref, h) + errorBudget;
             const float allowedWorst = curves.flipMaxAt(ref, h) + WORST_VIEW_BUDGET_FACTOR * errorBudget;
             auto isAllowed = [&](std::size_t l) {
-                return l == ref || (costOf[l] && curves.flipAt(l, h) <= allowed && curves.flipMaxAt(l, h) <= allowedWorst);
+                return l == ref ||
+                       (costOf[l] && curves.flipAt(l, h) <= allowed && curves.flipMaxAt(l, h) <= allowedWorst);
             };
             std::size_t best = ref;
             float bestCost = costOf[best] ? costOf[best]->msAt(h) : std::numeric_limits<float>::infinity();

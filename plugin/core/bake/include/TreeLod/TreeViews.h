@@ -14,7 +14,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <vector>
 
 namespace TreeLod
 {
@@ -57,20 +59,36 @@ namespace TreeLod
         return image.pixels.empty() ? 0.0 : double(covered) / double(image.pixels.size());
     }
 
+    /// One flag per pixel of `image`: whether it is a tree pixel (isTreePixel).
+    inline std::vector<std::uint8_t> treeMask(const Image& image)
+    {
+        std::vector<std::uint8_t> mask(image.pixels.size());
+        for (std::size_t i = 0; i < mask.size(); ++i)
+            mask[i] = isTreePixel(image.pixels[i]);
+        return mask;
+    }
+
     /// The mean of a FLIP error map (FlipOptions::keepErrorMap) over the pixels that are tree in
-    /// `reference` or in `test`: the error per pixel of the tree, whatever share of the image the
-    /// background is; `result.mean` where neither has a tree pixel.
-    inline double meanOverTree(const FlipResult& result, const Image& reference, const Image& test)
+    /// either image (their treeMask flags): the error per pixel of the tree, whatever share of the
+    /// image the background is; `result.mean` where neither has a tree pixel.
+    inline double meanOverTree(const FlipResult& result, const std::vector<std::uint8_t>& reference,
+                               const std::vector<std::uint8_t>& test)
     {
         double sum = 0.0;
         std::size_t count = 0;
         for (std::size_t i = 0; i < result.errorMap.size(); ++i)
-            if (isTreePixel(reference.pixels[i]) || isTreePixel(test.pixels[i]))
+            if (reference[i] || test[i])
             {
                 sum += result.errorMap[i];
                 ++count;
             }
         return count > 0 ? sum / double(count) : result.mean;
+    }
+
+    /// The same over the tree pixels of `reference` or `test`.
+    inline double meanOverTree(const FlipResult& result, const Image& reference, const Image& test)
+    {
+        return meanOverTree(result, treeMask(reference), treeMask(test));
     }
 
     inline Extent unite(Extent a, const Extent& b)
