@@ -519,12 +519,12 @@ namespace TreeLod
                                                   -4.0f, 4.0f, 9);
         mErrorBudgetSlider = nullptr;
         if (sample.hasErrorBudget())
-            mErrorBudgetSlider = mTrays->createLongSlider(TL_TOPLEFT, "ErrorBudget", "Error budget (auto)", WIDGET_WIDTH,
+            mErrorBudgetSlider = mTrays->createLongSlider(TL_TOPLEFT, "ErrorBudget", "Error budget", WIDGET_WIDTH,
                                                           60.0f, 54.0f, 0.0f, float(ERROR_BUDGETS.size() - 1),
                                                           unsigned(ERROR_BUDGETS.size()));
         mTransitionSlider = nullptr;
         if (sample.hasLodTransition())
-            mTransitionSlider = mTrays->createLongSlider(TL_TOPLEFT, "Transition", "Level transitions (X)", WIDGET_WIDTH,
+            mTransitionSlider = mTrays->createLongSlider(TL_TOPLEFT, "Transition", "Transitions (X)", WIDGET_WIDTH,
                                                          60.0f, 54.0f, 0.0f, float(TRANSITIONS.size() - 1),
                                                          unsigned(TRANSITIONS.size()));
         mShadowsBox = mTrays->createCheckBox(TL_TOPLEFT, "Shadows", "Shadows (H)", WIDGET_WIDTH);
