@@ -52,7 +52,7 @@ namespace TreeLod
                           [](Ogre::MovableObject& object) -> std::vector<TechniqueStateLine> {
                               const auto& tree = static_cast<CrossedQuadsTree&>(object);
                               return {{"quads " + std::to_string(tree.getQuadCount()), -1.0, ""}};
-                          }, TechniqueRoles{}});
+                          }, TechniqueRoles{}, nullptr}); // one level
         }
 
         const TechniqueRegistry::Registration registration(&registerCrossedQuads);

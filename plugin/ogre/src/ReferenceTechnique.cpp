@@ -63,7 +63,7 @@ namespace TreeLod
                                   lines.push_back({"bark LoD " + std::to_string(level) + "  ", drawn ? 1.0 : 0.0, ""});
                               }
                               return lines;
-                          }, roles});
+                          }, roles, nullptr}); // the mesh LoD of an Entity
         }
 
         const TechniqueRegistry::Registration registration(&registerReference);

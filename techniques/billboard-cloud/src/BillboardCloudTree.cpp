@@ -227,14 +227,15 @@ namespace TreeLod
         mLodValue = mLodBias.value(*this, camera);
         mPixelCountValue = mLodBias.screenSizeOf(mLodValue, *this, camera);
 
+        const std::uint32_t strategyLevel = levelForPixelCount(mPixelCountValue);
         if (mOptions.level < 0)
-            mLevel = mLodBias.clampMesh(Ogre::ushort(std::min<std::uint32_t>(levelForPixelCount(mPixelCountValue), 0xffff)));
+            mLevel = mLodBias.clampMesh(Ogre::ushort(std::min<std::uint32_t>(strategyLevel, 0xffff)));
         mLevel = std::min(mLevel, std::max<std::uint32_t>(getLevelCount(), 1) - 1);
         // A transition to the next level (ObjectTransition.h), where the strategy chose this one and
         // the next is allowed: screen sizes are square roots of pixel counts.
         mTransitionShare = 0.0f;
         if (mOptions.level < 0 && mLevel + 1 < mLevelParts.size() && mLevel < mSwitchPixelCounts.size() &&
-            levelForPixelCount(mPixelCountValue) == mLevel && mLodBias.clampMesh(Ogre::ushort(mLevel + 1)) == mLevel + 1 &&
+            strategyLevel == mLevel && mLodBias.clampMesh(Ogre::ushort(mLevel + 1)) == mLevel + 1 &&
             mSwitchPixelCounts[mLevel] > 0.0f && mLevelParts[mLevel + 1]->mIndexData.indexCount > 0)
         {
             const Ogre::Real threshold = mSwitchPixelCounts[mLevel];

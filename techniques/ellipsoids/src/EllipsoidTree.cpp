@@ -119,28 +119,31 @@ namespace TreeLod
     void EllipsoidTree::setLevels(float heightPx)
     {
         mHeightPx = heightPx;
-        bool natural = mOptions.level < 0; // the level the height selects: transitions allowed
-        if (mOptions.level >= 0)
+        // Forced or clamped: heightPx is not what the tree shows, so nothing fades.
+        bool held = mOptions.level >= 0;
+        if (held) // the lines made for its target height
+        {
             mLevel = std::size_t(mOptions.level);
+            heightPx = mGpu->levels[mLevel].targetHeightPx;
+        }
         else
         {
             mLevel = TreeLod::levelForHeight(mGpu->levels, heightPx);
             const std::size_t clamped = std::min<std::size_t>(
                 mLodBias.clampMesh(Ogre::ushort(std::min<std::size_t>(mLevel, 0xffff))), mGpu->levels.size() - 1);
-            if (clamped != mLevel) // a clamped level: the lines made for its target height
+            held = clamped != mLevel;
+            if (held) // the lines made for its target height
                 heightPx = mGpu->levels[clamped].targetHeightPx;
-            natural = clamped == mLevel && mLodBias.clampMesh(Ogre::ushort(std::min<std::size_t>(mLevel + 1, 0xffff))) ==
-                                               mLevel + 1;
             mLevel = clamped;
         }
-        setLevelDraw(mEllipsoids, mGpu->levels, mLevel, natural ? transitionShare(mGpu->levels, mLevel, heightPx) : 0.0f);
+        const bool nextAllowed = mLodBias.clampMesh(Ogre::ushort(std::min<std::size_t>(mLevel + 1, 0xffff))) == mLevel + 1;
+        setLevelDraw(mEllipsoids, mGpu->levels, mLevel,
+                     !held && nextAllowed ? transitionShare(mGpu->levels, mLevel, heightPx) : 0.0f);
         if (mLines)
         {
-            // A forced level: the lines made for its target height.
-            mLineLevel = TreeLod::levelForHeight(mLines->levels, mOptions.level >= 0 ? mGpu->levels[mLevel].targetHeightPx
-                                                                            : heightPx);
+            mLineLevel = TreeLod::levelForHeight(mLines->levels, heightPx);
             setLevelDraw(mLineParts, mLines->levels, mLineLevel,
-                         mOptions.level < 0 ? transitionShare(mLines->levels, mLineLevel, heightPx) : 0.0f);
+                         held ? 0.0f : transitionShare(mLines->levels, mLineLevel, heightPx));
         }
     }
 

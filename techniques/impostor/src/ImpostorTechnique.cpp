@@ -68,7 +68,7 @@ namespace TreeLod
                               [](TreeAsset& asset) { return ImpostorResources::of(asset).getGpu().quad(); }), std::make_shared<ImpostorLevels>(),
                           [](Ogre::MovableObject&) -> std::vector<TechniqueStateLine> {
                               return {{"one quad, 2 triangles", -1.0, ""}};
-                          }, roles});
+                          }, roles, nullptr}); // one level
 
             // The speed floors: the impostor's quad drawn as plain Ogre objects (QuadFloors.h).
             registry.addBaseline({"entities", "floor: one Ogre entity per tree (a quad)", '^', IMPOSTOR_CHUNK,

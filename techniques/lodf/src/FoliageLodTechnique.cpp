@@ -106,7 +106,7 @@ namespace TreeLod
                                        " " + std::to_string(tree.getLeafCount()) + "/" +
                                            std::to_string(tree.getMaxLeafCount())},
                                       {"bark LoD " + std::to_string(tree.getBarkLodIndex()), -1.0, ""}};
-                          }, roles});
+                          }, roles, nullptr}); // a continuous collapse
         }
 
         const TechniqueRegistry::Registration registration(&registerFoliageLod);

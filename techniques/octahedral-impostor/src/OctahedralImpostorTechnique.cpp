@@ -54,7 +54,7 @@ namespace TreeLod
                           std::make_shared<OctahedralImpostorLevels>(),
                           [](Ogre::MovableObject&) -> std::vector<TechniqueStateLine> {
                               return {{"one quad, 3 of the baked views blended", -1.0, ""}};
-                          }, roles});
+                          }, roles, nullptr}); // one level
         }
 
         const TechniqueRegistry::Registration registration(&registerOctahedralImpostor);

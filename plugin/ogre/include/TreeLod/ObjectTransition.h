@@ -3,8 +3,9 @@
 // switch the object draws both levels, each Renderable with its screen-door code, so the pair
 // covers what one level covers; shadow cameras read the viewer's LoD, so casters get the same
 // codes and cast one shadow. Length 0 (the default, as the Forest's) switches hard.
-// The code reaches the vertex programs as the Renderable's custom parameter
-// TRANSITION_CUSTOM_PARAMETER (uniform `objectTransition`, TreeLodTransition.glsl).
+// The clouds' and ellipsoids' codes reach their vertex programs as each Renderable's custom
+// parameter TRANSITION_CUSTOM_PARAMETER (uniform `objectTransition`, TreeLodTransition.glsl); the
+// volume octree's vertex program computes a code per cell from the band's end it is given.
 #pragma once
 
 #include "TreeLod/ForestInstances.h"
@@ -15,7 +16,6 @@
 #include <OgreRenderable.h>
 #include <OgreVector.h>
 
-#include <cmath>
 #include <string>
 
 namespace TreeLod
