@@ -140,6 +140,11 @@ namespace TreeLod
                 run.technique = r.value("technique", "");
                 run.lodBias = r.value("lodBias", 1.0f);
                 run.assetBytes = r.value("gpuBytes", std::uint64_t(0));
+                run.peakGpuBytes = r.value("peakGpuBytes", run.assetBytes);
+                run.residentLevels = r.value("residentLevels", std::int64_t(-1));
+                run.plannedGpuBytes = r.value("plannedGpuBytes", std::uint64_t(0));
+                run.memoryBudgetBytes = r.value("memoryBudgetBytes", std::uint64_t(0));
+                run.binding = r.value("binding", "");
                 run.instanceBytes = r.value("instanceBytes", std::uint64_t(0));
                 run.rssMiB = r.value("rssMiB", NAN);
                 run.peakRssMiB = r.value("peakRssMiB", NAN);
@@ -161,6 +166,7 @@ namespace TreeLod
                         record.visible = f.value("visible", 0u);
                         record.levels = f.value("levels", std::vector<std::uint32_t>{});
                         record.uploadedBytes = f.value("uploadedBytes", std::uint64_t(0));
+                        record.gpuBytes = f.value("gpuBytes", std::uint64_t(0));
                     }
                     if (f.contains("motionImage"))
                     {
@@ -389,7 +395,7 @@ namespace TreeLod
         cmd->add_option("--techniques", args->techniques,
                         "comma-separated techniques besides the comparison runs (" + comparisons + "): auto (the "
                         "script's choice), auto@E (budgeted auto at error budget E), auto~MS (under a frame budget of "
-                        "MS milliseconds) or any of " + known + "; each may end in +fadeT (level transitions of length T, 0: hard switches)")
+                        "MS milliseconds) or any of " + known + "; each may end in +fadeT (level transitions of length T, 0: hard switches) and +memMB (auto: a GPU memory budget of MB megabytes)")
             ->capture_default_str();
         cmd->add_option("--lod-bias", args->lodBiases, "comma-separated LoD biases (< 1 = less detail)")
             ->capture_default_str();

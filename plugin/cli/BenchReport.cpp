@@ -318,7 +318,7 @@ namespace TreeLod
             // frames.csv: one row per run and frame.
             std::string csv = "trees,technique,lod_bias,frame,time_s,timed,cpu_ms,frame_ms,batches,triangles,visible,"
                               "instances_per_level,flip,ms_rmse,temporal_noise,temporal_flip,pop_flip,level_switches,skipped,"
-                              "uploaded_bytes\n";
+                              "uploaded_bytes,gpu_bytes\n";
             for (const Run& run : runs)
                 for (const FrameRecord& r : run.frames)
                     csv += std::to_string(run.count) + "," + run.technique + "," + number(run.lodBias, 3) + "," +
@@ -331,7 +331,8 @@ namespace TreeLod
                            number(r.flip) + "," + number(r.msRmse) + "," + number(r.temporalNoise) + "," +
                            number(r.temporalFlip) + "," + number(r.popFlip) + "," +
                            (r.switches >= 0 ? std::to_string(r.switches) : "") + ",\"" +
-                           r.skipped + "\"," + (r.timed ? std::to_string(r.uploadedBytes) : "") + "\n";
+                           r.skipped + "\"," + (r.timed ? std::to_string(r.uploadedBytes) : "") + "," +
+                           (r.timed ? std::to_string(r.gpuBytes) : "") + "\n";
             if (Result<void> w = writeText(args.output + "/frames.csv", csv); !w)
                 return printError(w.error()), false;
 
@@ -372,7 +373,8 @@ namespace TreeLod
                             {"medianFrameMs", num(points[i].medianFrameMs)},
                             {"meanFlip", num(points[i].meanFlip)},
                             {"meanTemporalFlip", num(meanOf(runs[i], &FrameRecord::temporalFlip))},
-                            {"meanPopFlip", num(meanOf(runs[i], &FrameRecord::popFlip))}};
+                            {"meanPopFlip", num(meanOf(runs[i], &FrameRecord::popFlip))},
+                            {"peakGpuBytes", runs[i].peakGpuBytes}};
             };
             std::vector<std::uint32_t> counts;
             for (const Run& run : runs)
@@ -406,17 +408,19 @@ namespace TreeLod
                 for (std::size_t i : front)
                 {
                     frontJson.push_back(pointJson(i));
-                    char text[128];
+                    char text[160];
                     const double motion = meanOf(runs[i], &FrameRecord::temporalFlip);
                     const double pops = meanOf(runs[i], &FrameRecord::popFlip);
+                    const double megabytes = double(runs[i].peakGpuBytes) / 1e6;
                     if (std::isfinite(motion) && std::isfinite(pops))
-                        std::snprintf(text, sizeof text, " %.3g ms %.3g (motion %.3g pops %.3g)",
-                                      points[i].medianFrameMs, points[i].meanFlip, motion, pops);
+                        std::snprintf(text, sizeof text, " %.3g ms %.3g %.3g MB (motion %.3g pops %.3g)",
+                                      points[i].medianFrameMs, points[i].meanFlip, megabytes, motion, pops);
                     else if (std::isfinite(motion))
-                        std::snprintf(text, sizeof text, " %.3g ms %.3g (motion %.3g)", points[i].medianFrameMs,
-                                      points[i].meanFlip, motion);
+                        std::snprintf(text, sizeof text, " %.3g ms %.3g %.3g MB (motion %.3g)", points[i].medianFrameMs,
+                                      points[i].meanFlip, megabytes, motion);
                     else
-                        std::snprintf(text, sizeof text, " %.3g ms %.3g", points[i].medianFrameMs, points[i].meanFlip);
+                        std::snprintf(text, sizeof text, " %.3g ms %.3g %.3g MB", points[i].medianFrameMs,
+                                      points[i].meanFlip, megabytes);
                     line += (line.empty() ? "" : ", ") + runName(runs[i]) + text;
                 }
                 if (front.empty())
@@ -445,6 +449,20 @@ namespace TreeLod
                     std::printf("Pareto front (%s): %s\n", treesText(count).c_str(), line.c_str());
             }
             summary["pareto"] = pareto;
+            // The scene's GPU memory: each run's peak (levels and instance buffers), the largest.
+            std::uint64_t scenePeakGpu = 0;
+            std::string gpuLine;
+            for (const Run& run : runs)
+            {
+                scenePeakGpu = std::max(scenePeakGpu, run.peakGpuBytes);
+                char text[96];
+                std::snprintf(text, sizeof text, " %.3g MB", double(run.peakGpuBytes) / 1e6);
+                gpuLine += (gpuLine.empty() ? "" : ", ") + runName(run) + text +
+                           (run.binding.empty() ? "" : " (" + run.binding + " binds)");
+            }
+            summary["peakGpuBytes"] = scenePeakGpu;
+            if (!args.quiet && !runs.empty())
+                std::printf("peak GPU memory: %s\n", gpuLine.c_str());
             if (!args.quiet)
                 std::printf("peak resident memory: frame timer %.0f MiB, bench %.0f MiB\n", framesPeakMiB,
                             benchPeakMiB);
@@ -516,6 +534,11 @@ namespace TreeLod
                                    {"referenceTemporalNoise", num(statsOf(refNoise).mean)},
                                    {"motion", motionJson(run, reference)},
                                    {"assetBytes", run.assetBytes},
+                                   {"gpu", {{"peakBytes", run.peakGpuBytes},
+                                            {"residentLevels", run.residentLevels >= 0 ? json(run.residentLevels) : json(nullptr)},
+                                            {"plannedBytes", run.residentLevels >= 0 ? json(run.plannedGpuBytes) : json(nullptr)},
+                                            {"memoryBudgetBytes", run.memoryBudgetBytes},
+                                            {"binding", run.binding.empty() ? json(nullptr) : json(run.binding)}}},
                                    {"bakeSeconds", run.bakeSeconds},
                                    {"trade", {{"medianFrameMs", num(points[i].medianFrameMs)},
                                               {"meanFlip", num(points[i].meanFlip)}}},

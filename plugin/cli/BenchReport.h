@@ -72,6 +72,7 @@ namespace TreeLod
             std::uint32_t visible = 0;
             std::vector<std::uint32_t> levels; ///< visible instances per level index, all species summed
             std::uint64_t uploadedBytes = 0;   ///< levels made resident in this frame (Forest upload budget)
+            std::uint64_t gpuBytes = 0;        ///< GPU bytes after the frame (levels and instance buffers)
             double flip = NAN, msRmse = NAN, temporalNoise = NAN;
             /// Motion frames: FLIP between this frame and the next at the script's frame rate over
             /// the trees' pixels; the level switches between them and the trees visible (-1: not
@@ -91,7 +92,13 @@ namespace TreeLod
             std::string technique;
             float lodBias = 1.0f;
             std::vector<FrameRecord> frames;
-            std::uint64_t assetBytes = 0;    ///< GPU bytes of what the run drew
+            std::uint64_t assetBytes = 0;    ///< GPU bytes of what the run drew, at its end
+            std::uint64_t peakGpuBytes = 0;  ///< the most GPU bytes over its frames (levels, instance buffers)
+            /// The Forest's runs (-1 / empty for the floors): levels resident at the end, the planned
+            /// levels' bytes, the memory budget (0: none) and the budget that binds.
+            std::int64_t residentLevels = -1;
+            std::uint64_t plannedGpuBytes = 0, memoryBudgetBytes = 0;
+            std::string binding;
             std::uint64_t instanceBytes = 0; ///< the Forest's instance store on the CPU
             double rssMiB = NAN, peakRssMiB = NAN; ///< treelod_frames' resident memory after the run
             double bakeSeconds = 0.0;

@@ -311,6 +311,7 @@ namespace TreeLod
                         json run = {{"trees", trees}, {"technique", technique}, {"lodBias", bias},
                                     {"buildSeconds", buildSeconds}};
                         json frameRows = json::array();
+                        std::uint64_t peakGpuBytes = scene->getGpuBytes();
                         const std::string label = technique + " bias " + biasText(bias) + " (" + std::to_string(trees) +
                                                   (trees == 1 ? " tree)" : " trees)");
                         for (std::uint32_t f = 0; f < frames; ++f)
@@ -333,6 +334,8 @@ namespace TreeLod
                                 row["frameMs"] = timing.frameMilliseconds;
                                 row["batches"] = timing.batches;
                                 row["triangles"] = timing.triangles;
+                                row["gpuBytes"] = scene->getGpuBytes();
+                                peakGpuBytes = std::max(peakGpuBytes, scene->getGpuBytes());
                                 if (!baseline)
                                 {
                                     row["visible"] = stats.visibleInstances;
@@ -419,6 +422,19 @@ namespace TreeLod
                         run["frames"] = std::move(frameRows);
                         run["levelNotes"] = scene->getLevelNotes();
                         run["gpuBytes"] = scene->getGpuBytes();
+                        run["peakGpuBytes"] = std::max(peakGpuBytes, scene->getGpuBytes());
+                        if (!baseline)
+                        {
+                            const Forest& forest = scene->getForest();
+                            run["residentLevels"] = forest.getResidentLevelCount();
+                            run["plannedGpuBytes"] = forest.getStats().plannedGpuBytes;
+                            run["memoryBudgetBytes"] = forest.getMemoryBudget();
+                            bool budgeted = false;
+                            for (std::uint32_t s = 0; s < forest.getSpeciesCount(); ++s)
+                                budgeted = budgeted || forest.isBudgeted(s);
+                            if (budgeted)
+                                run["binding"] = toString(forest.getBindingBudget());
+                        }
                         run["instanceBytes"] = scene->getForest().getInstances().getMemoryBytes();
                         run["rssMiB"] = rss;
                         run["peakRssMiB"] = peak;

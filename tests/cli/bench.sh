@@ -168,6 +168,30 @@ awk -F, 'NR > 1 && $4 < 5 && ($2 == "mesh" || $2 == "impostor" || $2 == "auto") 
   || fail "Forest runs' frames without pops or switches above"
 awk -F, 'NR > 1 && ($2 == "entities" || $2 == "merged-quads" || $2 == "billboard-set") && ($17 != "" || $18 != "") {
   bad = 1; print } END { exit bad }' "$out/single/frames.csv" || fail "pops counted for a floor that is no Forest (above)"
+# GPU memory: every run's peak, each timed frame's bytes; the Forest's runs their resident levels and,
+# for auto, the planned bytes and the budget that binds (the error budget: no memory budget here).
+python3 - "$out/single/summary.json" "$out/single/frames.csv" <<'EOF' || fail "GPU memory figures above"
+import csv, json, sys
+summary = json.load(open(sys.argv[1]))
+bad = []
+for r in summary["results"]:
+    key, gpu = (r["technique"], r["lodBias"]), r["gpu"]
+    if not gpu["peakBytes"] > 0:
+        bad.append(f"{key}: peak GPU bytes {gpu['peakBytes']}")
+    forest = key[0] in ("mesh", "impostor", "auto", "auto@0.5")
+    if forest != (gpu["residentLevels"] is not None) or (forest and gpu["residentLevels"] < 1):
+        bad.append(f"{key}: resident levels {gpu['residentLevels']}")
+    auto = key[0].startswith("auto")
+    if auto != (gpu["binding"] == "error") or (auto and not gpu["plannedBytes"] > 0):
+        bad.append(f"{key}: binding {gpu['binding']}, planned {gpu['plannedBytes']}")
+if summary["peakGpuBytes"] != max(r["gpu"]["peakBytes"] for r in summary["results"]):
+    bad.append(f"scene peak {summary['peakGpuBytes']}")
+for row in csv.DictReader(open(sys.argv[2])):
+    if row["timed"] == "1" and not int(row["gpu_bytes"]) > 0:
+        bad.append(f"frame {row['technique']} {row['frame']}: gpu_bytes {row['gpu_bytes']}")
+print("\n".join(bad[:10]))
+sys.exit(1 if bad else 0)
+EOF
 plot "$out/single" motion 30 # the frame-time plot's runs, 5 motion frames each
 plot "$out/single" pops 15   # the Forest's among them
 python3 - "$out/single/summary.json" <<'EOF' || fail "motion figures above"
@@ -245,7 +269,7 @@ grep -q "incomplete (the frame timer stopped after 2 runs)" "$out/cut.txt" || { 
   --techniques auto --lod-bias 1,0.5 --samples 2 --cache "$shared" --frames-from "$out/single" \
   > "$out/report.txt" 2> "$out/report-progress.txt"
 grep -q '^Pareto front (1 tree): ' "$out/report.txt" || { cat "$out/report.txt"; fail "no Pareto front printed"; }
-grep -q '^Pareto front (1 tree): .* ms [0-9.e-]* (motion [0-9.e-]* pops [0-9.e-]*)' "$out/report.txt" \
+grep -q '^Pareto front (1 tree): .* ms [0-9.e-]* [0-9.e-]* MB (motion [0-9.e-]* pops [0-9.e-]*)' "$out/report.txt" \
   || { cat "$out/report.txt"; fail "the printed front lacks the temporal FLIP"; }
 pareto "$out/single-report" "$out/report.txt" || fail "single-report: Pareto front above"
 python3 -c 'import json, sys; a, b = (json.load(open(f))["pareto"] for f in sys.argv[1:]); sys.exit(a != b)' \

@@ -50,15 +50,43 @@ namespace TreeLod
             // Pair p: p / 16 at 8 px, p / 32 at 32 px, p / 64 at 128 px.
             for (std::size_t p = 0; p < ErrorCurves::switchPairs(c.levels.size()); ++p)
                 c.switchFlip.push_back({float(p) / 16.0f, float(p) / 32.0f, float(p) / 64.0f});
+            // The mesh's buffer, LoDF's vertex and index buffers (both levels), the cloud's and the
+            // impostor's textures.
+            c.resourceBytes = {1000000, 250000, 40000, 8000, 2000};
+            const std::vector<std::vector<std::uint32_t>> resources = {{0}, {1, 2}, {1, 2}, {3}, {4}};
+            for (std::size_t l = 0; l < c.levels.size(); ++l)
+                c.levels[l].resources = resources[l];
             return c;
         }
 
-        /// The bytes of `c` as version 1 wrote them: the version 2 layout ends with the switch
-        /// section, which for curves without switch data is one u32 of 0.
+        /// The bytes of the resource section of sample(): the count, 5 sizes, 5 lists.
+        constexpr std::size_t SAMPLE_RESOURCE_BYTES = 4 + 5 * 8 + 4 * 5 + 4 * 7;
+
+        /// `c` without GPU bytes (as decoded from versions 1 and 2).
+        ErrorCurves withoutGpuBytes(ErrorCurves c)
+        {
+            c.resourceBytes.clear();
+            for (ErrorCurveLevel& level : c.levels)
+                level.resources.clear();
+            return c;
+        }
+
+        /// The bytes of `c` as version 2 wrote them: the version 3 layout ends with the resource
+        /// section, which for curves without GPU bytes is one u32 of 0.
+        std::vector<std::uint8_t> versionTwoBytes(const ErrorCurves& c)
+        {
+            std::vector<std::uint8_t> bytes = encodeErrorCurves(withoutGpuBytes(c));
+            EXPECT_EQ(std::vector<std::uint8_t>(bytes.end() - 4, bytes.end()), std::vector<std::uint8_t>(4, 0));
+            bytes.resize(bytes.size() - 4);
+            return bytes;
+        }
+
+        /// The bytes of `c` as version 1 wrote them: version 2's less its switch section, which for
+        /// curves without switch data is one u32 of 0.
         std::vector<std::uint8_t> versionOneBytes(ErrorCurves c)
         {
             c.switchFlip.clear();
-            std::vector<std::uint8_t> bytes = encodeErrorCurves(c);
+            std::vector<std::uint8_t> bytes = versionTwoBytes(c);
             EXPECT_EQ(std::vector<std::uint8_t>(bytes.end() - 4, bytes.end()), std::vector<std::uint8_t>(4, 0));
             bytes.resize(bytes.size() - 4);
             return bytes;
@@ -99,7 +127,7 @@ namespace TreeLod
         ASSERT_TRUE(validateErrorCurves(c, "tree").ok()) << validateError(c);
         const std::vector<std::uint8_t> bytes = encodeErrorCurves(c);
         // 16 header + 12 heights + per level: 4 + name + 8 + 36; the pair count, 10 pairs of 3 heights.
-        EXPECT_EQ(bytes.size(), 16u + 12u + 5u * 48u + 4u + 4u + 4u + 15u + 8u + 4u + 10u * 12u);
+        EXPECT_EQ(bytes.size(), 16u + 12u + 5u * 48u + 4u + 4u + 4u + 15u + 8u + 4u + 10u * 12u + SAMPLE_RESOURCE_BYTES);
         Result<ErrorCurves> decoded = decodeErrorCurves(bytes, "tree");
         ASSERT_TRUE(decoded.ok()) << decoded.error().message();
         EXPECT_EQ(decoded->heightsPx, c.heightsPx);
@@ -117,6 +145,10 @@ namespace TreeLod
         }
         EXPECT_EQ(decoded->switchFlip, c.switchFlip);
         EXPECT_TRUE(decoded->hasSwitchFlip());
+        EXPECT_EQ(decoded->resourceBytes, c.resourceBytes);
+        for (std::size_t i = 0; i < c.levels.size(); ++i)
+            EXPECT_EQ(decoded->levels[i].resources, c.levels[i].resources);
+        EXPECT_TRUE(decoded->hasGpuBytes());
         EXPECT_EQ(encodeErrorCurves(decoded.value()), bytes); // deterministic
 
         // Curves without switch data (as decoded from version 1) encode as version 2 with 0 pairs.
@@ -144,39 +176,51 @@ namespace TreeLod
         EXPECT_EQ(decoded->switchFlipAt(3, 1, 32.0f), SWITCH_FLIP_UNKNOWN);
         EXPECT_EQ(decoded->switchFlipAt(2, 2, 32.0f), 0.0f); // no switch at all
 
-        // Each version's bytes read as the other are refused; other versions are refused.
+        // Version 2: switch FLIP, no GPU bytes.
+        Result<ErrorCurves> two = decodeErrorCurves(versionTwoBytes(c), "old.treelod", 2);
+        ASSERT_TRUE(two.ok()) << two.error().message();
+        EXPECT_EQ(two->switchFlip, c.switchFlip);
+        EXPECT_FALSE(two->hasGpuBytes());
+        EXPECT_EQ(two->gpuBytes({0, 1}), 0u);
+
+        // Each version's bytes read as another are refused; other versions are refused.
         std::string e = decodeError(encodeErrorCurves(c), 1);
-        EXPECT_TRUE(contains(e, "tree.treelod: error-curves: 124 trailing bytes")) << e;
+        EXPECT_TRUE(contains(e, "tree.treelod: error-curves: " + std::to_string(124 + SAMPLE_RESOURCE_BYTES) +
+                                    " trailing bytes"))
+            << e;
         e = decodeError(v1, 2);
         EXPECT_TRUE(contains(e, "tree.treelod: error-curves switchFlip: truncated")) << e;
-        for (std::uint32_t version : {0u, 3u})
+        e = decodeError(versionTwoBytes(c), 3);
+        EXPECT_TRUE(contains(e, "tree.treelod: error-curves resources")) << e;
+        for (std::uint32_t version : {0u, 4u})
         {
             e = decodeError(encodeErrorCurves(c), version);
             EXPECT_TRUE(contains(e, "error-curves: format version " + std::to_string(version) +
-                                        ", this build reads 1..2"))
+                                        ", this build reads 1..3"))
                 << e;
         }
 
-        // The descriptor reads both (treelod info, TreeAsset::readChunk); "reference" its one version.
+        // The descriptor reads all three (treelod info, TreeAsset::readChunk); "reference" its one version.
         const TechniqueDescriptor* d = findTechniqueDescriptor(ERROR_CURVES_CHUNK);
         ASSERT_NE(d, nullptr);
         EXPECT_TRUE(readsFormatVersion(*d, 1));
         EXPECT_TRUE(readsFormatVersion(*d, 2));
-        EXPECT_FALSE(readsFormatVersion(*d, 3));
+        EXPECT_TRUE(readsFormatVersion(*d, 3));
+        EXPECT_FALSE(readsFormatVersion(*d, 4));
         EXPECT_FALSE(readsFormatVersion(*d, 0));
         Result<ChunkSummary> summary = inspectChunk(*d, v1, "old.treelod", 1);
         ASSERT_TRUE(summary.ok()) << summary.error().message();
-        EXPECT_TRUE(contains(summary->text, "6 views; FLIP at")) << summary->text; // no switch pairs
-        Result<ChunkSummary> refused = inspectChunk(*d, v1, "old.treelod", 3);
+        EXPECT_TRUE(contains(summary->text, "6 views; FLIP at")) << summary->text; // no switch pairs, no bytes
+        Result<ChunkSummary> refused = inspectChunk(*d, v1, "old.treelod", 4);
         ASSERT_FALSE(refused.ok());
-        EXPECT_TRUE(contains(refused.error().message(), "old.treelod: error-curves: unsupported format version 3, "
-                                                        "this build reads 1..2"))
+        EXPECT_TRUE(contains(refused.error().message(), "old.treelod: error-curves: unsupported format version 4, "
+                                                        "this build reads 1..3"))
             << refused.error().message();
         const TechniqueDescriptor* reference = findTechniqueDescriptor("reference");
         ASSERT_NE(reference, nullptr);
         EXPECT_TRUE(readsFormatVersion(*reference, reference->formatVersion));
         EXPECT_FALSE(readsFormatVersion(*reference, reference->formatVersion - 1));
-        EXPECT_EQ(readFormatVersions(*d), "1..2");
+        EXPECT_EQ(readFormatVersions(*d), "1..3");
         EXPECT_EQ(readFormatVersions(*reference), std::to_string(reference->formatVersion));
     }
 
@@ -332,8 +376,11 @@ namespace TreeLod
         for (std::size_t size = 0; size < good.size(); ++size)
             EXPECT_NE(decodeError({good.begin(), good.begin() + std::ptrdiff_t(size)}), "") << size;
         std::string e = decodeError({good.begin(), good.end() - 1});
+        EXPECT_TRUE(contains(e, "tree.treelod: error-curves level 4 'impostor' 0 resources")) << e;
+        const std::size_t switchesEnd = good.size() - SAMPLE_RESOURCE_BYTES; // where the resources start
+        e = decodeError({good.begin(), good.begin() + std::ptrdiff_t(switchesEnd) - 1});
         EXPECT_TRUE(contains(e, "tree.treelod: error-curves switchFlip: truncated")) << e;
-        const std::size_t levelsEnd = good.size() - 4 - 10 * 12; // where the switch section starts
+        const std::size_t levelsEnd = switchesEnd - 4 - 10 * 12; // where the switch section starts
         e = decodeError({good.begin(), good.begin() + std::ptrdiff_t(levelsEnd) - 1});
         EXPECT_TRUE(contains(e, "tree.treelod: error-curves level 4 'impostor' 0: truncated")) << e;
 
@@ -388,6 +435,47 @@ namespace TreeLod
         e = decodeError(bytes);
         EXPECT_TRUE(contains(e, "error-curves level 0 'mesh' 0 to level 2 'lodf' 1200 switchFlip[1]: nan outside"))
             << e;
+
+        // The resource section: too many resources, an index out of the table, a list out of order.
+        bytes = good;
+        putU32(bytes, switchesEnd, 5000);
+        e = decodeError(bytes);
+        EXPECT_TRUE(contains(e, "error-curves resources: 5000 GPU resources (at most 4096)")) << e;
+        const std::size_t lists = switchesEnd + 4 + 5 * 8; // mesh's list: count 1, resource 0
+        bytes = good;
+        putU32(bytes, lists + 4, 7);
+        e = decodeError(bytes);
+        EXPECT_TRUE(contains(e, "error-curves level 0 'mesh' 0 resources[0]: resource 7 of a table of 5")) << e;
+        bytes = good;
+        putU32(bytes, lists + 8 + 4, 2); // lodf 0's list {1, 2} becomes {2, 2}
+        e = decodeError(bytes);
+        EXPECT_TRUE(contains(e, "error-curves level 1 'lodf' 0 resources[1]: resource 2 after 2")) << e;
+        bytes = good;
+        putU32(bytes, lists, 6);
+        EXPECT_NE(decodeError(bytes), "");
+    }
+
+    TEST(ErrorCurves, gpuBytesCountEachSharedResourceOnce)
+    {
+        const ErrorCurves c = sample();
+        EXPECT_EQ(c.gpuBytes({0}), 1000000u);
+        EXPECT_EQ(c.gpuBytes({1}), 290000u);
+        EXPECT_EQ(c.gpuBytes({1, 2}), 290000u); // both LoDF levels draw from the same buffers
+        EXPECT_EQ(c.gpuBytes({0, 1, 2, 3, 4}), 1300000u);
+        EXPECT_EQ(c.gpuBytes({4, 4, 99}), 2000u); // repeated and out-of-range levels
+        EXPECT_EQ(c.gpuBytes({}), 0u);
+        // Levels kept keep their resources.
+        ErrorCurves kept = c;
+        kept.keepLevels({false, true, false, false, true});
+        ASSERT_EQ(kept.levels.size(), 2u);
+        EXPECT_EQ(kept.gpuBytes({0, 1}), 292000u);
+        EXPECT_TRUE(validateErrorCurves(kept, "tree").ok());
+        // Resources without a table are refused.
+        ErrorCurves broken = withoutGpuBytes(c);
+        broken.levels[3].resources = {0};
+        EXPECT_TRUE(contains(validateError(broken), "level 3 'billboard-cloud' 1 low-res resources[0]: resource 0 of a "
+                                                    "table of 0"))
+            << validateError(broken);
     }
 
     TEST(ErrorCurves, descriptorIsRegisteredAndInspects)
@@ -405,10 +493,10 @@ namespace TreeLod
         const std::vector<std::uint8_t> bytes = encodeErrorCurves(sample());
         Result<ChunkSummary> summary = d->inspect(bytes, "tree.treelod");
         ASSERT_TRUE(summary.ok()) << summary.error().message();
-        EXPECT_EQ(summary->text, "5 levels x 3 heights (8-128 px), 6 views, switch FLIP of 10 pairs; FLIP at 8/128 "
-                                 "px: mesh 0.062/0.016, "
-                                 "lodf 0 0.500/0.125, lodf 1200 0.750/0.250, billboard-cloud low-res 1.000/0.500, "
-                                 "impostor 0.875/0.625");
+        EXPECT_EQ(summary->text, "5 levels x 3 heights (8-128 px), 6 views, switch FLIP of 10 pairs, GPU bytes of 5 "
+                                 "resources; FLIP at 8/128 px: mesh 0.062/0.016 (1.00 MB), "
+                                 "lodf 0 0.500/0.125 (0.29 MB), lodf 1200 0.750/0.250 (0.29 MB), billboard-cloud "
+                                 "low-res 1.000/0.500 (0.01 MB), impostor 0.875/0.625 (0.00 MB)");
         const nlohmann::json json = nlohmann::json::parse(summary->json, nullptr, false);
         ASSERT_TRUE(json.is_object()) << summary->json;
         EXPECT_EQ(json["levels"], 5);
@@ -425,6 +513,8 @@ namespace TreeLod
         ASSERT_EQ(json["switchFlip"].size(), 10u);
         EXPECT_EQ(json["switchFlip"][5]["levels"], nlohmann::json({1, 3}));
         EXPECT_EQ(json["switchFlip"][5]["flip"], nlohmann::json({0.3125, 0.15625, 0.078125}));
+        EXPECT_EQ(json["curves"][1]["gpuBytes"], 290000);
+        EXPECT_EQ(json["resourceBytes"], nlohmann::json({1000000, 250000, 40000, 8000, 2000}));
 
         // Broken: refused naming the package; the fuzz hook never traps on valid or broken bytes.
         Result<ChunkSummary> refused = d->inspect({bytes.begin(), bytes.begin() + 10}, "broken.treelod");

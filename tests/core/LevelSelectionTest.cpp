@@ -486,6 +486,132 @@ namespace TreeLod
         EXPECT_EQ(chooseFrameBudgetStep({}, 10.0, 0), 0u);
     }
 
+    TEST(LevelSelection, excludedLevelsAreNotCandidatesAndTheLeastFlipStandsInForTheReference)
+    {
+        Fixture f;
+        // Without the impostor, lodf everywhere (within 0.02 of the mesh at every height).
+        Result<std::vector<LevelChoice>> noImpostor =
+            chooseLevels(f.curves, f.costs, 0.02f, 16, LEVEL_SWITCH_COST_SLACK, {false, false, true});
+        ASSERT_TRUE(noImpostor) << noImpostor.error().message();
+        ASSERT_EQ(noImpostor->size(), 1u);
+        EXPECT_EQ(noImpostor->front().curveLevel, 1u);
+        EXPECT_TRUE(noImpostor->front().withinBudget);
+
+        // Without the mesh and lodf, at 0.005 nothing is allowed above 16 px: the impostor is drawn
+        // anyway, outside the budget; an empty or short mask excludes nothing.
+        Result<std::vector<LevelChoice>> onlyImpostor =
+            chooseLevels(f.curves, f.costs, 0.005f, 16, LEVEL_SWITCH_COST_SLACK, {true, true});
+        ASSERT_TRUE(onlyImpostor) << onlyImpostor.error().message();
+        ASSERT_EQ(onlyImpostor->size(), 1u);
+        EXPECT_EQ(onlyImpostor->front().curveLevel, 2u);
+        EXPECT_FALSE(onlyImpostor->front().withinBudget);
+        Result<std::vector<LevelChoice>> all = chooseLevels(f.curves, f.costs, 0.005f, 16, LEVEL_SWITCH_COST_SLACK, {});
+        ASSERT_TRUE(all);
+        EXPECT_EQ(all->front().curveLevel, 0u);
+        EXPECT_TRUE(all->front().withinBudget);
+
+        // Without the mesh, budget 0: the level of least FLIP, lodf, down to 16 px, where the
+        // impostor's equals it and costs less; no level is within a budget of 0.
+        Result<std::vector<LevelChoice>> zero = chooseLevels(f.curves, f.costs, 0.0f, 16, 0.0f, {true});
+        ASSERT_TRUE(zero);
+        ASSERT_EQ(zero->size(), 2u);
+        EXPECT_EQ((*zero)[0].curveLevel, 1u);
+        EXPECT_GT((*zero)[0].minHeightPx, 14.0f);
+        EXPECT_LT((*zero)[0].minHeightPx, 19.0f);
+        EXPECT_EQ((*zero)[1].curveLevel, 2u);
+        EXPECT_FALSE((*zero)[0].withinBudget);
+        EXPECT_FALSE((*zero)[1].withinBudget);
+
+        // Everything with a cost excluded: refused.
+        Result<std::vector<LevelChoice>> none =
+            chooseLevels(f.curves, f.costs, 0.02f, 16, LEVEL_SWITCH_COST_SLACK, {true, true, true});
+        ASSERT_FALSE(none);
+        EXPECT_NE(none.error().message().find("every level with a cost is excluded"), std::string::npos)
+            << none.error().message();
+    }
+
+    namespace
+    {
+        /// The fixture with GPU bytes: the mesh 10 MB, lodf 4 MB, the impostor 1 MB.
+        Fixture withBytes()
+        {
+            Fixture f;
+            f.curves.resourceBytes = {10000000, 4000000, 1000000};
+            for (std::uint32_t l = 0; l < 3; ++l)
+                f.curves.levels[l].resources = {l};
+            return f;
+        }
+    }
+
+    TEST(LevelSelection, aMemoryBudgetTakesOutTheLevelsItCannotHold)
+    {
+        Fixture f = withBytes();
+        const std::vector<MemoryPlanSpecies> one = {MemoryPlanSpecies{&f.curves, &f.costs, {}, nullptr}};
+        // Unbudgeted: lodf near, the impostor far, 5 MB; a budget of 5 MB holds it.
+        for (const std::uint64_t budget : {std::uint64_t(0), std::uint64_t(5000000)})
+        {
+            Result<MemoryPlan> plan = chooseLevelsWithinMemory(one, 0.02f, budget);
+            ASSERT_TRUE(plan) << plan.error().message();
+            EXPECT_EQ(plan->gpuBytes, 5000000u);
+            EXPECT_FALSE(plan->memoryBinds);
+            EXPECT_TRUE(plan->withinErrorBudget);
+            ASSERT_EQ(plan->choices.size(), 1u);
+            EXPECT_EQ(plan->choices[0].size(), 2u);
+        }
+        // 4.5 MB: the impostor goes (lodf alone keeps the error budget, at a higher cost).
+        Result<MemoryPlan> tighter = chooseLevelsWithinMemory(one, 0.02f, 4500000);
+        ASSERT_TRUE(tighter) << tighter.error().message();
+        EXPECT_EQ(tighter->gpuBytes, 4000000u);
+        EXPECT_TRUE(tighter->memoryBinds);
+        EXPECT_TRUE(tighter->withinErrorBudget);
+        ASSERT_EQ(tighter->choices[0].size(), 1u);
+        EXPECT_EQ(tighter->choices[0][0].curveLevel, 1u);
+        EXPECT_EQ(tighter->excluded[0], (std::vector<bool>{false, false, true}));
+        // 2 MB: taking lodf out brings the mesh in, so the plan is built up from the smallest: the
+        // impostor alone, over the error budget near, and said so.
+        Result<MemoryPlan> small = chooseLevelsWithinMemory(one, 0.02f, 2000000);
+        ASSERT_TRUE(small) << small.error().message();
+        EXPECT_EQ(small->gpuBytes, 1000000u);
+        EXPECT_TRUE(small->memoryBinds);
+        EXPECT_FALSE(small->withinErrorBudget);
+        ASSERT_EQ(small->choices[0].size(), 1u);
+        EXPECT_EQ(small->choices[0][0].curveLevel, 2u);
+        // Below the smallest plan: refused, naming the budget and that plan.
+        Result<MemoryPlan> tiny = chooseLevelsWithinMemory(one, 0.02f, 500000);
+        ASSERT_FALSE(tiny);
+        EXPECT_EQ(tiny.error().message(),
+                  "memory budget: 0.50 MB is below the smallest plan, 1.00 MB (species 0: impostor 0 1.00 MB)");
+    }
+
+    TEST(LevelSelection, aMemoryBudgetSharesResourcesAndNeedsMeasuredBytes)
+    {
+        Fixture f = withBytes();
+        Fixture g = withBytes();
+        // Two species of one asset hold its levels once: 5 MB for both; two assets 10 MB.
+        const std::vector<MemoryPlanSpecies> shared = {MemoryPlanSpecies{&f.curves, &f.costs, {}, &f},
+                                                       MemoryPlanSpecies{&f.curves, &f.costs, {}, &f}};
+        Result<MemoryPlan> one = chooseLevelsWithinMemory(shared, 0.02f, 6000000);
+        ASSERT_TRUE(one) << one.error().message();
+        EXPECT_EQ(one->gpuBytes, 5000000u);
+        EXPECT_FALSE(one->memoryBinds);
+        const std::vector<MemoryPlanSpecies> two = {MemoryPlanSpecies{&f.curves, &f.costs, {}, &f},
+                                                    MemoryPlanSpecies{&g.curves, &g.costs, {}, &g}};
+        Result<MemoryPlan> both = chooseLevelsWithinMemory(two, 0.02f, 6000000);
+        ASSERT_TRUE(both) << both.error().message();
+        EXPECT_LE(both->gpuBytes, 6000000u);
+        EXPECT_TRUE(both->memoryBinds);
+        EXPECT_EQ(planGpuBytes(two, both->choices), both->gpuBytes);
+
+        // Curves without GPU bytes cannot be planned within a memory budget, but can without.
+        Fixture old;
+        const std::vector<MemoryPlanSpecies> unmeasured = {MemoryPlanSpecies{&old.curves, &old.costs, {}, nullptr}};
+        EXPECT_TRUE(chooseLevelsWithinMemory(unmeasured, 0.02f, 0));
+        Result<MemoryPlan> refused = chooseLevelsWithinMemory(unmeasured, 0.02f, 1000000);
+        ASSERT_FALSE(refused);
+        EXPECT_NE(refused.error().message().find("species 0: its error curves hold no GPU bytes"), std::string::npos)
+            << refused.error().message();
+    }
+
     TEST(LevelCosts, costsInterpolateInLogLog)
     {
         const LevelCost c = cost("lodf", 1, {1.0f, 4.0f, 64.0f});

@@ -81,10 +81,41 @@ namespace TreeLod
         }
     }
 
+    TEST(LodPolicy, aMemoryBudgetFollowsAnyChoiceWithTheTransition)
+    {
+        Result<LodPolicy> memory = LodPolicy::parse("auto+mem40");
+        ASSERT_TRUE(memory.ok());
+        EXPECT_TRUE(memory->isAuto());
+        EXPECT_EQ(memory->memoryBudgetMB, 40.0f);
+        EXPECT_TRUE(std::isnan(memory->transition));
+        // Either order with a transition.
+        for (const char* text : {"auto@0.02+mem12.5+fade0.2", "auto@0.02+fade0.2+mem12.5"})
+        {
+            Result<LodPolicy> both = LodPolicy::parse(text);
+            ASSERT_TRUE(both.ok()) << text;
+            EXPECT_EQ(both->errorBudget, 0.02f);
+            EXPECT_EQ(both->memoryBudgetMB, 12.5f);
+            EXPECT_EQ(both->transition, 0.2f);
+            EXPECT_EQ(both->toString(), "auto@0.02+mem12.5+fade0.2");
+        }
+        EXPECT_TRUE(std::isnan(LodPolicy::parse("auto")->memoryBudgetMB)) << "the script's";
+        EXPECT_NE(*LodPolicy::parse("auto+mem0"), *LodPolicy::parse("auto"));
+        for (const char* bad : {"auto+mem", "auto+mem-1", "auto+memnan", "auto+mem4x", "auto+mem2e9"})
+        {
+            Result<LodPolicy> policy = LodPolicy::parse(bad, "--techniques");
+            ASSERT_FALSE(policy.ok()) << bad;
+            EXPECT_NE(policy.error().message().find("--techniques: '" + std::string(bad) +
+                                                    "': the memory budget after '+mem' must be megabytes"),
+                      std::string::npos)
+                << policy.error().message();
+        }
+    }
+
     TEST(LodPolicy, writesBackWhatItParses)
     {
         for (const char* text : {"", "auto", "auto@0.05", "auto@0", "auto@1", "auto~40", "auto~16.5", "lodf",
-                                 "auto+fade0", "auto@0.05+fade0.2", "impostor+fade1", "+fade0.1"})
+                                 "auto+fade0", "auto@0.05+fade0.2", "impostor+fade1", "+fade0.1", "auto+mem40",
+                                 "auto~16+mem0.5+fade0"})
         {
             Result<LodPolicy> policy = LodPolicy::parse(text);
             ASSERT_TRUE(policy.ok()) << text;

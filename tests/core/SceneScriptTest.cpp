@@ -379,6 +379,11 @@ namespace TreeLod
         EXPECT_EQ(both.lod.maxError, SceneLod::DEFAULT_MAX_ERROR);
         EXPECT_EQ(parsed(MINIMAL).lod.shadowMaxError, SceneLod::DEFAULT_SHADOW_MAX_ERROR);
         EXPECT_EQ(parsed(MINIMAL).lod.frameBudgetMs, 0.0f);
+        // The memory budget, megabytes.
+        EXPECT_EQ(parsed(MINIMAL).lod.memoryBudgetMB, 0.0f);
+        EXPECT_EQ(parsed(replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"lod\": {\"memoryBudgetMB\": 48.5}"))
+                      .lod.memoryBudgetMB,
+                  48.5f);
         // Level transitions.
         EXPECT_EQ(parsed(MINIMAL).lod.transition, ForestInstances::DEFAULT_TRANSITION);
         EXPECT_EQ(parsed(replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"lod\": {\"transition\": 0.3}")).lod.transition,
@@ -388,7 +393,9 @@ namespace TreeLod
                                       {"{\"transition\": 1.5}", "/lod/transition"},
                                       {"{\"transition\": \"smooth\"}", "/lod/transition"},
                                       {"{\"frameBudgetMs\": -1}", "/lod/frameBudgetMs"},
-                                      {"{\"frameBudgetMs\": \"fast\"}", "/lod/frameBudgetMs"}})
+                                      {"{\"frameBudgetMs\": \"fast\"}", "/lod/frameBudgetMs"},
+                                      {"{\"memoryBudgetMB\": -5}", "/lod/memoryBudgetMB"},
+                                      {"{\"memoryBudgetMB\": 2e9}", "/lod/memoryBudgetMB"}})
         {
             const std::string message =
                 errorOf(replaced(MINIMAL, "\"frames\": 2", std::string("\"frames\": 2, \"lod\": ") + bad));

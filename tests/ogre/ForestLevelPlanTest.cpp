@@ -248,13 +248,17 @@ namespace TreeLod
     TEST(Forest, errorCurvesOfVersionOneAreReadAndMeasuredAgain)
     {
         // The oak's package with its curves written as version 1 wrote them: without switch FLIP
-        // (version 2's layout less its last u32, 0 pairs).
+        // and GPU bytes (version 3's layout less its last two u32, 0 pairs and 0 resources).
         const TreeAssetPtr asset = oakWithCurves();
         Result<ErrorCurves> curves = decodeErrorCurves(asset->readChunk(ERROR_CURVES_CHUNK), "oak");
         ASSERT_TRUE(curves) << curves.error().message();
+        EXPECT_TRUE(curves->hasGpuBytes());
         curves->switchFlip.clear();
+        curves->resourceBytes.clear();
+        for (ErrorCurveLevel& level : curves->levels)
+            level.resources.clear();
         std::vector<std::uint8_t> v1 = encodeErrorCurves(*curves);
-        v1.resize(v1.size() - 4);
+        v1.resize(v1.size() - 8);
         PackageWriter writer;
         for (const ChunkInfo& info : asset->getPackage().chunks())
         {
@@ -265,19 +269,19 @@ namespace TreeLod
             }
         }
         // A version this build does not read: refused, naming both.
-        ASSERT_TRUE(writer.addChunk(ERROR_CURVES_CHUNK, 0, 3, v1));
+        ASSERT_TRUE(writer.addChunk(ERROR_CURVES_CHUNK, 0, 4, v1));
         Result<std::vector<std::uint8_t>> newer = writer.toBytes();
         ASSERT_TRUE(newer) << newer.error().message();
         TreeAssetPtr future =
-            TreeAssetManager::getSingleton().loadFromBytes("oak.v3-curves", Ogre::RGN_DEFAULT, *newer);
+            TreeAssetManager::getSingleton().loadFromBytes("oak.v4-curves", Ogre::RGN_DEFAULT, *newer);
         try
         {
             future->readChunk(ERROR_CURVES_CHUNK);
-            ADD_FAILURE() << "a chunk of version 3 was read";
+            ADD_FAILURE() << "a chunk of version 4 was read";
         }
         catch (const Ogre::InvalidParametersException& e)
         {
-            EXPECT_NE(e.getDescription().find("format version 3, this build reads 1..2"), std::string::npos)
+            EXPECT_NE(e.getDescription().find("format version 4, this build reads 1..3"), std::string::npos)
                 << e.getDescription();
         }
         TreeAssetManager::getSingleton().remove(future);
@@ -299,7 +303,7 @@ namespace TreeLod
         EXPECT_FALSE(Forest::levelsForErrorBudget(*old, fixedCosts(*old), DEFAULT_ERROR_BUDGET).empty());
         TreeAssetManager::getSingleton().remove(old);
 
-        // The package is measured again, to version 2 with switch FLIP.
+        // The package is measured again, to version 3 with switch FLIP and GPU bytes.
         const std::string path = OgreEnvironment::outDir() + "/oak-v1-curves.treelod";
         ASSERT_TRUE(writeFileAtomic(path, *bytes));
         Result<bool> measured = ensureErrorCurves(OgreEnvironment::renderer(), path, smallCurveOptions());
@@ -313,6 +317,7 @@ namespace TreeLod
         Result<ErrorCurves> again = decodeErrorCurves(rewritten->readChunk(std::size_t(chunk)).value(), path);
         ASSERT_TRUE(again) << again.error().message();
         EXPECT_TRUE(again->hasSwitchFlip());
+        EXPECT_TRUE(again->hasGpuBytes());
     }
 
     TEST(Forest, calibrationTimesEveryLevelAndIsCachedPerRenderer)
@@ -589,5 +594,182 @@ namespace TreeLod
             r.render(view, 160, 90, 1);
             EXPECT_EQ(other->getErrorBudget(), 0.0f) << "start " << start;
         }
+    }
+}
+
+namespace TreeLod
+{
+    namespace
+    {
+        /// Bytes Ogre's managers hold, counted from their own objects: every loaded texture's pixel
+        /// buffers (all faces and mips) and every hardware vertex and index buffer.
+        struct BufferLists : Ogre::HardwareBufferManagerBase
+        {
+            static std::uint64_t bytes(const Ogre::HardwareBufferManagerBase& manager)
+            {
+                std::uint64_t total = 0;
+                for (const Ogre::HardwareVertexBuffer* buffer : manager.*(&BufferLists::mVertexBuffers))
+                    total += buffer->getSizeInBytes();
+                for (const Ogre::HardwareIndexBuffer* buffer : manager.*(&BufferLists::mIndexBuffers))
+                    total += buffer->getSizeInBytes();
+                return total;
+            }
+        };
+
+        std::uint64_t ogreGpuBytes()
+        {
+            std::uint64_t total = BufferLists::bytes(Ogre::HardwareBufferManager::getSingleton());
+            auto textures = Ogre::TextureManager::getSingleton().getResourceIterator();
+            while (textures.hasMoreElements())
+            {
+                const Ogre::TexturePtr texture = Ogre::static_pointer_cast<Ogre::Texture>(textures.getNext());
+                if (!texture->isLoaded())
+                    continue;
+                for (std::size_t face = 0; face < texture->getNumFaces(); ++face)
+                    for (std::uint32_t mip = 0; mip <= texture->getNumMipmaps(); ++mip)
+                        total += texture->getBuffer(face, mip)->getSizeInBytes();
+            }
+            return total;
+        }
+    }
+
+    TEST(Forest, gpuBytesOfEachTechniqueAreWhatOgresManagersHold)
+    {
+        // As the curves are measured: no shadows (a shadowed material draws from more textures), and
+        // meshes not prepared for stencil shadow volumes (an earlier test's stencil shadows make
+        // Ogre double their position buffers).
+        OffscreenRenderer& renderer = OgreEnvironment::renderer();
+        renderer.clearContent();
+        renderer.setShadows(false);
+        Ogre::MeshManager& meshes = Ogre::MeshManager::getSingleton();
+        const bool shadowVolumes = meshes.getPrepareAllMeshesForShadowVolumes();
+        meshes.setPrepareAllMeshesForShadowVolumes(false);
+        const ForestTree& tree = oak();
+        const std::vector<std::uint8_t> package =
+            cachedPackage("forest", "oak", [&] { return bakePackage(tree.model, "oak"); });
+        // The curves' bytes, measured here (two heights, one view: the bytes do not depend on the views).
+        Result<ErrorCurves> curves = [&] {
+            const TreeAssetPtr asset =
+                TreeAssetManager::getSingleton().loadFromBytes("oak.gpu-bytes.curves", Ogre::RGN_DEFAULT, package);
+            ErrorCurveOptions options;
+            options.heightsPx = {16.0f, 192.0f};
+            options.views = {{0.0f, 10.0f}};
+            options.referenceSupersample = 1;
+            Result<ErrorCurves> measured = measureErrorCurves(renderer, *asset, options);
+            TreeAssetManager::getSingleton().remove(asset);
+            return measured;
+        }();
+        ASSERT_TRUE(curves) << curves.error().message();
+        ASSERT_TRUE(curves->hasGpuBytes());
+        std::vector<std::string> techniques;
+        for (const ErrorCurveLevel& level : curves->levels)
+            if (std::find(techniques.begin(), techniques.end(), level.technique) == techniques.end())
+                techniques.push_back(level.technique);
+        Ogre::SceneManager& scene = renderer.getSceneManager();
+        for (const std::string& technique : techniques)
+        {
+            // A fresh asset: only this technique's levels build anything.
+            const TreeAssetPtr asset =
+                TreeAssetManager::getSingleton().loadFromBytes("oak.gpu-bytes." + technique, Ogre::RGN_DEFAULT, package);
+            asset->getBounds();
+            const std::uint64_t before = ogreGpuBytes();
+            std::vector<Forest*> forests;
+            std::vector<std::size_t> levels;
+            std::set<const void*> seen;
+            std::uint64_t drawn = 0;
+            for (std::size_t l = 0; l < curves->levels.size(); ++l)
+            {
+                const ErrorCurveLevel& c = curves->levels[l];
+                if (c.technique != technique)
+                    continue;
+                levels.push_back(l);
+                ForestLevel level;
+                level.technique = c.technique;
+                level.techniqueLevel = c.techniqueLevel;
+                level.lowRes = c.lowRes;
+                Forest* forest = createLevelForest(scene, renderer.getContentNode(), *asset, level,
+                                                   {ForestInstance{}}, "gpu-bytes/" + technique + std::to_string(l), 0.0f);
+                forest->makeAllResident();
+                forests.push_back(forest);
+                for (const ForestGpuResource& resource : forest->getGpuResources(0, 0))
+                    if (seen.insert(resource.handle.get()).second)
+                        drawn += resource.bytes;
+            }
+            const std::uint64_t held = ogreGpuBytes() - before;
+            const std::uint64_t planned = curves->gpuBytes(levels);
+            std::printf("%s: Ogre's managers %llu bytes, the Forests draw from %llu, the curves say %llu\n",
+                        technique.c_str(), (unsigned long long)held, (unsigned long long)drawn,
+                        (unsigned long long)planned);
+            // Byte for byte: a level that draws a mesh holds every LoD level of it.
+            EXPECT_GT(drawn, 0u) << technique;
+            EXPECT_EQ(drawn, held) << technique;
+            EXPECT_EQ(planned, held) << technique;
+            for (Forest* forest : forests)
+                scene.destroyMovableObject(forest);
+            TreeAssetManager::getSingleton().remove(asset);
+        }
+        meshes.setPrepareAllMeshesForShadowVolumes(shadowVolumes);
+    }
+
+    TEST(Forest, aMemoryBudgetBindsThePlanAndOneBelowTheSmallestPlanIsRefused)
+    {
+        const TreeAssetPtr asset = oakWithCurves();
+        const std::vector<LevelCost> costs = fixedCosts(*asset);
+        Forest* forest = placeForest();
+        EXPECT_EQ(forest->getMemoryBudget(), 0u);
+        const std::uint32_t s = forest->addBudgetedSpecies(asset, costs);
+        const std::vector<ForestLevel> unbudgeted = forest->getLevels(s);
+        const std::uint64_t full = forest->getStats().plannedGpuBytes;
+        ASSERT_GT(full, 0u);
+        EXPECT_EQ(forest->getBindingBudget(), ForestBinding::Error);
+        // A second species of the same asset holds the same levels: no more bytes.
+        forest->addBudgetedSpecies(asset, costs);
+        EXPECT_EQ(forest->getStats().plannedGpuBytes, full);
+
+        // Half the bytes: levels taken out, the memory budget binds, and what is built fits it.
+        forest->setMemoryBudget(full / 2);
+        EXPECT_EQ(forest->getMemoryBudget(), full / 2);
+        EXPECT_LE(forest->getStats().plannedGpuBytes, full / 2);
+        EXPECT_EQ(forest->getBindingBudget(), ForestBinding::Memory);
+        std::string levels;
+        for (const ForestLevel& level : forest->getLevels(s))
+            levels += Forest::describeLevel(level) + "; ";
+        std::printf("planned %llu bytes; within %llu: %llu bytes, levels %s\n", (unsigned long long)full,
+                    (unsigned long long)(full / 2), (unsigned long long)forest->getStats().plannedGpuBytes,
+                    levels.c_str());
+        const ForestTree& tree = oak();
+        const float h = treeHeight(tree.model);
+        forest->addInstances(grid(4, 1.6f * h));
+        forest->makeAllResident();
+        EXPECT_LE(forest->getGpuBytes() - forest->getStats().instanceBufferBytes, full / 2);
+        const Image picture = toImage(OgreEnvironment::renderer().render(
+            look(glm::vec3(0.3f * h, 1.4f * h, 6.0f * h), glm::vec3(0.0f, 0.0f, -3.0f * h)), 320, 180, 1));
+        EXPECT_GT(treeCoverage(picture, BACKGROUND), 0.1);
+        // The error budget changes within the memory budget.
+        forest->setErrorBudget(0.0f);
+        EXPECT_LE(forest->getStats().plannedGpuBytes, full / 2);
+        forest->setErrorBudget(DEFAULT_ERROR_BUDGET);
+
+        // Below the smallest plan: refused, naming the budget and the smallest plan; nothing changes.
+        const std::vector<ForestLevel> held = forest->getLevels(s);
+        try
+        {
+            forest->setMemoryBudget(1000);
+            ADD_FAILURE() << "a budget of 1000 bytes was accepted";
+        }
+        catch (const Ogre::InvalidParametersException& e)
+        {
+            EXPECT_NE(e.getDescription().find("memory budget: 0.00 MB is below the smallest plan"), std::string::npos)
+                << e.getDescription();
+            EXPECT_NE(e.getDescription().find("impostor"), std::string::npos) << e.getDescription();
+        }
+        EXPECT_EQ(forest->getMemoryBudget(), full / 2);
+        EXPECT_EQ(forest->getLevels(s).size(), held.size());
+
+        // No budget: the first plan again.
+        forest->setMemoryBudget(0);
+        EXPECT_EQ(forest->getStats().plannedGpuBytes, full);
+        EXPECT_EQ(forest->getLevels(s).size(), unbudgeted.size());
+        EXPECT_EQ(forest->getBindingBudget(), ForestBinding::Error);
     }
 }

@@ -46,19 +46,35 @@ namespace TreeLod
         auto plan = std::make_unique<BudgetPlan>();
         plan->curves = autoCurves(*asset, label, source);
         plan->costs = costs;
+        // Under a memory budget, every budgeted species is planned again with this one.
+        std::optional<MemoryPlan> memory;
+        if (mMemoryBudget > 0)
+        {
+            memory = memoryPlan(plan.get(), asset.get(), mBudget.getUserErrorBudget(), mMemoryBudget, source);
+            plan->excluded.assign(plan->curves.levels.size(), true);
+            for (const LevelChoice& choice : memory->choices.back())
+                plan->excluded[choice.curveLevel] = false;
+        }
         for (const float step : frameBudgetLadder())
         {
-            Result<std::vector<LevelChoice>> choices = chooseLevels(plan->curves, costs, step, MAX_LEVELS);
+            Result<std::vector<LevelChoice>> choices =
+                chooseLevels(plan->curves, costs, step, MAX_LEVELS, LEVEL_SWITCH_COST_SLACK, plan->excluded);
             if (!choices)
                 invalid(label + choices.error().message(), source);
             plan->ladderChoices.push_back(std::move(*choices));
         }
-        Result<std::vector<LevelChoice>> choices = chooseLevels(plan->curves, costs, mBudget.getErrorBudget(), MAX_LEVELS);
+        Result<std::vector<LevelChoice>> choices = chooseLevels(plan->curves, costs, mBudget.getErrorBudget(), MAX_LEVELS,
+                                                                LEVEL_SWITCH_COST_SLACK, plan->excluded);
         if (!choices)
             invalid(label + choices.error().message(), source);
         plan->choices = *choices;
         const std::vector<ForestLevel> levels = levelsForChoices(*asset, plan->curves, plan->choices, label, source);
-        return addSpeciesImpl(asset, levels, std::move(plan));
+        const std::uint32_t added = addSpeciesImpl(asset, levels, std::move(plan));
+        if (memory)
+            applyMemoryPlan(*memory);
+        else
+            updatePlannedGpuBytes();
+        return added;
     }
 
     std::uint32_t Forest::addSpeciesImpl(const TreeAssetPtr& asset, const std::vector<ForestLevel>& levels,

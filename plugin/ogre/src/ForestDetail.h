@@ -117,10 +117,10 @@ namespace TreeLod
             // pixel-count values), so that a level's bark level (the one of its largest value,
             // Forest::buildParts) is the one each of its trees would pick alone. The reference,
             // bark and bark-AO meshes share those levels (the generator runs on the bark alone,
-            // with the same options: TreeMeshBuilder.h), so the plain bark mesh plans them all.
+            // with the same options: TreeMeshBuilder.h), so the one the technique draws plans them.
             Ogre::MeshPtr bark;
             if (technique.drawsBarkMesh() && !asset.getReference().model.barkIndices.empty())
-                bark = asset.getBarkMesh();
+                bark = technique.getBarkMesh(asset);
             if (!bark || bark->getLodStrategy() != Ogre::AbsolutePixelCountLodStrategy::getSingletonPtr())
                 return spans;
             std::vector<Span> split;
@@ -277,6 +277,9 @@ namespace TreeLod
         Ogre::IndexData ownIndexData;
         Ogre::MaterialPtr material;
         Ogre::MaterialPtr shadowedMaterial; ///< may be null
+        /// The mesh a submesh part draws from (ForestPartBuilder::addMesh): it holds all of its LoD
+        /// levels' index buffers on the GPU, whichever one the part draws. Null for ranges.
+        Ogre::MeshPtr mesh;
         unsigned short techniqueLod = 0;    ///< ForestPartOptions::techniqueLod
         float lengthFactor = 0.0f;          ///< ForestPartOptions::lengthFactor (custom parameter 0 when > 0)
         std::map<std::size_t, Ogre::Vector4> customParameters; ///< ForestPartOptions::customParameters
@@ -298,6 +301,8 @@ namespace TreeLod
         ErrorCurves curves;                  ///< the auto techniques' levels
         std::vector<LevelCost> costs;        ///< this machine's
         std::vector<LevelChoice> choices;    ///< the plan in use
+        /// Per curve level: taken out by the memory budget (Forest::setMemoryBudget); empty: none.
+        std::vector<bool> excluded;
         /// Per frameBudgetLadder() step: its plan (costed at each measurement, with the transition then).
         std::vector<std::vector<LevelChoice>> ladderChoices;
         HeightHistogram visible; ///< the viewer's trees at the frame budget's last measurement

@@ -74,7 +74,9 @@ namespace TreeLod
                     continue;
                 const auto it = std::find(plain.begin(), plain.end(), sub->getMaterialName());
                 const Ogre::String receiver = it == plain.end() ? "" : shadowed[std::size_t(it - plain.begin())];
-                add(sub->vertexData, sub->getMaterialName(), receiver, {}).indexData = indices;
+                Part& part = add(sub->vertexData, sub->getMaterialName(), receiver, {});
+                part.indexData = indices;
+                part.mesh = mesh;
             }
         }
 

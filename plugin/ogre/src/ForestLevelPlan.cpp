@@ -5,6 +5,8 @@
 
 namespace TreeLod
 {
+    Ogre::MeshPtr ForestLevelProvider::getBarkMesh(TreeAsset& asset) { return asset.getBarkMesh(); }
+
     std::vector<ForestBand> Forest::getAutoBands()
     {
         const TechniqueRegistry& registry = TechniqueRegistry::getSingleton();
@@ -288,6 +290,114 @@ namespace TreeLod
         updateShadowLevels(s);
     }
 
+    const char* toString(ForestBinding binding)
+    {
+        switch (binding)
+        {
+        case ForestBinding::Frame:
+            return "frame";
+        case ForestBinding::Memory:
+            return "memory";
+        case ForestBinding::Error:
+            break;
+        }
+        return "error";
+    }
+
+    ForestBinding Forest::getBindingBudget() const
+    {
+        if (mMemoryBinds)
+            return ForestBinding::Memory;
+        if (mBudget.getFrameBudgetMs() > 0.0f && mBudget.getErrorBudget() != mBudget.getUserErrorBudget())
+            return ForestBinding::Frame;
+        return ForestBinding::Error;
+    }
+
+    MemoryPlan Forest::memoryPlan(const BudgetPlan* extra, const TreeAsset* extraAsset, float errorBudget,
+                                  std::uint64_t memoryBudget, const char* source) const
+    {
+        std::vector<MemoryPlanSpecies> species;
+        std::vector<std::uint32_t> indices; // the Forest's species index of each entry
+        for (std::uint32_t s = 0; s < mSpecies.size(); ++s)
+            if (const BudgetPlan* plan = mSpecies[s]->budget.get())
+            {
+                species.push_back(MemoryPlanSpecies{&plan->curves, &plan->costs, plan->visible.counts,
+                                                    mSpecies[s]->asset.get()});
+                indices.push_back(s);
+            }
+        if (extra)
+        {
+            species.push_back(MemoryPlanSpecies{&extra->curves, &extra->costs, {}, extraAsset});
+            indices.push_back(std::uint32_t(mSpecies.size()));
+        }
+        Result<MemoryPlan> plan = chooseLevelsWithinMemory(species, errorBudget, memoryBudget, MAX_LEVELS);
+        if (!plan)
+        {
+            // The planner counts its own species; the Forest's are named.
+            Error error = plan.error();
+            const std::string prefix = "species ";
+            if (error.element.rfind(prefix, 0) == 0)
+            {
+                const std::size_t entry = std::size_t(std::stoul(error.element.substr(prefix.size())));
+                if (entry < indices.size())
+                {
+                    const std::uint32_t s = indices[entry];
+                    error.element = speciesLabel(s, s < mSpecies.size() ? mSpecies[s]->asset.get() : extraAsset) +
+                                    error.element.substr(error.element.find_first_not_of("0123456789", prefix.size()));
+                }
+            }
+            invalid("Forest '" + mName + "': " + error.message(), source);
+        }
+        return std::move(*plan);
+    }
+
+    void Forest::applyMemoryPlan(const MemoryPlan& plan)
+    {
+        std::size_t entry = 0;
+        for (const std::unique_ptr<Species>& species : mSpecies)
+        {
+            BudgetPlan* budget = species->budget.get();
+            if (!budget)
+                continue;
+            // Under a memory budget the levels outside the plan stay out at every step of the
+            // frame budget, so that its moves never hold more than the plan.
+            budget->excluded.assign(budget->curves.levels.size(), mMemoryBudget > 0);
+            for (const LevelChoice& choice : plan.choices.at(entry))
+                budget->excluded[choice.curveLevel] = false;
+            budget->ladderChoices.clear();
+            for (const float step : frameBudgetLadder())
+            {
+                Result<std::vector<LevelChoice>> choices = chooseLevels(
+                    budget->curves, budget->costs, step, MAX_LEVELS, LEVEL_SWITCH_COST_SLACK, budget->excluded);
+                budget->ladderChoices.push_back(choices ? std::move(*choices) : plan.choices.at(entry));
+            }
+            ++entry;
+        }
+        mMemoryBinds = plan.memoryBinds;
+        applyErrorBudget(mBudget.getErrorBudget());
+    }
+
+    void Forest::setMemoryBudget(std::uint64_t bytes)
+    {
+        const MemoryPlan plan =
+            memoryPlan(nullptr, nullptr, mBudget.getUserErrorBudget(), bytes, "Forest::setMemoryBudget");
+        mMemoryBudget = bytes;
+        applyMemoryPlan(plan);
+    }
+
+    void Forest::updatePlannedGpuBytes()
+    {
+        std::vector<MemoryPlanSpecies> planned;
+        std::vector<std::vector<LevelChoice>> plans;
+        for (const std::unique_ptr<Species>& species : mSpecies)
+            if (const BudgetPlan* plan = species->budget.get())
+            {
+                planned.push_back(MemoryPlanSpecies{&plan->curves, &plan->costs, {}, species->asset.get()});
+                plans.push_back(plan->choices);
+            }
+        mStats.plannedGpuBytes = planGpuBytes(planned, plans);
+    }
+
     void Forest::applyErrorBudget(float budget)
     {
         for (std::uint32_t s = 0; s < mSpecies.size(); ++s)
@@ -296,12 +406,14 @@ namespace TreeLod
             if (!species.budget)
                 continue;
             Result<std::vector<LevelChoice>> choices =
-                chooseLevels(species.budget->curves, species.budget->costs, budget, MAX_LEVELS);
+                chooseLevels(species.budget->curves, species.budget->costs, budget, MAX_LEVELS,
+                             LEVEL_SWITCH_COST_SLACK, species.budget->excluded);
             if (!choices)
                 invalid("Forest '" + mName + "' species " + std::to_string(s) + ": " + choices.error().message(),
                         "Forest::setErrorBudget");
             replan(s, *choices);
         }
+        updatePlannedGpuBytes();
         mBudget.setErrorBudgetInUse(budget);
     }
 
@@ -310,6 +422,14 @@ namespace TreeLod
         if (!(std::isfinite(budget) && budget >= 0.0f && budget <= 1.0f))
             invalid("Forest '" + mName + "': error budget " + std::to_string(budget) + " is not a number in [0, 1]",
                     "Forest::setErrorBudget");
+        if (mMemoryBudget > 0)
+        {
+            // The levels the memory budget leaves depend on the error budget they are planned for.
+            const MemoryPlan plan = memoryPlan(nullptr, nullptr, budget, mMemoryBudget, "Forest::setErrorBudget");
+            mBudget.setErrorBudget(budget);
+            applyMemoryPlan(plan);
+            return;
+        }
         applyErrorBudget(budget);
         mBudget.setErrorBudget(budget);
     }

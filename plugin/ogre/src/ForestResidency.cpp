@@ -6,31 +6,58 @@ namespace TreeLod
 {
     std::uint64_t Forest::getGpuBytes() const { return drawableBytes() + mInstanceBufferBytes; }
 
+    void Forest::visitPartResources(const Part& part, const ResourceVisitor& visit)
+    {
+        for (const auto& binding : part.vertexData->vertexBufferBinding->getBindings())
+            visit(std::shared_ptr<const void>(binding.second), binding.second->getSizeInBytes());
+        visit(std::shared_ptr<const void>(part.indexData->indexBuffer), part.indexData->indexBuffer->getSizeInBytes());
+        if (part.mesh)
+            for (const Ogre::SubMesh* sub : part.mesh->getSubMeshes())
+                for (const Ogre::IndexData* lod : sub->mLodFaceList)
+                    if (lod && lod->indexBuffer)
+                        visit(std::shared_ptr<const void>(lod->indexBuffer), lod->indexBuffer->getSizeInBytes());
+        for (const Ogre::MaterialPtr* material : {&part.material, &part.shadowedMaterial})
+            if (*material)
+                for (Ogre::Technique* technique : (*material)->getTechniques())
+                    for (Ogre::Pass* pass : technique->getPasses())
+                        for (Ogre::TextureUnitState* unit : pass->getTextureUnitStates())
+                            if (unit->getContentType() == Ogre::TextureUnitState::CONTENT_NAMED)
+                                if (const Ogre::TexturePtr& texture = unit->_getTexturePtr())
+                                    visit(std::shared_ptr<const void>(texture), textureBytes(*texture));
+    }
+
     std::uint64_t Forest::drawableBytes() const
     {
         std::set<const void*> seen;
         std::uint64_t bytes = 0;
-        auto once = [&](const void* what, std::uint64_t size) {
-            if (what && seen.insert(what).second)
-                bytes += size;
-        };
         for (const std::unique_ptr<Species>& species : mSpecies)
             for (const auto& level : species->parts)
                 for (const std::unique_ptr<Part>& part : level)
-                {
-                    for (const auto& binding : part->vertexData->vertexBufferBinding->getBindings())
-                        once(binding.second.get(), binding.second->getSizeInBytes());
-                    once(part->indexData->indexBuffer.get(), part->indexData->indexBuffer->getSizeInBytes());
-                    for (const Ogre::MaterialPtr* material : {&part->material, &part->shadowedMaterial})
-                        if (*material)
-                            for (Ogre::Technique* technique : (*material)->getTechniques())
-                                for (Ogre::Pass* pass : technique->getPasses())
-                                    for (Ogre::TextureUnitState* unit : pass->getTextureUnitStates())
-                                        if (unit->getContentType() == Ogre::TextureUnitState::CONTENT_NAMED)
-                                            if (const Ogre::TexturePtr& texture = unit->_getTexturePtr())
-                                                once(texture.get(), textureBytes(*texture));
-                }
+                    visitPartResources(*part, [&](const std::shared_ptr<const void>& what, std::uint64_t size) {
+                        if (what && seen.insert(what.get()).second)
+                            bytes += size;
+                    });
         return bytes;
+    }
+
+    std::vector<ForestGpuResource> Forest::getGpuResources(std::uint32_t species, std::uint32_t level) const
+    {
+        std::vector<ForestGpuResource> resources;
+        std::set<const void*> seen;
+        for (const std::unique_ptr<Part>& part : mSpecies.at(species)->parts.at(level))
+            visitPartResources(*part, [&](const std::shared_ptr<const void>& what, std::uint64_t size) {
+                if (what && seen.insert(what.get()).second)
+                    resources.push_back(ForestGpuResource{what, size});
+            });
+        return resources;
+    }
+
+    std::uint32_t Forest::getResidentLevelCount() const
+    {
+        std::uint32_t count = 0;
+        for (const std::unique_ptr<Species>& species : mSpecies)
+            count += std::uint32_t(std::count(species->residency.begin(), species->residency.end(), Residency::Resident));
+        return count;
     }
 
     // ---- residency (Forest.h) ---------------------------------------------------------------------

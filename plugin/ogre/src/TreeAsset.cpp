@@ -67,14 +67,15 @@ namespace TreeLod
         }
         for (const auto& [suffix, names] : mModelMaterials)
             for (const Ogre::String& m : names)
-                if (suffix.empty() || Ogre::StringUtil::endsWith(m, suffix, false)) // not plain leaves
+                if (!m.empty() && (suffix.empty() || Ogre::StringUtil::endsWith(m, suffix, false)))
                 {
                     Ogre::MaterialManager::getSingleton().remove(m, mGroup);
                     Ogre::MaterialManager::getSingleton().remove(m + "/Caster", mGroup);
                 }
         mModelMaterials.clear();
         for (const Ogre::String& t : mTextureNames)
-            Ogre::TextureManager::getSingleton().remove(t, mGroup);
+            if (!t.empty())
+                Ogre::TextureManager::getSingleton().remove(t, mGroup);
         mTextureNames.clear();
         mReference.reset();
         mPackage.reset();
@@ -169,19 +170,20 @@ namespace TreeLod
         return getModelMaterials("TreeLod/BarkShadowed", "TreeLod/LeafShadowed", "/Shadowed");
     }
 
-    void TreeAsset::createTextures()
+    const Ogre::String& TreeAsset::textureName(std::size_t t)
     {
+        // GPU-ready textures: RGBA8 with their baked mip chain, uploaded as they are, on first use
+        // (a technique drawing the bark alone loads no leaf texture).
         const ReferenceChunk& ref = getReference();
-        const Ogre::String prefix = "TreeLod/" + mName + "/";
-
-        // GPU-ready textures: RGBA8 with their baked mip chain, uploaded as they are.
-        for (std::size_t t = 0; t < ref.textures.size(); ++t)
+        mTextureNames.resize(ref.textures.size());
+        if (mTextureNames[t].empty())
         {
             const GpuTexture& gpu = ref.textures[t];
-            const Ogre::String name = prefix + "texture" + std::to_string(t);
+            const Ogre::String name = "TreeLod/" + mName + "/texture" + std::to_string(t);
             uploadTexture(name, mGroup, gpu.data.data(), gpu.width, gpu.height, Ogre::PF_BYTE_RGBA, gpu.mipCount);
-            mTextureNames.push_back(name);
+            mTextureNames[t] = name;
         }
+        return mTextureNames[t];
     }
 
     const std::vector<Ogre::String>& TreeAsset::getModelMaterials(const Ogre::String& barkBase,
@@ -192,8 +194,6 @@ namespace TreeLod
             if (entry.first == suffix)
                 return entry.second;
         const ReferenceChunk& ref = getReference();
-        if (mTextureNames.size() != ref.textures.size())
-            createTextures();
         const Ogre::String prefix = "TreeLod/" + mName + "/";
         std::vector<Ogre::String> names;
         for (std::size_t i = 0; i < ref.model.materials.size(); ++i)
@@ -201,12 +201,12 @@ namespace TreeLod
             const Material& src = ref.model.materials[i];
             if (src.isLeaf && leafBase.empty())
             {
-                names.push_back(getMaterialNames()[i]);
+                names.emplace_back(); // bark materials only
                 continue;
             }
             const Ogre::String name = prefix + std::to_string(i) + suffix;
             Ogre::MaterialPtr mat = cloneBaseMaterial(src.isLeaf ? leafBase : barkBase, name, mGroup, mName);
-            const Ogre::String texture = src.texture >= 0 ? mTextureNames[std::size_t(src.texture)] : "TreeLodWhite.png";
+            const Ogre::String texture = src.texture >= 0 ? textureName(std::size_t(src.texture)) : "TreeLodWhite.png";
             glm::vec3 back = src.backColour == glm::vec3(0.0f) ? glm::vec3(src.baseColour) : src.backColour;
 
             auto configure = [&](const Ogre::MaterialPtr& m) {

@@ -19,7 +19,9 @@
 #include <cmath>
 #include <future>
 #include <memory>
+#include <map>
 #include <optional>
+#include <set>
 
 namespace TreeLod
 {
@@ -240,6 +242,24 @@ namespace TreeLod
             renderer.clearContent();
             return fail(label, error.element, error.reason);
         };
+        // The GPU resources each level draws from at any height (the bark at its LoD level there):
+        // each once, by identity, held to the end so that no address is reused.
+        std::vector<std::shared_ptr<const void>> held;
+        std::map<const void*, std::uint32_t> resourceIndex;
+        std::vector<std::set<std::uint32_t>> levelResources(levels.size());
+        auto addResources = [&](std::size_t l, const Forest& forest) {
+            const std::uint32_t drawn = std::uint32_t(forest.getLevels(0).size() - 1); // built with the species
+            for (const ForestGpuResource& resource : forest.getGpuResources(0, drawn))
+            {
+                auto [at, added] = resourceIndex.emplace(resource.handle.get(), std::uint32_t(held.size()));
+                if (added)
+                {
+                    held.push_back(resource.handle);
+                    curves.resourceBytes.push_back(resource.bytes);
+                }
+                levelResources[l].insert(at->second);
+            }
+        };
         for (std::size_t h = 0; h < options.heightsPx.size(); ++h)
         {
             // One Forest per level, its bark at the mesh LoD level a Forest draws at this height.
@@ -254,6 +274,7 @@ namespace TreeLod
                                           "TreeLod/ErrorCurves/" + std::to_string(l), options.heightsPx[h]);
                     forest->setVisible(false);
                     forests.push_back(forest);
+                    addResources(l, *forest);
                 }
             }
             catch (const Ogre::Exception& e)
@@ -291,6 +312,8 @@ namespace TreeLod
             return abandon(collected.error());
         renderer.clearContent();
         report(progress, "error curves", 1.0f);
+        for (std::size_t l = 0; l < levels.size(); ++l)
+            curves.levels[l].resources.assign(levelResources[l].begin(), levelResources[l].end());
         for (ErrorCurveLevel& c : curves.levels)
             for (std::size_t h = 0; h < c.flip.size(); ++h)
             {
@@ -308,7 +331,8 @@ namespace TreeLod
 
     bool coversCandidateLevels(const ErrorCurves& curves, TreeAsset& asset, const ErrorCurveOptions& options)
     {
-        if (curves.heightsPx != options.heightsPx || curves.views != options.views.size() || !curves.hasSwitchFlip())
+        if (curves.heightsPx != options.heightsPx || curves.views != options.views.size() || !curves.hasSwitchFlip() ||
+            !curves.hasGpuBytes())
             return false;
         for (const ForestLevel& level : Forest::getCandidateLevels(asset))
             if (curves.find(level.technique, level.techniqueLevel, level.lowRes) < 0)

@@ -344,6 +344,8 @@ namespace TreeLod
         mForest->setShadowLodBias(mScript.shadows.lodBias);
         mForest->setFrameBudgetMs(std::isnan(mPolicy.frameBudgetMs) ? mScript.lod.frameBudgetMs : mPolicy.frameBudgetMs);
         mForest->setLodTransition(std::isnan(mPolicy.transition) ? mScript.lod.transition : mPolicy.transition);
+        const float memoryMB = std::isnan(mPolicy.memoryBudgetMB) ? mScript.lod.memoryBudgetMB : mPolicy.memoryBudgetMB;
+        mForest->setMemoryBudget(std::uint64_t(double(memoryMB) * 1e6));
 
         // Bands per species; then one bake request per distinct source with every technique its
         // species draw (two species sharing a file share one package and one asset).

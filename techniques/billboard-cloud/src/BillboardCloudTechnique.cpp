@@ -57,6 +57,11 @@ namespace TreeLod
                 return spans;
             }
 
+            Ogre::MeshPtr getBarkMesh(TreeAsset& asset) override
+            {
+                return BillboardCloudResources::of(asset, mClassic).getBarkAoMesh();
+            }
+
             void checkLevel(TreeAsset& asset, const ForestLevel& level, Ogre::AxisAlignedBox& drawnBounds) override
             {
                 const BillboardCloudGpu& layout = BillboardCloudResources::of(asset, mClassic).getLayout();

@@ -144,6 +144,8 @@ namespace TreeLod
                                (c.views == 1 ? " view" : " views") +
                                (c.switchFlip.empty() ? "" : ", switch FLIP of " + std::to_string(c.switchFlip.size()) +
                                                                 (c.switchFlip.size() == 1 ? " pair" : " pairs")) +
+                               (c.hasGpuBytes() ? ", GPU bytes of " + std::to_string(c.resourceBytes.size()) + " resources"
+                                                : std::string()) +
                                "; FLIP at ";
             for (std::size_t k = 0; k < shown.size(); ++k)
                 text += (k ? "/" : "") + number(c.heightsPx[shown[k]]);
@@ -168,6 +170,12 @@ namespace TreeLod
                     std::snprintf(value, sizeof(value), "%.3f", double(level.flip[shown[k]]));
                     text += (k ? "/" : " ") + std::string(value);
                 }
+                if (c.hasGpuBytes())
+                {
+                    char bytes[32];
+                    std::snprintf(bytes, sizeof(bytes), " (%.2f MB)", double(c.gpuBytes({l})) / 1e6);
+                    text += bytes;
+                }
             }
             if (c.levels.size() > LISTED)
                 text += ", ...";
@@ -179,7 +187,9 @@ namespace TreeLod
                                   {"lowRes", level.lowRes},
                                   {"flip", floats(level.flip)},
                                   {"flipMax", floats(level.flipMax)},
-                                  {"rmse", floats(level.rmse)}});
+                                  {"rmse", floats(level.rmse)},
+                                  {"gpuBytes", c.hasGpuBytes() ? nlohmann::json(c.gpuBytes({std::size_t(&level - c.levels.data())}))
+                                                               : nlohmann::json(nullptr)}});
             nlohmann::json switches = nlohmann::json::array();
             for (std::size_t a = 0; a < c.levels.size() && !c.switchFlip.empty(); ++a)
                 for (std::size_t b = a + 1; b < c.levels.size(); ++b)
@@ -191,7 +201,8 @@ namespace TreeLod
                                           {"views", c.views},
                                           {"referenceSamples", c.referenceSamples},
                                           {"curves", curves},
-                                          {"switchFlip", switches}}
+                                          {"switchFlip", switches},
+                                          {"resourceBytes", c.resourceBytes}}
                                .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
             return summary;
         }
@@ -296,6 +307,21 @@ namespace TreeLod
         return interpolateAt(heightsPx, switchFlip[switchPair(std::min(a, b), std::max(a, b))], heightPx);
     }
 
+    std::uint64_t ErrorCurves::gpuBytes(const std::vector<std::size_t>& levelIndices) const
+    {
+        std::vector<bool> counted(resourceBytes.size(), false);
+        std::uint64_t bytes = 0;
+        for (std::size_t l : levelIndices)
+            if (l < levels.size())
+                for (std::uint32_t r : levels[l].resources)
+                    if (r < counted.size() && !counted[r])
+                    {
+                        counted[r] = true;
+                        bytes += resourceBytes[r];
+                    }
+        return bytes;
+    }
+
     void ErrorCurves::keepLevels(const std::vector<bool>& keep)
     {
         std::vector<std::size_t> kept;
@@ -368,6 +394,26 @@ namespace TreeLod
                 if (!problem.empty())
                     return fail(label, switchElement(curves, a, b) + " " + at, problem);
             }
+        if (curves.resourceBytes.size() > ERROR_CURVES_MAX_RESOURCES)
+            return fail(label, element("resources"),
+                        std::to_string(curves.resourceBytes.size()) + " GPU resources (at most " +
+                            std::to_string(ERROR_CURVES_MAX_RESOURCES) + ")");
+        for (std::size_t l = 0; l < curves.levels.size(); ++l)
+        {
+            const std::vector<std::uint32_t>& resources = curves.levels[l].resources;
+            for (std::size_t i = 0; i < resources.size(); ++i)
+            {
+                const std::string at = levelElement(l, curves.levels[l]) + " resources[" + std::to_string(i) + "]";
+                if (resources[i] >= curves.resourceBytes.size())
+                    return fail(label, at,
+                                "resource " + std::to_string(resources[i]) + " of a table of " +
+                                    std::to_string(curves.resourceBytes.size()));
+                if (i > 0 && resources[i] <= resources[i - 1])
+                    return fail(label, at,
+                                "resource " + std::to_string(resources[i]) + " after " +
+                                    std::to_string(resources[i - 1]) + " (strictly increasing needed)");
+            }
+        }
         return {};
     }
 
@@ -396,6 +442,18 @@ namespace TreeLod
         for (const std::vector<float>& values : curves.switchFlip)
             for (float v : values)
                 w.f32(v);
+        w.u32(std::uint32_t(curves.resourceBytes.size()));
+        if (!curves.resourceBytes.empty())
+        {
+            for (std::uint64_t bytes : curves.resourceBytes)
+                w.u64(bytes);
+            for (const ErrorCurveLevel& level : curves.levels)
+            {
+                w.u32(std::uint32_t(level.resources.size()));
+                for (std::uint32_t r : level.resources)
+                    w.u32(r);
+            }
+        }
         return w.take();
     }
 
@@ -477,6 +535,39 @@ namespace TreeLod
                 values.resize(heightCount);
                 for (float& v : values)
                     v = r.f32();
+            }
+            if (!r.ok())
+                return r.error();
+        }
+        if (formatVersion >= 3) // the GPU resources
+        {
+            r.setElement(element("resources"));
+            const std::uint32_t count = r.u32();
+            if (r.ok() && count > ERROR_CURVES_MAX_RESOURCES)
+                return fail(label, element("resources"),
+                            std::to_string(count) + " GPU resources (at most " +
+                                std::to_string(ERROR_CURVES_MAX_RESOURCES) + ")");
+            if (r.ok() && count > 0 && 8 * std::size_t(count) + 4 * std::size_t(levelCount) > r.remaining())
+                return fail(label, element("resources"),
+                            "truncated: " + std::to_string(count) + " resources and " + std::to_string(levelCount) +
+                                " levels' lists need at least " +
+                                std::to_string(8 * std::size_t(count) + 4 * std::size_t(levelCount)) +
+                                " bytes, chunk has " + std::to_string(r.remaining()) + " left");
+            curves.resourceBytes.resize(r.ok() ? count : 0);
+            for (std::uint64_t& bytes : curves.resourceBytes)
+                bytes = r.u64();
+            for (std::uint32_t l = 0; l < levelCount && r.ok() && count > 0; ++l)
+            {
+                ErrorCurveLevel& level = curves.levels[l];
+                r.setElement(levelElement(l, level) + " resources");
+                const std::uint32_t k = r.u32();
+                if (r.ok() && (k > count || 4 * std::size_t(k) > r.remaining()))
+                    return fail(label, levelElement(l, level) + " resources",
+                                std::to_string(k) + " resources of a table of " + std::to_string(count) + " with " +
+                                    std::to_string(r.remaining()) + " bytes left");
+                level.resources.resize(r.ok() ? k : 0);
+                for (std::uint32_t& index : level.resources)
+                    index = r.u32();
             }
             if (!r.ok())
                 return r.error();

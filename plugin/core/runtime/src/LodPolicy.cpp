@@ -27,7 +27,21 @@ namespace TreeLod
 
     Result<LodPolicy> LodPolicy::parse(const std::string& text, const std::string& element)
     {
-        if (const std::size_t fade = text.rfind("+fade"); fade != std::string::npos)
+        const std::size_t fade = text.rfind("+fade"), memory = text.rfind("+mem");
+        if (memory != std::string::npos && (fade == std::string::npos || memory > fade))
+        {
+            const std::string number = text.substr(memory + 4);
+            char* end = nullptr;
+            const double value = std::strtod(number.c_str(), &end);
+            if (number.empty() || *end != '\0' || !(value >= 0.0 && value <= 1e9))
+                return fail("", element,
+                            "'" + text + "': the memory budget after '+mem' must be megabytes in [0, 1e9] (0: none)");
+            Result<LodPolicy> base = parse(text.substr(0, memory), element);
+            if (base)
+                base->memoryBudgetMB = float(value);
+            return base;
+        }
+        if (fade != std::string::npos)
         {
             const std::string number = text.substr(fade + 5);
             char* end = nullptr;
@@ -71,6 +85,14 @@ namespace TreeLod
             std::snprintf(fade, sizeof fade, "+fade%g", double(transition));
             return base.toString() + fade;
         }
+        if (!std::isnan(memoryBudgetMB))
+        {
+            LodPolicy base = *this;
+            base.memoryBudgetMB = std::numeric_limits<float>::quiet_NaN();
+            char memory[32];
+            std::snprintf(memory, sizeof memory, "+mem%g", double(memoryBudgetMB));
+            return base.toString() + memory;
+        }
         char text[48];
         switch (mode)
         {
@@ -94,6 +116,7 @@ namespace TreeLod
     {
         const auto same = [](float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); };
         return mode == other.mode && technique == other.technique && same(errorBudget, other.errorBudget) &&
-               same(frameBudgetMs, other.frameBudgetMs) && same(transition, other.transition);
+               same(frameBudgetMs, other.frameBudgetMs) && same(transition, other.transition) &&
+               same(memoryBudgetMB, other.memoryBudgetMB);
     }
 }

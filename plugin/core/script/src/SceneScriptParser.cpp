@@ -788,13 +788,15 @@ namespace TreeLod
                 s.shadows = readShadows(*v, "/shadows");
             if (const Json* v = find(root, "lod"))
             {
-                allowKeys(*v, "/lod", {"maxError", "shadowMaxError", "frameBudgetMs", "transition"});
+                allowKeys(*v, "/lod", {"maxError", "shadowMaxError", "frameBudgetMs", "memoryBudgetMB", "transition"});
                 if (const Json* e = find(*v, "maxError"))
                     s.lod.maxError = float(number(*e, "/lod/maxError", 0.0, 1.0));
                 if (const Json* e = find(*v, "shadowMaxError"))
                     s.lod.shadowMaxError = float(number(*e, "/lod/shadowMaxError", 0.0, 1.0));
                 if (const Json* e = find(*v, "frameBudgetMs"))
                     s.lod.frameBudgetMs = float(number(*e, "/lod/frameBudgetMs", 0.0, 1e6));
+                if (const Json* e = find(*v, "memoryBudgetMB"))
+                    s.lod.memoryBudgetMB = float(number(*e, "/lod/memoryBudgetMB", 0.0, 1e9));
                 if (const Json* e = find(*v, "transition"))
                     s.lod.transition = float(number(*e, "/lod/transition", 0.0, ForestInstances::MAX_TRANSITION));
             }

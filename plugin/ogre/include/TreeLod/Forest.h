@@ -41,14 +41,34 @@
 #include <OgreMovableObject.h>
 
 #include <deque>
+#include <functional>
 #include <limits>
 #include <map>
+#include <optional>
 #include <memory>
 #include <vector>
 
 namespace TreeLod
 {
     /// What the last frame of the viewer's camera drew.
+    /// Which budget decided the budgeted species' plans (Forest::getBindingBudget).
+    enum class ForestBinding : std::uint8_t
+    {
+        Error,  ///< the error budget: the cheapest levels within it
+        Frame,  ///< the frame budget: the error budget in use is coarser than the one set
+        Memory  ///< the memory budget: levels were taken out to fit it
+    };
+    /// "error", "frame", "memory".
+    const char* toString(ForestBinding binding);
+
+    /// One GPU resource a level draws from (Forest::getGpuResources): a vertex or index buffer or a
+    /// texture (all mips).
+    struct ForestGpuResource
+    {
+        std::shared_ptr<const void> handle; ///< keeps the resource alive while held; its identity
+        std::uint64_t bytes = 0;
+    };
+
     struct ForestStats
     {
         std::uint32_t instances = 0;          ///< in the Forest
@@ -75,6 +95,9 @@ namespace TreeLod
         /// The frame budget's prediction at its last re-plan (ms, the viewer's trees of budgeted
         /// species at the levels in use, times Forest::getFrameTimeRatio); 0 without a frame budget.
         double predictedMilliseconds = 0.0;
+        /// GPU bytes of the budgeted species' planned levels, from their error curves
+        /// (ErrorCurves::gpuBytes; 0 where the curves hold none).
+        std::uint64_t plannedGpuBytes = 0;
     };
 
     class Forest : public Ogre::MovableObject
@@ -149,6 +172,17 @@ namespace TreeLod
         /// Turning it off plans for the last setErrorBudget again.
         void setFrameBudgetMs(float milliseconds);
         float getFrameBudgetMs() const { return mBudget.getFrameBudgetMs(); }
+        /// GPU memory budget of the budgeted species' levels in bytes (0, the default: none): their
+        /// plans hold at most this many bytes of level resources (ErrorCurves' GPU bytes: buffers
+        /// and textures with mips; the instance buffers are not counted), levels taken out as
+        /// chooseLevelsWithinMemory says, in the plan for the error budget set (setErrorBudget);
+        /// the frame budget's steps choose among the levels left. Re-plans now. Throws
+        /// Ogre::InvalidParametersException, changing nothing, when a budgeted species' curves hold
+        /// no GPU bytes or the budget is below the smallest plan (naming both).
+        void setMemoryBudget(std::uint64_t bytes);
+        std::uint64_t getMemoryBudget() const { return mMemoryBudget; }
+        /// Which budget decides the plans now (ForestBinding); Error without budgeted species.
+        ForestBinding getBindingBudget() const;
         /// The application's measured time of the frame just drawn (ms, finite and > 0; others are
         /// ignored): under a frame budget the controller scales its predictions by the running ratio
         /// of measured to predicted time, closing the loop on what the calibration cannot see
@@ -218,8 +252,14 @@ namespace TreeLod
 
         const ForestStats& getStats() const { return mStats; }
         /// GPU bytes of the assets' drawables in use (vertex and index buffers and textures, all
-        /// mips, of every resident level's parts, each counted once) plus the instance buffers.
+        /// mips, of every resident level's parts, with every LoD level of the meshes they draw,
+        /// each counted once) plus the instance buffers.
         std::uint64_t getGpuBytes() const;
+        /// The resources level `level` of `species` draws from, each once (empty while it is not
+        /// resident): what getGpuBytes counts for it.
+        std::vector<ForestGpuResource> getGpuResources(std::uint32_t species, std::uint32_t level) const;
+        /// Levels resident now, all species.
+        std::uint32_t getResidentLevelCount() const;
 
         /// Bytes the levels built in one Root frame may upload (0, the default: no limit, every
         /// level is built in the frame that first needs it). See "Residency".
@@ -263,6 +303,14 @@ namespace TreeLod
         void replan(std::uint32_t species, const std::vector<LevelChoice>& choices);
         /// Plan every budgeted species for `budget` (replan where its levels change).
         void applyErrorBudget(float budget);
+        /// The memory plan of the budgeted species (and of `extra` for `extraAsset`, a species being
+        /// added, last) at `errorBudget` within `memoryBudget`; throws naming the Forest.
+        MemoryPlan memoryPlan(const BudgetPlan* extra, const TreeAsset* extraAsset, float errorBudget,
+                              std::uint64_t memoryBudget, const char* source) const;
+        /// Each budgeted species' excluded levels and frame-budget steps from `plan`, then re-plan at
+        /// the error budget in use.
+        void applyMemoryPlan(const MemoryPlan& plan);
+        void updatePlannedGpuBytes(); ///< ForestStats::plannedGpuBytes of the plans in use
         void updateShadowLevels(std::uint32_t species);
         /// The kind's table of `levels` of `species`, within setMeshLodBias's limits.
         std::vector<float> kindThresholds(const Species& species, const std::vector<ForestLevel>& levels) const;
@@ -282,6 +330,10 @@ namespace TreeLod
         void serviceUploads();
         static unsigned long currentFrame();
         std::uint64_t drawableBytes() const; ///< getGpuBytes without the instance buffers
+        using ResourceVisitor = std::function<void(const std::shared_ptr<const void>& handle, std::uint64_t bytes)>;
+        /// Each buffer and named texture `part` draws from, and the other LoD levels' index buffers of
+        /// its mesh (a resource may come twice).
+        static void visitPartResources(const Part& part, const ResourceVisitor& visit);
         /// This Forest's instanced clone of material `name` (and of its shadow casters).
         Ogre::MaterialPtr instancedMaterial(const Ogre::String& name, const Ogre::String& group);
         bool useShadowedMaterials() const;
@@ -309,6 +361,8 @@ namespace TreeLod
         Ogre::Real mLodTransitionMinHeight = DEFAULT_LOD_TRANSITION_MIN_HEIGHT;
         FrameBudgetController mBudget{DEFAULT_ERROR_BUDGET}; ///< the error budget, set or under a frame budget
         float mShadowErrorBudget = DEFAULT_SHADOW_ERROR_BUDGET;
+        std::uint64_t mMemoryBudget = 0;
+        bool mMemoryBinds = false; ///< the memory plan took levels out
         bool mLodFrozen = false;
         ForestStats mStats;
         std::uint64_t mInstanceBufferBytes = 0;

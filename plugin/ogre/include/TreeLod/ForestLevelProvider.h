@@ -102,6 +102,10 @@ namespace TreeLod
         /// Whether the levels draw the asset's bark mesh (or a mesh with its LoD levels): the Forest
         /// then splits spans where the bark mesh's LoD switches (Forest.h, "Bark").
         virtual bool drawsBarkMesh() const { return true; }
+        /// The bark mesh the levels draw (where drawsBarkMesh): its LoD levels split the spans. By
+        /// default the asset's plain bark mesh (TreeAsset::getBarkMesh); a technique that draws its
+        /// own copy returns that one, so that planning uploads no mesh its levels do not draw.
+        virtual Ogre::MeshPtr getBarkMesh(TreeAsset& asset);
         /// Check `level` when a species is added, from decoded data only; throw
         /// Ogre::InvalidParametersException with the reason. Merge into `drawnBounds` (local metres)
         /// what the level draws outside the reference's box.

@@ -87,7 +87,8 @@ namespace TreeLod
         [[noreturn]] void raise(const Error& error) const;
         /// Clones of `barkBase` and `leafBase`, one per model material, named
         /// "TreeLod/<asset>/<i><suffix>", textures and constants set, shadow casters cloned too; an
-        /// empty `leafBase` keeps the plain leaf materials. The clones are removed on unload.
+        /// empty `leafBase` makes the bark's only (leaf entries empty: for a mesh of the bark alone).
+        /// The clones are removed on unload. The model's textures are uploaded as materials use them.
         const std::vector<Ogre::String>& getModelMaterials(const Ogre::String& barkBase, const Ogre::String& leafBase,
                                                            const Ogre::String& suffix);
         /// The bark of the reference alone as mesh `name` in the asset's group, with
@@ -101,7 +102,8 @@ namespace TreeLod
         size_t calculateSize() const override;
 
     private:
-        void createTextures();
+        /// The Ogre texture of the model's texture `t` (< the reference's textures), uploaded on first use.
+        const Ogre::String& textureName(std::size_t t);
 
         std::vector<std::uint8_t> mManualBytes;
         std::unique_ptr<PackageReader> mPackage;

@@ -15,6 +15,8 @@
 // The switch FLIP of two levels (switchFlip, what a hard switch between them shows) compares the
 // two levels' images of the same views as flip with each other, over the pixels that are tree in
 // either: no extra frame, each image filtered for FLIP once (FlipReference).
+// The GPU bytes (resourceBytes) are read from the same one-tree Forests: each level's buffers and
+// textures at every height (Forest::getGpuResources), each resource once.
 //
 // Deviation: a level is measured with its bark at full detail (a Forest draws a level's bark at
 // the mesh LoD of the largest value the level is used at), so curves of coarse levels used near
@@ -55,7 +57,7 @@ namespace TreeLod
                                            const ErrorCurveOptions& options = {}, const ProgressCallback& progress = {});
 
     /// Whether `curves` hold every candidate level of `asset` at the heights of `options`, with the
-    /// switch FLIP between them (not so for curves of version 1).
+    /// switch FLIP between them and their GPU bytes (not so for curves of versions 1 and 2).
     bool coversCandidateLevels(const ErrorCurves& curves, TreeAsset& asset, const ErrorCurveOptions& options = {});
 
     /// The package `bytes` with its error-curves chunk measured and added (replaced), every other

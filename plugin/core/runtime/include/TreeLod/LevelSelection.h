@@ -18,6 +18,14 @@
 // A level without a cost is not a candidate.
 // Shadow casters (chooseShadowLevels) get their own, coarser budget: each run's casters draw the
 // cheapest of its level and the coarser runs' levels within that budget over the run's heights.
+// A memory budget (chooseLevelsWithinMemory) bounds the GPU bytes of the levels the plans of all
+// budgeted species hold (ErrorCurves::gpuBytes, measured with the curves): while the plans hold
+// more, the level whose exclusion saves most bytes is taken out of its species' candidates, first
+// among those whose exclusion keeps the error budget (most bytes per millisecond the plan adds),
+// then among the others (most bytes per FLIP over the budget added). Where every way out draws a
+// larger level instead, the plan is built up from the smallest one (each species' level of fewest
+// bytes alone), adding the level that removes most FLIP over the error budget (then most cost)
+// per byte while the bytes fit. A greedy search, not an optimum: the plan says which budget bound.
 // A frame budget (chooseFrameBudgetStep) picks the finest error budget of a ladder whose plans'
 // predicted cost, the visible trees counted by height (HeightHistogram) times each level's
 // LevelCost::msAt, fits: a model of this machine's calibrated costs, not a timer.
@@ -78,18 +86,57 @@ namespace TreeLod
         std::size_t curveLevel = 0;
         float minHeightPx = 0.0f; ///< the last run's is 0
         float flip = 0.0f;        ///< the curve's largest FLIP over the run's sampled heights
+        /// False where, at some sampled height of the run, no level left allowed the error budget
+        /// (chooseLevels' `excluded` took them) and the run draws the least FLIP there instead.
+        bool withinBudget = true;
     };
 
     /// Runs near to far, at most `maxRuns` (the shortest runs, counted in samples, are merged into
     /// the finer neighbour until they fit); `costSlack` as above (0: the cheapest level at each
-    /// sample). Errors: a budget that is not finite or not in [0, 1]; a slack that is not finite
-    /// or below 0; curves without the reference level or with no level that has a cost.
+    /// sample). `excluded` (one flag per curve level; shorter: the rest kept) takes levels out,
+    /// the reference too: where no level left is allowed, the one with the least FLIP is drawn
+    /// (LevelChoice::withinBudget false). Errors: a budget that is not finite or not in [0, 1];
+    /// a slack that is not finite or below 0; curves without the reference level or with no
+    /// level that has a cost; every level with a cost excluded.
     Result<std::vector<LevelChoice>> chooseLevels(const ErrorCurves& curves, const std::vector<LevelCost>& costs,
                                                   float errorBudget, std::size_t maxRuns = 16,
-                                                  float costSlack = LEVEL_SWITCH_COST_SLACK);
+                                                  float costSlack = LEVEL_SWITCH_COST_SLACK,
+                                                  const std::vector<bool>& excluded = {});
 
     /// The run of `choices` drawn at `heightPx` (the first whose minHeightPx it reaches).
     std::size_t choiceAt(const std::vector<LevelChoice>& choices, float heightPx);
+
+    /// One species of a memory plan (chooseLevelsWithinMemory).
+    struct MemoryPlanSpecies
+    {
+        const ErrorCurves* curves = nullptr;          ///< with GPU bytes (ErrorCurves::hasGpuBytes)
+        const std::vector<LevelCost>* costs = nullptr;
+        /// Trees at each selection sample (HeightHistogram::counts), weighing where the plan's added
+        /// cost and error count; empty or all 0: every sample alike.
+        std::vector<std::uint32_t> weights;
+        /// Species with one key draw one asset's resources: its bytes are counted once for them.
+        const void* resourceKey = nullptr;
+    };
+
+    struct MemoryPlan
+    {
+        std::vector<std::vector<LevelChoice>> choices; ///< per species, as chooseLevels
+        std::vector<std::vector<bool>> excluded;       ///< per species, per curve level: taken out
+        std::uint64_t gpuBytes = 0;                    ///< of the plans' levels
+        bool memoryBinds = false;      ///< levels were excluded to fit the memory budget
+        bool withinErrorBudget = true; ///< every run of every plan within the error budget
+    };
+
+    /// The plans of `species` within `errorBudget` whose levels hold at most `memoryBudget` GPU
+    /// bytes (0: no limit), as above. Errors: chooseLevels'; a species without curves, costs or
+    /// measured GPU bytes (under a memory budget); a memory budget below the smallest plan, naming
+    /// the budget and that plan (each species' level with the fewest bytes).
+    Result<MemoryPlan> chooseLevelsWithinMemory(const std::vector<MemoryPlanSpecies>& species, float errorBudget,
+                                                std::uint64_t memoryBudget, std::size_t maxRuns = 16);
+
+    /// GPU bytes of the levels of `plans` (one per species of `species`), each resource once per key.
+    std::uint64_t planGpuBytes(const std::vector<MemoryPlanSpecies>& species,
+                               const std::vector<std::vector<LevelChoice>>& plans);
 
     /// Shadow casters' levels: for each run r of `choices`, the index (>= r) of the run whose level
     /// its casters draw: the cheapest over run r's sampled heights among run r's own level and the

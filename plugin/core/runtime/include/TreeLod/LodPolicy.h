@@ -7,7 +7,9 @@
 //   "auto~MS"  Auto     budgeted auto under a frame budget of MS milliseconds, in (0, 1e6]
 //   any other  Fixed    every species drawn by that one technique or measurement baseline
 // Any of them + "+fadeT": level transitions of length T in [0, 1] (Forest::setLodTransition; 0:
-// hard switches), else the script's ("auto+fade0", "impostor+fade0.2", "+fade0.1").
+// hard switches), else the script's ("auto+fade0", "impostor+fade0.2", "+fade0.1"); and + "+memMB":
+// a memory budget of MB megabytes (10^6 bytes) for budgeted auto (Forest::setMemoryBudget; 0:
+// none), else the script's ("auto+mem40", "auto@0.02+mem40+fade0.2").
 #pragma once
 
 #include "TreeLod/Result.h"
@@ -34,6 +36,8 @@ namespace TreeLod
         float frameBudgetMs = std::numeric_limits<float>::quiet_NaN();
         /// Forest::setLodTransition, [0, 1]; NaN: the script's.
         float transition = std::numeric_limits<float>::quiet_NaN();
+        /// Forest::setMemoryBudget in megabytes (10^6 bytes), >= 0 (0: none); NaN: the script's.
+        float memoryBudgetMB = std::numeric_limits<float>::quiet_NaN();
 
         static LodPolicy scriptChoice() { return {}; }
         static LodPolicy automatic(float errorBudget = std::numeric_limits<float>::quiet_NaN(),

@@ -154,6 +154,9 @@ namespace TreeLod
         float shadowMaxError = DEFAULT_SHADOW_MAX_ERROR;
         /// Frame budget of budgeted auto (Forest::setFrameBudgetMs), ms; 0: none.
         float frameBudgetMs = 0.0f;
+        /// GPU memory budget of budgeted auto's levels (Forest::setMemoryBudget), megabytes (10^6
+        /// bytes); 0: none.
+        float memoryBudgetMB = 0.0f;
         /// Level transitions (Forest::setLodTransition) of every species, in [0, 1]; 0: hard switches.
         float transition = ForestInstances::DEFAULT_TRANSITION;
     };
