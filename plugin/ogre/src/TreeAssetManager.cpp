@@ -1,10 +1,15 @@
 #include "TreeLod/TreeAssetManager.h"
 
 #include <OgreException.h>
+#include <OgreLogManager.h>
+#include <OgreRenderSystem.h>
+#include <OgreRenderSystemCapabilities.h>
 #include <OgreResourceGroupManager.h>
+#include <OgreRoot.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 
@@ -20,6 +25,43 @@ namespace TreeLod
         mResourceType = "TreeAsset";
         mLoadOrder = 250.0f; // after materials (100) and meshes (200)
         Ogre::ResourceGroupManager::getSingleton()._registerResourceManager(mResourceType, this);
+        if (const char* env = std::getenv("TREELOD_COMPRESSED_TEXTURES"); env && *env)
+        {
+            const std::string value = env;
+            if (value == "as-stored" || value == "decoded")
+                setCompressedTextureUpload(value == "decoded" ? CompressedTextureUpload::Decoded
+                                                              : CompressedTextureUpload::AsStored);
+            else if (Ogre::LogManager* log = Ogre::LogManager::getSingletonPtr())
+                log->logWarning("TreeLod: TREELOD_COMPRESSED_TEXTURES='" + value +
+                                "' is neither 'as-stored' nor 'decoded'; ignored");
+        }
+    }
+
+    void TreeAssetManager::setCompressedTextureUpload(CompressedTextureUpload upload)
+    {
+        mTextureUpload = upload;
+        mTextureUploadChosen = true;
+    }
+
+    void TreeAssetManager::adoptMeasuredTextureUpload(CompressedTextureUpload upload)
+    {
+        if (!mTextureUploadChosen)
+            mTextureUpload = upload;
+    }
+
+    bool TreeAssetManager::decodesAtLoad(GpuTextureFormat format) const
+    {
+        if (!isBlockCompressed(format))
+            return false;
+        if (mTextureUpload == CompressedTextureUpload::Decoded)
+            return true;
+        const Ogre::RenderSystem* system =
+            Ogre::Root::getSingletonPtr() ? Ogre::Root::getSingleton().getRenderSystem() : nullptr;
+        const Ogre::RenderSystemCapabilities* caps = system ? system->getCapabilities() : nullptr;
+        if (!caps)
+            return false;
+        const bool rgtc = format == GpuTextureFormat::BC4 || format == GpuTextureFormat::BC5;
+        return !caps->hasCapability(rgtc ? Ogre::RSC_TEXTURE_COMPRESSION_BC4_BC5 : Ogre::RSC_TEXTURE_COMPRESSION_DXT);
     }
 
     TreeAssetManager::~TreeAssetManager()

@@ -41,6 +41,13 @@ namespace TreeLod
         TreeAssetPtr mAsset;
     };
 
+    /// How block-compressed textures (GpuTextureFormat DXT1, DXT5, BC4, BC5) of a package reach the GPU.
+    enum class CompressedTextureUpload
+    {
+        AsStored, ///< as baked: the texture unit decodes them (every GPU)
+        Decoded   ///< decoded to RGBA8 at load (decodeGpuTexture): for renderers that sample RGBA8 faster
+    };
+
     class TreeAssetManager : public Ogre::ResourceManager, public Ogre::Singleton<TreeAssetManager>
     {
     public:
@@ -73,6 +80,22 @@ namespace TreeLod
                                                        const std::vector<Ogre::String>& techniques,
                                                        const Ogre::String& group);
 
+        /// The user's choice for textures uploaded from now on (already uploaded ones stay as they
+        /// are); a calibration's measured choice (adoptMeasuredTextureUpload) no longer applies.
+        /// The environment variable TREELOD_COMPRESSED_TEXTURES ("as-stored" or "decoded") makes
+        /// the same choice when the manager is created.
+        void setCompressedTextureUpload(CompressedTextureUpload upload);
+        /// The choice measured on this renderer (LevelCalibration.h: sampling a compressed texture
+        /// against the same texture decoded); ignored once the user chose. AsStored until either.
+        void adoptMeasuredTextureUpload(CompressedTextureUpload upload);
+        CompressedTextureUpload getCompressedTextureUpload() const { return mTextureUpload; }
+        /// Whether the user chose (setCompressedTextureUpload or the environment variable).
+        bool isCompressedTextureUploadChosen() const { return mTextureUploadChosen; }
+        /// Whether a texture of `format` is decoded to RGBA8 before upload: a block format under
+        /// CompressedTextureUpload::Decoded, or one the render system cannot sample (no
+        /// RSC_TEXTURE_COMPRESSION_DXT for DXT1/DXT5, no RSC_TEXTURE_COMPRESSION_BC4_BC5 for BC4/BC5).
+        bool decodesAtLoad(GpuTextureFormat format) const;
+
         static TreeAssetManager& getSingleton();
         static TreeAssetManager* getSingletonPtr();
 
@@ -89,6 +112,8 @@ namespace TreeLod
                                const Ogre::String& path, const Ogre::String& group);
 
         TreeBaker* mBaker = nullptr;
+        CompressedTextureUpload mTextureUpload = CompressedTextureUpload::AsStored;
+        bool mTextureUploadChosen = false;
         std::mutex mBakeMutex; ///< one bake at a time
         std::vector<std::shared_future<Ogre::String>> mBakes; ///< running or ended; waited for at destruction
     };
