@@ -37,23 +37,16 @@ namespace TreeLod
         }
     }
 
-    void TreeAssetManager::setCompressedTextureUpload(CompressedTextureUpload upload)
+    void TreeAssetManager::setCompressedTextureUpload(std::optional<CompressedTextureUpload> upload)
     {
-        mTextureUpload = upload;
-        mTextureUploadChosen = true;
-    }
-
-    void TreeAssetManager::adoptMeasuredTextureUpload(CompressedTextureUpload upload)
-    {
-        if (!mTextureUploadChosen)
-            mTextureUpload = upload;
+        mChosenTextureUpload = upload;
     }
 
     bool TreeAssetManager::decodesAtLoad(GpuTextureFormat format) const
     {
         if (!isBlockCompressed(format))
             return false;
-        if (mTextureUpload == CompressedTextureUpload::Decoded)
+        if (getCompressedTextureUpload() == CompressedTextureUpload::Decoded)
             return true;
         const Ogre::RenderSystem* system =
             Ogre::Root::getSingletonPtr() ? Ogre::Root::getSingleton().getRenderSystem() : nullptr;

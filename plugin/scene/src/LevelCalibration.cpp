@@ -58,7 +58,7 @@ namespace TreeLod
     namespace
     {
         // The sampling draw of measureTextureSampling: clip-space quads, four trilinear reads a fragment.
-        constexpr const char* SAMPLING_VERTEX = R"(#version 330
+        constexpr const char* SAMPLING_VERTEX = R"(
 in vec4 vertex;
 in vec2 uv0;
 out vec2 uv;
@@ -68,7 +68,7 @@ void main()
     uv = uv0;
 }
 )";
-        constexpr const char* SAMPLING_FRAGMENT = R"(#version 330
+        constexpr const char* SAMPLING_FRAGMENT = R"(
 uniform sampler2D tex;
 in vec2 uv;
 out vec4 fragColour;
@@ -107,12 +107,15 @@ void main()
             SamplingScene()
             {
                 auto& programs = Ogre::HighLevelGpuProgramManager::getSingleton();
+                const bool es = programsAreGlslEs();
+                const std::string header = es ? "#version 300 es\nprecision highp float;\n" : "#version 330\n";
                 for (const auto& [name, source, type] :
                      {std::make_tuple(VERTEX, SAMPLING_VERTEX, Ogre::GPT_VERTEX_PROGRAM),
                       std::make_tuple(FRAGMENT, SAMPLING_FRAGMENT, Ogre::GPT_FRAGMENT_PROGRAM)})
                 {
-                    Ogre::HighLevelGpuProgramPtr program = programs.createProgram(name, Ogre::RGN_INTERNAL, "glsl", type);
-                    program->setSource(source);
+                    Ogre::HighLevelGpuProgramPtr program =
+                        programs.createProgram(name, Ogre::RGN_INTERNAL, es ? "glsles" : "glsl", type);
+                    program->setSource(header + source);
                     program->load();
                 }
                 const GpuTexture compressed = samplingTexture();
@@ -175,8 +178,9 @@ void main()
 
     Result<TextureSamplingCost> measureTextureSampling(OffscreenRenderer& renderer, const CalibrationOptions& options)
     {
-        if (!Ogre::HighLevelGpuProgramManager::getSingleton().isLanguageSupported("glsl"))
-            return fail("", "texture sampling", "the render system runs no GLSL programs");
+        const Ogre::HighLevelGpuProgramManager& programs = Ogre::HighLevelGpuProgramManager::getSingleton();
+        if (!programs.isLanguageSupported("glsl") && !programs.isLanguageSupported("glsles"))
+            return fail("", "texture sampling", "the render system runs no GLSL or GLSL ES programs");
         if (options.viewport < 16 || options.frames < 1)
             return fail("", "texture sampling", "needs a viewport of 16 px or more and frames");
         renderer.setShadows(false);
@@ -238,10 +242,18 @@ void main()
             if (Result<void> written = writeCostCalibration(path, calibration); !written)
                 return written.error();
         }
+        adoptCalibratedTextureUpload(calibration);
+        return calibration.textureSampling;
+    }
+
+    bool adoptCalibratedTextureUpload(const CostCalibration& calibration)
+    {
+        if (!calibration.hasTextureSampling)
+            return false;
         TreeAssetManager::getSingleton().adoptMeasuredTextureUpload(calibration.textureSampling.decodeAtLoad()
                                                                         ? CompressedTextureUpload::Decoded
                                                                         : CompressedTextureUpload::AsStored);
-        return calibration.textureSampling;
+        return true;
     }
 
     std::string rendererString(Ogre::Root& root)

@@ -276,7 +276,7 @@ namespace TreeLod
         readArray(r, chunk.textures, TEXTURES, [&](ByteReader& r, GpuTexture& tex, std::uint32_t i) {
             if (readGpuTexture(r, chunkName + ", texture " + std::to_string(i), tex) &&
                 tex.format != GpuTextureFormat::RGBA8)
-                r.failHere("format " + std::to_string(std::uint32_t(tex.format)) + ": reference textures are RGBA8");
+                r.failHere("format " + gpuTextureFormatName(tex.format) + ": reference textures are RGBA8");
         });
         if (!r.ok())
             return r.error();

@@ -18,6 +18,7 @@
 #include <future>
 #include <memory>
 #include <mutex>
+#include <optional>
 
 namespace TreeLod
 {
@@ -81,16 +82,20 @@ namespace TreeLod
                                                        const Ogre::String& group);
 
         /// The user's choice for textures uploaded from now on (already uploaded ones stay as they
-        /// are); a calibration's measured choice (adoptMeasuredTextureUpload) no longer applies.
-        /// The environment variable TREELOD_COMPRESSED_TEXTURES ("as-stored" or "decoded") makes
-        /// the same choice when the manager is created.
-        void setCompressedTextureUpload(CompressedTextureUpload upload);
+        /// are), which a calibration's measured choice (adoptMeasuredTextureUpload) does not change;
+        /// nullopt forgets it. The environment variable TREELOD_COMPRESSED_TEXTURES ("as-stored" or
+        /// "decoded") makes the same choice when the manager is created.
+        void setCompressedTextureUpload(std::optional<CompressedTextureUpload> upload);
         /// The choice measured on this renderer (LevelCalibration.h: sampling a compressed texture
-        /// against the same texture decoded); ignored once the user chose. AsStored until either.
-        void adoptMeasuredTextureUpload(CompressedTextureUpload upload);
-        CompressedTextureUpload getCompressedTextureUpload() const { return mTextureUpload; }
+        /// against the same texture decoded); the user's choice wins. AsStored until either.
+        void adoptMeasuredTextureUpload(CompressedTextureUpload upload) { mMeasuredTextureUpload = upload; }
+        /// The user's choice, else the measured one, else AsStored.
+        CompressedTextureUpload getCompressedTextureUpload() const
+        {
+            return mChosenTextureUpload ? *mChosenTextureUpload : mMeasuredTextureUpload;
+        }
         /// Whether the user chose (setCompressedTextureUpload or the environment variable).
-        bool isCompressedTextureUploadChosen() const { return mTextureUploadChosen; }
+        bool isCompressedTextureUploadChosen() const { return mChosenTextureUpload.has_value(); }
         /// Whether a texture of `format` is decoded to RGBA8 before upload: a block format under
         /// CompressedTextureUpload::Decoded, or one the render system cannot sample (no
         /// RSC_TEXTURE_COMPRESSION_DXT for DXT1/DXT5, no RSC_TEXTURE_COMPRESSION_BC4_BC5 for BC4/BC5).
@@ -112,8 +117,8 @@ namespace TreeLod
                                const Ogre::String& path, const Ogre::String& group);
 
         TreeBaker* mBaker = nullptr;
-        CompressedTextureUpload mTextureUpload = CompressedTextureUpload::AsStored;
-        bool mTextureUploadChosen = false;
+        std::optional<CompressedTextureUpload> mChosenTextureUpload;
+        CompressedTextureUpload mMeasuredTextureUpload = CompressedTextureUpload::AsStored;
         std::mutex mBakeMutex; ///< one bake at a time
         std::vector<std::shared_future<Ogre::String>> mBakes; ///< running or ended; waited for at destruction
     };

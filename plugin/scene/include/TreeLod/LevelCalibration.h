@@ -66,7 +66,8 @@ namespace TreeLod
     /// Time the same draw (a 1024² texture with mips, four trilinear reads a fragment, eight
     /// full-viewport layers at options.viewport²) sampling it block-compressed (DXT5) and decoded
     /// to RGBA8 (decodeGpuTexture), median of options.frames frames each, the empty frame
-    /// subtracted. Errors name the step; under GLSL ES (no "glsl" programs) an error too.
+    /// subtracted (GLSL 3.30, or GLSL ES 3.00 where the render system runs only that). Errors
+    /// name the step.
     Result<TextureSamplingCost> measureTextureSampling(OffscreenRenderer& renderer,
                                                        const CalibrationOptions& options = {});
 
@@ -76,6 +77,10 @@ namespace TreeLod
     Result<TextureSamplingCost> requireTextureUpload(OffscreenRenderer& renderer, const std::string& directory,
                                                      const CalibrationOptions& options = {},
                                                      const ProgressCallback& progress = {});
+
+    /// TreeAssetManager::adoptMeasuredTextureUpload with `calibration`'s decision when it holds a
+    /// texture sampling cost; false when it holds none.
+    bool adoptCalibratedTextureUpload(const CostCalibration& calibration);
 
     /// Calibrate every auto level of `asset` (loaded). Errors name the asset and the level.
     Result<std::vector<LevelCost>> calibrateLevels(OffscreenRenderer& renderer, TreeAsset& asset,
