@@ -79,7 +79,8 @@ void main()
 }
 )";
         constexpr std::uint32_t SAMPLING_TEXELS = 1024;
-        constexpr int SAMPLING_LAYERS = 8;
+        constexpr int SAMPLING_LAYERS = 4;
+        constexpr int SAMPLING_VIEWPORT = 256;
 
         /// A DXT5 texture of SAMPLING_TEXELS² with every mip level, of pseudo-random blocks (every
         /// byte string is a valid BC3 block; what the texels hold does not change the cost).
@@ -155,7 +156,7 @@ void main()
                 quads->begin(material, Ogre::RenderOperation::OT_TRIANGLE_LIST, Ogre::RGN_INTERNAL);
                 for (int layer = 0; layer < SAMPLING_LAYERS; ++layer)
                 {
-                    const float shift = 0.125f * float(layer);
+                    const float shift = 0.25f * float(layer);
                     for (const auto& [x, y] : {std::make_pair(-1.0f, -1.0f), std::make_pair(1.0f, -1.0f),
                                                std::make_pair(1.0f, 1.0f), std::make_pair(-1.0f, 1.0f)})
                     {
@@ -174,6 +175,23 @@ void main()
             static constexpr const char* COMPRESSED = "TreeLod/Calibration/Compressed";
             static constexpr const char* DECODED = "TreeLod/Calibration/Decoded";
         };
+
+        /// The calibration file at `path` for `renderer`, or an empty one (a warning when the file
+        /// is there but unreadable: it is calibrated again).
+        CostCalibration heldCalibration(const std::string& path, const std::string& renderer,
+                                        const ProgressCallback& progress)
+        {
+            CostCalibration calibration;
+            calibration.renderer = renderer;
+            std::error_code ec;
+            if (!std::filesystem::exists(path, ec))
+                return calibration;
+            Result<CostCalibration> read = readCostCalibration(path, renderer);
+            if (read)
+                return std::move(read.value());
+            report(progress, "warning: " + read.error().message() + "; calibrating again", 0.0f);
+            return calibration;
+        }
     }
 
     Result<TextureSamplingCost> measureTextureSampling(OffscreenRenderer& renderer, const CalibrationOptions& options)
@@ -186,9 +204,8 @@ void main()
         renderer.setShadows(false);
         renderer.clearContent();
         const CameraSpec camera; // the quads are in clip space
-        auto time = [&]() {
-            return median(renderer.timeFrames(camera, options.viewport, options.viewport, options.frames));
-        };
+        const int viewport = std::min(options.viewport, SAMPLING_VIEWPORT);
+        auto time = [&]() { return median(renderer.timeFrames(camera, viewport, viewport, options.frames)); };
         TextureSamplingCost cost;
         try
         {
@@ -219,17 +236,8 @@ void main()
     {
         const std::string renderString = rendererString(renderer.getRoot());
         const std::string path = costCalibrationPath(directory, renderString);
-        CostCalibration calibration;
-        calibration.renderer = renderString;
+        CostCalibration calibration = heldCalibration(path, renderString, progress);
         std::error_code ec;
-        if (std::filesystem::exists(path, ec))
-        {
-            Result<CostCalibration> read = readCostCalibration(path, renderString);
-            if (read)
-                calibration = std::move(read.value());
-            else
-                report(progress, "warning: " + read.error().message() + "; calibrating again", 0.0f);
-        }
         if (!calibration.hasTextureSampling)
         {
             report(progress, "calibrate texture sampling (block-compressed against RGBA8)", 0.0f);
@@ -418,17 +426,8 @@ void main()
         const std::string renderString = rendererString(renderer.getRoot());
         const std::string path = costCalibrationPath(directory, renderString);
         const std::string key = levelCostKey(asset);
-        CostCalibration calibration;
-        calibration.renderer = renderString;
+        CostCalibration calibration = heldCalibration(path, renderString, progress);
         std::error_code ec;
-        if (std::filesystem::exists(path, ec))
-        {
-            Result<CostCalibration> read = readCostCalibration(path, renderString);
-            if (read)
-                calibration = std::move(read.value());
-            else
-                report(progress, "warning: " + read.error().message() + "; calibrating again", 0.0f);
-        }
         if (const std::vector<LevelCost>* held = calibration.find(key))
         {
             bool all = true;

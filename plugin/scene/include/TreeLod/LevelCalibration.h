@@ -63,8 +63,8 @@ namespace TreeLod
                               const ForestLevel& level, const std::vector<ForestInstance>& instances,
                               const std::string& name, float heightPx = 0.0f);
 
-    /// Time the same draw (a 1024² texture with mips, four trilinear reads a fragment, eight
-    /// full-viewport layers at options.viewport²) sampling it block-compressed (DXT5) and decoded
+    /// Time the same draw (a 1024² texture with mips, four trilinear reads a fragment, four
+    /// full-viewport layers at min(options.viewport, 256)²) sampling it block-compressed (DXT5) and decoded
     /// to RGBA8 (decodeGpuTexture), median of options.frames frames each, the empty frame
     /// subtracted (GLSL 3.30, or GLSL ES 3.00 where the render system runs only that). Errors
     /// name the step.

@@ -11,8 +11,8 @@
 //   3. Bleed colour, normal and AO into the uncovered texels (bleedValues), then mip chains:
 //      colour with the coverage of level 0 kept (buildMipChain), normal and AO weighted by
 //      coverage.
-//   4. Compress (compressTexture; unless compress is false): colour DXT5, normal + AO DXT1.
-//      256 texels: 87 KB + 44 KB instead of 2 x 230 KB of RGBA8.
+//   4. Optionally compress (compressTexture): colour DXT5, normal + AO DXT1. 256 texels: 87 KB +
+//      44 KB instead of 2 x 230 KB of RGBA8.
 // Every size is relative to the model's bounds, so a 0.5 m and a 500 m tree give the same
 // textures. Deterministic for any thread count.
 #pragma once
@@ -42,10 +42,11 @@ namespace TreeLod
         /// darker than it (techniques/impostor/README.md, "Ambient occlusion").
         int aoRays = 0;
         float alphaCutoff = 0.5f;  ///< the quad's alpha test, in (0, 1]
-        /// DXT5 colour, DXT1 normal (libsquish), the default: a quarter of RGBA8's bytes within
-        /// 0.005 FLIP (docs/measurements.md "Texture formats"); else RGBA8. A renderer that samples
-        /// blocks slower (llvmpipe) gets them decoded at load (TreeAssetManager.h).
-        bool compress = true;
+        /// DXT5 colour, DXT1 normal (libsquish); else RGBA8, the default: at the 8 px where budgeted
+        /// auto draws this level DXT cost 0.0068 FLIP on average over the corpus, more than a
+        /// format may (docs/measurements.md "Texture formats"), and the RGBA8 pair stays small
+        /// (at most 700 KB at 256 texels). Compressed or not, llvmpipe samples RGBA8 (decoded at load).
+        bool compress = false;
     };
 
     /// Bake the impostor. Errors name `label`: an invalid model or options, and a model with
