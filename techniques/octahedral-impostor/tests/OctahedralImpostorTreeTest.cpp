@@ -287,7 +287,9 @@ namespace TreeLod::OctahedralImpostorTreeTests
                 type == "Entity" ? r.getSceneManager().createEntity(asset->getReferenceMesh())
                                  : r.getSceneManager().createMovableObject("decoded-test-" + type, type, &params);
             r.getContentNode().attachObject(object);
-            Image image = toImage(r.render(camera, 160, 160, 2));
+            // 4x4 samples a pixel: llvmpipe filters RGBA8 and DXT texels along two paths whose
+            // rounding differs by a level, which flips single alpha-tested samples at the edges.
+            Image image = toImage(r.render(camera, 160, 160, 4));
             r.clearContent();
             return image;
         };
@@ -305,10 +307,18 @@ namespace TreeLod::OctahedralImpostorTreeTests
                             "%.3f (mesh %.3f)\n",
                             type.c_str(), double(azimuth), double(elevation), error, treeCoverage(stored, BACKGROUND),
                             treeCoverage(decoded, BACKGROUND), wanted);
-                // Both are the tree (a black or empty picture fails here), and they agree.
-                EXPECT_NEAR(treeCoverage(stored, BACKGROUND), wanted, 0.25 * wanted) << type << " " << azimuth;
-                EXPECT_NEAR(treeCoverage(decoded, BACKGROUND), wanted, 0.25 * wanted) << type << " " << azimuth;
-                EXPECT_LT(error, 0.01) << type << " " << azimuth;
+                // Both are the tree (a black, empty or background-only picture fails here: the
+                // one-quad impostor seen from above covers less than the mesh), and they agree.
+                for (const Image* image : {&stored, &decoded})
+                {
+                    EXPECT_GT(treeCoverage(*image, BACKGROUND), 0.4 * wanted) << type << " " << azimuth;
+                    EXPECT_LT(treeCoverage(*image, BACKGROUND), 1.25 * wanted) << type << " " << azimuth;
+                }
+                EXPECT_NEAR(treeCoverage(stored, BACKGROUND), treeCoverage(decoded, BACKGROUND), 0.01);
+                // Measured on llvmpipe: 0.0045-0.0054 for the quad, 0.010-0.015 for the octahedral
+                // impostor, whose parallax step moves its colour reads by the sampled depth.
+                const bool octahedral = type == ImpostorTreeFactory::OCTAHEDRAL_TYPE_NAME;
+                EXPECT_LT(error, octahedral ? 0.02 : 0.01) << type << " " << azimuth;
                 row.insert(row.end(), {mesh, stored, decoded});
             }
         writePng(OgreEnvironment::outDir() + "/impostors-decoded-at-load.png", sideBySide(row));
