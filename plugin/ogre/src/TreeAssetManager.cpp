@@ -42,8 +42,9 @@ namespace TreeLod
         mChosenTextureUpload = upload;
     }
 
-    bool TreeAssetManager::decodesAtLoad(GpuTextureFormat format) const
+    bool TreeAssetManager::decodesAtLoad(const GpuTexture& texture) const
     {
+        const GpuTextureFormat format = texture.format;
         if (!isBlockCompressed(format))
             return false;
         if (getCompressedTextureUpload() == CompressedTextureUpload::Decoded)
@@ -54,7 +55,10 @@ namespace TreeLod
         if (!caps)
             return false;
         const bool rgtc = format == GpuTextureFormat::BC4 || format == GpuTextureFormat::BC5;
-        return !caps->hasCapability(rgtc ? Ogre::RSC_TEXTURE_COMPRESSION_BC4_BC5 : Ogre::RSC_TEXTURE_COMPRESSION_DXT);
+        if (!caps->hasCapability(rgtc ? Ogre::RSC_TEXTURE_COMPRESSION_BC4_BC5 : Ogre::RSC_TEXTURE_COMPRESSION_DXT))
+            return true;
+        const bool es = system->getName().find("OpenGL ES") != Ogre::String::npos;
+        return es && texture.mipCount < fullMipCount(texture.width, texture.height);
     }
 
     TreeAssetManager::~TreeAssetManager()

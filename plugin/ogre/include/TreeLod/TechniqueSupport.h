@@ -69,7 +69,7 @@ namespace TreeLod
     inline std::uint64_t uploadTexture(const Ogre::String& name, const Ogre::String& group, const GpuTexture& texture)
     {
         const TreeAssetManager* assets = TreeAssetManager::getSingletonPtr();
-        if (assets && assets->decodesAtLoad(texture.format))
+        if (assets && assets->decodesAtLoad(texture))
         {
             const GpuTexture decoded = decodeGpuTexture(texture);
             uploadTexture(name, group, decoded.data.data(), decoded.width, decoded.height, Ogre::PF_BYTE_RGBA,

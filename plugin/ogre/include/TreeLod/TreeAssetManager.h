@@ -96,10 +96,12 @@ namespace TreeLod
         }
         /// Whether the user chose (setCompressedTextureUpload or the environment variable).
         bool isCompressedTextureUploadChosen() const { return mChosenTextureUpload.has_value(); }
-        /// Whether a texture of `format` is decoded to RGBA8 before upload: a block format under
+        /// Whether `texture` is decoded to RGBA8 before upload: a block format under
         /// CompressedTextureUpload::Decoded, or one the render system cannot sample (no
-        /// RSC_TEXTURE_COMPRESSION_DXT for DXT1/DXT5, no RSC_TEXTURE_COMPRESSION_BC4_BC5 for BC4/BC5).
-        bool decodesAtLoad(GpuTextureFormat format) const;
+        /// RSC_TEXTURE_COMPRESSION_DXT for DXT1/DXT5, no RSC_TEXTURE_COMPRESSION_BC4_BC5 for
+        /// BC4/BC5), or, under OpenGL ES, a block format with fewer mip levels than the full chain
+        /// (OGRE 1.12's GLES2 render system drew those black: test rendersystem.GLES2).
+        bool decodesAtLoad(const GpuTexture& texture) const;
 
         static TreeAssetManager& getSingleton();
         static TreeAssetManager* getSingletonPtr();
