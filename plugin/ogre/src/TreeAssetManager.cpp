@@ -58,7 +58,7 @@ namespace TreeLod
         if (!caps->hasCapability(rgtc ? Ogre::RSC_TEXTURE_COMPRESSION_BC4_BC5 : Ogre::RSC_TEXTURE_COMPRESSION_DXT))
             return true;
         const bool es = system->getName().find("OpenGL ES") != Ogre::String::npos;
-        return es && texture.mipCount < fullMipCount(texture.width, texture.height);
+        return es && texture.mipCount > 1 && texture.mipCount < fullMipCount(texture.width, texture.height);
     }
 
     TreeAssetManager::~TreeAssetManager()

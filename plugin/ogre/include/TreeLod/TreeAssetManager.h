@@ -99,8 +99,9 @@ namespace TreeLod
         /// Whether `texture` is decoded to RGBA8 before upload: a block format under
         /// CompressedTextureUpload::Decoded, or one the render system cannot sample (no
         /// RSC_TEXTURE_COMPRESSION_DXT for DXT1/DXT5, no RSC_TEXTURE_COMPRESSION_BC4_BC5 for
-        /// BC4/BC5), or, under OpenGL ES, a block format with fewer mip levels than the full chain
-        /// (OGRE 1.12's GLES2 render system drew those black: test rendersystem.GLES2).
+        /// BC4/BC5), or, under OpenGL ES, a block format with more than one mip level but fewer
+        /// than the full chain (OGRE 1.12's GLES2 render system drew those black; one level and
+        /// full chains draw: test rendersystem.GLES2).
         bool decodesAtLoad(const GpuTexture& texture) const;
 
         static TreeAssetManager& getSingleton();
