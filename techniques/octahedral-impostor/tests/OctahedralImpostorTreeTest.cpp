@@ -228,19 +228,15 @@ namespace TreeLod::OctahedralImpostorTreeTests
         // alike over the tree's pixels, and each reports the bytes Ogre holds for its textures.
         OffscreenRenderer& r = OgreEnvironment::renderer();
         r.setShadows(false);
-        GeneratorOptions generator;
-        generator.leafCount = 3000;
-        generator.textureSize = 64;
-        Result<TreeModel> model = generateTree(generator);
-        ASSERT_TRUE(model.ok());
+        const TreeModel& model = oak().model;
         PackageWriter writer;
         ImpostorOptions quad;
         quad.compress = true;
         OctahedralImpostorOptions octahedral;
         octahedral.compress = true;
         octahedral.frameResolution = 64;
-        ASSERT_TRUE(addImpostorChunk(writer, *model, quad, "oak").ok());
-        ASSERT_TRUE(addOctahedralImpostorChunk(writer, *model, octahedral, "oak").ok());
+        ASSERT_TRUE(addImpostorChunk(writer, model, quad, "oak").ok());
+        ASSERT_TRUE(addOctahedralImpostorChunk(writer, model, octahedral, "oak").ok());
         const std::vector<std::uint8_t> bytes = writer.toBytes();
 
         TreeAssetManager& manager = TreeAssetManager::getSingleton();
@@ -298,7 +294,7 @@ namespace TreeLod::OctahedralImpostorTreeTests
             for (const auto& [azimuth, elevation] : {std::make_pair(0.0f, 5.0f), std::make_pair(120.0f, 20.0f),
                                                      std::make_pair(300.0f, 60.0f)})
             {
-                const CameraSpec camera = CameraSpec::framing(model->boundsMin, model->boundsMax, azimuth, elevation, 1.0f);
+                const CameraSpec camera = CameraSpec::framing(model.boundsMin, model.boundsMax, azimuth, elevation, 1.0f);
                 const Image mesh = draw(assets[0], "Entity", camera);
                 const Image stored = draw(assets[0], type, camera), decoded = draw(assets[1], type, camera);
                 const double error = flipMean(stored, decoded, FlipOver::Tree);
