@@ -2,7 +2,8 @@
 // What each level of each tree costs on this machine (LevelCalibration.h): instanced draws of every
 // level budgeted auto chooses among, at a few screen heights, timed by read-back; cached per
 // renderer string in DIR (default: the user's cache), where treelod_frames, the bench and the
-// browser read it. A .glb/.gltf is baked in memory first.
+// browser read it. A .glb/.gltf is baked in memory first. First, whether this renderer samples
+// block-compressed textures slower than RGBA8 (then they are decoded at load).
 #include "CliSupport.h"
 #include "Commands.h"
 
@@ -47,6 +48,30 @@ namespace TreeLod
             {
                 OffscreenRenderer renderer;
                 const std::string rendererName = rendererString(renderer.getRoot());
+                if (args.force)
+                {
+                    // Measure the texture sampling again too.
+                    const std::string path = costCalibrationPath(directory, rendererName);
+                    Result<CostCalibration> held = readCostCalibration(path, rendererName);
+                    if (held && held->hasTextureSampling)
+                    {
+                        held->hasTextureSampling = false;
+                        if (Result<void> w = writeCostCalibration(path, *held); !w)
+                            return printError(w.error());
+                    }
+                }
+                Result<TextureSamplingCost> sampling = requireTextureUpload(renderer, directory, {}, progress);
+                if (!sampling)
+                    return printError(sampling.error());
+                const bool decoded = TreeAssetManager::getSingleton().getCompressedTextureUpload() ==
+                                     CompressedTextureUpload::Decoded;
+                if (!args.json)
+                    std::printf("texture sampling on %s: block-compressed %.2f ms, RGBA8 %.2f ms: %s%s\n",
+                                rendererName.c_str(), sampling->compressedMs, sampling->decodedMs,
+                                decoded ? "decoded to RGBA8 at load" : "uploaded as stored",
+                                TreeAssetManager::getSingleton().isCompressedTextureUploadChosen()
+                                    ? " (TREELOD_COMPRESSED_TEXTURES)"
+                                    : "");
                 std::vector<std::string> chunks = {REFERENCE_CHUNK};
                 for (const Ogre::String& t : Forest::getAutoTechniques())
                     if (const std::string chunk = bakeTechniqueOf(t); !chunk.empty() && chunk != REFERENCE_CHUNK)
@@ -101,6 +126,10 @@ namespace TreeLod
                     }
                     out.push_back({{"input", input},
                                    {"renderer", rendererName},
+                                   {"textureSampling",
+                                    {{"compressedMs", sampling->compressedMs},
+                                     {"decodedMs", sampling->decodedMs},
+                                     {"decodedAtLoad", decoded}}},
                                    {"calibrated", calibrated},
                                    {"file", costCalibrationPath(directory, rendererName)},
                                    {"levels", levels}});

@@ -200,6 +200,20 @@ namespace TreeLod
                 OffscreenRenderer::savePng(image, args.output + "/images/" + stem + ".png");
             };
 
+            // Block-compressed textures as this renderer samples them faster: measured once per renderer
+            // (cached with the costs), before any texture is uploaded.
+            const std::string calibrationDir = args.calibration.empty() ? userCacheDirectory() : args.calibration;
+            if (Result<TextureSamplingCost> sampling = requireTextureUpload(renderer, calibrationDir, {}, progress);
+                !sampling)
+                return printError(sampling.error());
+            else if (!args.quiet)
+                std::fprintf(stderr, "block-compressed textures on %s: %s (sampling %.2f ms, RGBA8 %.2f ms)\n",
+                             rendererString(renderer.getRoot()).c_str(),
+                             TreeAssetManager::getSingleton().getCompressedTextureUpload() ==
+                                     CompressedTextureUpload::Decoded
+                                 ? "decoded at load"
+                                 : "as stored",
+                             sampling->compressedMs, sampling->decodedMs);
             // Budgeted auto needs this machine's cost of every level: calibrated once per package and
             // renderer (cached), before any scene exists, since calibrating draws alone.
             std::map<std::string, std::vector<LevelCost>> levelCosts; // by assetCostKey
@@ -215,8 +229,7 @@ namespace TreeLod
                         continue; // auto draws the fixed bands (ForestScene logs why)
                     bool calibrated = false;
                     Result<std::vector<LevelCost>> costs = requireLevelCosts(
-                        renderer, *asset, args.calibration.empty() ? userCacheDirectory() : args.calibration, {},
-                        progress, &calibrated);
+                        renderer, *asset, calibrationDir, {}, progress, &calibrated);
                     if (!costs)
                         return printError(costs.error());
                     if (calibrated && !args.quiet)

@@ -58,6 +58,13 @@ namespace TreeLod
         ForestSceneOptions options;
         options.uploadBudget = UPLOAD_BUDGET;
         // Budgeted auto with this renderer's costs from the user's cache; none: the fixed bands.
+        {
+            // Block-compressed textures decoded at load where this renderer's calibration says so.
+            const std::string renderer = rendererString(mRoot);
+            if (Result<CostCalibration> calibration =
+                    readCostCalibration(costCalibrationPath(userCacheDirectory(), renderer), renderer))
+                adoptCalibratedTextureUpload(*calibration);
+        }
         options.levelCosts = [this](TreeAsset& asset) {
             const std::string renderer = rendererString(mRoot);
             const std::string path = costCalibrationPath(userCacheDirectory(), renderer);

@@ -668,4 +668,49 @@ namespace TreeLod
         }
         std::filesystem::remove_all(dir);
     }
+
+    TEST(LevelCosts, textureSamplingDecidesDecodingAtLoadAndRoundTripsThroughTheFile)
+    {
+        // llvmpipe-like: compressed sampling 1.8x the decoded one decodes at load; a GPU's (equal, or
+        // compressed faster) does not; within the margin (1.05x) neither noise nor rounding decodes.
+        TextureSamplingCost software{9.0, 5.0};
+        EXPECT_TRUE(software.decodeAtLoad());
+        EXPECT_FALSE((TextureSamplingCost{1.0, 1.0}).decodeAtLoad());
+        EXPECT_FALSE((TextureSamplingCost{0.8, 1.0}).decodeAtLoad());
+        EXPECT_FALSE((TextureSamplingCost{1.05, 1.0}).decodeAtLoad());
+        EXPECT_TRUE((TextureSamplingCost{1.2, 1.0}).decodeAtLoad());
+        EXPECT_FALSE((TextureSamplingCost{0.0, 0.0}).decodeAtLoad()) << "nothing measured: as stored";
+
+        const std::string dir = testing::TempDir() + "/treelod-sampling-" + std::to_string(::getpid());
+        std::filesystem::create_directories(dir);
+        const std::string path = costCalibrationPath(dir, "r");
+        CostCalibration calibration;
+        calibration.renderer = "r";
+        ASSERT_TRUE(writeCostCalibration(path, calibration));
+        Result<CostCalibration> read = readCostCalibration(path, "r");
+        ASSERT_TRUE(read) << read.error().message();
+        EXPECT_FALSE(read->hasTextureSampling) << "a file without it is measured again";
+        calibration.hasTextureSampling = true;
+        calibration.textureSampling = software;
+        ASSERT_TRUE(writeCostCalibration(path, calibration));
+        read = readCostCalibration(path, "r");
+        ASSERT_TRUE(read) << read.error().message();
+        ASSERT_TRUE(read->hasTextureSampling);
+        EXPECT_DOUBLE_EQ(read->textureSampling.compressedMs, 9.0);
+        EXPECT_DOUBLE_EQ(read->textureSampling.decodedMs, 5.0);
+        EXPECT_TRUE(read->textureSampling.decodeAtLoad());
+
+        for (const std::string& text :
+             {std::string(R"({"renderer": "r", "version": 1, "assets": {}, "textureSampling": {"compressedMs": 1}})"),
+              std::string(R"({"renderer": "r", "version": 1, "assets": {}, "textureSampling": {"compressedMs": -1, "decodedMs": 1}})"),
+              std::string(R"({"renderer": "r", "version": 1, "assets": {}, "textureSampling": 3})")})
+        {
+            ASSERT_TRUE(writeFileAtomic(path, std::vector<std::uint8_t>(text.begin(), text.end())));
+            Result<CostCalibration> r = readCostCalibration(path, "r");
+            ASSERT_FALSE(r) << text;
+            EXPECT_NE(r.error().message().find(path), std::string::npos) << r.error().message();
+            EXPECT_NE(r.error().message().find("textureSampling"), std::string::npos) << r.error().message();
+        }
+        std::filesystem::remove_all(dir);
+    }
 }

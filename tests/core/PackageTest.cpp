@@ -960,3 +960,172 @@ TEST(PackageWriter, Fnv1aMatchesPublishedValues)
     EXPECT_EQ(fnv1a64("a", 1), 0xaf63dc4c8601ec8cull);
     EXPECT_EQ(fnv1a64("foobar", 6), 0x85944171f73967e8ull);
 }
+
+namespace
+{
+    /// An RGBA8 texture of `mips` levels, each a ramp of red along x and green along y (0 to 255,
+    /// the same ramps at every level) and alpha `alpha`, or a ramp along x + y when 0: values a
+    /// 4x4 block holds on a line, so that a block format's error is its quantisation only.
+    GpuTexture rampTexture(std::uint32_t size, std::uint32_t mips, std::uint8_t alpha = 0)
+    {
+        GpuTexture t;
+        t.name = "ramp";
+        t.width = t.height = size;
+        t.mipCount = mips;
+        t.data.resize(gpuTextureBytes(GpuTextureFormat::RGBA8, size, size, mips));
+        for (std::uint32_t m = 0; m < mips; ++m)
+        {
+            const std::uint32_t w = t.mipWidth(m), h = t.mipHeight(m);
+            std::uint8_t* p = t.data.data() + t.mipOffset(m);
+            for (std::uint32_t y = 0; y < h; ++y)
+                for (std::uint32_t x = 0; x < w; ++x, p += 4)
+                {
+                    p[0] = std::uint8_t(255 * x / std::max(1u, w - 1));
+                    p[1] = std::uint8_t(255 * y / std::max(1u, h - 1));
+                    p[2] = 0;
+                    p[3] = alpha ? alpha : std::uint8_t(255 - 255 * (x + y) / std::max(1u, w + h - 2));
+                }
+        }
+        return t;
+    }
+
+    /// Largest absolute difference of channel `c` between two RGBA8 textures of one size, over
+    /// mip level `level` (-1: every level).
+    int maxChannelError(const GpuTexture& a, const GpuTexture& b, int c, int level = -1)
+    {
+        const std::size_t begin = level < 0 ? 0 : a.mipOffset(std::uint32_t(level));
+        const std::size_t end = level < 0 ? a.data.size() : begin + a.mipBytes(std::uint32_t(level));
+        int worst = 0;
+        for (std::size_t i = begin + std::size_t(c); i < end; i += 4)
+            worst = std::max(worst, std::abs(int(a.data[i]) - int(b.data[i])));
+        return worst;
+    }
+}
+
+TEST(GpuTextureDecode, Bc4AndBc5RoundTripTheirChannelsAndSampleAsTheGpuDoes)
+{
+    // A ramp is what BC4/BC5 encode best: 8 levels between two endpoints a block, so at level 0 a
+    // 4-texel stretch of a 0..255 ramp over 64 texels is within 3 of exact. On the small levels a
+    // block spans up to the whole ramp (2x2: 0 and 255, 3 texels: 0, 127, 255), and the bound is
+    // half a palette step of the whole range in the 6-step mode: 255 / 5 / 2 < 26.
+    const GpuTexture ramp = rampTexture(64, 7);
+    for (GpuTextureFormat format : {GpuTextureFormat::BC4, GpuTextureFormat::BC5})
+    {
+        const GpuTexture packed = compressTexture(ramp, format);
+        EXPECT_EQ(gpuTextureProblem(packed, {format}), "") << gpuTextureFormatName(format);
+        EXPECT_EQ(packed.data.size(), gpuTextureBytes(format, 64, 64, 7));
+        EXPECT_EQ(packed.mipBytes(0), format == GpuTextureFormat::BC4 ? 16u * 16u * 8u : 16u * 16u * 16u);
+        const GpuTexture decoded = decodeGpuTexture(packed);
+        ASSERT_EQ(decoded.format, GpuTextureFormat::RGBA8);
+        ASSERT_EQ(decoded.data.size(), ramp.data.size());
+        for (int c = 0; c < (format == GpuTextureFormat::BC5 ? 2 : 1); ++c)
+        {
+            EXPECT_LE(maxChannelError(decoded, ramp, c, 0), 3) << gpuTextureFormatName(format) << " channel " << c;
+            EXPECT_LE(maxChannelError(decoded, ramp, c), 26) << gpuTextureFormatName(format) << " channel " << c;
+        }
+        // The channels the format does not hold read as a GPU samples them: (r, 0, 0, 1), (r, g, 0, 1).
+        for (std::size_t i = 0; i < decoded.data.size(); i += 4)
+        {
+            if (format == GpuTextureFormat::BC4)
+                ASSERT_EQ(decoded.data[i + 1], 0) << "texel " << i / 4;
+            ASSERT_EQ(decoded.data[i + 2], 0) << "texel " << i / 4;
+            ASSERT_EQ(decoded.data[i + 3], 255) << "texel " << i / 4;
+        }
+    }
+}
+
+TEST(GpuTextureDecode, HandMadeBlocksGiveTheirPalettes)
+{
+    // BC4, a0 = 200 > a1 = 60: index 0 is a0, 1 is a1, 2..7 the six steps between (200*6+60)/7 = 180, ...
+    // Indices 0, 1, 2, 7 then zeros, 3 bits each from the lowest bit of byte 2.
+    GpuTexture bc4;
+    bc4.format = GpuTextureFormat::BC4;
+    bc4.width = bc4.height = 4;
+    bc4.mipCount = 1;
+    const std::uint64_t indices = 0u | 1u << 3 | 2u << 6 | 7u << 9;
+    bc4.data = {200, 60};
+    for (int i = 0; i < 6; ++i)
+        bc4.data.push_back(std::uint8_t(indices >> (8 * i)));
+    GpuTexture d = decodeGpuTexture(bc4);
+    EXPECT_EQ(d.data[0], 200);
+    EXPECT_EQ(d.data[4], 60);
+    EXPECT_EQ(d.data[8], (6 * 200 + 60) / 7);
+    EXPECT_EQ(d.data[12], (200 + 6 * 60) / 7);
+    // a0 <= a1 is the other mode: four steps, then 0 and 255 (indices 6 and 7).
+    bc4.data[0] = 60;
+    bc4.data[1] = 200;
+    d = decodeGpuTexture(bc4);
+    EXPECT_EQ(d.data[8], (4 * 60 + 200) / 5);
+    EXPECT_EQ(d.data[12], 255);
+
+    // DXT1 with c0 <= c1: index 3 is transparent black; DXT5's colour block ignores that order.
+    GpuTexture dxt1;
+    dxt1.format = GpuTextureFormat::DXT1;
+    dxt1.width = dxt1.height = 4;
+    dxt1.mipCount = 1;
+    dxt1.data = {0x00, 0x00, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF}; // black, white; every index 3
+    d = decodeGpuTexture(dxt1);
+    EXPECT_EQ(d.data[3], 0) << "transparent";
+    GpuTexture dxt5 = dxt1;
+    dxt5.format = GpuTextureFormat::DXT5;
+    dxt5.data.insert(dxt5.data.begin(), {255, 255, 0, 0, 0, 0, 0, 0}); // alpha 255 everywhere
+    d = decodeGpuTexture(dxt5);
+    EXPECT_EQ(d.data[3], 255);
+    EXPECT_EQ(d.data[0], (0 + 2 * 255) / 3) << "the four-colour palette's last step";
+}
+
+TEST(GpuTextureDecode, DxtDecodesWhatTheEncoderMadeOfEveryMipLevel)
+{
+    // Odd sizes too: the last blocks of a 6x6 or 3x3 level hang over its edge. Opaque for DXT1,
+    // whose encoder makes texels under alpha 128 transparent black.
+    for (std::uint32_t size : {64u, 6u})
+    {
+        for (GpuTextureFormat format : {GpuTextureFormat::DXT1, GpuTextureFormat::DXT5})
+        {
+            // Grey along x: every block's colours lie on a line, which DXT's four steps between
+            // two 5:6:5 endpoints hold at level 0 (64 texels) to within an endpoint's rounding (8
+            // levels of 255 at 5 bits). A small level's block spans the whole ramp, where three
+            // even steps hold 0, 127, 255 only to half a step, 43, plus that rounding.
+            GpuTexture ramp = rampTexture(size, fullMipCount(size, size), format == GpuTextureFormat::DXT1 ? 255 : 0);
+            for (std::size_t i = 0; i < ramp.data.size(); i += 4)
+                ramp.data[i + 1] = ramp.data[i + 2] = ramp.data[i];
+            const GpuTexture decoded = decodeGpuTexture(compressTexture(ramp, format));
+            ASSERT_EQ(decoded.data.size(), ramp.data.size());
+            for (int c = 0; c < 3; ++c)
+            {
+                if (size == 64)
+                    EXPECT_LE(maxChannelError(decoded, ramp, c, 0), 8) << gpuTextureFormatName(format);
+                EXPECT_LE(maxChannelError(decoded, ramp, c), 51) << gpuTextureFormatName(format) << " " << size;
+            }
+            if (format == GpuTextureFormat::DXT5) // alpha: BC4's block, as above
+            {
+                if (size == 64)
+                    EXPECT_LE(maxChannelError(decoded, ramp, 3, 0), 3);
+                EXPECT_LE(maxChannelError(decoded, ramp, 3), 26) << size;
+            }
+        }
+    }
+}
+
+TEST(ModelChunk, UnknownTextureFormatsNameFileChunkTextureAndFormat)
+{
+    std::vector<std::uint8_t> chunk = encodeReferenceChunk(makeReferenceChunk(makeTree()));
+    const std::vector<std::uint8_t> named = {8, 0, 0, 0, 'l', 'e', 'a', 'f', '.', 'p', 'n', 'g'};
+    auto found = std::search(chunk.begin(), chunk.end(), named.begin(), named.end());
+    ASSERT_NE(found, chunk.end());
+    const std::size_t format = std::size_t(found - chunk.begin()) + named.size();
+    for (std::uint32_t value : {6u, 0u})
+    {
+        std::vector<std::uint8_t> bad = chunk;
+        putU32(bad, format, value);
+        PackageWriter writer;
+        ASSERT_TRUE(writer.addChunk(REFERENCE_CHUNK, 0, REFERENCE_CHUNK_FORMAT_VERSION, bad));
+        Result<ReferenceChunk> decoded = decodeFrom(writer.toBytes());
+        ASSERT_FALSE(decoded) << value;
+        EXPECT_EQ(decoded.error().file, "mem.treelod");
+        EXPECT_EQ(decoded.error().element.rfind("chunk 'reference' level 0, texture", 0), 0u) << decoded.error().message();
+        EXPECT_NE(decoded.error().element.find("leaf.png"), std::string::npos) << decoded.error().message();
+        EXPECT_NE(decoded.error().reason.find("unknown format " + std::to_string(value)), std::string::npos)
+            << decoded.error().message();
+    }
+}

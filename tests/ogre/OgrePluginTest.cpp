@@ -2,6 +2,7 @@
 // packages found through resource groups, the reference mesh, bad packages, the LoD strategy.
 #include "OgreTestSupport.h"
 
+#include "TreeLod/LevelCalibration.h"
 #include "TreeLod/PackageWriter.h"
 #include "TreeLod/ScreenSizeLodStrategy.h"
 #include "TreeLod/TechniqueRegistry.h"
@@ -15,6 +16,7 @@
 #include <OgrePixelCountLodStrategy.h>
 #include <OgrePlugin.h>
 #include <OgreSubMesh.h>
+#include <OgreTextureManager.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -312,5 +314,59 @@ namespace TreeLod
         r.getContentNode().removeAndDestroyChild(node);
         Ogre::MeshManager::getSingleton().remove(mesh);
         Ogre::MaterialManager::getSingleton().remove(material);
+    }
+
+    TEST(TreeAssetManager, theUsersTextureUploadChoiceWinsOverTheMeasuredOne)
+    {
+        OgreEnvironment::renderer(); // Ogre and the render system up first
+        TreeAssetManager& manager = TreeAssetManager::getSingleton();
+        const std::optional<CompressedTextureUpload> chosen =
+            manager.isCompressedTextureUploadChosen() ? std::optional(manager.getCompressedTextureUpload()) : std::nullopt;
+        manager.setCompressedTextureUpload(std::nullopt);
+        manager.adoptMeasuredTextureUpload(CompressedTextureUpload::Decoded);
+        EXPECT_EQ(manager.getCompressedTextureUpload(), CompressedTextureUpload::Decoded);
+        auto texture = [](GpuTextureFormat format) { // 64², the full chain
+            GpuTexture t;
+            t.format = format;
+            t.width = t.height = 64;
+            t.mipCount = 7;
+            return t;
+        };
+        for (GpuTextureFormat f : {GpuTextureFormat::DXT1, GpuTextureFormat::DXT5, GpuTextureFormat::BC4, GpuTextureFormat::BC5})
+            EXPECT_TRUE(manager.decodesAtLoad(texture(f))) << gpuTextureFormatName(f);
+        EXPECT_FALSE(manager.decodesAtLoad(texture(GpuTextureFormat::RGBA8)));
+        manager.setCompressedTextureUpload(CompressedTextureUpload::AsStored);
+        manager.adoptMeasuredTextureUpload(CompressedTextureUpload::Decoded);
+        EXPECT_EQ(manager.getCompressedTextureUpload(), CompressedTextureUpload::AsStored) << "the user's choice stays";
+        EXPECT_TRUE(manager.isCompressedTextureUploadChosen());
+        // As stored, a block format is decoded only where the render system cannot sample it.
+        const Ogre::RenderSystemCapabilities* caps = Ogre::Root::getSingleton().getRenderSystem()->getCapabilities();
+        EXPECT_EQ(manager.decodesAtLoad(texture(GpuTextureFormat::DXT5)),
+                  !caps->hasCapability(Ogre::RSC_TEXTURE_COMPRESSION_DXT));
+        EXPECT_EQ(manager.decodesAtLoad(texture(GpuTextureFormat::BC5)),
+                  !caps->hasCapability(Ogre::RSC_TEXTURE_COMPRESSION_BC4_BC5));
+        manager.setCompressedTextureUpload(std::nullopt);
+        EXPECT_EQ(manager.getCompressedTextureUpload(), CompressedTextureUpload::Decoded) << "the measured one again";
+        manager.adoptMeasuredTextureUpload(CompressedTextureUpload::AsStored);
+        manager.setCompressedTextureUpload(chosen);
+    }
+
+    TEST(LevelCalibration, measuresTextureSamplingAndLeavesNothingBehind)
+    {
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        CalibrationOptions options;
+        options.viewport = 128;
+        options.frames = 1;
+        Result<TextureSamplingCost> cost = measureTextureSampling(r, options);
+        ASSERT_TRUE(cost) << cost.error().message();
+        std::printf("texture sampling at 128 px: compressed %.3f ms, decoded %.3f ms\n", cost->compressedMs,
+                    cost->decodedMs);
+        EXPECT_TRUE(std::isfinite(cost->compressedMs) && std::isfinite(cost->decodedMs));
+        EXPECT_GT(cost->compressedMs + cost->decodedMs, 0.0) << "four layers of four reads take time";
+        EXPECT_FALSE(Ogre::TextureManager::getSingleton().resourceExists("TreeLod/Calibration/Compressed",
+                                                                        Ogre::RGN_INTERNAL));
+        EXPECT_FALSE(Ogre::MaterialManager::getSingleton().resourceExists("TreeLod/Calibration/Decoded",
+                                                                         Ogre::RGN_INTERNAL));
+        EXPECT_EQ(r.getContentNode().numAttachedObjects(), 0u);
     }
 }

@@ -75,6 +75,7 @@ namespace TreeLod
         auto gpu = std::make_unique<CrossedQuadsGpu>();
         const Ogre::String prefix = "TreeLod/" + mAsset.getName() + "/crossed-quads/";
         std::vector<float> vertices; // x y z, nx ny nz, u v
+        std::uint64_t textureBytes = 0; // as uploaded (decoded at load or not)
         std::vector<std::uint16_t> indices;
         // A failure half-way (e.g. TreeLod's materials missing) removes what was made so far, so a
         // later call can try again.
@@ -105,7 +106,7 @@ namespace TreeLod
                 part.shadowedMaterial = name + "/Shadowed";
                 part.casterMaterial = name + "/Caster";
                 gpu->parts.push_back(part); // named before anything is made, for removeParts
-                uploadTexture(part.texture, mAsset.getGroup(), q.colour);
+                textureBytes += uploadTexture(part.texture, mAsset.getGroup(), q.colour);
                 Ogre::MaterialPtr plain = cloneBaseMaterial("TreeLod/Leaf", part.material, mAsset.getGroup(), mAsset.getName());
                 Ogre::MaterialPtr shadowed =
                     cloneBaseMaterial("TreeLod/LeafShadowed", part.shadowedMaterial, mAsset.getGroup(), mAsset.getName());
@@ -142,7 +143,7 @@ namespace TreeLod
             Ogre::HardwareIndexBuffer::IT_16BIT, indices.size(), Ogre::HardwareBuffer::HBU_STATIC_WRITE_ONLY);
         gpu->indexBuffer->writeData(0, indices.size() * sizeof(std::uint16_t), indices.data(), true);
         gpu->gpuBytes =
-            data.textureBytes() + vertices.size() * sizeof(float) + indices.size() * sizeof(std::uint16_t);
+            textureBytes + vertices.size() * sizeof(float) + indices.size() * sizeof(std::uint16_t);
         mGpu = std::move(gpu);
         return *mGpu;
     }

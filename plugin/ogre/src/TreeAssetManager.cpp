@@ -1,10 +1,15 @@
 #include "TreeLod/TreeAssetManager.h"
 
 #include <OgreException.h>
+#include <OgreLogManager.h>
+#include <OgreRenderSystem.h>
+#include <OgreRenderSystemCapabilities.h>
 #include <OgreResourceGroupManager.h>
+#include <OgreRoot.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 
@@ -20,6 +25,40 @@ namespace TreeLod
         mResourceType = "TreeAsset";
         mLoadOrder = 250.0f; // after materials (100) and meshes (200)
         Ogre::ResourceGroupManager::getSingleton()._registerResourceManager(mResourceType, this);
+        if (const char* env = std::getenv("TREELOD_COMPRESSED_TEXTURES"); env && *env)
+        {
+            const std::string value = env;
+            if (value == "as-stored" || value == "decoded")
+                setCompressedTextureUpload(value == "decoded" ? CompressedTextureUpload::Decoded
+                                                              : CompressedTextureUpload::AsStored);
+            else if (Ogre::LogManager* log = Ogre::LogManager::getSingletonPtr())
+                log->logWarning("TreeLod: TREELOD_COMPRESSED_TEXTURES='" + value +
+                                "' is neither 'as-stored' nor 'decoded'; ignored");
+        }
+    }
+
+    void TreeAssetManager::setCompressedTextureUpload(std::optional<CompressedTextureUpload> upload)
+    {
+        mChosenTextureUpload = upload;
+    }
+
+    bool TreeAssetManager::decodesAtLoad(const GpuTexture& texture) const
+    {
+        const GpuTextureFormat format = texture.format;
+        if (!isBlockCompressed(format))
+            return false;
+        if (getCompressedTextureUpload() == CompressedTextureUpload::Decoded)
+            return true;
+        const Ogre::RenderSystem* system =
+            Ogre::Root::getSingletonPtr() ? Ogre::Root::getSingleton().getRenderSystem() : nullptr;
+        const Ogre::RenderSystemCapabilities* caps = system ? system->getCapabilities() : nullptr;
+        if (!caps)
+            return false;
+        const bool rgtc = format == GpuTextureFormat::BC4 || format == GpuTextureFormat::BC5;
+        if (!caps->hasCapability(rgtc ? Ogre::RSC_TEXTURE_COMPRESSION_BC4_BC5 : Ogre::RSC_TEXTURE_COMPRESSION_DXT))
+            return true;
+        const bool es = system->getName().find("OpenGL ES") != Ogre::String::npos;
+        return es && texture.mipCount > 1 && texture.mipCount < fullMipCount(texture.width, texture.height);
     }
 
     TreeAssetManager::~TreeAssetManager()

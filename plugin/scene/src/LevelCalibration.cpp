@@ -4,8 +4,11 @@
 #include "TreeLod/OffscreenRenderer.h"
 #include "TreeLod/Package.h"
 #include "TreeLod/TechniqueRegistry.h"
+#include "TreeLod/TechniqueSupport.h"
 #include "TreeLod/TreeAssetManager.h"
 
+#include <OgreHighLevelGpuProgram.h>
+#include <OgreManualObject.h>
 #include <OgreRenderSystem.h>
 #include <OgreRenderSystemCapabilities.h>
 #include <OgreRoot.h>
@@ -14,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <tuple>
 
 namespace TreeLod
 {
@@ -49,6 +53,215 @@ namespace TreeLod
             }
             return instances;
         }
+    }
+
+    namespace
+    {
+        // The sampling draw of measureTextureSampling: clip-space quads, four trilinear reads a fragment.
+        constexpr const char* SAMPLING_VERTEX = R"(
+in vec4 vertex;
+in vec2 uv0;
+out vec2 uv;
+void main()
+{
+    gl_Position = vec4(vertex.xy, 0.0, 1.0);
+    uv = uv0;
+}
+)";
+        constexpr const char* SAMPLING_FRAGMENT = R"(
+uniform sampler2D tex;
+in vec2 uv;
+out vec4 fragColour;
+void main()
+{
+    fragColour = 0.25 * (texture(tex, uv) + texture(tex, uv * 0.93 + 0.03) + texture(tex, uv * 1.07 + 0.11) +
+                         texture(tex, uv.yx));
+}
+)";
+        constexpr std::uint32_t SAMPLING_TEXELS = 1024;
+        constexpr int SAMPLING_LAYERS = 4;
+        constexpr int SAMPLING_VIEWPORT = 256;
+
+        /// A DXT5 texture of SAMPLING_TEXELS² with every mip level, of pseudo-random blocks (every
+        /// byte string is a valid BC3 block; what the texels hold does not change the cost).
+        GpuTexture samplingTexture()
+        {
+            GpuTexture t;
+            t.name = "sampling";
+            t.format = GpuTextureFormat::DXT5;
+            t.width = t.height = SAMPLING_TEXELS;
+            t.mipCount = fullMipCount(t.width, t.height);
+            t.data.resize(gpuTextureBytes(t.format, t.width, t.height, t.mipCount));
+            std::uint64_t state = 0x9E3779B97F4A7C15ull;
+            for (std::uint8_t& b : t.data)
+            {
+                state = state * 6364136223846793005ull + 1442695040888963407ull;
+                b = std::uint8_t(state >> 56);
+            }
+            return t;
+        }
+
+        /// Makes the sampling programs, textures and materials in RGN_INTERNAL; removes them when destroyed.
+        class SamplingScene
+        {
+        public:
+            SamplingScene()
+            {
+                auto& programs = Ogre::HighLevelGpuProgramManager::getSingleton();
+                const bool es = programsAreGlslEs();
+                const std::string header = es ? "#version 300 es\nprecision highp float;\n" : "#version 330\n";
+                for (const auto& [name, source, type] :
+                     {std::make_tuple(VERTEX, SAMPLING_VERTEX, Ogre::GPT_VERTEX_PROGRAM),
+                      std::make_tuple(FRAGMENT, SAMPLING_FRAGMENT, Ogre::GPT_FRAGMENT_PROGRAM)})
+                {
+                    Ogre::HighLevelGpuProgramPtr program =
+                        programs.createProgram(name, Ogre::RGN_INTERNAL, es ? "glsles" : "glsl", type);
+                    program->setSource(header + source);
+                    program->load();
+                }
+                const GpuTexture compressed = samplingTexture();
+                const GpuTexture decoded = decodeGpuTexture(compressed);
+                for (const GpuTexture* t : {&compressed, &decoded})
+                {
+                    const Ogre::String name = t == &compressed ? COMPRESSED : DECODED;
+                    uploadTexture(name, Ogre::RGN_INTERNAL, t->data.data(), t->width, t->height, ogreFormat(t->format),
+                                  t->mipCount);
+                    Ogre::MaterialPtr m = Ogre::MaterialManager::getSingleton().create(name, Ogre::RGN_INTERNAL);
+                    Ogre::Pass* pass = m->getTechnique(0)->getPass(0);
+                    pass->setVertexProgram(VERTEX);
+                    pass->setFragmentProgram(FRAGMENT);
+                    pass->setDepthCheckEnabled(false);
+                    pass->setDepthWriteEnabled(false);
+                    pass->setCullingMode(Ogre::CULL_NONE);
+                    pass->setLightingEnabled(false);
+                    pass->createTextureUnitState(name)->setTextureFiltering(Ogre::TFO_TRILINEAR);
+                    pass->getFragmentProgramParameters()->setNamedConstant("tex", 0);
+                    m->load();
+                }
+            }
+            ~SamplingScene()
+            {
+                for (const char* name : {COMPRESSED, DECODED})
+                {
+                    Ogre::MaterialManager::getSingleton().remove(name, Ogre::RGN_INTERNAL);
+                    Ogre::TextureManager::getSingleton().remove(name, Ogre::RGN_INTERNAL);
+                }
+                for (const char* name : {VERTEX, FRAGMENT})
+                    Ogre::HighLevelGpuProgramManager::getSingleton().remove(name, Ogre::RGN_INTERNAL);
+            }
+            /// SAMPLING_LAYERS quads covering the viewport, drawn with `material`.
+            static void attach(OffscreenRenderer& renderer, const char* material)
+            {
+                Ogre::ManualObject* quads = renderer.getSceneManager().createManualObject();
+                quads->begin(material, Ogre::RenderOperation::OT_TRIANGLE_LIST, Ogre::RGN_INTERNAL);
+                for (int layer = 0; layer < SAMPLING_LAYERS; ++layer)
+                {
+                    const float shift = 0.25f * float(layer);
+                    for (const auto& [x, y] : {std::make_pair(-1.0f, -1.0f), std::make_pair(1.0f, -1.0f),
+                                               std::make_pair(1.0f, 1.0f), std::make_pair(-1.0f, 1.0f)})
+                    {
+                        quads->position(x, y, 0.0f);
+                        quads->textureCoord(0.5f * (x + 1.0f) + shift, 0.5f * (1.0f - y));
+                    }
+                    const Ogre::uint32 first = Ogre::uint32(4 * layer);
+                    quads->quad(first, first + 1, first + 2, first + 3);
+                }
+                quads->end();
+                quads->setBoundingBox(Ogre::AxisAlignedBox::BOX_INFINITE);
+                renderer.getContentNode().attachObject(quads);
+            }
+            static constexpr const char* VERTEX = "TreeLod/Calibration/SamplingVertex";
+            static constexpr const char* FRAGMENT = "TreeLod/Calibration/SamplingFragment";
+            static constexpr const char* COMPRESSED = "TreeLod/Calibration/Compressed";
+            static constexpr const char* DECODED = "TreeLod/Calibration/Decoded";
+        };
+
+        /// The calibration file at `path` for `renderer`, or an empty one (a warning when the file
+        /// is there but unreadable: it is calibrated again).
+        CostCalibration heldCalibration(const std::string& path, const std::string& renderer,
+                                        const ProgressCallback& progress)
+        {
+            CostCalibration calibration;
+            calibration.renderer = renderer;
+            std::error_code ec;
+            if (!std::filesystem::exists(path, ec))
+                return calibration;
+            Result<CostCalibration> read = readCostCalibration(path, renderer);
+            if (read)
+                return std::move(read.value());
+            report(progress, "warning: " + read.error().message() + "; calibrating again", 0.0f);
+            return calibration;
+        }
+    }
+
+    Result<TextureSamplingCost> measureTextureSampling(OffscreenRenderer& renderer, const CalibrationOptions& options)
+    {
+        const Ogre::HighLevelGpuProgramManager& programs = Ogre::HighLevelGpuProgramManager::getSingleton();
+        if (!programs.isLanguageSupported("glsl") && !programs.isLanguageSupported("glsles"))
+            return fail("", "texture sampling", "the render system runs no GLSL or GLSL ES programs");
+        if (options.viewport < 16 || options.frames < 1)
+            return fail("", "texture sampling", "needs a viewport of 16 px or more and frames");
+        renderer.setShadows(false);
+        renderer.clearContent();
+        const CameraSpec camera; // the quads are in clip space
+        const int viewport = std::min(options.viewport, SAMPLING_VIEWPORT);
+        auto time = [&]() { return median(renderer.timeFrames(camera, viewport, viewport, options.frames)); };
+        TextureSamplingCost cost;
+        try
+        {
+            SamplingScene scene;
+            const double emptyMs = time();
+            // Twice each, alternating, so that a drift of the machine's load falls on both.
+            std::vector<double> compressed, decoded;
+            for (int round = 0; round < 2; ++round)
+                for (const char* material : {SamplingScene::COMPRESSED, SamplingScene::DECODED})
+                {
+                    SamplingScene::attach(renderer, material);
+                    (material == SamplingScene::COMPRESSED ? compressed : decoded).push_back(time());
+                    renderer.clearContent();
+                }
+            cost.compressedMs = std::max(0.0, median(compressed) - emptyMs);
+            cost.decodedMs = std::max(0.0, median(decoded) - emptyMs);
+        }
+        catch (const Ogre::Exception& e)
+        {
+            renderer.clearContent();
+            return fail("", "texture sampling", e.getDescription());
+        }
+        return cost;
+    }
+
+    Result<TextureSamplingCost> requireTextureUpload(OffscreenRenderer& renderer, const std::string& directory,
+                                                     const CalibrationOptions& options, const ProgressCallback& progress)
+    {
+        const std::string renderString = rendererString(renderer.getRoot());
+        const std::string path = costCalibrationPath(directory, renderString);
+        CostCalibration calibration = heldCalibration(path, renderString, progress);
+        std::error_code ec;
+        if (!calibration.hasTextureSampling)
+        {
+            report(progress, "calibrate texture sampling (block-compressed against RGBA8)", 0.0f);
+            Result<TextureSamplingCost> measured = measureTextureSampling(renderer, options);
+            if (!measured)
+                return measured.error();
+            calibration.hasTextureSampling = true;
+            calibration.textureSampling = measured.value();
+            std::filesystem::create_directories(directory, ec);
+            if (Result<void> written = writeCostCalibration(path, calibration); !written)
+                return written.error();
+        }
+        adoptCalibratedTextureUpload(calibration);
+        return calibration.textureSampling;
+    }
+
+    bool adoptCalibratedTextureUpload(const CostCalibration& calibration)
+    {
+        if (!calibration.hasTextureSampling)
+            return false;
+        TreeAssetManager::getSingleton().adoptMeasuredTextureUpload(calibration.textureSampling.decodeAtLoad()
+                                                                        ? CompressedTextureUpload::Decoded
+                                                                        : CompressedTextureUpload::AsStored);
+        return true;
     }
 
     std::string rendererString(Ogre::Root& root)
@@ -208,20 +421,13 @@ namespace TreeLod
     {
         if (calibrated)
             *calibrated = false;
+        if (Result<TextureSamplingCost> sampling = requireTextureUpload(renderer, directory, options, progress); !sampling)
+            report(progress, "warning: " + sampling.error().message() + "; textures uploaded as stored", 0.0f);
         const std::string renderString = rendererString(renderer.getRoot());
         const std::string path = costCalibrationPath(directory, renderString);
         const std::string key = levelCostKey(asset);
-        CostCalibration calibration;
-        calibration.renderer = renderString;
+        CostCalibration calibration = heldCalibration(path, renderString, progress);
         std::error_code ec;
-        if (std::filesystem::exists(path, ec))
-        {
-            Result<CostCalibration> read = readCostCalibration(path, renderString);
-            if (read)
-                calibration = std::move(read.value());
-            else
-                report(progress, "warning: " + read.error().message() + "; calibrating again", 0.0f);
-        }
         if (const std::vector<LevelCost>* held = calibration.find(key))
         {
             bool all = true;

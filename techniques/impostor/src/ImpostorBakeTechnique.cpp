@@ -36,6 +36,6 @@ namespace TreeLod
              {{"resolution", "texels along the quad's longer side, a multiple of 4 in [16, 4096]", "256"},
               {"aoRays", "ambient occlusion rays per vertex, 0 (none) to 4096", "0"},
               {"alphaCutoff", "the quad's alpha test, in (0, 1]", "0.5"},
-              {"compress", "DXT5 colour and DXT1 normal (true) or RGBA8 (false, faster to sample on llvmpipe)", "false"}}});
+              {"compress", "DXT5 colour and DXT1 normal (true) or RGBA8 (false: DXT cost more than 0.005 FLIP)", "false"}}});
     }
 }

@@ -114,8 +114,8 @@ namespace TreeLod
         gpu->shadowedMaterial = prefix + "/Shadowed";
         try
         {
-            uploadTexture(gpu->texture, mAsset.getGroup(), data.colour);
-            uploadTexture(gpu->normalTexture, mAsset.getGroup(), data.normal);
+            const std::uint64_t textureBytes = uploadTexture(gpu->texture, mAsset.getGroup(), data.colour) +
+                                               uploadTexture(gpu->normalTexture, mAsset.getGroup(), data.normal);
 
             // The quad (ImpostorData.h): x in [-halfWidth, halfWidth], y in [bottom, top], facing +Z.
             const float w = data.halfWidth;
@@ -126,7 +126,7 @@ namespace TreeLod
                                           {w, data.bottom, 0.0f, 1.0f, 1.0f},
                                           {w, data.top, 0.0f, 1.0f, 0.0f},
                                           {-w, data.top, 0.0f, 0.0f, 0.0f}};
-            gpu->gpuBytes = data.gpuBytes() + makeImpostorQuad(vertices, gpu->vertexData, gpu->indexBuffer);
+            gpu->gpuBytes = textureBytes + makeImpostorQuad(vertices, gpu->vertexData, gpu->indexBuffer);
 
             // Materials: clones of TreeLod/Impostor(Shadowed) and of their shadow caster, the textures
             // bound to units Colour and Normal, the alpha cutoff set.

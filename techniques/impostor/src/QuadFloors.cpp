@@ -263,9 +263,8 @@ namespace TreeLod
                 // The impostor's colour texture, written as it is read (sRGB), unlit.
                 const ImpostorData& data = *impostors[s];
                 const Ogre::String texture = uniqueName("BillboardSetFloorColour");
-                uploadTexture(texture, assets[s]->getGroup(), data.colour);
+                mGpuBytes += uploadTexture(texture, assets[s]->getGroup(), data.colour);
                 mTextures.push_back(Ogre::TextureManager::getSingleton().getByName(texture, assets[s]->getGroup()));
-                mGpuBytes += data.colour.data.size();
                 mMaterials.push_back(cloneBaseMaterial("TreeLod/BillboardSetFloor", uniqueName("BillboardSetFloor"),
                                                        assets[s]->getGroup(), assets[s]->getName()));
                 Ogre::Pass* pass = mMaterials.back()->getTechnique(0)->getPass(0);

@@ -40,10 +40,10 @@ namespace TreeLod
              "one quad (adds reference)",
              &bake,
              {{"framesPerSide", "views a side of the hemi-octahedral grid, 2 to 32", "8"},
-              {"frameResolution", "texels a side of one view, a multiple of 4 in [8, 1024]", "128"},
+              {"frameResolution", "texels a side of one view, a multiple of 4 in [8, 1024]", "64"},
               {"samplesPerPixel", "reference samples per texel, a square in [1, 256]", "9"},
               {"aoRays", "ambient occlusion rays per vertex, 0 (none) to 4096", "0"},
               {"alphaCutoff", "the quad's alpha test, in (0, 1]", "0.5"},
-              {"compress", "DXT5 colour and normal (true) or RGBA8 (false, faster to sample on llvmpipe)", "false"}}});
+              {"compress", "DXT5 colour and normal (true) or RGBA8 (false)", "true"}}});
     }
 }

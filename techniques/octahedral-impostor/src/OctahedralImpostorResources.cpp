@@ -70,13 +70,13 @@ namespace TreeLod
         gpu->bounds = getDrawnBounds();
         try
         {
-            uploadTexture(gpu->texture, mAsset.getGroup(), data.colour);
-            uploadTexture(gpu->normalTexture, mAsset.getGroup(), data.normal);
+            const std::uint64_t textureBytes = uploadTexture(gpu->texture, mAsset.getGroup(), data.colour) +
+                                               uploadTexture(gpu->normalTexture, mAsset.getGroup(), data.normal);
             const float vertices[4][5] = {{-1.0f, -1.0f, 0.0f, 0.0f, 1.0f},
                                           {1.0f, -1.0f, 0.0f, 1.0f, 1.0f},
                                           {1.0f, 1.0f, 0.0f, 1.0f, 0.0f},
                                           {-1.0f, 1.0f, 0.0f, 0.0f, 0.0f}};
-            gpu->gpuBytes = data.gpuBytes() + makeImpostorQuad(vertices, gpu->vertexData, gpu->indexBuffer);
+            gpu->gpuBytes = textureBytes + makeImpostorQuad(vertices, gpu->vertexData, gpu->indexBuffer);
 
             // The programs' constants (TreeLodOctahedralImpostor.vert/.frag).
             const Ogre::Vector4 cylinder(data.radius, data.bottom, data.top,

@@ -32,6 +32,7 @@ namespace TreeLod
             o.frameResolution = 32;
             o.samplesPerPixel = 4;
             o.aoRays = 4;
+            o.compress = false; // texels read back as baked
             return o;
         }
 
@@ -185,6 +186,11 @@ namespace TreeLod
         bad.normal.data.resize(gpuTextureBytes(GpuTextureFormat::DXT1, bad.normal.width, bad.normal.height,
                                                bad.normal.mipCount));
         expectError(encodeOctahedralImpostorChunk(bad), "normal texture", "RGBA8 or DXT5 needed");
+        bad = good;
+        bad.normal.format = GpuTextureFormat::BC5; // two channels: no AO, no depth
+        bad.normal.data.resize(gpuTextureBytes(GpuTextureFormat::BC5, bad.normal.width, bad.normal.height,
+                                               bad.normal.mipCount));
+        expectError(encodeOctahedralImpostorChunk(bad), "normal texture", "format 5 (BC5): RGBA8 or DXT5 needed");
         bad = good;
         bad.normal.data.pop_back();
         expectError(encodeOctahedralImpostorChunk(bad), "normal texture", "bytes of texel data, expected");

@@ -30,7 +30,7 @@ namespace TreeLod
             std::uint32_t cameras = 0, perRow = 0;
         };
         auto decoded = std::make_shared<Decoded>();
-        decoded->atlas = decompressTexture(data.atlas);
+        decoded->atlas = decodeGpuTexture(data.atlas);
         decoded->slots = data.slots;
         decoded->cameras = data.cameraCount();
         decoded->perRow = data.atlas.width / VOLUME_BILLBOARD_TEXELS;

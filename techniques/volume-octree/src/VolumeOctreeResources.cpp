@@ -142,8 +142,7 @@ namespace TreeLod
             uploadTexture(textures->slots, mAsset.getGroup(), slots.data(), textures->slotsWidth, rows,
                           Ogre::PF_BYTE_RGBA, 1);
             textures->codebook = prefix + "-codebook";
-            uploadTexture(textures->codebook, mAsset.getGroup(), d.atlas);
-            textures->bytes = d.atlas.data.size() + slots.size();
+            textures->bytes = uploadTexture(textures->codebook, mAsset.getGroup(), d.atlas) + slots.size();
         }
         catch (...)
         {

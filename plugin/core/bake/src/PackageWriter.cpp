@@ -255,9 +255,14 @@ namespace TreeLod
         out.height = src.height;
         out.mipCount = src.mipCount;
         out.data.resize(gpuTextureBytes(format, src.width, src.height, src.mipCount));
-        const int flags =
-            (format == GpuTextureFormat::DXT5 ? squish::kDxt5 : squish::kDxt1) | squish::kColourClusterFit;
-        const std::size_t blockBytes = format == GpuTextureFormat::DXT5 ? 16 : 8;
+        int flags = squish::kDxt1 | squish::kColourClusterFit;
+        if (format == GpuTextureFormat::DXT5)
+            flags = squish::kDxt5 | squish::kColourClusterFit;
+        else if (format == GpuTextureFormat::BC4)
+            flags = squish::kBc4;
+        else if (format == GpuTextureFormat::BC5)
+            flags = squish::kBc5;
+        const std::size_t blockBytes = format == GpuTextureFormat::DXT1 || format == GpuTextureFormat::BC4 ? 8 : 16;
         for (std::uint32_t mip = 0; mip < src.mipCount; ++mip)
         {
             const std::uint32_t w = src.mipWidth(mip), h = src.mipHeight(mip);
@@ -270,24 +275,6 @@ namespace TreeLod
                                       flags);
             });
         }
-        return out;
-    }
-
-    GpuTexture decompressTexture(const GpuTexture& src)
-    {
-        if (!isBlockCompressed(src.format))
-            return src;
-        GpuTexture out;
-        out.name = src.name;
-        out.format = GpuTextureFormat::RGBA8;
-        out.width = src.width;
-        out.height = src.height;
-        out.mipCount = src.mipCount;
-        out.data.resize(gpuTextureBytes(GpuTextureFormat::RGBA8, src.width, src.height, src.mipCount));
-        const int flags = src.format == GpuTextureFormat::DXT5 ? squish::kDxt5 : squish::kDxt1;
-        for (std::uint32_t mip = 0; mip < src.mipCount; ++mip)
-            squish::DecompressImage(out.data.data() + out.mipOffset(mip), int(src.mipWidth(mip)),
-                                    int(src.mipHeight(mip)), src.data.data() + src.mipOffset(mip), flags);
         return out;
     }
 

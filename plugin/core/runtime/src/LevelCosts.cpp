@@ -118,6 +118,19 @@ namespace TreeLod
                 out.push_back(std::move(level.value()));
             }
         }
+        if (j.contains("textureSampling"))
+        {
+            const nlohmann::json& t = j["textureSampling"];
+            auto valid = [&](const char* name) {
+                return t.is_object() && t.contains(name) && t[name].is_number() && std::isfinite(t[name].get<double>()) &&
+                       t[name].get<double>() >= 0.0;
+            };
+            if (!valid("compressedMs") || !valid("decodedMs"))
+                return fail(path, "textureSampling", "needs compressedMs and decodedMs, finite and >= 0");
+            calibration.hasTextureSampling = true;
+            calibration.textureSampling.compressedMs = t["compressedMs"].get<double>();
+            calibration.textureSampling.decodedMs = t["decodedMs"].get<double>();
+        }
         return calibration;
     }
 
@@ -135,7 +148,10 @@ namespace TreeLod
                                 {"msPerTree", level.msPerTree}});
             assets[key] = list;
         }
-        const nlohmann::json j = {{"renderer", calibration.renderer}, {"version", CostCalibration::VERSION}, {"assets", assets}};
+        nlohmann::json j = {{"renderer", calibration.renderer}, {"version", CostCalibration::VERSION}, {"assets", assets}};
+        if (calibration.hasTextureSampling)
+            j["textureSampling"] = {{"compressedMs", calibration.textureSampling.compressedMs},
+                                    {"decodedMs", calibration.textureSampling.decodedMs}};
         const std::string text = j.dump(1) + "\n";
         return writeFileAtomic(path, std::vector<std::uint8_t>(text.begin(), text.end()));
     }

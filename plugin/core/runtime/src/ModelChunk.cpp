@@ -21,7 +21,7 @@ namespace TreeLod
         constexpr std::uint32_t MATERIAL_LEAF = 1u;
         constexpr std::uint32_t MATERIAL_DOUBLE_SIDED = 2u;
 
-        /// Bytes per texel (RGBA8) or per 4x4 block (DXT); 0 for an unknown format.
+        /// Bytes per texel (RGBA8) or per 4x4 block (BC1-BC5); 0 for an unknown format.
         std::uint32_t bytesPerUnit(GpuTextureFormat format)
         {
             switch (format)
@@ -29,8 +29,10 @@ namespace TreeLod
             case GpuTextureFormat::RGBA8:
                 return 4;
             case GpuTextureFormat::DXT1:
+            case GpuTextureFormat::BC4:
                 return 8;
             case GpuTextureFormat::DXT5:
+            case GpuTextureFormat::BC5:
                 return 16;
             }
             return 0;
@@ -115,7 +117,26 @@ namespace TreeLod
 
     bool isBlockCompressed(GpuTextureFormat format)
     {
-        return format == GpuTextureFormat::DXT1 || format == GpuTextureFormat::DXT5;
+        return format == GpuTextureFormat::DXT1 || format == GpuTextureFormat::DXT5 || format == GpuTextureFormat::BC4 ||
+               format == GpuTextureFormat::BC5;
+    }
+
+    std::string gpuTextureFormatName(GpuTextureFormat format)
+    {
+        switch (format)
+        {
+        case GpuTextureFormat::RGBA8:
+            return "RGBA8";
+        case GpuTextureFormat::DXT1:
+            return "DXT1";
+        case GpuTextureFormat::DXT5:
+            return "DXT5";
+        case GpuTextureFormat::BC4:
+            return "BC4";
+        case GpuTextureFormat::BC5:
+            return "BC5";
+        }
+        return "format " + std::to_string(std::uint32_t(format));
     }
 
     std::string gpuTextureProblem(const GpuTexture& tex, std::initializer_list<GpuTextureFormat> formats)
@@ -128,10 +149,11 @@ namespace TreeLod
             for (GpuTextureFormat f : formats)
             {
                 names += i == 0 ? "" : (i + 1 == formats.size() ? " or " : ", ");
-                names += f == GpuTextureFormat::RGBA8 ? "RGBA8" : f == GpuTextureFormat::DXT1 ? "DXT1" : "DXT5";
+                names += gpuTextureFormatName(f);
                 ++i;
             }
-            return "format " + std::to_string(std::uint32_t(tex.format)) + " (" + names + " needed)";
+            const std::string given = bytesPerUnit(tex.format) ? " (" + gpuTextureFormatName(tex.format) + ")" : "";
+            return "format " + std::to_string(std::uint32_t(tex.format)) + given + ": " + names + " needed";
         }
         if (tex.width < 1 || tex.height < 1 || tex.width > GPU_TEXTURE_MAX_SIZE || tex.height > GPU_TEXTURE_MAX_SIZE)
             return "size " + size(tex.width, tex.height) + " outside 1.." + std::to_string(GPU_TEXTURE_MAX_SIZE);
@@ -254,7 +276,7 @@ namespace TreeLod
         readArray(r, chunk.textures, TEXTURES, [&](ByteReader& r, GpuTexture& tex, std::uint32_t i) {
             if (readGpuTexture(r, chunkName + ", texture " + std::to_string(i), tex) &&
                 tex.format != GpuTextureFormat::RGBA8)
-                r.failHere("format " + std::to_string(std::uint32_t(tex.format)) + ": reference textures are RGBA8");
+                r.failHere("format " + gpuTextureFormatName(tex.format) + ": reference textures are RGBA8");
         });
         if (!r.ok())
             return r.error();

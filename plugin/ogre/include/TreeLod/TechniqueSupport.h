@@ -1,10 +1,11 @@
 // TechniqueSupport: what a technique's Ogre half (its TechniqueResources) uses to put its chunk's
 // textures and materials on the GPU: the Ogre format of a baked texture, its upload with every
-// baked mip, a clone of one of TreeLod's base materials and its passes' textures, and a single
-// tree as one instance.
+// baked mip (decoded at load where TreeAssetManager says so), a clone of one of TreeLod's base
+// materials and its passes' textures, and a single tree as one instance.
 #pragma once
 
 #include "TreeLod/ModelChunk.h"
+#include "TreeLod/TreeAssetManager.h"
 
 #include <OgreException.h>
 #include <OgreHardwareBufferManager.h>
@@ -24,7 +25,7 @@
 
 namespace TreeLod
 {
-    /// The Ogre pixel format of a baked texture: DXT1, DXT5, else RGBA8.
+    /// The Ogre pixel format of a baked texture: DXT1, DXT5, BC4, BC5 (unsigned normalised), else RGBA8.
     inline Ogre::PixelFormat ogreFormat(GpuTextureFormat format)
     {
         switch (format)
@@ -33,6 +34,10 @@ namespace TreeLod
             return Ogre::PF_DXT1;
         case GpuTextureFormat::DXT5:
             return Ogre::PF_DXT5;
+        case GpuTextureFormat::BC4:
+            return Ogre::PF_BC4_UNORM;
+        case GpuTextureFormat::BC5:
+            return Ogre::PF_BC5_UNORM;
         default:
             return Ogre::PF_BYTE_RGBA;
         }
@@ -59,11 +64,21 @@ namespace TreeLod
                                                        int(mips > 0 ? mips - 1 : 0));
     }
 
-    /// Upload `texture` with every baked mip level, in its own format, as texture `name` in `group`.
-    inline void uploadTexture(const Ogre::String& name, const Ogre::String& group, const GpuTexture& texture)
+    /// Upload `texture` with every baked mip level as texture `name` in `group`: in its own format,
+    /// or decoded to RGBA8 where TreeAssetManager::decodesAtLoad says so. Returns the bytes uploaded.
+    inline std::uint64_t uploadTexture(const Ogre::String& name, const Ogre::String& group, const GpuTexture& texture)
     {
+        const TreeAssetManager* assets = TreeAssetManager::getSingletonPtr();
+        if (assets && assets->decodesAtLoad(texture))
+        {
+            const GpuTexture decoded = decodeGpuTexture(texture);
+            uploadTexture(name, group, decoded.data.data(), decoded.width, decoded.height, Ogre::PF_BYTE_RGBA,
+                          decoded.mipCount);
+            return decoded.data.size();
+        }
         uploadTexture(name, group, texture.data.data(), texture.width, texture.height, ogreFormat(texture.format),
                       texture.mipCount);
+        return texture.data.size();
     }
 
     /// A clone of TreeLod's material `base` named `name` in `group`; throws naming `base` (and the

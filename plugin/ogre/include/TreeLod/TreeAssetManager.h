@@ -18,6 +18,7 @@
 #include <future>
 #include <memory>
 #include <mutex>
+#include <optional>
 
 namespace TreeLod
 {
@@ -39,6 +40,13 @@ namespace TreeLod
         std::vector<Ogre::String> mTechniques;
         std::shared_future<Ogre::String> mPath; ///< the baker's answer
         TreeAssetPtr mAsset;
+    };
+
+    /// How block-compressed textures (GpuTextureFormat DXT1, DXT5, BC4, BC5) of a package reach the GPU.
+    enum class CompressedTextureUpload
+    {
+        AsStored, ///< as baked: the texture unit decodes them (every GPU)
+        Decoded   ///< decoded to RGBA8 at load (decodeGpuTexture): for renderers that sample RGBA8 faster
     };
 
     class TreeAssetManager : public Ogre::ResourceManager, public Ogre::Singleton<TreeAssetManager>
@@ -73,6 +81,29 @@ namespace TreeLod
                                                        const std::vector<Ogre::String>& techniques,
                                                        const Ogre::String& group);
 
+        /// The user's choice for textures uploaded from now on (already uploaded ones stay as they
+        /// are), which a calibration's measured choice (adoptMeasuredTextureUpload) does not change;
+        /// nullopt forgets it. The environment variable TREELOD_COMPRESSED_TEXTURES ("as-stored" or
+        /// "decoded") makes the same choice when the manager is created.
+        void setCompressedTextureUpload(std::optional<CompressedTextureUpload> upload);
+        /// The choice measured on this renderer (LevelCalibration.h: sampling a compressed texture
+        /// against the same texture decoded); the user's choice wins. AsStored until either.
+        void adoptMeasuredTextureUpload(CompressedTextureUpload upload) { mMeasuredTextureUpload = upload; }
+        /// The user's choice, else the measured one, else AsStored.
+        CompressedTextureUpload getCompressedTextureUpload() const
+        {
+            return mChosenTextureUpload ? *mChosenTextureUpload : mMeasuredTextureUpload;
+        }
+        /// Whether the user chose (setCompressedTextureUpload or the environment variable).
+        bool isCompressedTextureUploadChosen() const { return mChosenTextureUpload.has_value(); }
+        /// Whether `texture` is decoded to RGBA8 before upload: a block format under
+        /// CompressedTextureUpload::Decoded, or one the render system cannot sample (no
+        /// RSC_TEXTURE_COMPRESSION_DXT for DXT1/DXT5, no RSC_TEXTURE_COMPRESSION_BC4_BC5 for
+        /// BC4/BC5), or, under OpenGL ES, a block format with more than one mip level but fewer
+        /// than the full chain (OGRE 1.12's GLES2 render system drew those black; one level and
+        /// full chains draw: test rendersystem.GLES2).
+        bool decodesAtLoad(const GpuTexture& texture) const;
+
         static TreeAssetManager& getSingleton();
         static TreeAssetManager* getSingletonPtr();
 
@@ -89,6 +120,8 @@ namespace TreeLod
                                const Ogre::String& path, const Ogre::String& group);
 
         TreeBaker* mBaker = nullptr;
+        std::optional<CompressedTextureUpload> mChosenTextureUpload;
+        CompressedTextureUpload mMeasuredTextureUpload = CompressedTextureUpload::AsStored;
         std::mutex mBakeMutex; ///< one bake at a time
         std::vector<std::shared_future<Ogre::String>> mBakes; ///< running or ended; waited for at destruction
     };

@@ -9,6 +9,11 @@
 // trees sizes the timed grid to about targetFrameMs, so a calibration stays short whatever a
 // level costs (a few seconds per level on llvmpipe). Results are cached per renderer
 // string (costCalibrationPath): a calibration from another renderer is never reused.
+//
+// The same file holds whether this renderer samples block-compressed textures slower than RGBA8
+// (measureTextureSampling, TextureSamplingCost): where it does (llvmpipe decodes every fetch in
+// software), requireTextureUpload makes TreeAssetManager decode them at load, before any level
+// is calibrated, so that the costs are those of the textures as drawn.
 #pragma once
 
 #include "TreeLod/ForestLevelProvider.h"
@@ -58,13 +63,33 @@ namespace TreeLod
                               const ForestLevel& level, const std::vector<ForestInstance>& instances,
                               const std::string& name, float heightPx = 0.0f);
 
+    /// Time the same draw (a 1024² texture with mips, four trilinear reads a fragment, four
+    /// full-viewport layers at min(options.viewport, 256)²) sampling it block-compressed (DXT5) and decoded
+    /// to RGBA8 (decodeGpuTexture), median of options.frames frames each, the empty frame
+    /// subtracted (GLSL 3.30, or GLSL ES 3.00 where the render system runs only that). Errors
+    /// name the step.
+    Result<TextureSamplingCost> measureTextureSampling(OffscreenRenderer& renderer,
+                                                       const CalibrationOptions& options = {});
+
+    /// The texture sampling cost of this renderer from the calibration file in `directory`, else
+    /// measured and added to it; then TreeAssetManager::adoptMeasuredTextureUpload with its
+    /// decision (which the user's choice overrides). Errors name the file.
+    Result<TextureSamplingCost> requireTextureUpload(OffscreenRenderer& renderer, const std::string& directory,
+                                                     const CalibrationOptions& options = {},
+                                                     const ProgressCallback& progress = {});
+
+    /// TreeAssetManager::adoptMeasuredTextureUpload with `calibration`'s decision when it holds a
+    /// texture sampling cost; false when it holds none.
+    bool adoptCalibratedTextureUpload(const CostCalibration& calibration);
+
     /// Calibrate every auto level of `asset` (loaded). Errors name the asset and the level.
     Result<std::vector<LevelCost>> calibrateLevels(OffscreenRenderer& renderer, TreeAsset& asset,
                                                    const CalibrationOptions& options = {},
                                                    const ProgressCallback& progress = {});
 
     /// The costs of `asset`'s levels on this renderer: from the calibration file in `directory`
-    /// when it holds them all, else calibrated and added to it (atomically). `calibrated` tells
+    /// when it holds them all, else calibrated and added to it (atomically); requireTextureUpload
+    /// first. `calibrated` tells
     /// which. Errors name the file or the asset.
     Result<std::vector<LevelCost>> requireLevelCosts(OffscreenRenderer& renderer, TreeAsset& asset,
                                                      const std::string& directory,

@@ -42,10 +42,10 @@ namespace TreeLod
         /// darker than it (techniques/impostor/README.md, "Ambient occlusion").
         int aoRays = 0;
         float alphaCutoff = 0.5f;  ///< the quad's alpha test, in (0, 1]
-        /// DXT5 colour, DXT1 normal (libsquish); else RGBA8, the default: the far level of every
-        /// forest samples it on every fragment, and llvmpipe decodes DXT in software (the quad
-        /// level draws 1.6-1.9x faster from RGBA8 there, techniques/impostor/README.md "Cost"), while the four
-        /// times larger textures stay small: one pair per species, at most 700 KB at 256 texels.
+        /// DXT5 colour, DXT1 normal (libsquish); else RGBA8, the default: at the 8 px where budgeted
+        /// auto draws this level DXT cost 0.0068 FLIP on average over the corpus, more than a
+        /// format may (docs/measurements.md "Texture formats"), and the RGBA8 pair stays small
+        /// (at most 700 KB at 256 texels). Compressed or not, llvmpipe samples RGBA8 (decoded at load).
         bool compress = false;
     };
 

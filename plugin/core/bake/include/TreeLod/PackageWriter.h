@@ -76,12 +76,11 @@ namespace TreeLod
     /// An empty image (0x0) gives a GpuTexture with mipCount 0 and no data.
     GpuTexture buildMipChain(const TextureImage& image, const MipChainOptions& options = {});
 
-    /// `rgba8` (an RGBA8 GpuTexture, every mip level) block-compressed to `format` (DXT1 or
-    /// DXT5) with libsquish's cluster fit, level by level. Block rows run in parallel; each
-    /// block depends on its own texels only, so the bytes do not depend on the thread count.
+    /// `rgba8` (an RGBA8 GpuTexture, every mip level) block-compressed to `format` with libsquish,
+    /// level by level: DXT1 and DXT5 with its cluster fit, BC4 from the R channel, BC5 from R and
+    /// G. Block rows run in parallel; each block depends on its own texels only, so the bytes do
+    /// not depend on the thread count. Decoding is the runtime's decodeGpuTexture (ModelChunk.h).
     GpuTexture compressTexture(const GpuTexture& rgba8, GpuTextureFormat format);
-    /// A DXT1 or DXT5 texture back to RGBA8 (every mip level, libsquish); RGBA8 is returned as it is.
-    GpuTexture decompressTexture(const GpuTexture& compressed);
 
     /// The reference chunk of `model`: the model without its decoded textures plus a mip chain
     /// per texture, alpha-coverage preserving (with that material's cutoff) for the textures

@@ -5,7 +5,8 @@
 //
 // File (JSON, written atomically): {"renderer": "...", "version": 1, "assets": {"<asset key>":
 // [{"technique": "<technique>", "level": 1200, "lowRes": false, "heightsPx": [16, 64, 256],
-// "msPerTree": [0.012, 0.020, 0.151]}, ...]}}. The asset key (assetCostKey) hashes the chunks the
+// "msPerTree": [0.012, 0.020, 0.151]}, ...]}, "textureSampling": {"compressedMs": 9.1,
+// "decodedMs": 5.0}} (textureSampling optional: a file without it is measured again for it). The asset key (assetCostKey) hashes the chunks the
 // levels draw from, so a rebaked tree is calibrated again.
 #pragma once
 
@@ -34,11 +35,27 @@ namespace TreeLod
         float msAt(float heightPx) const;
     };
 
+    /// The renderer's time for the same draw sampling a block-compressed texture and the same
+    /// texture decoded to RGBA8 (LevelCalibration.h measureTextureSampling), empty frame subtracted.
+    struct TextureSamplingCost
+    {
+        /// Compressed sampling slower than decoded by more than this fraction decodes at load.
+        static constexpr double DECODE_MARGIN = 0.1;
+        double compressedMs = 0.0; ///< finite, >= 0
+        double decodedMs = 0.0;    ///< finite, >= 0
+        /// Whether this renderer should get block-compressed textures decoded to RGBA8 at load:
+        /// compressedMs > (1 + DECODE_MARGIN) decodedMs. A GPU's texture unit decodes blocks at no
+        /// cost and reads a quarter of the bytes; a software rasteriser (llvmpipe) decodes per fetch.
+        bool decodeAtLoad() const { return compressedMs > (1.0 + DECODE_MARGIN) * decodedMs; }
+    };
+
     struct CostCalibration
     {
         static constexpr int VERSION = 1;
         std::string renderer; ///< the render system's renderer string (GL_RENDERER)
         std::map<std::string, std::vector<LevelCost>> assets; ///< by assetCostKey
+        bool hasTextureSampling = false; ///< whether textureSampling was measured
+        TextureSamplingCost textureSampling;
 
         /// The levels of `assetKey`, or null.
         const std::vector<LevelCost>* find(const std::string& assetKey) const;

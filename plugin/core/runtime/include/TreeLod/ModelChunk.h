@@ -51,11 +51,22 @@ namespace TreeLod
     {
         RGBA8 = 1, ///< 4 bytes per texel, R G B A; colour sRGB-encoded, alpha straight (linear)
         DXT1 = 2,  ///< BC1, 8 bytes per 4x4 block (levels under 4 texels still take one block)
-        DXT5 = 3   ///< BC3, 16 bytes per 4x4 block
+        DXT5 = 3,  ///< BC3, 16 bytes per 4x4 block
+        BC4 = 4,   ///< one channel (R), 8 bytes per 4x4 block; sampled as (r, 0, 0, 1)
+        BC5 = 5    ///< two channels (R, G), 16 bytes per 4x4 block; sampled as (r, g, 0, 1)
     };
 
-    /// True for the 4x4 block formats.
+    /// True for the 4x4 block formats (DXT1, DXT5, BC4, BC5).
     bool isBlockCompressed(GpuTextureFormat format);
+    /// "RGBA8", "DXT1", "DXT5", "BC4", "BC5"; "format N" for a value outside the enum.
+    std::string gpuTextureFormatName(GpuTextureFormat format);
+
+    struct GpuTexture;
+    /// `texture` decoded to RGBA8, every mip level, as a GPU samples it (Microsoft's BC1-BC5
+    /// block formats; DXT5's colour block always in its four-colour mode; BC4 as (r, 0, 0, 255),
+    /// BC5 as (r, g, 0, 255)). RGBA8 comes back as it is. The caller validates first
+    /// (gpuTextureProblem): the texel bytes must be the size's.
+    GpuTexture decodeGpuTexture(const GpuTexture& texture);
 
     /// A texture as the GPU takes it: every mip level, largest first.
     struct GpuTexture
