@@ -98,6 +98,12 @@ namespace TreeLod
         ASSERT_FALSE(unknown.ok());
         EXPECT_NE(unknown.error().message().find("roles-test"), std::string::npos) << "the known list names it";
         EXPECT_FALSE(parseBenchRuns({"auto@2"}).ok());
+        // The bench's auto keeps its suffixes.
+        Result<std::vector<BenchRun>> suffixed = parseBenchRuns({"auto+mem8+fade0.1"});
+        ASSERT_TRUE(suffixed.ok()) << suffixed.error().message();
+        EXPECT_EQ((*suffixed)[0].policy.mode, LodPolicy::Mode::Script);
+        EXPECT_EQ((*suffixed)[0].policy.memoryBudgetMB, 8.0f);
+        EXPECT_EQ((*suffixed)[0].policy.transition, 0.1f);
 
         // A baseline registered by a technique is a scene technique and a comparison run.
         registry.addBaseline({"roles-test-baseline", "a test's floor", '*', info.chunkTechnique, nullptr});

@@ -127,15 +127,16 @@ namespace TreeLod
                 return policy.error();
             if (policy->isAuto() && std::isnan(policy->errorBudget) && std::isnan(policy->frameBudgetMs))
             {
-                // The bench's "auto": each species as its script says.
-                const float transition = policy->transition;
+                // The bench's "auto": each species as its script says (with the run's own suffixes).
+                const float transition = policy->transition, memory = policy->memoryBudgetMB;
                 policy = LodPolicy::scriptChoice();
                 policy->transition = transition;
+                policy->memoryBudgetMB = memory;
             }
             if (policy->mode == LodPolicy::Mode::Fixed && bakeTechniqueOf(policy->technique).empty())
                 return fail("", "--techniques",
                             "unknown technique '" + policy->technique + "' (known: auto, auto@E, auto~MS, " +
-                                knownSceneTechniques() + "; any with +fadeT)");
+                                knownSceneTechniques() + "; any with +fadeT, auto with +memMB)");
             runs.push_back({name, *policy});
         }
         return runs;
