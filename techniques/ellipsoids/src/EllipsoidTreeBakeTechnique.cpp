@@ -50,7 +50,7 @@ namespace TreeLod
              "the leaves as ellipsoids, one per leaf then EM/GMM clusters of a quarter as many per level down "
              "to one, sized by image error (adds reference)",
              &bake,
-             {{"tries", "EM runs per level from random starts, the best by image error kept, 1 to 16", "4"},
+             {{"tries", "EM runs from random starts per level of at most 12 clusters (one above), the best by image error kept, 1 to 16", "4"},
               {"seed", "random seed of the EM starts, 0 to 4294967295", "1"},
               {"clustersDivisor", "each level has 1 / this of the previous level's clusters, 2 to 64", "4"},
               {"minAreaShare", "ellipsoids under this share of the level's largest surface area are dropped, 0 to 0.5",
