@@ -58,6 +58,8 @@ namespace TreeLod
         {
             if (o.tries < 1 || o.tries > 16)
                 return fail(label, "ellipsoids option tries", std::to_string(o.tries) + " is outside [1, 16]");
+            if (o.triedClusters < 1)
+                return fail(label, "ellipsoids option triedClusters", "0 is below 1");
             if (o.clustersDivisor < 2 || o.clustersDivisor > 64)
                 return fail(label, "ellipsoids option clustersDivisor",
                             std::to_string(o.clustersDivisor) + " is outside [2, 64]");
@@ -341,11 +343,11 @@ namespace TreeLod
             return level;
         }
 
-        /// EM runs of a level of k clusters (Alg. 1's t): `tries` where k is at most EM_CANDIDATES
-        /// (few clusters, an exact E-step), one above, and one for one cluster (every start ends alike).
-        std::uint32_t levelTries(std::uint32_t k, std::uint32_t tries)
+        /// EM runs of a level of k clusters (Alg. 1's t): `tries` up to triedClusters, one above, and
+        /// one for one cluster (every start ends alike).
+        std::uint32_t levelTries(std::uint32_t k, const EllipsoidTreeOptions& options)
         {
-            return k == 1 ? 1 : (k <= EM_CANDIDATES ? tries : 1);
+            return k == 1 ? 1 : (k <= options.triedClusters ? options.tries : 1);
         }
 
         struct Calibrated
@@ -672,7 +674,7 @@ namespace TreeLod
                 em.candidateRefresh = EM_CANDIDATE_REFRESH;
                 const double side = 0.5 / std::cbrt(double(k)); // a start's spread: k of them fill the box
                 em.initialVariance = side * side;
-                const std::uint32_t tries = levelTries(k, options.tries);
+                const std::uint32_t tries = levelTries(k, options);
                 WorkLevel best;
                 std::vector<Ellipsoid> bestMetres;
                 double bestError = std::numeric_limits<double>::infinity();
