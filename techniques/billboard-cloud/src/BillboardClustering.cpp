@@ -46,6 +46,97 @@ namespace TreeLod
             return e;
         }
 
+        /// The centroids in a grid of cubic cells over the leaf centres' box (centroids are means
+        /// of leaf centres: inside it). visit() walks the cells in shells of growing Chebyshev
+        /// radius around a point's cell and hands over the centroids of each cell whose distance
+        /// from the point passes `keep` (a lower bound, kept below the true distance by a margin
+        /// for rounding), until no cell of the next shell can.
+        class CentroidGrid
+        {
+        public:
+            CentroidGrid(const std::vector<glm::vec3>& centroids, const glm::vec3& lo, const glm::vec3& hi)
+            {
+                const glm::vec3 extent = glm::max(hi - lo, glm::vec3(1e-6f));
+                const float pad = 1e-3f * std::max({extent.x, extent.y, extent.z});
+                mLo = lo - pad;
+                const glm::vec3 size = extent + 2.0f * pad;
+                // About two centroids per cell.
+                const double volume = double(size.x) * size.y * size.z;
+                mCell = float(std::cbrt(volume / std::max(0.5 * double(centroids.size()), 1.0)));
+                mCell = std::max(mCell, 1.001f * std::max({size.x, size.y, size.z}) / 256.0f);
+                for (int a = 0; a < 3; ++a)
+                    mCells[a] = std::clamp(int(std::ceil(size[a] / mCell)), 1, 256);
+                mStart.assign(std::size_t(mCells[0]) * mCells[1] * mCells[2] + 1, 0);
+                std::vector<std::uint32_t> cellOf(centroids.size());
+                for (std::size_t k = 0; k < centroids.size(); ++k)
+                {
+                    const glm::ivec3 c = cellCoords(centroids[k]);
+                    cellOf[k] = std::uint32_t(index(c.x, c.y, c.z));
+                    ++mStart[cellOf[k] + 1];
+                }
+                for (std::size_t c = 1; c < mStart.size(); ++c)
+                    mStart[c] += mStart[c - 1];
+                mItems.resize(centroids.size());
+                std::vector<std::uint32_t> next(mStart.begin(), mStart.end() - 1);
+                for (std::size_t k = 0; k < centroids.size(); ++k)
+                    mItems[next[cellOf[k]]++] = std::uint32_t(k);
+            }
+
+            template <typename Keep, typename Visit>
+            void visit(const glm::vec3& p, const Keep& keep, const Visit& visitItem) const
+            {
+                const glm::ivec3 centre = cellCoords(p);
+                const int maxRadius = std::max({mCells[0], mCells[1], mCells[2]});
+                for (int r = 0; r < maxRadius; ++r)
+                {
+                    if (r > 1 && !keep(float(r - 1) * mCell * 0.999f))
+                        return;
+                    for (int dz = -r; dz <= r; ++dz)
+                        for (int dy = -r; dy <= r; ++dy)
+                        {
+                            const bool face = dz == -r || dz == r || dy == -r || dy == r;
+                            for (int dx = -r; dx <= r; dx += face || r == 0 ? 1 : 2 * r)
+                                visitCell(p, centre + glm::ivec3(dx, dy, dz), keep, visitItem);
+                        }
+                }
+            }
+
+        private:
+            glm::ivec3 cellCoords(const glm::vec3& p) const
+            {
+                glm::ivec3 c;
+                for (int a = 0; a < 3; ++a)
+                    c[a] = std::clamp(int(std::floor((p[a] - mLo[a]) / mCell)), 0, mCells[a] - 1);
+                return c;
+            }
+
+            std::size_t index(int x, int y, int z) const
+            {
+                return (std::size_t(z) * mCells[1] + std::size_t(y)) * mCells[0] + std::size_t(x);
+            }
+
+            template <typename Keep, typename Visit>
+            void visitCell(const glm::vec3& p, const glm::ivec3& c, const Keep& keep, const Visit& visitItem) const
+            {
+                if (c.x < 0 || c.y < 0 || c.z < 0 || c.x >= mCells[0] || c.y >= mCells[1] || c.z >= mCells[2])
+                    return;
+                const std::size_t id = index(c.x, c.y, c.z);
+                if (mStart[id] == mStart[id + 1])
+                    return;
+                const glm::vec3 lo = mLo + glm::vec3(c) * mCell, hi = lo + mCell;
+                const glm::vec3 out = glm::max(glm::max(lo - p, p - hi), glm::vec3(0.0f));
+                if (!keep(glm::length(out) * 0.999f))
+                    return;
+                for (std::uint32_t m = mStart[id]; m < mStart[id + 1]; ++m)
+                    visitItem(mItems[m]);
+            }
+
+            glm::vec3 mLo{0.0f};
+            float mCell = 1.0f;
+            int mCells[3] = {1, 1, 1};
+            std::vector<std::uint32_t> mStart, mItems;
+        };
+
         glm::vec3 canonicalSign(const glm::vec3& n)
         {
             const glm::vec3 a = glm::abs(n);
@@ -89,6 +180,13 @@ namespace TreeLod
             leaf.count = src.vertexCount;
             for (std::uint32_t v = leaf.first; v < leaf.first + leaf.count; ++v)
                 leaf.radius = std::max(leaf.radius, glm::length(vertices[v] - leaf.centre));
+        }
+
+        glm::vec3 centreLo(INF), centreHi(-INF);
+        for (const LeafData& leaf : leaves)
+        {
+            centreLo = glm::min(centreLo, leaf.centre);
+            centreHi = glm::max(centreHi, leaf.centre);
         }
 
         // Seeds: farthest-point sampling of the centres.
@@ -201,7 +299,12 @@ namespace TreeLod
         while (passes < maxPasses)
         {
             ++passes;
-            // 1. Assignment (per leaf, in parallel).
+            // 1. Assignment (per leaf, in parallel): the cluster of least cost, ties to the lower
+            // index. Its cost is at least spatialWeight x the distance to its centroid, so with
+            // spatialWeight > 0 only the centroids in grid cells within bestCost / spatialWeight
+            // of the leaf can win; the cells are visited in shells around the leaf's cell, its
+            // previous cluster first (the same choice as a scan of every cluster).
+            const CentroidGrid grid(centroid, centreLo, centreHi);
             tbb::parallel_for(
                 tbb::blocked_range<std::uint32_t>(0, L, 64), [&](const tbb::blocked_range<std::uint32_t>& r) {
                     for (std::uint32_t i = r.begin(); i < r.end(); ++i)
@@ -209,34 +312,47 @@ namespace TreeLod
                         const LeafData& leaf = leaves[i];
                         float bestCost = INF, bestErr = 0.0f, fallbackErr = INF;
                         std::uint32_t best = NONE, fallback = NONE;
-                        for (std::uint32_t k = 0; k < C; ++k)
-                        {
+                        const auto consider = [&](std::uint32_t k) {
                             const float spatial =
                                 w * glm::length(leaf.centre - centroid[k]) +
                                 wn * 2.0f * leaf.radius * (1.0f - std::abs(glm::dot(leaf.normal, normal[k])));
-                            if (best != NONE && spatial >= bestCost)
-                                continue;
+                            if (best != NONE && (spatial > bestCost || (spatial == bestCost && k > best)))
+                                return;
                             const float lower = std::abs(glm::dot(normal[k], leaf.centre) - offset[k]) - leaf.radius;
-                            if (lower > bound && (best != NONE || lower >= fallbackErr))
-                                continue;
+                            if (lower > bound && (best != NONE || lower > fallbackErr))
+                                return;
                             const float limit =
                                 best != NONE ? std::min(bound, bestCost - spatial) : std::max(bound, fallbackErr);
                             const float e = planeError(leaf, vertices, normal[k], offset[k], limit);
                             if (e <= bound)
                             {
-                                if (e + spatial < bestCost)
+                                const float cost = e + spatial;
+                                if (best == NONE || cost < bestCost || (cost == bestCost && k < best))
                                 {
-                                    bestCost = e + spatial;
+                                    bestCost = cost;
                                     bestErr = e;
                                     best = k;
                                 }
                             }
-                            else if (e < fallbackErr)
+                            else if (e < fallbackErr || (e == fallbackErr && k < fallback))
                             {
                                 fallbackErr = e;
                                 fallback = k;
                             }
+                        };
+                        if (w > 0.0f)
+                        {
+                            if (assign[i] != NONE)
+                                consider(assign[i]);
+                            grid.visit(leaf.centre, [&](float distance) { return best == NONE || w * distance <= bestCost; },
+                                       [&](std::uint32_t k) {
+                                           if (k != assign[i])
+                                               consider(k);
+                                       });
                         }
+                        else
+                            for (std::uint32_t k = 0; k < C; ++k)
+                                consider(k);
                         next[i] = best != NONE ? best : fallback;
                         error[i] = best != NONE ? bestErr : fallbackErr;
                     }

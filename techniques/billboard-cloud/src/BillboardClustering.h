@@ -28,6 +28,12 @@
 //     the cloud lost a quarter of the foliage's coverage from oblique views (coverage ratio 0.75
 //     at 20k leaves); grouping leaves that face their plane brings it to 0.95.
 //
+// The assignment visits only the clusters that can win: a cluster's cost is at least
+// spatialWeight x the distance to its centroid, so the centroids are put in a grid and a leaf
+// looks at the cells around it, nearest shells first, its previous cluster before them, until no
+// cell is within its best cost (the same choice as a scan of every cluster, which spatialWeight 0
+// still does).
+//
 // Deterministic for any thread count: per-leaf work in parallel, reductions per cluster in leaf
 // order, ties to the lower index.
 #pragma once

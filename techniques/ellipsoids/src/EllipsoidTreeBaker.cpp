@@ -33,6 +33,7 @@ namespace TreeLod
         constexpr std::uint32_t EM_CANDIDATES = 12;
         constexpr std::uint32_t EM_MAX_ITERATIONS = 100;
         constexpr double EM_TOLERANCE = 1e-5;
+        constexpr std::uint32_t EM_CANDIDATE_REFRESH = 8;
         /// Calibration factors (§3.1): a coarse grid, extended by its step while the best is at
         /// an end (within [MIN_SCALE, MAX_SCALE]), then +-REFINE around the best.
         constexpr std::array<float, 5> COARSE_SCALES = {0.6f, 0.8f, 1.0f, 1.2f, 1.4f};
@@ -57,6 +58,8 @@ namespace TreeLod
         {
             if (o.tries < 1 || o.tries > 16)
                 return fail(label, "ellipsoids option tries", std::to_string(o.tries) + " is outside [1, 16]");
+            if (o.triedClusters < 1)
+                return fail(label, "ellipsoids option triedClusters", "0 is below 1");
             if (o.clustersDivisor < 2 || o.clustersDivisor > 64)
                 return fail(label, "ellipsoids option clustersDivisor",
                             std::to_string(o.clustersDivisor) + " is outside [2, 64]");
@@ -338,6 +341,13 @@ namespace TreeLod
                     level.colours.push_back(colours[j]);
                 }
             return level;
+        }
+
+        /// EM runs of a level of k clusters (Alg. 1's t): `tries` up to triedClusters, one above, and
+        /// one for one cluster (every start ends alike).
+        std::uint32_t levelTries(std::uint32_t k, const EllipsoidTreeOptions& options)
+        {
+            return k == 1 ? 1 : (k <= options.triedClusters ? options.tries : 1);
         }
 
         struct Calibrated
@@ -661,9 +671,10 @@ namespace TreeLod
                 em.tolerance = EM_TOLERANCE;
                 em.candidates = EM_CANDIDATES;
                 em.covarianceFloor = COVARIANCE_FLOOR;
+                em.candidateRefresh = EM_CANDIDATE_REFRESH;
                 const double side = 0.5 / std::cbrt(double(k)); // a start's spread: k of them fill the box
                 em.initialVariance = side * side;
-                const std::uint32_t tries = k == 1 ? 1 : options.tries; // one cluster: every start ends alike
+                const std::uint32_t tries = levelTries(k, options);
                 WorkLevel best;
                 std::vector<Ellipsoid> bestMetres;
                 double bestError = std::numeric_limits<double>::infinity();

@@ -94,12 +94,13 @@ namespace TreeLod
                         const glm::dvec3 d = mSorted[i] - q;
                         const std::pair<double, std::uint32_t> c(glm::dot(d, d), mOrder[i]);
                         if (out.size() < k)
-                            out.insert(std::upper_bound(out.begin(), out.end(), c), c);
+                            out.push_back(c);
                         else if (c < out.back())
-                        {
-                            out.pop_back();
-                            out.insert(std::upper_bound(out.begin(), out.end(), c), c);
-                        }
+                            out.back() = c;
+                        else
+                            continue;
+                        for (std::size_t m = out.size() - 1; m > 0 && c < out[m - 1]; --m)
+                            std::swap(out[m], out[m - 1]);
                     }
                     return;
                 }
@@ -126,18 +127,32 @@ namespace TreeLod
             double logNorm = 0.0; ///< log pi - 0.5 (log det C + 3 log 2 pi)
         };
 
-        double logSumExp(const double* v, std::size_t n)
+        /// The sparse responsibilities' entries grouped by component (a counting sort), each
+        /// group in point order, with each entry's point.
+        struct EntriesByComponent
         {
-            double top = -std::numeric_limits<double>::infinity();
-            for (std::size_t i = 0; i < n; ++i)
-                top = std::max(top, v[i]);
-            if (!std::isfinite(top))
-                return top;
-            double sum = 0.0;
-            for (std::size_t i = 0; i < n; ++i)
-                sum += std::exp(v[i] - top);
-            return top + std::log(sum);
-        }
+            std::vector<std::uint32_t> start;   ///< K + 1
+            std::vector<std::uint32_t> entries; ///< indices into component / responsibility
+            std::vector<std::uint32_t> point;   ///< per grouped entry, its point
+
+            EntriesByComponent(const std::vector<std::uint32_t>& offsets, const std::vector<std::uint32_t>& component,
+                               std::size_t k)
+                : start(k + 1, 0), entries(component.size()), point(component.size())
+            {
+                for (std::uint32_t j : component)
+                    ++start[j + 1];
+                for (std::size_t j = 0; j < k; ++j)
+                    start[j + 1] += start[j];
+                std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
+                for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
+                    for (std::uint32_t e = offsets[i]; e < offsets[i + 1]; ++e)
+                    {
+                        const std::uint32_t m = next[component[e]]++;
+                        entries[m] = e;
+                        point[m] = std::uint32_t(i);
+                    }
+            }
+        };
     }
 
     GaussianMixtureResult fitGaussianMixture(const GaussianMixtureInput& input,
@@ -189,7 +204,10 @@ namespace TreeLod
             }
 
             // E-step, per point (parallel; each point writes only its own entries).
-            const KdTree tree(out.means);
+            // The nearest components: on the first iteration, after a re-seed and every
+            // candidateRefresh iterations; otherwise the points keep the previous ones.
+            const bool search = c < k && (it == 0 || reseededLast || it % std::max(options.candidateRefresh, 1u) == 0);
+            const KdTree tree(search ? out.means : std::vector<glm::dvec3>{});
             tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const tbb::blocked_range<std::size_t>& range) {
                 std::vector<std::pair<double, std::uint32_t>> near;
                 std::vector<double> logP(c);
@@ -199,7 +217,7 @@ namespace TreeLod
                     std::uint32_t* comp = out.component.data() + out.offsets[i];
                     if (c == k)
                         std::iota(comp, comp + c, 0u);
-                    else
+                    else if (search)
                     {
                         tree.nearest(x, c, near);
                         for (std::uint32_t m = 0; m < c; ++m)
@@ -211,11 +229,19 @@ namespace TreeLod
                         const glm::dvec3 d = x - out.means[comp[m]];
                         logP[m] = components[comp[m]].logNorm - 0.5 * glm::dot(d, components[comp[m]].precision * d);
                     }
-                    const double lse = logSumExp(logP.data(), c);
+                    // LSE = top + log sum exp(logP - top); r = exp(logP - top) / that sum.
+                    double top = -std::numeric_limits<double>::infinity();
+                    for (std::uint32_t m = 0; m < c; ++m)
+                        top = std::max(top, logP[m]);
                     double* r = out.responsibility.data() + out.offsets[i];
+                    double sum = 0.0;
+                    if (std::isfinite(top))
+                        for (std::uint32_t m = 0; m < c; ++m)
+                            sum += (r[m] = std::exp(logP[m] - top));
+                    const double lse = std::isfinite(top) ? top + std::log(sum) : top;
                     if (std::isfinite(lse))
                         for (std::uint32_t m = 0; m < c; ++m)
-                            r[m] = std::exp(logP[m] - lse);
+                            r[m] /= sum;
                     else // unreachable with finite inputs; keep the point whole on its nearest candidate
                         for (std::uint32_t m = 0; m < c; ++m)
                             r[m] = m == 0 ? 1.0 : 0.0;
@@ -238,36 +264,40 @@ namespace TreeLod
             if (it + 1 >= options.maxIterations)
                 break; // the responsibilities stay those of the parameters returned
 
-            // M-step, serial in point order (the same sums for any thread count).
-            std::vector<glm::dvec3> sums(k, glm::dvec3(0.0));
-            std::fill(out.mass.begin(), out.mass.end(), 0.0);
-            for (std::size_t i = 0; i < n; ++i)
-                for (std::uint32_t e = out.offsets[i]; e < out.offsets[i + 1]; ++e)
+            // M-step, per component in parallel; each component's sums run over its entries in
+            // point order, as a serial pass over the points would add them (the same bits for any
+            // thread count).
+            const EntriesByComponent byComponent(out.offsets, out.component, k);
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, k, 64), [&](const tbb::blocked_range<std::size_t>& range) {
+                for (std::size_t j = range.begin(); j != range.end(); ++j)
                 {
-                    const double w = weights[i] * out.responsibility[e];
-                    out.mass[out.component[e]] += w;
-                    sums[out.component[e]] += w * input.points[i];
+                    double mass = 0.0;
+                    glm::dvec3 sum(0.0);
+                    for (std::uint32_t m = byComponent.start[j]; m < byComponent.start[j + 1]; ++m)
+                    {
+                        const std::uint32_t e = byComponent.entries[m];
+                        const double w = weights[byComponent.point[m]] * out.responsibility[e];
+                        mass += w;
+                        sum += w * input.points[byComponent.point[m]];
+                    }
+                    out.mass[j] = mass;
+                    if (mass > 0.0)
+                        out.means[j] = sum / mass;
+                    glm::dmat3 scatter(0.0);
+                    for (std::uint32_t m = byComponent.start[j]; m < byComponent.start[j + 1]; ++m)
+                    {
+                        const std::uint32_t e = byComponent.entries[m], i = byComponent.point[m];
+                        const double w = weights[i] * out.responsibility[e];
+                        const glm::dvec3 d = input.points[i] - out.means[j];
+                        scatter += w * glm::outerProduct(d, d);
+                        if (hasSpreads)
+                            scatter += w * input.spreads[i];
+                    }
+                    if (mass > 0.0)
+                        out.covariances[j] = scatter / mass + glm::dmat3(floor);
+                    out.mixing[j] = mass / std::max(totalWeight, 1e-300);
                 }
-            std::vector<glm::dmat3> scatter(k, glm::dmat3(0.0));
-            for (std::size_t j = 0; j < k; ++j)
-                if (out.mass[j] > 0.0)
-                    out.means[j] = sums[j] / out.mass[j];
-            for (std::size_t i = 0; i < n; ++i)
-                for (std::uint32_t e = out.offsets[i]; e < out.offsets[i + 1]; ++e)
-                {
-                    const double w = weights[i] * out.responsibility[e];
-                    const std::uint32_t j = out.component[e];
-                    const glm::dvec3 d = input.points[i] - out.means[j];
-                    scatter[j] += w * glm::outerProduct(d, d);
-                    if (hasSpreads)
-                        scatter[j] += w * input.spreads[i];
-                }
-            for (std::size_t j = 0; j < k; ++j)
-            {
-                if (out.mass[j] > 0.0)
-                    out.covariances[j] = scatter[j] / out.mass[j] + glm::dmat3(floor);
-                out.mixing[j] = out.mass[j] / std::max(totalWeight, 1e-300);
-            }
+            });
 
             // Re-seed empty components and ones on an earlier component's mean.
             reseededLast = false;
@@ -301,12 +331,14 @@ namespace TreeLod
             if (!kept.empty())
             {
                 const KdTree keptTree(kept);
-                std::vector<std::pair<double, std::uint32_t>> near;
-                for (std::size_t i = 0; i < n; ++i)
-                {
-                    keptTree.nearest(input.points[i], 1, near);
-                    distance[i] = near[0].first;
-                }
+                tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+                    std::vector<std::pair<double, std::uint32_t>> near;
+                    for (std::size_t i = range.begin(); i != range.end(); ++i)
+                    {
+                        keptTree.nearest(input.points[i], 1, near);
+                        distance[i] = near[0].first;
+                    }
+                });
             }
             for (std::size_t j = 0; j < k; ++j)
             {

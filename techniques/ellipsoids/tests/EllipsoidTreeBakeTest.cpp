@@ -298,6 +298,63 @@ namespace TreeLod
             }
         }
 
+        // With candidateRefresh 8 the candidates are searched on iterations 0 and 8 only: after 8
+        // iterations every point still holds the 8 nearest of the starts (the means have moved),
+        // after 9 the 8 nearest of the means returned.
+        TEST(EllipsoidTreeBake, candidatesAreSearchedEveryRefresh)
+        {
+            std::uint64_t state = 5;
+            const auto next = [&state] {
+                state = state * 6364136223846793005ull + 1442695040888963407ull;
+                return double(state >> 11) / 9007199254740992.0;
+            };
+            std::vector<glm::dvec3> starts(300);
+            for (glm::dvec3& m : starts)
+                m = glm::dvec3(next(), next(), next()) * 6.0;
+            GaussianMixtureInput input;
+            for (int i = 0; i < 3000; ++i)
+                input.points.push_back(glm::dvec3(next(), next(), next()) * 6.0);
+            const auto nearest = [](const std::vector<glm::dvec3>& means, const glm::dvec3& p) {
+                std::vector<std::pair<double, std::uint32_t>> all;
+                for (std::uint32_t j = 0; j < means.size(); ++j)
+                    all.emplace_back(glm::dot(means[j] - p, means[j] - p), j);
+                std::partial_sort(all.begin(), all.begin() + 8, all.end());
+                std::vector<std::uint32_t> out;
+                for (int m = 0; m < 8; ++m)
+                    out.push_back(all[std::size_t(m)].second);
+                std::sort(out.begin(), out.end());
+                return out;
+            };
+            GaussianMixtureOptions options;
+            options.candidates = 8;
+            options.candidateRefresh = 8;
+            options.maxReseedRounds = 0;
+            options.tolerance = 0.0;
+            for (const std::uint32_t iterations : {8u, 9u})
+            {
+                options.maxIterations = iterations;
+                const GaussianMixtureResult r = fitGaussianMixture(input, starts, options);
+                ASSERT_EQ(r.iterations, iterations);
+                ASSERT_NE(r.means, starts);
+                int fromStarts = 0, fromMeans = 0;
+                for (std::size_t i = 0; i < input.points.size(); ++i)
+                {
+                    const std::vector<std::uint32_t> taken(r.component.begin() + r.offsets[i],
+                                                           r.component.begin() + r.offsets[i + 1]);
+                    fromStarts += taken == nearest(starts, input.points[i]);
+                    fromMeans += taken == nearest(r.means, input.points[i]);
+                }
+                const int all = int(input.points.size());
+                if (iterations == 8)
+                {
+                    EXPECT_EQ(fromStarts, all);
+                    EXPECT_LT(fromMeans, all); // the means moved: some points' nearest changed
+                }
+                else
+                    EXPECT_EQ(fromMeans, all);
+            }
+        }
+
         // 256 leaves, divisor 4: targets 64, 16, 4, 1 after the 256 leaves (dropping may only lower
         // them); divisor 8: 32, 4, 1 (the division stops at 4, one ellipsoid is added).
         TEST(EllipsoidTreeBake, levelCountsFollowTheDivisor)

@@ -14,6 +14,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <array>
@@ -792,6 +793,8 @@ namespace TreeLod
             // fixed point.
             const bool converged = mse - next <= options.tolerance * mse;
             mse = next;
+            if (options.progress)
+                options.progress(float(iteration) / float(options.maxIterations));
             if (converged)
                 break;
         }
@@ -905,7 +908,7 @@ namespace TreeLod
     }
 
     QuantisedBillboards quantiseBillboards(const std::vector<BillboardTexture>& billboards,
-                                           const BillboardQuantisationOptions& options)
+                                           const BillboardQuantisationOptions& options, const ProgressCallback& progress)
     {
         const std::size_t n = billboards.size();
         std::vector<float> colour(n * COLOUR_DIM), alpha(n * BILLBOARD_TEXELS);
@@ -926,11 +929,19 @@ namespace TreeLod
         gla.nearestInput = options.nearestInput;
         gla.seed = options.seed;
         gla.maxTrainingVectors = options.maxTrainingVectors;
-        gla.codebookSize = options.colourCodebookSize;
-        GlaResult colourGla = runGla(colour, COLOUR_DIM, gla);
-        colour = {};
-        gla.codebookSize = options.alphaCodebookSize;
-        GlaResult alphaGla = runGla(alpha, BILLBOARD_TEXELS, gla);
+        // The two codebooks at once (each GLA is deterministic alone); the colour one, the
+        // longer, reports progress.
+        GlaOptions colourOptions = gla, alphaOptions = gla;
+        colourOptions.codebookSize = options.colourCodebookSize;
+        colourOptions.progress = [&](float fraction) { report(progress, "vector quantisation", fraction); };
+        alphaOptions.codebookSize = options.alphaCodebookSize;
+        GlaResult colourGla, alphaGla;
+        tbb::parallel_invoke(
+            [&] {
+                colourGla = runGla(colour, COLOUR_DIM, colourOptions);
+                colour = {};
+            },
+            [&] { alphaGla = runGla(alpha, BILLBOARD_TEXELS, alphaOptions); });
 
         QuantisedBillboards q;
         for (std::uint32_t j = 0; j < colourGla.codebookSize(); ++j)

@@ -43,11 +43,13 @@ namespace TreeLod
             bakeOptionNumber(given, chunk, "alphaCodebookSize", q.alphaCodebookSize, 1, 16384, label);
         Result<double> prune = bakeOptionNumber(given, chunk, "pruneAlpha", options.pruneAlpha, 1e-3, 1.0, label);
         Result<double> seed = bakeOptionNumber(given, chunk, "seed", double(q.seed), 0, 4294967295.0, label);
+        Result<double> training = bakeOptionNumber(given, chunk, "trainingBillboards", double(q.maxTrainingVectors), 0,
+                                                   4294967295.0, label);
         Result<bool> compress = bakeOptionFlag(given, chunk, "compress", options.compress, label);
         Result<bool> lab = bakeOptionFlag(given, chunk, "lab", q.space == QuantisationSpace::Lab, label);
         Result<bool> modified = bakeOptionFlag(given, chunk, "modifiedGla", q.nearestInput, label);
         for (const Result<double>* r : {&levels, &tomography, &cameras, &resolution, &samples, &colours, &alphas, &prune,
-                                        &seed})
+                                        &seed, &training})
             if (!*r)
                 return r->error();
         for (const Result<bool>* r : {&compress, &lab, &modified})
@@ -60,7 +62,8 @@ namespace TreeLod
                                           {"samplesPerPixel", samples.value()},
                                           {"codebookSize", colours.value()},
                                           {"alphaCodebookSize", alphas.value()},
-                                          {"seed", seed.value()}})
+                                          {"seed", seed.value()},
+                                          {"trainingBillboards", training.value()}})
             if (value != std::floor(value))
                 return fail(label, std::string("option '") + chunk + "." + name + "'",
                             std::to_string(value) + " is not a whole number");
@@ -72,6 +75,7 @@ namespace TreeLod
         q.colourCodebookSize = std::uint32_t(colours.value());
         q.alphaCodebookSize = std::uint32_t(alphas.value());
         q.seed = std::uint64_t(seed.value());
+        q.maxTrainingVectors = std::size_t(training.value());
         q.space = lab.value() ? QuantisationSpace::Lab : QuantisationSpace::Rgb;
         q.nearestInput = modified.value();
         options.pruneAlpha = float(prune.value());
@@ -121,6 +125,10 @@ namespace TreeLod
               {"alphaCodebookSize", "alpha codewords, 1 to 16384", "512"},
               {"pruneAlpha", "accumulated alpha in front that hides a billboard, (0, 1]", "0.95"},
               {"seed", "seed of the codebook's initial codewords, 0 to 4294967295", "1"},
+              {"trainingBillboards",
+               "billboards the codebooks are trained on (an even stride through all; every billboard still gets its "
+               "nearest codeword), 0 (all) to 4294967295",
+               std::to_string(BillboardQuantisationOptions{}.maxTrainingVectors)},
               {"compress", "DXT5 codebook atlas (true) or RGBA8", "true"},
               {"lab", "quantise colour in CIELab (true) or RGB", "true"},
               {"modifiedGla", "replace each codeword by its nearest training billboard (true) or keep the mean",

@@ -597,7 +597,10 @@ namespace TreeLod
         if (reconstruction.billboards.empty())
             return fail(label, CHUNK, "no billboard survived the pruning: nothing to draw");
         report(progress, "volume octree: vector quantisation", 0.0f);
-        const QuantisedBillboards q = quantiseBillboards(reconstruction.billboards, options.quantisation);
+        const QuantisedBillboards q =
+            quantiseBillboards(reconstruction.billboards, options.quantisation, [&](const std::string&, float fraction) {
+                report(progress, "volume octree: vector quantisation", fraction);
+            });
         report(progress, "volume octree: vector quantisation", 1.0f);
 
         VolumeOctreeData data = reconstruction.octree;

@@ -7,8 +7,9 @@
 //      over the leaf's triangles, PCA (eigenvectors = axes, semi-axis = 2 sqrt(eigenvalue)); the
 //      smallest semi-axes are floored at 2 % of the largest, so a flat leaf is a thin disc.
 //   2. Levels (Alg. 1): K = floor(|L| / clustersDivisor), then / clustersDivisor per level while
-//      K >= 1. Per level, `tries` runs of EM/GMM (GaussianMixture.h) over the leaf centres,
-//      weighted by leaf area, from random starts in the box of the centres; each component's
+//      K >= 1. Per level, `tries` runs of EM/GMM (GaussianMixture.h) over the leaf centres (one
+//      run where K > triedClusters, see below), weighted by leaf area, from random starts in the box of the
+//      centres; each component's
 //      ellipsoid is the weighted PCA of its leaves' points with the fuzzy memberships w_ij as
 //      weights (Fig. 5): covariance = sum_i w_ij a_i (S_i + (c_i - m_j)(c_i - m_j)^T) / sum_i w_ij a_i,
 //      so a cluster covers its leaves' extent, not only the spread of their centres. Ellipsoids
@@ -37,8 +38,12 @@
 //     uniform distribution over its triangles (the limit of infinitely many samples): no sampling
 //     noise, no seed needed, and O(triangles).
 //   - The EM input carries each leaf's covariance and is truncated to the 12 nearest components
-//     per point (GaussianMixture.h): the paper needs 0.9 s per leaf, a 24k-leaf tree must bake in
-//     about a minute here.
+//     per point, searched every 8 iterations (GaussianMixture.h): the paper needs 0.9 s per leaf,
+//     a 20k-leaf tree must bake in seconds here.
+//   - One EM run instead of t on levels of more than triedClusters (12) clusters (Alg. 1 runs t
+//     on every level):
+//     there the runs' image errors differ little and the best of 4 did not pay for its time
+//     (techniques/ellipsoids/README.md); the tries stay where the clusters are few.
 //   - Every level clusters the leaves (as Alg. 1), but a last level of one ellipsoid is added when
 //     the division stops above one (fewer than clustersDivisor^2 leaves, e.g. 2 or 3 leaves).
 //   - Leaves of zero area are left out (they cannot be seen).
@@ -70,7 +75,8 @@ namespace TreeLod
 {
     struct EllipsoidTreeOptions
     {
-        std::uint32_t tries = 4;           ///< EM runs per level, 1 to 16 (the paper's t)
+        std::uint32_t tries = 4;           ///< EM runs per level of at most triedClusters clusters, 1 to 16 (the paper's t)
+        std::uint32_t triedClusters = 12;  ///< >= 1: larger levels get one EM run
         std::uint64_t seed = 1;            ///< of the EM starts
         std::uint32_t clustersDivisor = 4; ///< 2 to 64: each level has 1 / this of the previous' target
         float minAreaShare = 0.01f;        ///< in [0, 0.5]: smaller ellipsoids (surface area) dropped

@@ -16,15 +16,17 @@
 //   - Truncated E-step: a point is only given to its `candidates` nearest components (by distance
 //     to the means, a k-d tree); the rest get responsibility 0. Exact when K <= candidates; for
 //     thousands of clusters it makes an iteration O(N log K) instead of O(N K) (the paper spends
-//     0.9 s per leaf; we need a 24k-leaf tree in a minute).
+//     0.9 s per leaf; we need a 24k-leaf tree in a minute). The candidates are searched every
+//     candidateRefresh iterations (and after a re-seed); in between, EM runs on fixed candidate
+//     sets, which still never lowers the likelihood.
 //   - S_i in the covariance (see above) and a covariance floor: clusters of coplanar or colinear
 //     leaves are normal in trees and must not make C_c singular.
 //   - A component that holds (nearly) no weight, or sits on the same mean as an earlier one (all
 //     starts at one point), is re-seeded at the worst-explained point: the one farthest from
 //     every kept mean and every earlier re-seed of the round (farthest-point seeding, so that
 //     re-seeds spread out), at most maxReseedRounds rounds.
-// Deterministic for given inputs and any TBB thread count: the E-step is per point, every sum is
-// taken serially in point order.
+// Deterministic for given inputs and any TBB thread count: the E-step is per point; the M-step
+// is per component, each component's sums taken over its points in point order.
 #pragma once
 
 #include <glm/glm.hpp>
@@ -39,6 +41,9 @@ namespace TreeLod
         std::uint32_t maxIterations = 100;
         double tolerance = 1e-5;           ///< on the weighted mean log-likelihood per point
         std::uint32_t candidates = 12;     ///< components considered per point (>= 1)
+        /// Iterations between searches for each point's nearest components (>= 1; 1: every
+        /// iteration). In between the points keep their candidates.
+        std::uint32_t candidateRefresh = 1;
         double covarianceFloor = 1e-6;     ///< added to every covariance's diagonal, > 0 (units^2)
         double initialVariance = 1e-2;     ///< isotropic covariance of a start or re-seeded component
         std::uint32_t maxReseedRounds = 10;

@@ -27,7 +27,10 @@
 // a fixed order).
 #pragma once
 
+#include "TreeLod/Progress.h"
+
 #include <array>
+#include <functional>
 #include <cstdint>
 #include <vector>
 
@@ -58,6 +61,8 @@ namespace TreeLod
         /// > 0: train on an evenly strided subset of this many vectors (vector i * count / limit),
         /// then give every vector its nearest codeword; 0: train on all.
         std::size_t maxTrainingVectors = 0;
+        /// Called after every GLA iteration with the share of maxIterations done; may be empty.
+        std::function<void(float)> progress;
     };
 
     struct GlaResult
@@ -113,7 +118,8 @@ namespace TreeLod
     /// Quantise `billboards` (§4.1): fillTransparentTexels on a copy of each, colour GLA in
     /// options.space, alpha GLA on the 16 alpha bytes. Deterministic.
     QuantisedBillboards quantiseBillboards(const std::vector<BillboardTexture>& billboards,
-                                           const BillboardQuantisationOptions& options);
+                                           const BillboardQuantisationOptions& options,
+                                           const ProgressCallback& progress = {});
 
     /// Billboard i as the quantisation gives it back: colourCodebook[colourIndex[i]]'s colour with
     /// alphaCodebook[alphaIndex[i]]'s alpha.
