@@ -347,8 +347,9 @@ namespace TreeLod
                                 row["frameMs"] = timing.frameMilliseconds;
                                 row["batches"] = timing.batches;
                                 row["triangles"] = timing.triangles;
-                                row["gpuBytes"] = scene->getGpuBytes();
-                                peakGpuBytes = std::max(peakGpuBytes, scene->getGpuBytes());
+                                const std::uint64_t gpuBytes = scene->getGpuBytes(); // walks every part
+                                row["gpuBytes"] = gpuBytes;
+                                peakGpuBytes = std::max(peakGpuBytes, gpuBytes);
                                 if (!baseline)
                                 {
                                     row["visible"] = stats.visibleInstances;
