@@ -246,9 +246,6 @@ namespace TreeLod
         stats.emplace_back("Triangles (frame)", formatCount(mCamera->_getNumRenderedFaces()));
         stats.emplace_back("Forest draws", std::to_string(s.batches));
         stats.emplace_back("GPU memory", formatBytes(mScene->getGpuBytes()));
-        if (s.plannedGpuBytes > 0)
-            stats.emplace_back("Auto's levels", formatBytes(s.plannedGpuBytes) + " (" +
-                                                    toString(mScene->getForest().getBindingBudget()) + " budget binds)");
         stats.emplace_back("Cull + LoD", cull);
         if (s.pendingLevels > 0 || s.fallbackInstances > 0)
             stats.emplace_back("Levels uploading", std::to_string(s.pendingLevels) + " (" +
