@@ -8,11 +8,15 @@
 #include "TreeLodShaderSupport.glsl"
 #include "TreeLodTransition.glsl"
 // Shadow caster: passes clip-space z and w on; the fragment stage writes depth in 0..1.
-// INSTANCED: placed by the Forest's instance data first (TreeLodInstance.glsl).
+// INSTANCED: placed by the Forest's instance data first (TreeLodInstance.glsl). Moved by the wind
+// as the lit programs move the tree (TreeLodWind.glsl).
 uniform mat4 worldViewProj;
+uniform mat4 world;
+uniform mat4 inverseWorld;
 #ifdef INSTANCED
 #include "TreeLodInstance.glsl"
 #endif
+#include "TreeLodWind.glsl"
 
 MAIN_PARAMETERS
     IN(vec4 vertex, POSITION)
@@ -31,9 +35,10 @@ MAIN_DECLARATION
     vTransition = NO_TRANSITION;
 #endif
 #ifdef INSTANCED
-    gl_Position = mul(worldViewProj, instancePosition(uv4, uv5, vertex));
+    vec4 rest = vec4(vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld), 1.0);
+    gl_Position = mul(worldViewProj, instancePosition(uv4, uv5, rest));
 #else
-    gl_Position = mul(worldViewProj, vertex);
+    gl_Position = mul(worldViewProj, vec4(vertex.xyz + windObjectOffset(vertex.xyz, world, inverseWorld), 1.0));
 #endif
     vClipZW = gl_Position.zw;
     vUv = uv0;

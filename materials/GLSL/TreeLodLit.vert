@@ -10,9 +10,10 @@
 // Lit tree surfaces (bark and leaves): world-space normal and UV to the fragment stage;
 // SHADOW_RECEIVER: also the position in the sun's shadow texture. AO: the vertex colour's red
 // channel (ambient occlusion) to the fragment stage. INSTANCED: placed by the Forest's
-// instance data first (TreeLodInstance.glsl).
+// instance data first (TreeLodInstance.glsl). Every vertex moves with the wind (TreeLodWind.glsl).
 uniform mat4 worldViewProj;
 uniform mat4 world;
+uniform mat4 inverseWorld;
 uniform mat4 normalMatrix;
 uniform vec4 cameraPosition;
 #ifdef SHADOW_RECEIVER
@@ -21,6 +22,7 @@ uniform vec4 cameraPosition;
 #ifdef INSTANCED
 #include "TreeLodInstance.glsl"
 #endif
+#include "TreeLodWind.glsl"
 
 MAIN_PARAMETERS
     IN(vec4 vertex, POSITION)
@@ -50,10 +52,11 @@ MAIN_DECLARATION
     vTransition = NO_TRANSITION;
 #endif
 #ifdef INSTANCED
-    vec4 position = instancePosition(uv4, uv5, vertex);
+    vec4 rest = vec4(vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld), 1.0);
+    vec4 position = instancePosition(uv4, uv5, rest);
     vec3 objectNormal = instanceDirection(uv5, normal);
 #else
-    vec4 position = vertex;
+    vec4 position = vec4(vertex.xyz + windObjectOffset(vertex.xyz, world, inverseWorld), 1.0);
     vec3 objectNormal = normal;
 #endif
     gl_Position = mul(worldViewProj, position);

@@ -30,6 +30,7 @@
 #include "TreeLod/ForestScene.h"
 #include "TreeLod/LevelCalibration.h"
 #include "TreeLod/OffscreenRenderer.h"
+#include "TreeLod/Wind.h"
 #include "TreeLod/PackageListBaker.h"
 #include "TreeLod/ProcessMemory.h"
 #include "TreeLod/SceneScript.h"
@@ -195,7 +196,13 @@ namespace TreeLod
             // temporal noise does not depend on how much the bench thins the path out.
             const double nativeStep =
                 script.frames > 1 ? frameTime(script, 1, script.frames) - frameTime(script, 0, script.frames) : 0.0;
-            auto nextCamera = [&](std::uint32_t f) { return cameraAt(script, frameTime(script, f, frames) + nativeStep); };
+            // The camera at path time t, with the wind's clock set to t: the reference and every
+            // technique see the same wind in the same frame.
+            auto frameAt = [&](double t) {
+                Wind::setTime(t);
+                return cameraAt(script, t);
+            };
+            auto nextCamera = [&](std::uint32_t f) { return frameAt(frameTime(script, f, frames) + nativeStep); };
             auto save = [&](const RgbaImage& image, const std::string& stem) {
                 OffscreenRenderer::savePng(image, args.output + "/images/" + stem + ".png");
             };
@@ -320,7 +327,7 @@ namespace TreeLod
                         // become resident during the timed frames, within the upload budget (worst frame).
                         renderer.setLodBias(bias);
                         for (std::uint32_t w = 0; w < std::min<std::uint32_t>(frames, 4); ++w)
-                            renderer.renderTimedFrame(scene->cameraAtFrame(w * (frames - 1) / 3, frames), width, height);
+                            renderer.renderTimedFrame(frameAt(frameTime(script, w * (frames - 1) / 3, frames)), width, height);
                         json run = {{"trees", trees}, {"technique", technique}, {"lodBias", bias},
                                     {"buildSeconds", buildSeconds}};
                         json frameRows = json::array();
@@ -330,8 +337,9 @@ namespace TreeLod
                         for (std::uint32_t f = 0; f < frames; ++f)
                         {
                             progress(label, float(f) / float(frames));
-                            json row = {{"frame", f}, {"time", frameTime(script, f, frames)}};
-                            const CameraSpec camera = scene->cameraAtFrame(f, frames);
+                            const double time = frameTime(script, f, frames);
+                            json row = {{"frame", f}, {"time", time}};
+                            const CameraSpec camera = frameAt(time);
                             std::uint64_t referenceCost = 0;
                             if (technique == REFERENCE_TECHNIQUE)
                                 referenceCost = referenceTriangles(*scene, camera, width, height);
@@ -375,7 +383,7 @@ namespace TreeLod
                                 {
                                     if (double(referenceCost) <= imageBudget)
                                     {
-                                        save(renderer.render(camera, width, height, 2), stem + "-ref");
+                                        save(renderer.render(frameAt(time), width, height, 2), stem + "-ref");
                                         save(renderer.render(nextCamera(f), width, height, 2), stem + "-ref-next");
                                         row["referenceImage"] = stem + "-ref";
                                     }
@@ -387,7 +395,7 @@ namespace TreeLod
                                 }
                                 if (technique != REFERENCE_TECHNIQUE || double(referenceCost) <= imageBudget)
                                 {
-                                    save(renderer.render(camera, width, height, 1), stem);
+                                    save(renderer.render(frameAt(time), width, height, 1), stem);
                                     save(renderer.render(nextCamera(f), width, height, 1), stem + "-next");
                                     row["image"] = stem;
                                 }
@@ -408,19 +416,19 @@ namespace TreeLod
                                 const double t = frameTime(script, f, frames);
                                 if (!row.contains("frameMs") || t + nativeStep > pathEnd + 1e-6)
                                     continue; // not drawn (over the reference budget), or no next frame
-                                renderer.render(cameraAt(script, t - nativeStep), width, height, 1);
+                                renderer.render(frameAt(t - nativeStep), width, height, 1);
                                 const std::string stem = imageStem(trees, technique, bias, f) + "-motion";
-                                save(renderer.render(cameraAt(script, t), width, height, 1), stem);
+                                save(renderer.render(frameAt(t), width, height, 1), stem);
                                 if (!baseline)
                                 {
                                     // The next frame with the levels held (the LoD camera of this
                                     // one): what it would show without the switches.
                                     scene->getForest().setLodFrozen(true);
-                                    save(renderer.render(cameraAt(script, t + nativeStep), width, height, 1), stem + "-held");
+                                    save(renderer.render(frameAt(t + nativeStep), width, height, 1), stem + "-held");
                                     scene->getForest().setLodFrozen(false);
                                     row["motionHeld"] = true;
                                 }
-                                save(renderer.render(cameraAt(script, t + nativeStep), width, height, 1), stem + "-next");
+                                save(renderer.render(frameAt(t + nativeStep), width, height, 1), stem + "-next");
                                 row["motionImage"] = stem;
                                 if (!baseline)
                                 {

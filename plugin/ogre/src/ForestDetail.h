@@ -233,7 +233,8 @@ namespace TreeLod
         }
 
         /// The INSTANCED variant of vertex program `plain`: "<name>/Instanced", same source and
-        /// entry point and target, defines + INSTANCED=1, made once in the plain program's group. A unified program
+        /// entry point and target, defines + INSTANCED=1, the same default and shared parameters, made once
+        /// in the plain program's group. A unified program
         /// (materials/TreeLod.program) is varied through the delegate the render system chose.
         inline Ogre::String instancedProgram(const Ogre::GpuProgramPtr& plain)
         {
@@ -260,7 +261,12 @@ namespace TreeLod
             program->setParameter("preprocessor_defines", defines.empty() ? "INSTANCED=1" : defines + ",INSTANCED=1");
             program->load();
             if (plain->hasDefaultParameters() && program->isSupported())
-                program->getDefaultParameters()->copyMatchingNamedConstantsFrom(*plain->getDefaultParameters());
+            {
+                const Ogre::GpuProgramParametersSharedPtr& defaults = plain->getDefaultParameters();
+                program->getDefaultParameters()->copyMatchingNamedConstantsFrom(*defaults);
+                for (const Ogre::GpuSharedParametersUsage& shared : defaults->getSharedParameters())
+                    program->getDefaultParameters()->addSharedParameters(shared.getName());
+            }
             return name;
         }
     }

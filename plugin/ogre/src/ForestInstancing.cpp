@@ -1,6 +1,7 @@
 // The Forest's instancing: a level's parts built through its provider (PartBuilder), and the
 // instanced variants of their materials (per-instance uv4/uv5, Forest.h "Materials").
 #include "ForestDetail.h"
+#include "TreeLod/Wind.h"
 
 namespace TreeLod
 {
@@ -92,6 +93,8 @@ namespace TreeLod
             part->techniqueLod = options.techniqueLod;
             part->lengthFactor = options.lengthFactor;
             part->customParameters = options.customParameters;
+            part->customParameters.emplace(WIND_CUSTOM_PARAMETER,
+                                           Ogre::Vector4(Wind::treeHeight(mAsset.getBounds()), 0.0f, 0.0f, 0.0f));
             part->backToFront = options.backToFront;
             if (options.instancedMaterial)
             {

@@ -5,8 +5,10 @@
 #include "TreeLod/Package.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAsset.h"
+#include "TreeLod/Wind.h"
 
 #include <OgreEntity.h>
+#include <OgreSubEntity.h>
 #include <OgreException.h>
 #include <OgreSceneManager.h>
 
@@ -50,7 +52,11 @@ namespace TreeLod
                           Ogre::EntityFactory::FACTORY_TYPE_NAME,
                           [](Ogre::SceneManager& sm, const Ogre::String& name, TreeAsset& asset,
                              const Ogre::NameValuePairList&) {
-                              return static_cast<Ogre::MovableObject*>(sm.createEntity(name, asset.getReferenceMesh()));
+                              Ogre::Entity* entity = sm.createEntity(name, asset.getReferenceMesh());
+                              const Ogre::Real height = Wind::treeHeight(asset.getBounds());
+                              for (Ogre::SubEntity* sub : entity->getSubEntities())
+                                  Wind::setTreeHeight(*sub, height);
+                              return static_cast<Ogre::MovableObject*>(entity);
                           },
                           nullptr, std::make_shared<ReferenceLevels>(),
                           [](Ogre::MovableObject& object) {

@@ -5,6 +5,7 @@
 #include "TreeLod/ShadowSetup.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
+#include "TreeLod/Wind.h"
 
 #include <MeshLodGenerator/OgreMeshLodGenerator.h>
 #include <OgreLodStrategyManager.h>
@@ -17,15 +18,18 @@
 
 namespace TreeLod
 {
-    /// Creates the casters' shared parameters before the first script that may reference them is
-    /// parsed (the render system, which owns the GpuProgramManager, exists by then).
+    /// Creates the shared parameters (the casters', the wind's) before the first script that may
+    /// reference them is parsed (the render system, which owns the GpuProgramManager, exists by then).
     class TreeLodPlugin::ShadowParamsListener : public Ogre::ResourceGroupListener
     {
     public:
         void scriptParseStarted(const Ogre::String&, bool&) override
         {
             if (Ogre::GpuProgramManager::getSingletonPtr())
+            {
                 createShadowParams();
+                Wind::updateSharedParameters();
+            }
         }
     };
 

@@ -5,6 +5,7 @@
 #include "TreeLod/ShadowSetup.h"
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
+#include "TreeLod/Wind.h"
 
 #include <OgreLogManager.h>
 #include <OgreManualObject.h>
@@ -211,6 +212,8 @@ namespace TreeLod
             mSunNode->attachObject(mSun);
         }
         applyLighting(mSceneManager, *mSun, sceneLighting(mScript));
+        Wind::setParameters(mScript.wind); // the scene's (calm by default); its clock is the caller's
+        Wind::setTime(frameTime(mScript, 0));
         try
         {
             if (mOptions.ground)

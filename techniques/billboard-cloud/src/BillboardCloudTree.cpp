@@ -8,6 +8,7 @@
 #include "TreeLod/TreePart.h"
 
 #include "TreeLod/TreeAssetManager.h"
+#include "TreeLod/Wind.h"
 
 #include <OgreCamera.h>
 #include <OgreException.h>
@@ -34,6 +35,7 @@ namespace TreeLod
                        "BillboardCloudTree"),
               mParent(parent), mCloud(cloud)
         {
+            Wind::setTreeHeight(*this, Wind::treeHeight(parent.mAsset->getBounds()));
         }
 
         /// Custom Renderables pick the material LoD technique themselves (§5.1: layers close

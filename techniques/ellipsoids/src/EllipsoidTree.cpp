@@ -7,6 +7,7 @@
 #include "TreeLod/ShadowSetup.h"
 #include "TreeLod/TechniqueSupport.h"
 #include "TreeLod/TreePart.h"
+#include "TreeLod/Wind.h"
 
 #include <OgreCamera.h>
 #include <OgreLodStrategy.h>
@@ -33,6 +34,7 @@ namespace TreeLod
             : TreePart(parent, group, vertexData, material, shadowedMaterial, "EllipsoidTree"),
               mParent(parent)
         {
+            Wind::setTreeHeight(*this, Wind::treeHeight(parent.mAsset->getBounds()));
         }
 
     protected:

@@ -3,6 +3,7 @@
 #include "TreeLod/ObjectParams.h"
 #include "TreeLod/ShadowSetup.h"
 #include "TreeLod/TechniqueSupport.h"
+#include "TreeLod/Wind.h"
 
 #include <OgreException.h>
 #include <OgreMaterialManager.h>
@@ -40,6 +41,7 @@ namespace TreeLod
 
         mBounds = quad.bounds;
         mRadius = Ogre::Math::boundingRadiusFromAABB(mBounds);
+        Wind::setTreeHeight(*this, Wind::treeHeight(asset->getBounds()));
     }
 
     ImpostorTree::~ImpostorTree() = default;

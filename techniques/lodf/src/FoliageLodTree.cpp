@@ -7,6 +7,7 @@
 
 #include "TreeLod/FoliageLodResources.h"
 #include "TreeLod/TreeAssetManager.h"
+#include "TreeLod/Wind.h"
 
 #include <OgreCamera.h>
 #include <OgreException.h>
@@ -32,6 +33,7 @@ namespace TreeLod
             : TreePart(parent, parent.mAsset->getGroup(), vertexData, material, shadowedMaterial, "FoliageLodTree"),
               mParent(parent)
         {
+            Wind::setTreeHeight(*this, Wind::treeHeight(parent.mAsset->getBounds()));
         }
 
     protected:

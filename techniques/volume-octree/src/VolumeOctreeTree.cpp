@@ -6,6 +6,7 @@
 #include "TreeLod/ScreenSizeLodStrategy.h"
 #include "TreeLod/ShadowSetup.h"
 #include "TreeLod/TreePart.h"
+#include "TreeLod/Wind.h"
 
 #include <OgreCamera.h>
 #include <OgreHardwareBufferManager.h>
@@ -27,6 +28,7 @@ namespace TreeLod
              const Ogre::String& material)
             : TreePart(parent, group, vertexData, material, "", "VolumeOctreeTree")
         {
+            Wind::setTreeHeight(*this, Wind::treeHeight(parent.mAsset->getBounds()));
         }
 
     protected:

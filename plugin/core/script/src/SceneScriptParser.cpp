@@ -691,6 +691,26 @@ namespace TreeLod
             return s;
         }
 
+        WindParameters readWind(const Json& j, const std::string& pointer)
+        {
+            allowKeys(j, pointer, {"strength", "direction", "gustiness", "gustWavelength"});
+            WindParameters w;
+            w.strength = float(number(need(j, pointer, "strength"), child(pointer, "strength"), 0.0, 100.0));
+            if (const Json* v = find(j, "direction"))
+            {
+                const std::vector<double> d = numbers(*v, child(pointer, "direction"), 2, -1e9, 1e9);
+                const glm::dvec2 dir(d[0], d[1]);
+                if (!(glm::length(dir) > 0.0))
+                    bad(child(pointer, "direction"), "a zero vector has no direction");
+                w.direction = glm::vec2(dir / glm::length(dir));
+            }
+            if (const Json* v = find(j, "gustiness"))
+                w.gustiness = float(number(*v, child(pointer, "gustiness"), 0.0, 1.0));
+            if (const Json* v = find(j, "gustWavelength"))
+                w.gustWavelength = float(number(*v, child(pointer, "gustWavelength"), 0.0, 1e6, true));
+            return w;
+        }
+
         SceneCamera readCamera(const Json& j, const std::string& pointer)
         {
             allowKeys(j, pointer, {"fovY", "near", "far", "interpolation", "keyframes"});
@@ -739,7 +759,7 @@ namespace TreeLod
         SceneScript readScript(const Json& root, const std::string& baseDir, const GreyImageReader& readImage)
         {
             allowKeys(root, "", {"name", "description", "ground", "species", "placements", "sun", "shadows", "lod",
-                                 "camera", "resolution", "frames", "counts"});
+                                 "wind", "camera", "resolution", "frames", "counts"});
             SceneScript s;
             s.name = text(need(root, "", "name"), "/name");
             if (const Json* v = find(root, "description"))
@@ -786,6 +806,8 @@ namespace TreeLod
                 s.sun = readSun(*v, "/sun");
             if (const Json* v = find(root, "shadows"))
                 s.shadows = readShadows(*v, "/shadows");
+            if (const Json* v = find(root, "wind"))
+                s.wind = readWind(*v, "/wind");
             if (const Json* v = find(root, "lod"))
             {
                 allowKeys(*v, "/lod", {"maxError", "shadowMaxError", "frameBudgetMs", "memoryBudgetMB", "transition"});

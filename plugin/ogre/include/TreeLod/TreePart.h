@@ -1,11 +1,13 @@
 // TreePart: one draw of a tree MovableObject (FoliageLodTree, BillboardCloudTree): a range of
 // an index buffer over shared vertices, or a bark submesh with its MeshLodGenerator levels,
 // drawn with its material or, under integrated texture shadows, the shadow-receiving clone.
-// The owning object says which (useShadowedMaterials) and which bark level (barkLodIndex).
+// The owning object says which (useShadowedMaterials) and which bark level (barkLodIndex), and
+// gives its tree's height to the wind (Wind::setTreeHeight).
 #pragma once
 
 #include "TreeLod/ObjectLodBias.h"
 #include "TreeLod/ObjectTransition.h"
+#include "TreeLod/Wind.h"
 
 #include <OgreMaterialManager.h>
 #include <OgreTechnique.h>
@@ -35,6 +37,7 @@ namespace TreeLod
                 if (*m)
                     (*m)->load();
             ObjectTransition::apply(*this, 0.0f, Ogre::Vector3::ZERO); // the whole tree
+            Wind::setTreeHeight(*this, 0.0f); // still until the owner gives its tree's height
         }
 
         Ogre::IndexData mIndexData;            ///< ranged parts: start and count in a shared buffer

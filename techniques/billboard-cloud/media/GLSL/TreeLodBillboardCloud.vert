@@ -14,8 +14,10 @@
 // camera's view +z, a directional light) instead of the camera.
 // SHADOW_RECEIVER: the position in the sun's shadow texture.
 // INSTANCED: placed by the Forest's instance data first (TreeLodInstance.glsl).
+// Each corner moves with the wind as the mesh's points there do (TreeLodWind.glsl).
 uniform mat4 worldViewProj;
 uniform mat4 world;
+uniform mat4 inverseWorld;
 #ifdef CASTER
 uniform mat4 view;
 #else
@@ -29,6 +31,7 @@ uniform vec4 objectTransition; // custom 7 (TreeLod/ObjectTransition.h)
 #ifdef INSTANCED
 #include "TreeLodInstance.glsl"
 #endif
+#include "TreeLodWind.glsl"
 
 MAIN_PARAMETERS
     IN(vec4 vertex, POSITION)
@@ -61,11 +64,12 @@ MAIN_DECLARATION
     vTransition = objectTransition.xy;
 #endif
 #ifdef INSTANCED
-    vec4 local = instancePosition(uv4, uv5, vertex);
+    vec4 rest = vec4(vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld), 1.0);
+    vec4 local = instancePosition(uv4, uv5, rest);
     vec3 objectNormal = instanceDirection(uv5, normal);
     vec3 objectTangent = instanceDirection(uv5, tangent);
 #else
-    vec4 local = vertex;
+    vec4 local = vec4(vertex.xyz + windObjectOffset(vertex.xyz, world, inverseWorld), 1.0);
     vec3 objectNormal = normal;
     vec3 objectTangent = tangent;
 #endif

@@ -21,6 +21,9 @@
 // colour, alpha = ambient occlusion. Per instance (TreeLodInstance.glsl): uv4, uv5.
 // The noise lod is raised to the pixel footprint's at the centre (EllipsoidNoise.h: the paper
 // (001) §5 limits the noise frequency by the screen-space derivatives; here once per ellipsoid).
+// Wind (TreeLodWind.glsl): each ellipsoid moves rigidly with the mesh's points at its centre.
+uniform mat4 world;
+uniform mat4 inverseWorld;
 uniform mat4 worldView;
 uniform mat4 projection;
 uniform mat4 inverseProjection;
@@ -28,6 +31,7 @@ uniform vec4 viewportSize; // pixels: width, height, 1 / width, 1 / height
 uniform vec4 objectTransition; // custom 7 (TreeLod/ObjectTransition.h)
 
 #include "TreeLodInstance.glsl"
+#include "TreeLodWind.glsl"
 
 STATIC const float NOISE_SIZE = 256.0; // EllipsoidNoise.h: ELLIPSOID_NOISE_SIZE
 STATIC const float NOISE_MAX_LOD = 8.0;
@@ -50,7 +54,8 @@ MAIN_PARAMETERS
 MAIN_DECLARATION
 {
     vTransition = drawTransition(uv4, uv5, objectTransition);
-    vec3 centre = mul(worldView, instancePosition(uv4, uv5, vec4(vertex.xyz, 1.0))).xyz;
+    vec3 rest = vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld);
+    vec3 centre = mul(worldView, instancePosition(uv4, uv5, vec4(rest, 1.0))).xyz;
     mat3 toView = toMat3(worldView);
     vec3 axis0 = mul(toView, instanceDirection(uv5, uv4.w * uv1.xyz));
     vec3 axis1 = mul(toView, instanceDirection(uv5, uv4.w * uv2));

@@ -16,7 +16,10 @@
 // them the pixel's width as a line rasteriser would.
 // Per vertex: vertex = start (tree space, metres), uv0 = corner (x: 0 start, 1 end; y: -1, +1
 // across), uv1 = end xyz and radius, colour = sRGB colour, alpha = ambient occlusion. Per instance
-// (TreeLodInstance.glsl): uv4, uv5.
+// (TreeLodInstance.glsl): uv4, uv5. Wind (TreeLodWind.glsl): each end moves with the mesh's points
+// there (a skinned segment).
+uniform mat4 world;
+uniform mat4 inverseWorld;
 uniform mat4 worldView;
 uniform mat4 projection;
 uniform mat4 inverseProjection;
@@ -24,6 +27,7 @@ uniform vec4 viewportSize; // width, height, 1 / width, 1 / height
 uniform vec4 objectTransition; // custom 7 (TreeLod/ObjectTransition.h)
 
 #include "TreeLodInstance.glsl"
+#include "TreeLodWind.glsl"
 
 // The projection's centre (w = 1) or, for a parallel projection, its direction (w = 0).
 vec4 projectionCentre()
@@ -49,8 +53,10 @@ MAIN_PARAMETERS
 MAIN_DECLARATION
 {
     vTransition = drawTransition(uv4, uv5, objectTransition);
-    vec3 a = mul(worldView, instancePosition(uv4, uv5, vec4(vertex.xyz, 1.0))).xyz;
-    vec3 b = mul(worldView, instancePosition(uv4, uv5, vec4(uv1.xyz, 1.0))).xyz;
+    vec3 start = vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld);
+    vec3 end = uv1.xyz + windInstanceOffset(uv1.xyz, uv4, uv5, world, inverseWorld);
+    vec3 a = mul(worldView, instancePosition(uv4, uv5, vec4(start, 1.0))).xyz;
+    vec3 b = mul(worldView, instancePosition(uv4, uv5, vec4(end, 1.0))).xyz;
     float radius = uv1.w * uv4.w;
     vec4 centre = projectionCentre();
     vec3 p = mix(a, b, uv0.x);

@@ -18,8 +18,11 @@
 // CASTER: faces the light: the shadow camera's view +z (a directional light's direction) instead
 // of the camera position; passes clip z and w on.
 // SHADOW_RECEIVER: the position in the sun's shadow texture.
+// Wind (TreeLodWind.glsl): each corner moves with the mesh's points there, so the quad sways and
+// shears with the trunk.
 uniform mat4 worldViewProj;
 uniform mat4 world;
+uniform mat4 inverseWorld;
 #ifdef CASTER
 uniform mat4 view;
 #else
@@ -29,12 +32,13 @@ uniform vec4 sunDirection;   // world space, towards the sun (w = 0 for a direct
 #ifdef SHADOW_RECEIVER
 #include "TreeLodShadowReceiver.glsl"
 #endif
+#include "TreeLodInstance.glsl"
+#include "TreeLodWind.glsl"
 
 MAIN_PARAMETERS
     IN(vec4 vertex, POSITION)
     IN(vec2 uv0, TEXCOORD0)
-    IN(vec4 uv4, TEXCOORD4)
-    IN(vec3 uv5, TEXCOORD5)
+    INSTANCE_IN
     OUT(vec2 vUv, TEXCOORD0)
 #ifdef CASTER
     OUT(vec2 vClipZW, TEXCOORD1)
@@ -59,7 +63,9 @@ MAIN_DECLARATION
     vec2 f = dot(away.xz, away.xz) > 1e-12 * dot(away, away) ? normalize(away.xz) : vec2(0.0, 1.0);
     vec3 towards = vec3(f.x, 0.0, f.y);
     vec3 right = vec3(f.y, 0.0, -f.x);
-    vec4 position = vec4(centre + uv4.w * (vertex.x * right + vec3(0.0, vertex.y, 0.0)), 1.0);
+    vec3 corner = vertex.x * right + vec3(0.0, vertex.y, 0.0);
+    corner += instanceDirection(uv5, windInstanceOffset(instanceLocalDirection(uv5, corner), uv4, uv5, world, inverseWorld));
+    vec4 position = vec4(centre + uv4.w * corner, 1.0);
     gl_Position = mul(worldViewProj, position);
     vUv = uv0;
 #ifdef CASTER

@@ -22,8 +22,10 @@
 // The frame mapping mirrors OctahedralImpostorData.cpp (hemiOctahedralEncode/Decode,
 // octahedralFrameAxes, octahedralHalfHeight, octahedralFrameSide).
 // SHADOW_RECEIVER: the position in the sun's shadow texture. CASTER: clip z and w.
+// Wind (TreeLodWind.glsl): each corner moves with the mesh's points there.
 uniform mat4 worldViewProj;
 uniform mat4 world;
+uniform mat4 inverseWorld;
 uniform vec4 cylinder; // radius, bottom, top, depth radius (metres, the tree's own frame)
 uniform vec4 atlas;    // frames a side N, frame texels F, margin texels, 0
 #ifdef CASTER
@@ -36,6 +38,7 @@ uniform vec4 sunDirection;   // world space, towards the sun
 #include "TreeLodShadowReceiver.glsl"
 #endif
 #include "TreeLodInstance.glsl"
+#include "TreeLodWind.glsl"
 
 vec2 hemiOctahedralEncode(vec3 d)
 {
@@ -120,6 +123,7 @@ MAIN_DECLARATION
     vec3 right, up;
     frameAxes(v, right, up);
     vec3 corner = (vertex.x * cylinder.x * right + vertex.y * halfHeight(up) * up) * marginScale();
+    corner += windInstanceOffset(corner + vec3(0.0, centreY, 0.0), uv4, uv5, world, inverseWorld);
     vec4 position = vec4(centre + uv4.w * instanceDirection(uv5, corner), 1.0);
     gl_Position = mul(worldViewProj, position);
 

@@ -27,6 +27,8 @@
 //   the active level everywhere; passes clip z and w and the cell on.
 uniform mat4 worldViewProj;
 uniform mat4 worldView;
+uniform mat4 world;        // the wind (TreeLodWind.glsl): each cell moves rigidly with the mesh's
+uniform mat4 inverseWorld; // points at its centre; levels are chosen at rest
 uniform vec4 octree;     // cameras, slot texture width, atlas blocks a row, atlas width
 SAMPLER2D(slots, 1);
 #ifdef INSTANCED
@@ -45,6 +47,7 @@ SAMPLER2D(orders, 3);         // RGBA8: cell indices
 uniform vec4 lodState;   // active level, plane depth (view metres), weight of camera 0, of camera 1
 uniform vec4 cameraPair; // input camera 0, input camera 1, transition band's end (1: none), pattern shift
 #endif
+#include "TreeLodWind.glsl"
 
 // The codewords of the slot of `cell` for `camera`: (colour, alpha), -1 when pruned.
 ivec2 codewords(int cell, int camera)
@@ -143,7 +146,8 @@ MAIN_DECLARATION
     float edge = octreeBox.w / exp2(level);
     float halfEdge = 0.5 * edge;
     vec3 parentCentre = octreeBox.xyz + (vec3(coords / 2) + 0.5) * (2.0 * edge);
-    vec4 centre = instancePosition(uv4, uv5, vec4(octreeBox.xyz + (vec3(coords) + 0.5) * edge, 1.0));
+    vec3 cellCentre = octreeBox.xyz + (vec3(coords) + 0.5) * edge;
+    vec4 centre = instancePosition(uv4, uv5, vec4(cellCentre, 1.0));
     float depth = -mul(worldView, centre).z;
     float parentDepth = -mul(worldView, instancePosition(uv4, uv5, vec4(parentCentre, 1.0))).z;
 #ifdef CASTER
@@ -200,6 +204,11 @@ MAIN_DECLARATION
     }
     vColourBlocks = vec4(blockOrigin(max(first.x, 0)), blockOrigin(max(second.x, 0)));
     vAlphaBlocks = vec4(blockOrigin(max(first.y, 0)), blockOrigin(max(second.y, 0)));
+#ifdef INSTANCED
+    centre.xyz += uv4.w * instanceDirection(uv5, windInstanceOffset(cellCentre, uv4, uv5, world, inverseWorld));
+#else
+    centre.xyz += windObjectOffset(vertex.xyz, world, inverseWorld);
+#endif
     vec3 right = normalize(row3(worldView, 0));
     vec3 up = normalize(row3(worldView, 1));
     vec3 position = centre.xyz + (corner.x * right + corner.y * up) * size;

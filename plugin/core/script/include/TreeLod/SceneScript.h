@@ -39,6 +39,7 @@
 #include "TreeLod/GreyImage.h"
 #include "TreeLod/LevelSelection.h"
 #include "TreeLod/Result.h"
+#include "TreeLod/WindModel.h"
 
 #include <glm/glm.hpp>
 
@@ -188,6 +189,9 @@ namespace TreeLod
         SceneSun sun;
         SceneShadows shadows;
         SceneLod lod;
+        /// "wind": the wind every tree follows (TreeLod/WindModel.h), on the clock of the camera path
+        /// (frameTime): frames are reproducible. Default calm.
+        WindParameters wind;
         SceneCamera camera;
         int width = 1280, height = 720; ///< "resolution": [w, h]
         std::uint32_t frames = 1;       ///< frames spread over the camera path
