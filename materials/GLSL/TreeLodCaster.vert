@@ -13,6 +13,7 @@
 uniform mat4 worldViewProj;
 uniform mat4 world;
 uniform mat4 inverseWorld;
+uniform float windLeaf; // 1 in the leaf materials: the leaves flutter (TreeLodWind.glsl)
 #ifdef INSTANCED
 #include "TreeLodInstance.glsl"
 #endif
@@ -35,10 +36,10 @@ MAIN_DECLARATION
     vTransition = NO_TRANSITION;
 #endif
 #ifdef INSTANCED
-    vec4 rest = vec4(vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld), 1.0);
+    vec4 rest = vec4(vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld, windLeaf > 0.5), 1.0);
     gl_Position = mul(worldViewProj, instancePosition(uv4, uv5, rest));
 #else
-    gl_Position = mul(worldViewProj, vec4(vertex.xyz + windObjectOffset(vertex.xyz, world, inverseWorld), 1.0));
+    gl_Position = mul(worldViewProj, vec4(vertex.xyz + windObjectOffset(vertex.xyz, world, inverseWorld, windLeaf > 0.5), 1.0));
 #endif
     vClipZW = gl_Position.zw;
     vUv = uv0;

@@ -14,6 +14,7 @@
 uniform mat4 worldViewProj;
 uniform mat4 world;
 uniform mat4 inverseWorld;
+uniform float windLeaf; // 1 in the leaf materials: the leaves flutter (TreeLodWind.glsl)
 uniform mat4 normalMatrix;
 uniform vec4 cameraPosition;
 #ifdef SHADOW_RECEIVER
@@ -52,11 +53,11 @@ MAIN_DECLARATION
     vTransition = NO_TRANSITION;
 #endif
 #ifdef INSTANCED
-    vec4 rest = vec4(vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld), 1.0);
+    vec4 rest = vec4(vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld, windLeaf > 0.5), 1.0);
     vec4 position = instancePosition(uv4, uv5, rest);
     vec3 objectNormal = instanceDirection(uv5, normal);
 #else
-    vec4 position = vec4(vertex.xyz + windObjectOffset(vertex.xyz, world, inverseWorld), 1.0);
+    vec4 position = vec4(vertex.xyz + windObjectOffset(vertex.xyz, world, inverseWorld, windLeaf > 0.5), 1.0);
     vec3 objectNormal = normal;
 #endif
     gl_Position = mul(worldViewProj, position);

@@ -50,18 +50,19 @@ vec3 windOffset(vec3 p, vec3 along, vec3 treeBase, bool leaf)
 }
 
 /// The offset of `p` (object space) of a tree drawn alone: its object frame is the tree's frame.
-vec3 windObjectOffset(vec3 p, mat4 world, mat4 inverseWorld)
+/// `leaf`: a leaf vertex of the mesh or LoDF (flutter).
+vec3 windObjectOffset(vec3 p, mat4 world, mat4 inverseWorld, bool leaf)
 {
     vec3 treeBase = mul(world, vec4(0.0, 0.0, 0.0, 1.0)).xyz;
-    return windOffset(p, windAlongObject(inverseWorld), treeBase, false);
+    return windOffset(p, windAlongObject(inverseWorld), treeBase, leaf);
 }
 
 #ifdef INSTANCE_IN
 /// The offset of `p` (the tree's frame) of a Forest instance (TreeLodInstance.glsl), in the tree's
 /// frame: instancePosition places p + offset.
-vec3 windInstanceOffset(vec3 p, vec4 uv4, vec3 uv5, mat4 world, mat4 inverseWorld)
+vec3 windInstanceOffset(vec3 p, vec4 uv4, vec3 uv5, mat4 world, mat4 inverseWorld, bool leaf)
 {
     vec3 treeBase = mul(world, vec4(uv4.xyz, 1.0)).xyz;
-    return windOffset(p, instanceLocalDirection(uv5, windAlongObject(inverseWorld)), treeBase, false);
+    return windOffset(p, instanceLocalDirection(uv5, windAlongObject(inverseWorld)), treeBase, leaf);
 }
 #endif

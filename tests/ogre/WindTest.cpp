@@ -69,7 +69,7 @@ namespace TreeLod::WindTests
         }
 
         /// everyTechniqueOak's model with every vertex moved by the CPU wind at `seconds` (the tree at
-        /// the origin, unturned), as a package holding its reference.
+        /// the origin, unturned; the leaves flutter), as a package holding its reference.
         TreeAssetPtr displacedOak(const WindParameters& wind, double seconds, const std::string& name)
         {
             TreeModel model = everyTechniqueOak().model;
@@ -77,9 +77,9 @@ namespace TreeLod::WindTests
             const glm::vec2 world = glm::normalize(wind.direction);
             const glm::vec3 along(world.x, 0.0f, world.y);
             const WindPhases phases = WindPhases::at(seconds);
-            for (std::vector<Vertex>* vertices : {&model.barkVertices, &model.leafVertices})
+            for (auto [vertices, leaf] : {std::pair(&model.barkVertices, false), std::pair(&model.leafVertices, true)})
                 for (Vertex& v : *vertices)
-                    v.position += WindModel::offset(wind, phases, v.position, height, along, world, glm::vec3(0.0f), false);
+                    v.position += WindModel::offset(wind, phases, v.position, height, along, world, glm::vec3(0.0f), leaf);
             PackageWriter writer;
             Result<void> added = addReferenceChunk(writer, model, name);
             EXPECT_TRUE(added.ok()) << (added.ok() ? "" : added.error().message());
@@ -180,15 +180,16 @@ namespace TreeLod::WindTests
     TEST(Wind, coarseLevelsFollowTheMeshsSilhouette)
     {
         const WindParameters wind = breeze(3.0f);
+        constexpr int SILHOUETTE_SIZE = 320; // the centres move a few pixels
         std::vector<Image> strip;
         for (const auto& [technique, params] :
              {std::make_pair(std::string("billboard-cloud"), Ogre::NameValuePairList{{"level", "1"}}),
               std::make_pair(std::string("ellipsoids"), Ogre::NameValuePairList{{"level", "1"}})})
         {
             placeTechnique(REFERENCE_TECHNIQUE, *everyTechniqueOak().asset);
-            const Image meshStill = render();
+            const Image meshStill = render(view(), SILHOUETTE_SIZE);
             placeTechnique(technique, *everyTechniqueOak().asset, params);
-            const Image levelStill = render();
+            const Image levelStill = render(view(), SILHOUETTE_SIZE);
             const double calm = coveredOverlap(levelStill, meshStill, BACKGROUND);
             const glm::dvec2 meshRest = centroid(meshStill), levelRest = centroid(levelStill);
             for (double seconds : {2.0, 5.5})
@@ -196,9 +197,9 @@ namespace TreeLod::WindTests
                 SCOPED_TRACE(technique + " at " + std::to_string(seconds) + " s");
                 ScopedWind scoped(wind, seconds);
                 placeTechnique(REFERENCE_TECHNIQUE, *everyTechniqueOak().asset);
-                const Image mesh = render();
+                const Image mesh = render(view(), SILHOUETTE_SIZE);
                 placeTechnique(technique, *everyTechniqueOak().asset, params);
-                const Image level = render();
+                const Image level = render(view(), SILHOUETTE_SIZE);
                 const double follows = coveredOverlap(level, mesh, BACKGROUND);
                 const glm::dvec2 meshShift = centroid(mesh) - meshRest, levelShift = centroid(level) - levelRest;
                 const double apart = glm::length(levelShift - meshShift);
@@ -207,8 +208,8 @@ namespace TreeLod::WindTests
                             technique.c_str(), seconds, follows, calm, meshShift.x, meshShift.y, levelShift.x,
                             levelShift.y);
                 EXPECT_GT(follows, calm - 0.03);
-                ASSERT_GT(glm::length(meshShift), 1.0) << "the wind moves the mesh visibly";
-                EXPECT_LT(apart, 0.3 * glm::length(meshShift)) << "the level moves as the mesh does";
+                ASSERT_GT(glm::length(meshShift), 2.0) << "the wind moves the mesh visibly";
+                EXPECT_LT(apart, 0.25 * glm::length(meshShift) + 0.5) << "the level moves as the mesh does";
                 strip.insert(strip.end(), {mesh, level});
             }
         }

@@ -64,12 +64,12 @@ MAIN_DECLARATION
     vTransition = objectTransition.xy;
 #endif
 #ifdef INSTANCED
-    vec4 rest = vec4(vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld), 1.0);
+    vec4 rest = vec4(vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld, false), 1.0);
     vec4 local = instancePosition(uv4, uv5, rest);
     vec3 objectNormal = instanceDirection(uv5, normal);
     vec3 objectTangent = instanceDirection(uv5, tangent);
 #else
-    vec4 local = vec4(vertex.xyz + windObjectOffset(vertex.xyz, world, inverseWorld), 1.0);
+    vec4 local = vec4(vertex.xyz + windObjectOffset(vertex.xyz, world, inverseWorld, false), 1.0);
     vec3 objectNormal = normal;
     vec3 objectTangent = tangent;
 #endif

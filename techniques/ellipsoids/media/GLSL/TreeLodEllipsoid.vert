@@ -54,7 +54,7 @@ MAIN_PARAMETERS
 MAIN_DECLARATION
 {
     vTransition = drawTransition(uv4, uv5, objectTransition);
-    vec3 rest = vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld);
+    vec3 rest = vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld, false);
     vec3 centre = mul(worldView, instancePosition(uv4, uv5, vec4(rest, 1.0))).xyz;
     mat3 toView = toMat3(worldView);
     vec3 axis0 = mul(toView, instanceDirection(uv5, uv4.w * uv1.xyz));

@@ -53,8 +53,8 @@ MAIN_PARAMETERS
 MAIN_DECLARATION
 {
     vTransition = drawTransition(uv4, uv5, objectTransition);
-    vec3 start = vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld);
-    vec3 end = uv1.xyz + windInstanceOffset(uv1.xyz, uv4, uv5, world, inverseWorld);
+    vec3 start = vertex.xyz + windInstanceOffset(vertex.xyz, uv4, uv5, world, inverseWorld, false);
+    vec3 end = uv1.xyz + windInstanceOffset(uv1.xyz, uv4, uv5, world, inverseWorld, false);
     vec3 a = mul(worldView, instancePosition(uv4, uv5, vec4(start, 1.0))).xyz;
     vec3 b = mul(worldView, instancePosition(uv4, uv5, vec4(end, 1.0))).xyz;
     float radius = uv1.w * uv4.w;

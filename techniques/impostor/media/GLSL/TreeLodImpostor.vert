@@ -64,7 +64,7 @@ MAIN_DECLARATION
     vec3 towards = vec3(f.x, 0.0, f.y);
     vec3 right = vec3(f.y, 0.0, -f.x);
     vec3 corner = vertex.x * right + vec3(0.0, vertex.y, 0.0);
-    corner += instanceDirection(uv5, windInstanceOffset(instanceLocalDirection(uv5, corner), uv4, uv5, world, inverseWorld));
+    corner += instanceDirection(uv5, windInstanceOffset(instanceLocalDirection(uv5, corner), uv4, uv5, world, inverseWorld, false));
     vec4 position = vec4(centre + uv4.w * corner, 1.0);
     gl_Position = mul(worldViewProj, position);
     vUv = uv0;

@@ -123,7 +123,7 @@ MAIN_DECLARATION
     vec3 right, up;
     frameAxes(v, right, up);
     vec3 corner = (vertex.x * cylinder.x * right + vertex.y * halfHeight(up) * up) * marginScale();
-    corner += windInstanceOffset(corner + vec3(0.0, centreY, 0.0), uv4, uv5, world, inverseWorld);
+    corner += windInstanceOffset(corner + vec3(0.0, centreY, 0.0), uv4, uv5, world, inverseWorld, false);
     vec4 position = vec4(centre + uv4.w * instanceDirection(uv5, corner), 1.0);
     gl_Position = mul(worldViewProj, position);
 

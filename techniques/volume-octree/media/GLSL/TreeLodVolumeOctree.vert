@@ -205,9 +205,9 @@ MAIN_DECLARATION
     vColourBlocks = vec4(blockOrigin(max(first.x, 0)), blockOrigin(max(second.x, 0)));
     vAlphaBlocks = vec4(blockOrigin(max(first.y, 0)), blockOrigin(max(second.y, 0)));
 #ifdef INSTANCED
-    centre.xyz += uv4.w * instanceDirection(uv5, windInstanceOffset(cellCentre, uv4, uv5, world, inverseWorld));
+    centre.xyz += uv4.w * instanceDirection(uv5, windInstanceOffset(cellCentre, uv4, uv5, world, inverseWorld, false));
 #else
-    centre.xyz += windObjectOffset(vertex.xyz, world, inverseWorld);
+    centre.xyz += windObjectOffset(vertex.xyz, world, inverseWorld, false);
 #endif
     vec3 right = normalize(row3(worldView, 0));
     vec3 up = normalize(row3(worldView, 1));
