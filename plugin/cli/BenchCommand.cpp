@@ -275,6 +275,8 @@ namespace TreeLod
             SceneScript& script = *loaded;
             if (Result<void> shadows = applyShadowOptions(args.shadowSize, args.shadowLodBias, script.shadows); !shadows)
                 return printError(shadows.error());
+            if (Result<void> wind = applyWindOption(args.wind, script.wind); !wind)
+                return printError(wind.error());
             if (!(args.scale > 0.0) || !std::isfinite(args.scale))
                 return printError(fail("", "--scale", "must be a positive number"));
             int width = script.width, height = script.height;
@@ -342,7 +344,8 @@ namespace TreeLod
                                                 std::to_string(frames), "--upload-budget",
                                                 std::to_string(args.uploadBudget), "--shadow-size",
                                                 std::to_string(args.shadowSize), "--shadow-lod-bias",
-                                                number(args.shadowLodBias, 8), "--motion-frames", args.motionFrames};
+                                                number(args.shadowLodBias, 8), "--wind", number(args.wind, 8),
+                                                "--motion-frames", args.motionFrames};
             if (!args.counts.empty())
                 command.insert(command.end(), {"--counts", args.counts});
             if (args.quiet)
@@ -417,6 +420,8 @@ namespace TreeLod
             ->capture_default_str();
         cmd->add_option("--shadow-lod-bias", args->shadowLodBias,
                         "LoD bias of the Forest's shadow casters over the script's (0: the script's; < 1: coarser)")
+            ->capture_default_str();
+        cmd->add_option("--wind", args->wind, "the wind's strength over the script's (-1: the script's, 0: calm)")
             ->capture_default_str();
         cmd->add_option("--upload-budget", args->uploadBudget,
                         "bytes of Forest levels built per frame (0 = no limit); levels waiting draw a coarser one")

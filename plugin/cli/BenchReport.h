@@ -42,6 +42,7 @@ namespace TreeLod
             std::uint64_t uploadBudget = 8000000; // bytes of Forest levels built per frame (0 = no limit)
             int shadowSize = -1;                  // -1: the script's; 0: off (applyShadowOptions)
             double shadowLodBias = 0.0;           // 0: the script's
+            double wind = -1.0;                   // the wind's strength; -1: the script's
             std::string motionFrames = "all";     // treelod_frames --motion-frames
             bool bakeOnly = false;    // bake, write packages.json, print the treelod_frames command
             std::string framesFrom;   // "" = run treelod_frames here; else read its output from this directory

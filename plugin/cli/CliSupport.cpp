@@ -146,4 +146,14 @@ namespace TreeLod
             shadows.textureSize = size;
         return {};
     }
+
+    Result<void> applyWindOption(double strength, WindParameters& wind)
+    {
+        if (strength == -1.0)
+            return {};
+        if (!(strength >= 0.0 && strength <= 100.0))
+            return fail("", "--wind", std::to_string(strength) + " is not -1 (the script's) or a strength in 0..100");
+        wind.strength = float(strength);
+        return {};
+    }
 }

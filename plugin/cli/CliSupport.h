@@ -3,6 +3,7 @@
 
 #include "TreeLod/Progress.h"
 #include "TreeLod/Result.h"
+#include "TreeLod/WindModel.h"
 #include "TreeLod/SceneScript.h"
 
 #include <functional>
@@ -42,6 +43,9 @@ namespace TreeLod
     /// the map's fill does not scale with the tree count). Bias: 0 keeps the script's, else
     /// finite and > 0 (Forest::setShadowLodBias).
     Result<void> applyShadowOptions(int size, double lodBias, SceneShadows& shadows);
+    /// `--wind S`: the script's wind strength replaced by S (-1: the script's, 0: calm); an error
+    /// names the option.
+    Result<void> applyWindOption(double strength, WindParameters& wind);
 
     /// Set the exit code a subcommand callback produced (CLI11 callbacks return void).
     void setExitCode(int code);

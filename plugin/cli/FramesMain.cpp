@@ -1,6 +1,6 @@
 // treelod_frames SCENE.json --packages LIST -o DIR [--techniques] [--lod-bias] [--frames] [--scale] [--counts]
 //                [--size] [--samples] [--reference-budget] [--reference-image-budget] [--entity-limit]
-//                [--upload-budget] [--shadow-size] [--shadow-lod-bias] [--preload] [--skip-comparisons] [-q]
+//                [--upload-budget] [--shadow-size] [--shadow-lod-bias] [--wind] [--preload] [--skip-comparisons] [-q]
 //
 // The program that renders and times the frames of `treelod bench`: it links OGRE and the
 // runtime only (Plugin_TreeLod, TreeLodOffscreen, TreeLodScene, TreeLodScript, TreeLodRuntime), never
@@ -69,6 +69,7 @@ namespace TreeLod
             std::uint64_t uploadBudget = 8000000; // bytes per frame (Forest::setUploadBudget; 0 = no limit)
             int shadowSize = -1;          // -1: the script's; 0: off (applyShadowOptions)
             double shadowLodBias = 0.0;   // 0: the script's
+            double wind = -1.0;           // the wind's strength; -1: the script's
             bool preload = false;         // every Forest level built before the frames (no uploads timed)
             bool skipComparisons = false; // only the techniques: no reference, no floors (memory of one scene)
             std::string motionFrames = "all"; // frames measured in motion: "all", or a count evenly along the path
@@ -131,6 +132,8 @@ namespace TreeLod
             SceneScript& script = *loaded;
             if (Result<void> shadows = applyShadowOptions(args.shadowSize, args.shadowLodBias, script.shadows); !shadows)
                 return printError(shadows.error());
+            if (Result<void> wind = applyWindOption(args.wind, script.wind); !wind)
+                return printError(wind.error());
             if (!(args.scale > 0.0) || !std::isfinite(args.scale))
                 return printError(fail("", "--scale", "must be a positive number"));
             int width = script.width, height = script.height;
@@ -260,6 +263,7 @@ namespace TreeLod
                                   {"scale", args.scale},
                                   {"shadowMap", script.shadows.enabled ? script.shadows.textureSize : 0},
                                   {"shadowLodBias", script.shadows.lodBias},
+                                  {"windStrength", script.wind.strength},
                                   {"renderer", renderer.getRoot().getRenderSystem()->getName()},
                                   {"complete", complete},
                                   {"runs", runsJson}};
@@ -505,6 +509,8 @@ int main(int argc, char** argv)
         ->capture_default_str();
     app.add_option("--shadow-lod-bias", args.shadowLodBias,
                    "LoD bias of the Forest's shadow casters over the script's (0: the script's; < 1: coarser)")
+        ->capture_default_str();
+    app.add_option("--wind", args.wind, "the wind's strength over the script's (-1: the script's, 0: calm)")
         ->capture_default_str();
     app.add_option("--motion-frames", args.motionFrames,
                    "frames measured in motion (the frame and the next at the script's frame rate, after a "

@@ -11,6 +11,7 @@
 #include "TreeLod/TechniqueRegistry.h"
 #include "TreeLod/TreeAssetManager.h"
 #include "TreeLod/TreeLodPlugin.h"
+#include "TreeLod/Wind.h"
 
 #include <OgreAdvancedRenderControls.h>
 #include <OgreBorderPanelOverlayElement.h>
@@ -64,6 +65,18 @@ namespace TreeLod
 
         /// The transition slider's steps (Forest::setLodTransition; 0: hard switches).
         const std::vector<float> TRANSITIONS = {0.0f, 0.05f, 0.1f, 0.2f, 0.3f, 0.5f, 1.0f};
+
+        /// The wind panel's steps (TreeLod::Wind): strength (0 calm, 1 a fresh breeze, 3 a gale), the
+        /// direction it blows to (degrees from +X towards +Z), gustiness.
+        const std::vector<float> WIND_STRENGTHS = {0.0f, 0.25f, 0.5f, 1.0f, 2.0f, 3.0f};
+        const std::vector<float> WIND_DIRECTIONS = {0.0f, 45.0f, 90.0f, 135.0f, 180.0f, 225.0f, 270.0f, 315.0f};
+        const std::vector<float> WIND_GUSTS = {0.0f, 0.25f, 0.5f, 0.75f, 1.0f};
+
+        float windDirectionDegrees(const TreeLod::WindParameters& wind)
+        {
+            const float degrees = float(std::atan2(wind.direction.y, wind.direction.x) * 180.0 / 3.141592653589793);
+            return degrees < 0.0f ? degrees + 360.0f : degrees;
+        }
 
         std::string transitionCaption(float transition)
         {
@@ -440,6 +453,7 @@ namespace TreeLod
         mLodBiasSlider = nullptr;
         mErrorBudgetSlider = nullptr;
         mTransitionSlider = nullptr;
+        mWindSlider = mWindDirectionSlider = mGustSlider = nullptr;
         mShadowsBox = mWireframeBox = mFreezeBox = nullptr;
         mPlayButton = nullptr;
         mStatsPanel = nullptr;
@@ -533,6 +547,15 @@ namespace TreeLod
         if (sample.hasCameraPath())
             mPlayButton = mTrays->createButton(TL_TOPLEFT, "Play", "Pause path (Space)", WIDGET_WIDTH);
 
+        // The wind (every sample's trees sway in it): its own column, on the right.
+        mWindSlider = mTrays->createLongSlider(TL_TOPRIGHT, "Wind", "Wind (B)", WIDGET_WIDTH, 60.0f, 54.0f, 0.0f,
+                                               float(WIND_STRENGTHS.size() - 1), unsigned(WIND_STRENGTHS.size()));
+        mWindDirectionSlider = mTrays->createLongSlider(TL_TOPRIGHT, "WindDirection", "Blowing to", WIDGET_WIDTH, 60.0f,
+                                                        54.0f, 0.0f, float(WIND_DIRECTIONS.size() - 1),
+                                                        unsigned(WIND_DIRECTIONS.size()));
+        mGustSlider = mTrays->createLongSlider(TL_TOPRIGHT, "Gusts", "Gusts", WIDGET_WIDTH, 60.0f, 54.0f, 0.0f,
+                                               float(WIND_GUSTS.size() - 1), unsigned(WIND_GUSTS.size()));
+
         mStatsPanel = mTrays->createParamsPanel(TL_BOTTOMLEFT, "Stats", WIDGET_WIDTH, 8);
         mHistogramBox = mTrays->createTextBox(TL_BOTTOMLEFT, "Levels", "LoD levels in use", WIDGET_WIDTH,
                                               float(52 + 19 * HISTOGRAM_LINES));
@@ -562,11 +585,42 @@ namespace TreeLod
             mTransitionSlider->setValue(Ogre::Real(step), false);
             mTransitionSlider->setValueCaption(transitionCaption(TRANSITIONS[step]));
         }
+        syncWindControls();
         mShadowsBox->setChecked(sample.getShadows(), false);
         mWireframeBox->setChecked(sample.getWireframe(), false);
         mFreezeBox->setChecked(sample.isLodFrozen(), false);
         if (mPlayButton)
             mPlayButton->setCaption(sample.isPlaying() ? "Pause path (Space)" : "Play path (Space)");
+    }
+
+    void TreeLodBrowser::syncWindControls()
+    {
+        if (!mWindSlider)
+            return;
+        const TreeLod::WindParameters& wind = TreeLod::Wind::getParameters();
+        const std::size_t strength = nearestStep(WIND_STRENGTHS, wind.strength);
+        mWindSlider->setValue(Ogre::Real(strength), false);
+        mWindSlider->setValueCaption(wind.calm() ? "calm" : Ogre::StringConverter::toString(wind.strength));
+        const std::size_t direction = nearestStep(WIND_DIRECTIONS, windDirectionDegrees(wind));
+        mWindDirectionSlider->setValue(Ogre::Real(direction), false);
+        mWindDirectionSlider->setValueCaption(Ogre::StringConverter::toString(WIND_DIRECTIONS[direction]) + " deg");
+        const std::size_t gusts = nearestStep(WIND_GUSTS, wind.gustiness);
+        mGustSlider->setValue(Ogre::Real(gusts), false);
+        mGustSlider->setValueCaption(Ogre::StringConverter::toString(wind.gustiness));
+    }
+
+    void TreeLodBrowser::setWindFromControls()
+    {
+        auto step = [](const std::vector<float>& steps, OgreBites::Slider* slider) {
+            return steps[std::min(steps.size() - 1, std::size_t(std::lround(slider->getValue())))];
+        };
+        TreeLod::WindParameters wind = TreeLod::Wind::getParameters();
+        wind.strength = step(WIND_STRENGTHS, mWindSlider);
+        const double radians = double(step(WIND_DIRECTIONS, mWindDirectionSlider)) * 3.141592653589793 / 180.0;
+        wind.direction = {float(std::cos(radians)), float(std::sin(radians))};
+        wind.gustiness = step(WIND_GUSTS, mGustSlider);
+        TreeLod::Wind::setParameters(wind);
+        syncWindControls();
     }
 
     void TreeLodBrowser::setLodBiasExponent(int exponent)
@@ -623,7 +677,9 @@ namespace TreeLod
         mPendingScreen = NO_SCREEN;
         if (mCurrent >= 0)
         {
-            mSamples[std::size_t(mCurrent)]->frame(mFixedFrameSeconds.value_or(double(evt.timeSinceLastFrame)));
+            const double seconds = mFixedFrameSeconds.value_or(double(evt.timeSinceLastFrame));
+            TreeLod::Wind::setTime(TreeLod::Wind::getTime() + seconds);
+            mSamples[std::size_t(mCurrent)]->frame(seconds);
             updateStats();
         }
         mFrameStart = std::chrono::steady_clock::now();
@@ -831,6 +887,14 @@ namespace TreeLod
             mWireframeBox->toggle();
         else if (key == 'l')
             mFreezeBox->toggle();
+        else if (key == 'b' && mWindSlider)
+        {
+            // Calm and back to the last wind.
+            const float now = TreeLod::Wind::getParameters().strength;
+            if (now > 0.0f)
+                mLastWind = now;
+            mWindSlider->setValue(Ogre::Real(nearestStep(WIND_STRENGTHS, now > 0.0f ? 0.0f : mLastWind)));
+        }
         else if (key == 'x' && mTransitionSlider)
         {
             // Hard switches and back to the last transition length.
@@ -966,6 +1030,8 @@ namespace TreeLod
             mSamples[std::size_t(mCurrent)]->setLodTransition(transition);
             slider->setValueCaption(transitionCaption(transition));
         }
+        if ((slider == mWindSlider || slider == mWindDirectionSlider || slider == mGustSlider) && mCurrent >= 0)
+            setWindFromControls();
         if (slider == mErrorBudgetSlider && mCurrent >= 0)
         {
             const std::size_t step = std::min(ERROR_BUDGETS.size() - 1, std::size_t(std::lround(slider->getValue())));

@@ -108,6 +108,9 @@ namespace TreeLod
         void buttonHit(OgreBites::Button* button) override;
         void itemSelected(OgreBites::SelectMenu* menu) override;
         void sliderMoved(OgreBites::Slider* slider) override;
+        /// The wind panel from TreeLod::Wind, and TreeLod::Wind from the panel.
+        void syncWindControls();
+        void setWindFromControls();
         void checkBoxToggled(OgreBites::CheckBox* box) override;
 
     private:
@@ -155,6 +158,10 @@ namespace TreeLod
         OgreBites::Slider* mErrorBudgetSlider = nullptr; ///< samples with budgeted auto only
         OgreBites::Slider* mTransitionSlider = nullptr;  ///< samples with level transitions only
         float mLastTransition = 0.2f; ///< what the X key turns transitions back on to
+        OgreBites::Slider* mWindSlider = nullptr; ///< the wind panel (TreeLod::Wind), every sample
+        OgreBites::Slider* mWindDirectionSlider = nullptr;
+        OgreBites::Slider* mGustSlider = nullptr;
+        float mLastWind = 1.0f; ///< what the B key turns the wind back on to
         OgreBites::CheckBox* mShadowsBox = nullptr;
         OgreBites::CheckBox* mWireframeBox = nullptr;
         OgreBites::CheckBox* mFreezeBox = nullptr;

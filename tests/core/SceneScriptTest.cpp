@@ -95,7 +95,7 @@ namespace TreeLod
     TEST(SceneScript, shippedScenesParse)
     {
         for (const char* name : {"single-tree.json", "table2.json", "flythrough-10k.json", "plaza-290.json",
-                                 "forest-100k.json"})
+                                 "forest-100k.json", "windy-grove.json"})
         {
             Result<SceneScript> s = loadSceneScript(scenePath(name));
             ASSERT_TRUE(s.ok()) << s.error().message();
@@ -135,7 +135,7 @@ namespace TreeLod
         // Splines overshoot: a walk at 1.7 m must not dip under the ground, and a low camera must
         // not pass through a trunk (the flythrough's glade and track keep trees off its path).
         for (const char* name : {"single-tree.json", "table2.json", "flythrough-10k.json", "plaza-290.json",
-                                 "forest-100k.json"})
+                                 "forest-100k.json", "windy-grove.json"})
         {
             Result<SceneScript> s = loadSceneScript(scenePath(name));
             ASSERT_TRUE(s.ok()) << s.error().message();
@@ -352,6 +352,33 @@ namespace TreeLod
             "test.json", "");
         ASSERT_TRUE(coarse.ok()) << coarse.error().message();
         EXPECT_EQ(coarse->shadows.lodBias, 0.25f);
+    }
+
+    TEST(SceneScript, windIsCalmByDefaultAndCheckedByKey)
+    {
+        EXPECT_TRUE(parsed(MINIMAL).wind.calm());
+        const SceneScript windy = parsed(replaced(
+            MINIMAL, "\"frames\": 2",
+            "\"frames\": 2, \"wind\": {\"strength\": 1.5, \"direction\": [3, 4], \"gustiness\": 0.2, \"gustWavelength\": 80}"));
+        EXPECT_EQ(windy.wind.strength, 1.5f);
+        EXPECT_NEAR(windy.wind.direction.x, 0.6f, 1e-6f);
+        EXPECT_NEAR(windy.wind.direction.y, 0.8f, 1e-6f);
+        EXPECT_EQ(windy.wind.gustiness, 0.2f);
+        EXPECT_EQ(windy.wind.gustWavelength, 80.0f);
+        EXPECT_TRUE(windy.wind.validate().ok());
+        for (const auto& [wind, key] : {std::pair<std::string, std::string>("{\"direction\": [1, 0]}", "/wind/strength"),
+                                        {"{\"strength\": -1}", "/wind/strength"},
+                                        {"{\"strength\": 1, \"direction\": [0, 0]}", "/wind/direction"},
+                                        {"{\"strength\": 1, \"direction\": [1, 0, 0]}", "/wind/direction"},
+                                        {"{\"strength\": 1, \"gustiness\": 2}", "/wind/gustiness"},
+                                        {"{\"strength\": 1, \"gustWavelength\": 0}", "/wind/gustWavelength"},
+                                        {"{\"strength\": 1, \"speed\": 2}", "/wind/speed"}})
+        {
+            const std::string message = errorOf(replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"wind\": " + wind));
+            EXPECT_NE(message.find(key), std::string::npos) << wind << ": " << message;
+        }
+        const SceneScript grove = *loadSceneScript(scenePath("windy-grove.json"));
+        EXPECT_EQ(grove.wind.strength, 1.5f);
     }
 
     TEST(SceneScript, lodTakesAnErrorBudget)
