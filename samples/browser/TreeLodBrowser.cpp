@@ -547,14 +547,8 @@ namespace TreeLod
         if (sample.hasCameraPath())
             mPlayButton = mTrays->createButton(TL_TOPLEFT, "Play", "Pause path (Space)", WIDGET_WIDTH);
 
-        // The wind (every sample's trees sway in it): its own column, on the right.
-        mWindSlider = mTrays->createLongSlider(TL_TOPRIGHT, "Wind", "Wind (B)", WIDGET_WIDTH, 60.0f, 54.0f, 0.0f,
-                                               float(WIND_STRENGTHS.size() - 1), unsigned(WIND_STRENGTHS.size()));
-        mWindDirectionSlider = mTrays->createLongSlider(TL_TOPRIGHT, "WindDirection", "Blowing to", WIDGET_WIDTH, 60.0f,
-                                                        54.0f, 0.0f, float(WIND_DIRECTIONS.size() - 1),
-                                                        unsigned(WIND_DIRECTIONS.size()));
-        mGustSlider = mTrays->createLongSlider(TL_TOPRIGHT, "Gusts", "Gusts", WIDGET_WIDTH, 60.0f, 54.0f, 0.0f,
-                                               float(WIND_GUSTS.size() - 1), unsigned(WIND_GUSTS.size()));
+        if (mWindPanelShown)
+            showWindPanel(true);
 
         mStatsPanel = mTrays->createParamsPanel(TL_BOTTOMLEFT, "Stats", WIDGET_WIDTH, 8);
         mHistogramBox = mTrays->createTextBox(TL_BOTTOMLEFT, "Levels", "LoD levels in use", WIDGET_WIDTH,
@@ -591,6 +585,33 @@ namespace TreeLod
         mFreezeBox->setChecked(sample.isLodFrozen(), false);
         if (mPlayButton)
             mPlayButton->setCaption(sample.isPlaying() ? "Pause path (Space)" : "Play path (Space)");
+    }
+
+    void TreeLodBrowser::showWindPanel(bool shown)
+    {
+        using namespace OgreBites;
+        mWindPanelShown = shown;
+        if (!shown)
+        {
+            for (Slider** slider : {&mWindSlider, &mWindDirectionSlider, &mGustSlider})
+                if (*slider)
+                {
+                    mTrays->destroyWidget(*slider);
+                    *slider = nullptr;
+                }
+            return;
+        }
+        if (mWindSlider)
+            return;
+        // On the right, over the picture (a split view's heat map too): shown on request only.
+        mWindSlider = mTrays->createLongSlider(TL_TOPRIGHT, "Wind", "Wind strength", WIDGET_WIDTH, 60.0f, 54.0f, 0.0f,
+                                               float(WIND_STRENGTHS.size() - 1), unsigned(WIND_STRENGTHS.size()));
+        mWindDirectionSlider = mTrays->createLongSlider(TL_TOPRIGHT, "WindDirection", "Blowing to", WIDGET_WIDTH, 60.0f,
+                                                        54.0f, 0.0f, float(WIND_DIRECTIONS.size() - 1),
+                                                        unsigned(WIND_DIRECTIONS.size()));
+        mGustSlider = mTrays->createLongSlider(TL_TOPRIGHT, "Gusts", "Gusts", WIDGET_WIDTH, 60.0f, 54.0f, 0.0f,
+                                               float(WIND_GUSTS.size() - 1), unsigned(WIND_GUSTS.size()));
+        syncWindControls();
     }
 
     void TreeLodBrowser::syncWindControls()
@@ -887,14 +908,8 @@ namespace TreeLod
             mWireframeBox->toggle();
         else if (key == 'l')
             mFreezeBox->toggle();
-        else if (key == 'b' && mWindSlider)
-        {
-            // Calm and back to the last wind.
-            const float now = TreeLod::Wind::getParameters().strength;
-            if (now > 0.0f)
-                mLastWind = now;
-            mWindSlider->setValue(Ogre::Real(nearestStep(WIND_STRENGTHS, now > 0.0f ? 0.0f : mLastWind)));
-        }
+        else if (key == 'b')
+            showWindPanel(!mWindPanelShown);
         else if (key == 'x' && mTransitionSlider)
         {
             // Hard switches and back to the last transition length.

@@ -110,6 +110,7 @@ namespace TreeLod
         void sliderMoved(OgreBites::Slider* slider) override;
         /// The wind panel from TreeLod::Wind, and TreeLod::Wind from the panel.
         void syncWindControls();
+        void showWindPanel(bool shown);
         void setWindFromControls();
         void checkBoxToggled(OgreBites::CheckBox* box) override;
 
@@ -158,10 +159,10 @@ namespace TreeLod
         OgreBites::Slider* mErrorBudgetSlider = nullptr; ///< samples with budgeted auto only
         OgreBites::Slider* mTransitionSlider = nullptr;  ///< samples with level transitions only
         float mLastTransition = 0.2f; ///< what the X key turns transitions back on to
-        OgreBites::Slider* mWindSlider = nullptr; ///< the wind panel (TreeLod::Wind), every sample
+        OgreBites::Slider* mWindSlider = nullptr; ///< the wind panel (TreeLod::Wind), every sample; B shows it
         OgreBites::Slider* mWindDirectionSlider = nullptr;
         OgreBites::Slider* mGustSlider = nullptr;
-        float mLastWind = 1.0f; ///< what the B key turns the wind back on to
+        bool mWindPanelShown = false;
         OgreBites::CheckBox* mShadowsBox = nullptr;
         OgreBites::CheckBox* mWireframeBox = nullptr;
         OgreBites::CheckBox* mFreezeBox = nullptr;
