@@ -232,10 +232,10 @@ namespace TreeLod
             return bytes * texture.getNumFaces();
         }
 
-        /// The INSTANCED variant of vertex program `plain`: "<name>/Instanced", same source and
-        /// entry point and target, defines + INSTANCED=1, the same default and shared parameters, made once
-        /// in the plain program's group. A unified program
-        /// (materials/TreeLod.program) is varied through the delegate the render system chose.
+        /// The INSTANCED variant of vertex program `plain`: "<name>/Instanced", same source, entry
+        /// point and target, defines + INSTANCED=1, the same default and shared parameters, made
+        /// once in the plain program's group. A unified program (materials/TreeLod.program) is
+        /// varied through the delegate the render system chose.
         inline Ogre::String instancedProgram(const Ogre::GpuProgramPtr& plain)
         {
             const Ogre::String name = plain->getName() + "/Instanced";
