@@ -345,6 +345,7 @@ namespace TreeLod
                             {"scale", args.scale},
                             {"shadowMap", script.shadows.enabled ? script.shadows.textureSize : 0},
                             {"shadowLodBias", script.shadows.lodBias},
+                            {"windStrength", script.wind.strength},
                             {"referenceBudgetTriangles", args.referenceBudget},
                             {"referenceImageBudgetTriangles", imageBudget(args)},
                             {"timing", "frame_ms: wall time until a one-pixel read-back (GPU-bounded; Ogre's GL3Plus "

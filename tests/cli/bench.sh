@@ -339,8 +339,11 @@ grep -q "bad.json: line" "$out/bad.txt" || { cat "$out/bad.txt"; fail "error doe
 # --shadow-size: 0 turns the script's shadows off (recorded), a size that is no power of two is
 # refused before anything is written.
 "$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/noshadow" --frames 2 --size 64x36 \
-  --techniques lodf --lod-bias 1 --samples 1 --cache "$shared" --shadow-size 0 --shadow-lod-bias 0.5 -q
+  --techniques lodf --lod-bias 1 --samples 1 --cache "$shared" --shadow-size 0 --shadow-lod-bias 0.5 --wind 0.5 -q
 grep -q '"shadowMap": 0' "$out/noshadow/summary.json" || fail "--shadow-size 0 not recorded"
+grep -q '"windStrength": 0.5' "$out/noshadow/summary.json" || fail "--wind 0.5 not recorded"
+grep -q '"windStrength": 0.5' "$out/noshadow/timings.json" || fail "--wind did not reach treelod_frames"
+grep -q '"windStrength": 0' "$out/single/summary.json" || fail "the script's calm not recorded"
 grep -q '"shadowLodBias": 0.5' "$out/noshadow/summary.json" || fail "--shadow-lod-bias 0.5 not recorded"
 grep -q '"shadowLodBias": 0.5' "$out/noshadow/timings.json" || fail "--shadow-lod-bias did not reach treelod_frames"
 grep -Eq '"shadowMap": [1-9]' "$out/single/summary.json" || fail "the script's shadow map not recorded"
@@ -364,4 +367,10 @@ set -e
 [ "$code" = 2 ] && grep -q -- "--motion-frames: '-1' is not" "$out/badmotion.txt" \
   || { cat "$out/badmotion.txt"; fail "--motion-frames -1 accepted"; }
 [ ! -e "$out/badmotion" ] || fail "a bad --motion-frames created its output directory"
+set +e
+"$treelod" bench "$src/samples/scenes/single-tree.json" -o "$out/badwind" --wind 200 -q 2> "$out/badwind.txt"
+code=$?
+set -e
+[ "$code" = 2 ] && grep -q -- "--wind: 200" "$out/badwind.txt" || { cat "$out/badwind.txt"; fail "--wind 200 accepted"; }
+[ ! -e "$out/badwind" ] || fail "a bad --wind created its output directory"
 echo "bench test passed"
