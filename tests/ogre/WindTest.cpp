@@ -232,8 +232,12 @@ namespace TreeLod::WindTests
             ScopedWind scoped(breeze(2.0f), seconds);
             Ogre::MovableObject* tree = placeTechnique(REFERENCE_TECHNIQUE, *everyTechniqueOak().asset);
             tree->getParentSceneNode()->setScale(Ogre::Vector3(scale));
-            const Image picture =
-                render(CameraSpec::framing(model.boundsMin * scale, model.boundsMax * scale, 30.0f, 10.0f));
+            const CameraSpec framing = CameraSpec::framing(model.boundsMin * scale, model.boundsMax * scale, 30.0f, 10.0f);
+            const Image picture = render(framing);
+            {
+                ScopedWind calm(WindParameters{}, seconds);
+                EXPECT_LT(coveredOverlap(picture, render(framing), BACKGROUND), 0.9) << "the wind moves it";
+            }
             if (reference.pixels.empty())
                 reference = picture;
             else
@@ -254,6 +258,7 @@ namespace TreeLod::WindTests
             std::printf("strength %.0f: IoU with the calm tree %.4f\n", double(strength), overlap);
             EXPECT_GT(treeCoverage(gale, BACKGROUND), 0.5 * treeCoverage(still, BACKGROUND)) << "still drawn";
             EXPECT_GT(overlap, 0.3) << "bent, not blown away";
+            EXPECT_LT(overlap, 0.9) << "bent";
             strip.push_back(gale);
         }
         save(strip, "wind-extremes");
