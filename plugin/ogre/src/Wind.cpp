@@ -47,7 +47,7 @@ namespace TreeLod
         writeShared(gWind, gSeconds);
     }
 
-    const WindParameters& Wind::getParameters()
+    WindParameters Wind::getParameters()
     {
         std::lock_guard<std::mutex> lock(gMutex);
         return gWind;

@@ -25,7 +25,7 @@ namespace TreeLod
         /// Throws Ogre::InvalidParametersException with WindParameters::validate's message (NaN,
         /// negative strength, ...) and keeps the wind it had.
         static void setParameters(const WindParameters& wind);
-        static const WindParameters& getParameters();
+        static WindParameters getParameters();
         /// Seconds on the wind's clock (finite; throws otherwise).
         static void setTime(double seconds);
         static double getTime();
