@@ -103,6 +103,51 @@ namespace TreeLod
             EXPECT_NE(c.curveLevel, 1u);
     }
 
+    TEST(LevelSelection, occlusionScalesTheHeightAsFarAsTheBudgetOverTheVisibleShareAllows)
+    {
+        Fixture f;
+        Result<std::vector<LevelChoice>> plan = chooseLevels(f.curves, f.costs, 0.02f);
+        ASSERT_TRUE(plan) << plan.error().message();
+        const std::size_t ref = 0;
+        // Whether the plan drawn at h * s keeps every sampled height within errorBudget / v (or no
+        // worse than the plan's own level there).
+        auto holds = [&](float s, float v) {
+            const float budget = std::min(1.0f, 0.02f / v);
+            for (std::size_t j = 0; j < SELECTION_SAMPLES; ++j)
+            {
+                const float h = selectionHeight(j);
+                const std::size_t own = (*plan)[choiceAt(*plan, h)].curveLevel;
+                const std::size_t level = (*plan)[choiceAt(*plan, h * s)].curveLevel;
+                if (f.curves.flipAt(level, h) >
+                    std::max(f.curves.flipAt(ref, h) + budget, f.curves.flipAt(own, h)) + 1e-6f)
+                    return false;
+            }
+            return true;
+        };
+        EXPECT_EQ(occlusionHeightScale(f.curves, *plan, 0.02f, 1.0f), 1.0f);
+        float previous = 1.0f;
+        // Visible shares whose budgets put no level's limit on a sampled height (no ties).
+        for (const float v : {0.6f, 0.3f, 0.15f})
+        {
+            const float s = occlusionHeightScale(f.curves, *plan, 0.02f, v);
+            // Less visible, at most as fine; within the budget, and the next quarter octave is not.
+            EXPECT_LT(s, 1.0f) << "v " << v;
+            EXPECT_LE(s, previous) << "v " << v;
+            EXPECT_TRUE(holds(s, v)) << "v " << v << ", s " << s;
+            EXPECT_FALSE(holds(s * std::exp2(-1.0f / SELECTION_SAMPLES_PER_OCTAVE), v)) << "v " << v << ", s " << s;
+            previous = s;
+        }
+        // The impostor's curve grows 0.06 per octave from 0.06 at 16 px; the plan draws it below
+        // 19.03 px (2^4.25). At v = 0.6 (0.033 allowed) it may be drawn up to 20.9 px: the sample at
+        // 19.03 px may draw it, the one at 22.6 px may not, so s = 2^-0.25.
+        EXPECT_NEAR(occlusionHeightScale(f.curves, *plan, 0.02f, 0.6f), std::exp2(-0.25f), 1e-6f);
+        // Nothing to scale: no plan, a bad budget or visibility.
+        EXPECT_EQ(occlusionHeightScale(f.curves, {}, 0.02f, 0.5f), 1.0f);
+        EXPECT_EQ(occlusionHeightScale(f.curves, *plan, NAN, 0.5f), 1.0f);
+        EXPECT_EQ(occlusionHeightScale(f.curves, *plan, 0.02f, 0.0f), 1.0f);
+        EXPECT_EQ(occlusionHeightScale(f.curves, *plan, 0.02f, NAN), 1.0f);
+    }
+
     TEST(LevelSelection, aLevelWhoseWorstViewFailsIsNotChosen)
     {
         // The impostor's mean is within 0.02 below 16 px; its worst view (the mesh's is 0.05) may

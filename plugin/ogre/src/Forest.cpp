@@ -68,6 +68,7 @@ namespace TreeLod
         if (!choices)
             invalid(label + choices.error().message(), source);
         plan->choices = *choices;
+        plan->errorBudget = mBudget.getErrorBudget();
         const std::vector<ForestLevel> levels = levelsForChoices(*asset, plan->curves, plan->choices, label, source);
         const std::uint32_t added = addSpeciesImpl(asset, levels, std::move(plan));
         if (memory)
@@ -136,6 +137,7 @@ namespace TreeLod
         kind.boundsRadius = radius;
         kind.thresholds = kindThresholds(*species, levels);
         kind.hardSwitches = kindHardSwitches(*species, levels);
+        kind.occlusionMask = occlusionMask(*asset, kind.boundsCentre, kind.boundsRadius);
         Result<std::uint32_t> added = mInstances.addKind(kind);
         if (!added)
             invalid(label + added.error().message(), source);
@@ -143,6 +145,7 @@ namespace TreeLod
         mSpecies.push_back(std::move(species));
         mStats.levelCounts.emplace_back(levels.size(), 0u);
         updateShadowLevels(added.value());
+        updateOcclusionScales(added.value());
         return added.value();
     }
 
@@ -272,6 +275,28 @@ namespace TreeLod
     }
 
     void Forest::setLodFrozen(bool frozen) { mLodFrozen = frozen; }
+
+    void Forest::setOcclusion(bool occlusion) { mOcclusion = occlusion; }
+
+    std::shared_ptr<const OcclusionMask> Forest::occlusionMask(TreeAsset& asset, const glm::vec3& centre, float radius)
+    {
+        // The reference's polygons (a tree baked from photographs has none: it hides nothing).
+        if (!hasPolygons(asset.getReference().model))
+            return nullptr;
+        return std::make_shared<const OcclusionMask>(makeOcclusionMask(asset.getReference(), centre, radius));
+    }
+
+    void Forest::updateOcclusionScales(std::uint32_t s)
+    {
+        const Species& species = *mSpecies[s];
+        std::array<float, OCCLUSION_CLASSES> scales;
+        scales.fill(1.0f);
+        if (const BudgetPlan* plan = species.budget.get())
+            for (std::size_t c = 1; c < OCCLUSION_CLASSES; ++c)
+                scales[c] = occlusionHeightScale(plan->curves, plan->choices, plan->errorBudget, std::exp2(-float(c)));
+        if (Result<void> set = mInstances.setKindOcclusion(s, mInstances.getKind(s).occlusionMask, scales); !set)
+            invalid(speciesLabel(s, species.asset.get()) + set.error().message(), "Forest::updateOcclusionScales");
+    }
 
     bool Forest::useShadowedMaterials() const
     {

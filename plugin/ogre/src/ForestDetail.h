@@ -307,6 +307,7 @@ namespace TreeLod
         ErrorCurves curves;                  ///< the auto techniques' levels
         std::vector<LevelCost> costs;        ///< this machine's
         std::vector<LevelChoice> choices;    ///< the plan in use
+        float errorBudget = 0.0f;            ///< the error budget `choices` were planned for
         /// Per curve level: taken out by the memory budget (Forest::setMemoryBudget); empty: none.
         std::vector<bool> excluded;
         /// Per frameBudgetLadder() step: its plan (costed at each measurement, with the transition then).

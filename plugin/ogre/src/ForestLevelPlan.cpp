@@ -187,6 +187,7 @@ namespace TreeLod
         {
             plan.choices = choices;
             updateShadowLevels(s);
+            updateOcclusionScales(s);
             return;
         }
         Ogre::AxisAlignedBox drawn = asset.getBounds();
@@ -288,6 +289,7 @@ namespace TreeLod
         mStats.levelCounts[s].assign(count, 0u);
         mStats.instanceBufferBytes = mInstanceBufferBytes;
         updateShadowLevels(s);
+        updateOcclusionScales(s);
     }
 
     const char* toString(ForestBinding binding)
@@ -411,6 +413,7 @@ namespace TreeLod
             if (!choices)
                 invalid("Forest '" + mName + "' species " + std::to_string(s) + ": " + choices.error().message(),
                         "Forest::setErrorBudget");
+            species.budget->errorBudget = budget;
             replan(s, *choices);
         }
         updatePlannedGpuBytes();

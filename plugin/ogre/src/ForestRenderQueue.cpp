@@ -27,6 +27,7 @@ namespace TreeLod
         mStats.visibleInstances = 0;
         mStats.levelSwitches = 0;
         mStats.transitionInstances = 0;
+        mStats.occludedInstances = 0;
         mStats.batches = 0;
         mStats.triangles = 0;
         mStats.cullMilliseconds = 0.0;
@@ -147,8 +148,14 @@ namespace TreeLod
 
         // Culling: this camera's frustum in the Forest's local space (instances are local).
         const Ogre::Affine3& world = _getParentNodeFullTransform();
-        state.camera.planes = CullCamera::frustumPlanes(toGlm(camera->getProjectionMatrix()) *
-                                                        toGlm(camera->getViewMatrix()) * toGlm(world));
+        const glm::dmat4 localToClip =
+            toGlm(camera->getProjectionMatrix()) * toGlm(camera->getViewMatrix()) * toGlm(world);
+        state.camera.planes = CullCamera::frustumPlanes(localToClip);
+        // Occlusion: the viewer's own cull only (Forest.h, setOcclusion).
+        state.camera.occlusion = mOcclusion && viewer;
+        state.camera.viewProjection = glm::mat4(localToClip);
+        state.camera.projectionScale = glm::vec2(float(camera->getProjectionMatrix()[0][0]),
+                                                 float(camera->getProjectionMatrix()[1][1]));
         // LoD: the LoD camera (the viewer's, for shadow cameras), unless frozen.
         if (!mLodFrozen || !state.hasLod)
         {
@@ -237,6 +244,7 @@ namespace TreeLod
             mStats.visibleInstances = state.visibility.getVisibleCount();
             mStats.levelSwitches = state.visibility.getSwitchCount();
             mStats.transitionInstances = state.visibility.getTransitionCount();
+            mStats.occludedInstances = state.visibility.getOccludedCount();
             mStats.batches = batches;
             mStats.triangles = triangles;
             mStats.cullMilliseconds = cullMs;

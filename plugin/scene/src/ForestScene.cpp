@@ -129,15 +129,17 @@ namespace TreeLod
             if (policy->isAuto() && std::isnan(policy->errorBudget) && std::isnan(policy->frameBudgetMs))
             {
                 // The bench's "auto": each species as its script says (with the run's own suffixes).
-                const float transition = policy->transition, memory = policy->memoryBudgetMB;
+                const float transition = policy->transition, memory = policy->memoryBudgetMB,
+                            occlusion = policy->occlusion;
                 policy = LodPolicy::scriptChoice();
                 policy->transition = transition;
                 policy->memoryBudgetMB = memory;
+                policy->occlusion = occlusion;
             }
             if (policy->mode == LodPolicy::Mode::Fixed && bakeTechniqueOf(policy->technique).empty())
                 return fail("", "--techniques",
                             "unknown technique '" + policy->technique + "' (known: auto, auto@E, auto~MS, " +
-                                knownSceneTechniques() + "; any with +fadeT, auto with +memMB)");
+                                knownSceneTechniques() + "; any with +fadeT or +occB, auto with +memMB)");
             runs.push_back({name, *policy});
         }
         return runs;
@@ -350,6 +352,7 @@ namespace TreeLod
         mForest->setLodTransition(std::isnan(mPolicy.transition) ? mScript.lod.transition : mPolicy.transition);
         const float memoryMB = std::isnan(mPolicy.memoryBudgetMB) ? mScript.lod.memoryBudgetMB : mPolicy.memoryBudgetMB;
         mForest->setMemoryBudget(std::uint64_t(double(memoryMB) * 1e6));
+        mForest->setOcclusion(std::isnan(mPolicy.occlusion) ? mScript.lod.occlusion : mPolicy.occlusion != 0.0f);
 
         // Bands per species; then one bake request per distinct source with every technique its
         // species draw (two species sharing a file share one package and one asset).

@@ -96,6 +96,8 @@ namespace TreeLod
         camera.lodPixelScale =
             float(double(viewportWidth) * double(viewportHeight) * std::abs(projection[0][0] * projection[1][1]));
         camera.lodOrthographic = projection[3][3] != 0.0f;
+        camera.viewProjection = projection * view;
+        camera.projectionScale = glm::vec2(projection[0][0], projection[1][1]);
         return camera;
     }
 
@@ -113,8 +115,9 @@ namespace TreeLod
                (mIndices.capacity() + mVisible.capacity() + mVisibleBucket.capacity() + mCursor.capacity() +
                 mNearFirst.capacity()) *
                    sizeof(std::uint32_t) +
-               mVisibleClass.capacity() + mLastLevel.capacity() +
-               (mTransforms.capacity() + mCodes.capacity() + mVisibleCode.capacity() + mBandEnds.capacity()) *
+               mVisibleClass.capacity() + mLastLevel.capacity() + mDrawInstance.capacity() * sizeof(std::uint32_t) +
+               (mTransforms.capacity() + mCodes.capacity() + mVisibleCode.capacity() + mBandEnds.capacity() +
+                mVisibleKey.capacity() + mVisibility.capacity()) *
                    sizeof(float);
     }
 
@@ -148,6 +151,10 @@ namespace TreeLod
                                              (distance ? "distance thresholds increase" :
                                                          "pixel-count thresholds decrease"));
         }
+        for (std::size_t c = 0; c < OCCLUSION_CLASSES; ++c)
+            if (!(kind.occlusionHeightScales[c] > 0.0f && kind.occlusionHeightScales[c] <= 1.0f))
+                return fail("", element, "occlusion height scale " + std::to_string(c) + " (" +
+                                             text(kind.occlusionHeightScales[c]) + ") is not in (0, 1]");
         return {};
     }
 
@@ -160,6 +167,9 @@ namespace TreeLod
         for (std::size_t i = 0; i < MAX_THRESHOLDS; ++i)
             table[i] = i >= kind.thresholds.size() ? -std::numeric_limits<float>::infinity() // never above the key
                                                    : distance ? -kind.thresholds[i] : kind.thresholds[i];
+        for (std::size_t c = 0; c < OCCLUSION_CLASSES; ++c)
+            mKindOcclusionLog2[std::size_t(index) * OCCLUSION_CLASSES + c] =
+                (distance ? -2.0f : 2.0f) * std::log2(kind.occlusionHeightScales[c]);
         ++mTableGeneration; // levels remembered for hysteresis may mean others now
         // Buckets are kind-major: a kind's level count moves the buckets of the kinds after it.
         mBucketCount = 0;
@@ -187,6 +197,7 @@ namespace TreeLod
         mKindFirstBucket.push_back(0);
         mKindDistance.push_back(0);
         mKindTable.resize(mKindTable.size() + MAX_THRESHOLDS);
+        mKindOcclusionLog2.resize(mKindOcclusionLog2.size() + OCCLUSION_CLASSES);
         writeKindTable(index);
         // Instances already placed keep their kinds; their spheres do not depend on new kinds.
         return index;
@@ -205,6 +216,27 @@ namespace TreeLod
             return valid;
         mKinds[kind] = std::move(changed);
         writeKindTable(kind);
+        return {};
+    }
+
+    Result<void> ForestInstances::setKindOcclusion(std::uint32_t kind, std::shared_ptr<const OcclusionMask> mask,
+                                                   const std::array<float, OCCLUSION_CLASSES>& heightScales)
+    {
+        if (kind >= mKinds.size())
+            return fail("", "kind " + std::to_string(kind), "no such kind (" + std::to_string(mKinds.size()) + " kinds)");
+        ForestKind changed = mKinds[kind];
+        changed.occlusionMask = std::move(mask);
+        changed.occlusionHeightScales = heightScales;
+        if (Result<void> valid = checkThresholds(changed, "kind " + std::to_string(kind) + " '" + changed.name + "'");
+            !valid)
+            return valid;
+        if (changed.occlusionHeightScales != mKinds[kind].occlusionHeightScales)
+        {
+            mKinds[kind] = std::move(changed);
+            writeKindTable(kind);
+        }
+        else
+            mKinds[kind] = std::move(changed);
         return {};
     }
 
@@ -500,18 +532,23 @@ namespace TreeLod
         if (!finite(camera.lodPosition) || !std::isfinite(camera.lodPixelScale) || camera.lodPixelScale < 0.0f)
             return fail("", "camera", "LoD position or pixel scale is not finite");
 
-        // Warm-up: arrays grow to the instance and bucket counts (twice the instances with
-        // transitions: a tree may be drawn at two levels), never shrink.
+        // Warm-up: arrays grow to the instance and bucket counts (draws: twice the instances with
+        // transitions, a tree may be drawn at two levels), never shrink.
         const std::size_t n = size();
         const bool transitions = transition > 0.0f;
         const std::size_t entries = transitions ? 2 * n : n;
-        if (out.mVisible.size() < entries)
+        if (out.mVisible.size() < n)
         {
-            out.mVisible.resize(entries);
+            out.mVisible.resize(n);
+            out.mVisibleClass.resize(n);
+            out.mVisibleKey.resize(n);
+            out.mNearFirst.resize(n);
+        }
+        if (out.mVisibleBucket.size() < entries)
+        {
             out.mVisibleBucket.resize(entries);
-            out.mVisibleClass.resize(entries);
             out.mVisibleCode.resize(entries);
-            out.mNearFirst.resize(entries);
+            out.mDrawInstance.resize(entries);
         }
         if (transitions && (out.mBandTransition != transition || out.mBandTables != mTableGeneration ||
                             out.mBandEnds.size() != mKinds.size() * MAX_THRESHOLDS))
@@ -529,7 +566,8 @@ namespace TreeLod
         std::uint8_t* lastLevel = out.mLastLevel.data();
         const float nearFactor = 1.0f + hysteresis, farFactor = 1.0f / (1.0f + hysteresis);
 
-        // Pass 1: cull, pick the level, count per bucket. Planes copied out for the compiler.
+        // Pass 1: cull; each visible instance's LoD key and distance class. Planes copied out for
+        // the compiler.
         float pl[6][4];
         for (int p = 0; p < 6; ++p)
             for (int k = 0; k < 4; ++k)
@@ -552,12 +590,10 @@ namespace TreeLod
         const std::uint32_t* kindFirst = mKindFirstBucket.data();
         const float* tables = mKindTable.data();
         std::uint32_t* visible = out.mVisible.data();
-        std::uint32_t* visibleBucket = out.mVisibleBucket.data();
         std::uint8_t* visibleClass = out.mVisibleClass.data();
-        float* visibleCode = out.mVisibleCode.data();
+        float* visibleKey = out.mVisibleKey.data();
         std::array<std::uint32_t, ForestVisibility::DISTANCE_CLASSES> classCounts{};
-        std::uint32_t* counts = out.mCursor.data();
-        std::uint32_t visibleCount = 0, switchCount = 0, transitionCount = 0, entryCount = 0;
+        std::uint32_t visibleCount = 0;
         const float* blocks = mBlockBounds.data();
         for (std::size_t block = 0, begin = 0; begin < n; ++block, begin += BLOCK_SIZE)
         {
@@ -578,22 +614,99 @@ namespace TreeLod
                 continue;
             const std::size_t end = std::min(n, begin + BLOCK_SIZE);
             for (std::size_t i = begin; i < end; ++i)
+            {
+                const std::uint32_t kind = kinds[i];
+                const glm::vec4 local = fewKinds ? localSpheres[kind]
+                                                 : glm::vec4(mKinds[kind].boundsCentre, mKinds[kind].boundsRadius);
+                const float cs = cosScale[i], ss = sinScale[i], s = std::sqrt(cs * cs + ss * ss);
+                const float x = px[i] + cs * local.x + ss * local.z, y = py[i] + s * local.y,
+                            z = pz[i] - ss * local.x + cs * local.z, r = s * local.w, negR = -r;
+                bool visibleSphere = true;
+                if (!inside)
+                    for (int p = 0; p < 6; ++p)
+                        visibleSphere &= pl[p][0] * x + pl[p][1] * y + pl[p][2] * z + pl[p][3] >= negR;
+                if (!visibleSphere)
+                    continue;
+                const float dx = px[i] - eye.x, dy = py[i] - eye.y, dz = pz[i] - eye.z;
+                const float d2 = dx * dx + dy * dy + dz * dz;
+                // Distance class: the exponent and top two mantissa bits of d^2 (monotonic for d^2 >= 0).
+                std::uint32_t bits;
+                std::memcpy(&bits, &d2, sizeof bits);
+                const std::uint8_t distanceClass = std::uint8_t(
+                    std::clamp(int(bits >> 21) - 127 * 4, 0, ForestVisibility::DISTANCE_CLASSES - 1));
+                visible[visibleCount] = std::uint32_t(i);
+                visibleKey[visibleCount] = lodKey(d2, r, kindDistance[kind] != 0, c);
+                visibleClass[visibleCount] = distanceClass;
+                ++classCounts[distanceClass];
+                ++visibleCount;
+            }
+        }
+
+        // Near first: the visible instances counting-sorted by distance class (stable).
+        std::uint32_t* nearFirst = out.mNearFirst.data();
+        std::uint32_t at = 0;
+        for (std::uint32_t& count : classCounts)
         {
+            const std::uint32_t size = count;
+            count = at;
+            at += size;
+        }
+        for (std::uint32_t j = 0; j < visibleCount; ++j)
+            nearFirst[classCounts[visibleClass[j]]++] = j;
+
+        // Pass 2, near first: occlusion, the level (hysteresis, transitions), the draws and their
+        // count per bucket.
+        const bool occlusion = camera.occlusion;
+        out.mVisibilityValid = occlusion;
+        if (occlusion)
+        {
+            const float aspect = std::abs(camera.projectionScale.y / camera.projectionScale.x);
+            out.mGrid.clear(OCCLUSION_GRID_COLUMNS,
+                            std::isfinite(aspect) && aspect > 0.0f
+                                ? std::clamp(int(std::lround(OCCLUSION_GRID_COLUMNS / aspect)), 8, 4 * OCCLUSION_GRID_COLUMNS)
+                                : OCCLUSION_GRID_COLUMNS);
+            out.mVisibility.assign(std::max(n, out.mVisibility.size()), -1.0f);
+        }
+        const glm::mat4& vp = camera.viewProjection;
+        const float* occlusionLog2 = mKindOcclusionLog2.data();
+        std::uint32_t* drawInstance = out.mDrawInstance.data();
+        std::uint32_t* drawBucket = out.mVisibleBucket.data();
+        float* drawCode = out.mVisibleCode.data();
+        std::uint32_t* counts = out.mCursor.data();
+        std::uint32_t drawnCount = 0, occludedCount = 0, switchCount = 0, transitionCount = 0, drawCount = 0;
+        for (std::uint32_t k = 0; k < visibleCount; ++k)
+        {
+            const std::uint32_t j = nearFirst[k];
+            const std::uint32_t i = visible[j];
             const std::uint32_t kind = kinds[i];
-            const glm::vec4 local = fewKinds ? localSpheres[kind]
-                                             : glm::vec4(mKinds[kind].boundsCentre, mKinds[kind].boundsRadius);
-            const float cs = cosScale[i], ss = sinScale[i], s = std::sqrt(cs * cs + ss * ss);
-            const float x = px[i] + cs * local.x + ss * local.z, y = py[i] + s * local.y,
-                        z = pz[i] - ss * local.x + cs * local.z, r = s * local.w, negR = -r;
-            bool visibleSphere = true;
-            if (!inside)
-                for (int p = 0; p < 6; ++p)
-                    visibleSphere &= pl[p][0] * x + pl[p][1] * y + pl[p][2] * z + pl[p][3] >= negR;
-            if (!visibleSphere)
-                continue;
-            const float dx = px[i] - eye.x, dy = py[i] - eye.y, dz = pz[i] - eye.z;
-            const float d2 = dx * dx + dy * dy + dz * dz;
-            const float key = lodKey(d2, r, kindDistance[kind] != 0, c);
+            float key = visibleKey[j];
+            if (occlusion)
+            {
+                const glm::vec4 sphere = getWorldSphere(i);
+                const glm::vec4 clip = vp * glm::vec4(glm::vec3(sphere), 1.0f);
+                float share = 1.0f;
+                if (clip.w > sphere.w) // in front of the camera's plane
+                {
+                    const float cx = clip.x / clip.w, cy = clip.y / clip.w;
+                    const float rx = sphere.w * std::abs(camera.projectionScale.x) / clip.w;
+                    const float ry = sphere.w * std::abs(camera.projectionScale.y) / clip.w;
+                    share = out.mGrid.addTree(mKinds[kind].occlusionMask.get(), cx - rx, cy - ry, cx + rx, cy + ry);
+                }
+                out.mVisibility[i] = share;
+                if (share < OCCLUSION_HIDDEN)
+                {
+                    ++occludedCount;
+                    continue;
+                }
+                // The kind's factor, interpolated in log2 between its classes (v = 2^-c).
+                const float* factors = occlusionLog2 + std::size_t(kind) * OCCLUSION_CLASSES;
+                const float t = std::min(-std::log2(share), float(OCCLUSION_CLASSES - 1));
+                const int c0 = std::min(int(t), int(OCCLUSION_CLASSES) - 2);
+                const float f = t - float(c0);
+                const float log2Factor = factors[c0] * (1.0f - f) + factors[c0 + 1] * f;
+                if (log2Factor != 0.0f)
+                    key *= std::exp2(log2Factor);
+            }
             const float* table = tables + kind * MAX_THRESHOLDS;
             std::uint32_t level = levelForKey(table, key);
             // Hysteresis holds hard switches only: a switch through a fading threshold has a band.
@@ -616,11 +729,6 @@ namespace TreeLod
             switchCount += lastLevel[i] != LEVEL_NONE && lastLevel[i] != level;
             lastLevel[i] = std::uint8_t(level);
             const std::uint32_t bucket = kindFirst[kind] + level;
-            // Distance class: the exponent and top two mantissa bits of d^2 (monotonic for d^2 >= 0).
-            std::uint32_t bits;
-            std::memcpy(&bits, &d2, sizeof bits);
-            const std::uint8_t distanceClass = std::uint8_t(
-                std::clamp(int(bits >> 21) - 127 * 4, 0, ForestVisibility::DISTANCE_CLASSES - 1));
             // In a transition band (the file comment): the coarse level's share f of the pixels.
             float coarseShare = 0.0f;
             if (transitions && level < MAX_THRESHOLDS)
@@ -631,26 +739,21 @@ namespace TreeLod
                 if (end > 1.0f && ratio < end * end)
                     coarseShare = transitionCoarseShare(std::sqrt(ratio), end);
             }
-            visible[entryCount] = std::uint32_t(i);
-            visibleBucket[entryCount] = bucket;
-            visibleClass[entryCount] = distanceClass;
-            visibleCode[entryCount] = coarseShare > 0.0f ? -coarseShare : 0.0f;
-            ++classCounts[distanceClass];
+            drawInstance[drawCount] = i;
+            drawBucket[drawCount] = bucket;
+            drawCode[drawCount] = coarseShare > 0.0f ? -coarseShare : 0.0f;
             ++counts[bucket];
-            ++entryCount;
-            ++visibleCount;
+            ++drawCount;
+            ++drawnCount;
             if (coarseShare > 0.0f)
             {
-                visible[entryCount] = std::uint32_t(i);
-                visibleBucket[entryCount] = bucket + 1;
-                visibleClass[entryCount] = distanceClass;
-                visibleCode[entryCount] = coarseShare;
-                ++classCounts[distanceClass];
+                drawInstance[drawCount] = i;
+                drawBucket[drawCount] = bucket + 1;
+                drawCode[drawCount] = coarseShare;
                 ++counts[bucket + 1];
-                ++entryCount;
+                ++drawCount;
                 ++transitionCount;
             }
-        }
         }
 
         // Prefix sums: bucket ranges; counts become fill cursors.
@@ -663,42 +766,30 @@ namespace TreeLod
                 counts[b] = out.mBuckets[b].first;
             }
 
-        // Near first: the visible instances counting-sorted by distance class (stable).
-        std::uint32_t* nearFirst = out.mNearFirst.data();
-        std::uint32_t at = 0;
-        for (std::uint32_t& count : classCounts)
+        // Pass 3: fill indices, world matrices and transition codes, bucket by bucket, near first.
+        if (out.mIndices.size() < drawCount)
         {
-            const std::uint32_t size = count;
-            count = at;
-            at += size;
-        }
-        for (std::uint32_t j = 0; j < entryCount; ++j)
-            nearFirst[classCounts[visibleClass[j]]++] = j;
-
-        // Pass 2: fill indices, world matrices and transition codes, bucket by bucket, near first.
-        if (out.mIndices.size() < entryCount)
-        {
-            out.mIndices.resize(entryCount);
-            out.mCodes.resize(entryCount);
-            out.mTransforms.resize(ForestVisibility::TRANSFORM_FLOATS * entryCount);
+            out.mIndices.resize(drawCount);
+            out.mCodes.resize(drawCount);
+            out.mTransforms.resize(ForestVisibility::TRANSFORM_FLOATS * drawCount);
         }
         std::uint32_t* indices = out.mIndices.data();
         float* codes = out.mCodes.data();
         float* transforms = out.mTransforms.data();
-        for (std::uint32_t k = 0; k < entryCount; ++k)
+        for (std::uint32_t k = 0; k < drawCount; ++k)
         {
-            const std::uint32_t j = nearFirst[k];
-            const std::uint32_t i = visible[j];
-            const std::uint32_t slot = counts[visibleBucket[j]]++;
+            const std::uint32_t i = drawInstance[k];
+            const std::uint32_t slot = counts[drawBucket[k]]++;
             indices[slot] = i;
-            codes[slot] = visibleCode[j];
+            codes[slot] = drawCode[k];
             float* m = transforms + ForestVisibility::TRANSFORM_FLOATS * slot;
             const float cs = cosScale[i], ss = sinScale[i];
             m[0] = cs, m[1] = 0.0f, m[2] = ss, m[3] = px[i];
             m[4] = 0.0f, m[5] = std::sqrt(cs * cs + ss * ss), m[6] = 0.0f, m[7] = py[i];
             m[8] = -ss, m[9] = 0.0f, m[10] = cs, m[11] = pz[i];
         }
-        out.mVisibleCount = visibleCount;
+        out.mOccludedCount = occludedCount;
+        out.mVisibleCount = drawnCount;
         out.mCulledCount = std::uint32_t(n - visibleCount);
         out.mSwitchCount = switchCount;
         out.mTransitionCount = transitionCount;

@@ -506,6 +506,37 @@ namespace TreeLod
         return plan;
     }
 
+    float occlusionHeightScale(const ErrorCurves& curves, const std::vector<LevelChoice>& choices, float errorBudget,
+                               float visibility, int maxOctaves)
+    {
+        const int reference = curves.find(LEVEL_SELECTION_REFERENCE, 0, false);
+        if (choices.empty() || reference < 0 || !(visibility > 0.0f && visibility < 1.0f) ||
+            !(errorBudget >= 0.0f && errorBudget <= 1.0f))
+            return 1.0f;
+        const std::size_t ref = std::size_t(reference);
+        const float budget = std::min(1.0f, errorBudget / visibility);
+        float scale = 1.0f;
+        for (int k = 1; k <= maxOctaves * SELECTION_SAMPLES_PER_OCTAVE; ++k)
+        {
+            const float s = std::exp2(-float(k) / SELECTION_SAMPLES_PER_OCTAVE);
+            for (std::size_t j = 0; j < SELECTION_SAMPLES; ++j)
+            {
+                const float h = selectionHeight(j);
+                const std::size_t own = choices[choiceAt(choices, h)].curveLevel;
+                const std::size_t level = choices[choiceAt(choices, h * s)].curveLevel;
+                if (level == own)
+                    continue;
+                const float allowed = std::max(curves.flipAt(ref, h) + budget, curves.flipAt(own, h));
+                const float allowedWorst = std::max(curves.flipMaxAt(ref, h) + WORST_VIEW_BUDGET_FACTOR * budget,
+                                                    curves.flipMaxAt(own, h));
+                if (curves.flipAt(level, h) > allowed || curves.flipMaxAt(level, h) > allowedWorst)
+                    return scale;
+            }
+            scale = s;
+        }
+        return scale;
+    }
+
     std::size_t choiceAt(const std::vector<LevelChoice>& choices, float heightPx)
     {
         for (std::size_t r = 0; r < choices.size(); ++r)

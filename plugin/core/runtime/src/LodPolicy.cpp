@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 namespace TreeLod
 {
@@ -27,30 +28,38 @@ namespace TreeLod
 
     Result<LodPolicy> LodPolicy::parse(const std::string& text, const std::string& element)
     {
-        const std::size_t fade = text.rfind("+fade"), memory = text.rfind("+mem");
-        if (memory != std::string::npos && (fade == std::string::npos || memory > fade))
+        // The last suffix first: "+fadeT", "+memMB", "+occB".
+        struct Suffix
         {
-            const std::string number = text.substr(memory + 4);
+            const char* key;
+            double lo, hi;
+            const char* what;
+        };
+        static const Suffix suffixes[] = {
+            {"+fade", 0.0, ForestInstances::MAX_TRANSITION, "the transition after '+fade' must be in [0, 1] (0: hard switches)"},
+            {"+mem", 0.0, 1e9, "the memory budget after '+mem' must be megabytes in [0, 1e9] (0: none)"},
+            {"+occ", 0.0, 1.0, "occlusion after '+occ' must be 0 (off) or 1 (on)"}};
+        const Suffix* last = nullptr;
+        std::size_t at = 0;
+        for (const Suffix& suffix : suffixes)
+            if (const std::size_t found = text.rfind(suffix.key); found != std::string::npos && (!last || found > at))
+            {
+                last = &suffix;
+                at = found;
+            }
+        if (last)
+        {
+            const std::string number = text.substr(at + std::strlen(last->key));
             char* end = nullptr;
             const double value = std::strtod(number.c_str(), &end);
-            if (number.empty() || *end != '\0' || !(value >= 0.0 && value <= 1e9))
-                return fail("", element,
-                            "'" + text + "': the memory budget after '+mem' must be megabytes in [0, 1e9] (0: none)");
-            Result<LodPolicy> base = parse(text.substr(0, memory), element);
+            const bool occlusion = last == &suffixes[2];
+            if (number.empty() || *end != '\0' || !(value >= last->lo && value <= last->hi) ||
+                (occlusion && value != 0.0 && value != 1.0))
+                return fail("", element, "'" + text + "': " + last->what);
+            Result<LodPolicy> base = parse(text.substr(0, at), element);
             if (base)
-                base->memoryBudgetMB = float(value);
-            return base;
-        }
-        if (fade != std::string::npos)
-        {
-            const std::string number = text.substr(fade + 5);
-            char* end = nullptr;
-            const double value = std::strtod(number.c_str(), &end);
-            if (number.empty() || *end != '\0' || !(value >= 0.0 && value <= ForestInstances::MAX_TRANSITION))
-                return fail("", element, "'" + text + "': the transition after '+fade' must be in [0, 1] (0: hard switches)");
-            Result<LodPolicy> base = parse(text.substr(0, fade), element);
-            if (base)
-                base->transition = float(value);
+                (last == &suffixes[0] ? base->transition : last == &suffixes[1] ? base->memoryBudgetMB : base->occlusion) =
+                    float(value);
             return base;
         }
         if (text.empty())
@@ -93,6 +102,12 @@ namespace TreeLod
             std::snprintf(memory, sizeof memory, "+mem%g", double(memoryBudgetMB));
             return base.toString() + memory;
         }
+        if (!std::isnan(occlusion))
+        {
+            LodPolicy base = *this;
+            base.occlusion = std::numeric_limits<float>::quiet_NaN();
+            return base.toString() + (occlusion != 0.0f ? "+occ1" : "+occ0");
+        }
         char text[48];
         switch (mode)
         {
@@ -117,6 +132,6 @@ namespace TreeLod
         const auto same = [](float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); };
         return mode == other.mode && technique == other.technique && same(errorBudget, other.errorBudget) &&
                same(frameBudgetMs, other.frameBudgetMs) && same(transition, other.transition) &&
-               same(memoryBudgetMB, other.memoryBudgetMB);
+               same(memoryBudgetMB, other.memoryBudgetMB) && same(occlusion, other.occlusion);
     }
 }

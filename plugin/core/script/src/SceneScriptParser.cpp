@@ -810,7 +810,7 @@ namespace TreeLod
                 s.wind = readWind(*v, "/wind");
             if (const Json* v = find(root, "lod"))
             {
-                allowKeys(*v, "/lod", {"maxError", "shadowMaxError", "frameBudgetMs", "memoryBudgetMB", "transition"});
+                allowKeys(*v, "/lod", {"maxError", "shadowMaxError", "frameBudgetMs", "memoryBudgetMB", "transition", "occlusion"});
                 if (const Json* e = find(*v, "maxError"))
                     s.lod.maxError = float(number(*e, "/lod/maxError", 0.0, 1.0));
                 if (const Json* e = find(*v, "shadowMaxError"))
@@ -821,6 +821,8 @@ namespace TreeLod
                     s.lod.memoryBudgetMB = float(number(*e, "/lod/memoryBudgetMB", 0.0, 1e9));
                 if (const Json* e = find(*v, "transition"))
                     s.lod.transition = float(number(*e, "/lod/transition", 0.0, ForestInstances::MAX_TRANSITION));
+                if (const Json* e = find(*v, "occlusion"))
+                    s.lod.occlusion = flag(*e, "/lod/occlusion");
             }
             s.camera = readCamera(need(root, "", "camera"), "/camera");
 

@@ -78,6 +78,9 @@ namespace TreeLod
         std::uint32_t levelSwitches = 0;
         /// Visible instances drawn at two levels, in a transition (setLodTransition).
         std::uint32_t transitionInstances = 0;
+        /// Instances in the frustum not drawn: hidden behind the trees in front (setOcclusion).
+        /// Not counted in visibleInstances.
+        std::uint32_t occludedInstances = 0;
         std::uint32_t batches = 0;            ///< instanced draws queued (all parts)
         std::uint64_t triangles = 0;          ///< submitted, summed over instances
         /// Instances drawn per species and level: levelCounts[species][level] (a tree in a
@@ -249,6 +252,15 @@ namespace TreeLod
         /// Keep the LoD camera of the last frame (levels stop changing; culling goes on).
         void setLodFrozen(bool frozen);
         bool isLodFrozen() const { return mLodFrozen; }
+        /// Occlusion between the trees (default on; docs/forest.md, "Occlusion"): the viewer's cull
+        /// estimates the share of each tree the trees in front leave visible (ForestOcclusion.h,
+        /// each species' silhouette from its reference), does not draw a tree of which less than
+        /// OCCLUSION_HIDDEN is visible, and draws a partly hidden tree of a budgeted species at the
+        /// level its plan gives for its error budget over that share (occlusionHeightScale,
+        /// LevelSelection.h). Shadow cameras draw every tree: what the viewer does not see still
+        /// casts shadows it sees.
+        void setOcclusion(bool occlusion);
+        bool getOcclusion() const { return mOcclusion; }
 
         const ForestStats& getStats() const { return mStats; }
         /// GPU bytes of the assets' drawables in use (vertex and index buffers and textures, all
@@ -312,6 +324,10 @@ namespace TreeLod
         void applyMemoryPlan(const MemoryPlan& plan);
         void updatePlannedGpuBytes(); ///< ForestStats::plannedGpuBytes of the plans in use
         void updateShadowLevels(std::uint32_t species);
+        /// The kind's occlusion height scales from its plan (1 for fixed levels).
+        void updateOcclusionScales(std::uint32_t species);
+        /// The silhouette of `asset` in the sphere (centre, radius) for occlusion; null without polygons.
+        static std::shared_ptr<const OcclusionMask> occlusionMask(TreeAsset& asset, const glm::vec3& centre, float radius);
         /// The kind's table of `levels` of `species`, within setMeshLodBias's limits.
         std::vector<float> kindThresholds(const Species& species, const std::vector<ForestLevel>& levels) const;
         /// ForestKind::hardSwitches of `levels`: the switches below the transitions' smallest height.
@@ -364,6 +380,7 @@ namespace TreeLod
         std::uint64_t mMemoryBudget = 0;
         bool mMemoryBinds = false; ///< the memory plan took levels out
         bool mLodFrozen = false;
+        bool mOcclusion = true;
         ForestStats mStats;
         std::uint64_t mInstanceBufferBytes = 0;
         std::uint64_t mUploadBudget = 0;

@@ -36,9 +36,18 @@
 // square root of the pixel value and falls as the distance, so s = sqrt(value / threshold) or
 // sqrt(threshold / d^2) for distance tables. A band takes at most the lower half of its level's
 // own range of s (in ratio), so bands never meet and each level is drawn whole somewhere.
+//
+// Occlusion (a CullCamera with `occlusion` set; ForestOcclusion.h): the visible instances, near
+// first, are added to the camera's OcclusionGrid with their kind's mask, which gives the share v of
+// each that the trees in front leave visible. An instance with v < OCCLUSION_HIDDEN is not drawn
+// (getOccludedCount). Its kind's occlusionHeightScales (s_c for v = 2^-c, LevelSelection.h's
+// occlusionHeightScale; 1 for none) scale its screen size before its level is picked: s
+// interpolated in log2 between the classes (so that v moving smoothly moves no level by a jump),
+// its value times s^2 (a distance table: its squared distance over s^2).
 #pragma once
 
 #include "TreeLod/Camera.h"
+#include "TreeLod/ForestOcclusion.h"
 #include "TreeLod/LevelTransition.h"
 #include "TreeLod/Result.h"
 
@@ -47,6 +56,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -72,6 +82,11 @@ namespace TreeLod
         std::vector<float> thresholds;
         /// Bit i: threshold i switches hard, also while cull draws transitions.
         std::uint16_t hardSwitches = 0;
+        /// The tree's silhouette, for occlusion (the file comment); null: it hides nothing.
+        std::shared_ptr<const OcclusionMask> occlusionMask;
+        /// Screen-size factor per visibility class (the file comment): finite, in (0, 1]; all 1: the
+        /// levels do not depend on what is hidden (hidden instances are still not drawn).
+        std::array<float, OCCLUSION_CLASSES> occlusionHeightScales{1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
     };
 
     /// One tree. Rotation in radians about +Y (right-handed), uniform scale > 0.
@@ -98,6 +113,13 @@ namespace TreeLod
         glm::vec3 lodPosition{0.0f};  ///< LoD camera position, world space
         float lodPixelScale = 0.0f;   ///< W * H * P00 * P11 of the LoD camera (pixels)
         bool lodOrthographic = false; ///< value does not fall with distance
+        /// Occlusion (the file comment): the culling camera's world-to-clip matrix and its
+        /// projection's P00, P11 place each tree's square on its OcclusionGrid. Off by default
+        /// (fromMatrices fills the matrices, not the flag); shadow cameras keep it off: what the
+        /// viewer does not see still casts shadows it sees.
+        bool occlusion = false;
+        glm::mat4 viewProjection{1.0f};
+        glm::vec2 projectionScale{1.0f};
 
         /// Planes of an OpenGL-convention clip space (clip = viewProjection * world, inside where
         /// -w <= x, y, z <= w), normalised (Gribb & Hartmann's extraction, in double). The far
@@ -170,6 +192,18 @@ namespace TreeLod
         /// that comes back into view at another level does).
         std::uint32_t getSwitchCount() const { return mSwitchCount; }
 
+        /// Visible instances not drawn because occlusion found less than OCCLUSION_HIDDEN of them
+        /// visible (0 without occlusion). Not counted in getVisibleCount.
+        std::uint32_t getOccludedCount() const { return mOccludedCount; }
+        /// The visible share occlusion found for the instance at a dense index in the last cull, in
+        /// [0, 1]; -1 where it was not estimated (outside the frustum, occlusion off).
+        float getVisibility(std::size_t index) const
+        {
+            return index < mVisibility.size() && mVisibilityValid ? mVisibility[index] : -1.0f;
+        }
+        /// The last cull's grid (empty without occlusion).
+        const OcclusionGrid& getOcclusionGrid() const { return mGrid; }
+
         /// Bytes reserved by the arrays (to check that a second cull allocates nothing).
         std::size_t getCapacityBytes() const;
 
@@ -179,12 +213,14 @@ namespace TreeLod
         std::vector<std::uint32_t> mIndices;     // grown to the largest visible count so far
         std::vector<float> mTransforms;          // grown to 12 x the largest visible count so far
         std::vector<float> mCodes;               // transition code per draw
-        std::vector<float> mVisibleCode;         // scratch: per entry of mVisible
+        std::vector<float> mVisibleCode;         // scratch: per draw, near first (transition code)
+        std::vector<std::uint32_t> mDrawInstance; // scratch: per draw, near first (dense index)
+        std::vector<float> mVisibleKey;          // scratch: per entry of mVisible, its LoD key
         std::vector<float> mBandEnds;            // per kind and threshold: 1 + the band's length (1: none)
         float mBandTransition = -1.0f;           // the transition mBandEnds were made for
         std::uint32_t mBandTables = 0;           // and the table generation
         std::vector<std::uint32_t> mVisible;     // scratch: visible instances in input order
-        std::vector<std::uint32_t> mVisibleBucket; // scratch: their buckets
+        std::vector<std::uint32_t> mVisibleBucket; // scratch: per draw, near first (bucket)
         std::vector<std::uint8_t> mVisibleClass;   // scratch: their distance classes
         std::vector<std::uint32_t> mNearFirst;     // scratch: positions in mVisible, near first
         std::vector<std::uint32_t> mCursor;      // scratch: fill position per bucket
@@ -195,6 +231,10 @@ namespace TreeLod
         std::uint32_t mCulledCount = 0;
         std::uint32_t mSwitchCount = 0;
         std::uint32_t mTransitionCount = 0;
+        std::uint32_t mOccludedCount = 0;
+        OcclusionGrid mGrid;
+        std::vector<float> mVisibility;          // per dense instance (getVisibility)
+        bool mVisibilityValid = false;
     };
 
     /// The instance store. Removal swaps the last instance into the hole, so dense indices
@@ -228,6 +268,9 @@ namespace TreeLod
         /// the levels it remembered for hysteresis (a level index may mean another level now).
         Result<void> setKindThresholds(std::uint32_t kind, const std::vector<float>& thresholds,
                                        std::uint16_t hardSwitches = 0);
+        /// Replace a kind's occlusion mask and height scales (ForestKind; checked as addKind does).
+        Result<void> setKindOcclusion(std::uint32_t kind, std::shared_ptr<const OcclusionMask> mask,
+                                      const std::array<float, OCCLUSION_CLASSES>& heightScales);
         std::uint32_t getKindCount() const { return std::uint32_t(mKinds.size()); }
         const ForestKind& getKind(std::uint32_t kind) const { return mKinds[kind]; }
         std::uint32_t getLevelCount(std::uint32_t kind) const
@@ -283,7 +326,7 @@ namespace TreeLod
         /// one its LoD value times or divided by (1 + h) would give, so trees near a switch do not
         /// flicker between two levels under camera jitter (0: none). `out` remembers the levels
         /// per instance; after instances are added or removed, or a kind's table changes, it
-        /// starts afresh. Transition t (file comment): trees near a switch are drawn at both levels;
+        /// starts afresh. Occlusion as the file comment says, where `camera.occlusion` is set. Transition t (file comment): trees near a switch are drawn at both levels;
         /// hysteresis holds only the switches that do not fade (a fade has nothing to flicker).
         Result<void> cull(const CullCamera& camera, float lodBias, ForestVisibility& out, float hysteresis = 0.0f,
                           float transition = 0.0f) const;
@@ -306,6 +349,9 @@ namespace TreeLod
         /// Per kind MAX_THRESHOLDS keys, compared as key >= table[i]: pixel thresholds as they
         /// are, distance thresholds negated (value = -d^2 / bias), padding never reached.
         std::vector<float> mKindTable;
+        /// Per kind OCCLUSION_CLASSES factors on the key, log2 (0: none): 2 log2 s for pixel tables,
+        /// -2 log2 s for distance tables (keys negated).
+        std::vector<float> mKindOcclusionLog2;
         std::uint32_t mBucketCount = 0;
         std::uint32_t mTableGeneration = 0; ///< counts table changes (addKind, setKindThresholds)
 

@@ -106,6 +106,17 @@ namespace TreeLod
     /// The run of `choices` drawn at `heightPx` (the first whose minHeightPx it reaches).
     std::size_t choiceAt(const std::vector<LevelChoice>& choices, float heightPx);
 
+    /// Occlusion (ForestOcclusion.h): a tree of which only the share `visibility` is visible adds that
+    /// share of its level's error to the frame, so its plan may spend errorBudget / visibility. The
+    /// factor s <= 1 on its height on screen that spends it with the levels of `choices` (planned for
+    /// `errorBudget`): the smallest s = 2^(-k / SELECTION_SAMPLES_PER_OCTAVE), k at most
+    /// `maxOctaves` octaves, such that for every k' <= k and every sample height h the level the plan
+    /// draws at h s is allowed at h for min(1, errorBudget / visibility) (chooseLevels' test), or is
+    /// no worse there than the level it draws at h. 1 for a visibility of 1 (or more), curves without
+    /// the reference, a budget that is not in [0, 1] or a visibility that is not > 0.
+    float occlusionHeightScale(const ErrorCurves& curves, const std::vector<LevelChoice>& choices, float errorBudget,
+                               float visibility, int maxOctaves = 5);
+
     /// One species of a memory plan (chooseLevelsWithinMemory).
     struct MemoryPlanSpecies
     {

@@ -9,7 +9,8 @@
 // Any of them + "+fadeT": level transitions of length T in [0, 1] (Forest::setLodTransition; 0:
 // hard switches), else the script's ("auto+fade0", "impostor+fade0.2", "+fade0.1"); and + "+memMB":
 // a memory budget of MB megabytes (10^6 bytes) for budgeted auto (Forest::setMemoryBudget; 0:
-// none), else the script's ("auto+mem40", "auto@0.02+mem40+fade0.2").
+// none), else the script's ("auto+mem40", "auto@0.02+mem40+fade0.2"); and + "+occB": occlusion
+// between the trees off (0) or on (1) (Forest::setOcclusion), else the script's ("auto+occ0").
 #pragma once
 
 #include "TreeLod/Result.h"
@@ -38,6 +39,8 @@ namespace TreeLod
         float transition = std::numeric_limits<float>::quiet_NaN();
         /// Forest::setMemoryBudget in megabytes (10^6 bytes), >= 0 (0: none); NaN: the script's.
         float memoryBudgetMB = std::numeric_limits<float>::quiet_NaN();
+        /// Forest::setOcclusion: 0 off, 1 on; NaN: the script's.
+        float occlusion = std::numeric_limits<float>::quiet_NaN();
 
         static LodPolicy scriptChoice() { return {}; }
         static LodPolicy automatic(float errorBudget = std::numeric_limits<float>::quiet_NaN(),

@@ -160,6 +160,8 @@ namespace TreeLod
         float memoryBudgetMB = 0.0f;
         /// Level transitions (Forest::setLodTransition) of every species, in [0, 1]; 0: hard switches.
         float transition = ForestInstances::DEFAULT_TRANSITION;
+        /// Occlusion between the trees (Forest::setOcclusion).
+        bool occlusion = true;
     };
 
     struct SceneKeyframe
