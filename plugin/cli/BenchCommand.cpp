@@ -145,6 +145,8 @@ namespace TreeLod
                 run.plannedGpuBytes = r.value("plannedGpuBytes", std::uint64_t(0));
                 run.memoryBudgetBytes = r.value("memoryBudgetBytes", std::uint64_t(0));
                 run.binding = r.value("binding", "");
+                run.errorBudget = r.value("errorBudget", double(NAN));
+                run.occlusion = r.value("occlusion", false);
                 run.instanceBytes = r.value("instanceBytes", std::uint64_t(0));
                 run.rssMiB = r.value("rssMiB", NAN);
                 run.peakRssMiB = r.value("peakRssMiB", NAN);
@@ -164,6 +166,7 @@ namespace TreeLod
                         record.timing.batches = f["batches"];
                         record.timing.triangles = f["triangles"];
                         record.visible = f.value("visible", 0u);
+                        record.occluded = f.value("occluded", 0u);
                         record.levels = f.value("levels", std::vector<std::uint32_t>{});
                         record.uploadedBytes = f.value("uploadedBytes", std::uint64_t(0));
                         record.gpuBytes = f.value("gpuBytes", std::uint64_t(0));

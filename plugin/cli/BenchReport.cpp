@@ -475,7 +475,7 @@ namespace TreeLod
                 for (const Run& other : runs)
                     if (other.count == run.count && other.technique == REFERENCE_TECHNIQUE)
                         reference = &other;
-                std::vector<double> frameMs, cpuMs, flips, rmse, noise, refNoise;
+                std::vector<double> frameMs, cpuMs, flips, rmse, noise, refNoise, occluded, used;
                 std::vector<std::string> skipped;
                 if (!run.skipped.empty())
                     skipped.push_back(run.skipped);
@@ -491,7 +491,13 @@ namespace TreeLod
                             worst = {{"frame", r.frame}, {"time", r.time}, {"frameMs", r.timing.frameMilliseconds},
                                      {"uploadedBytes", r.uploadedBytes}};
                         maxUploaded = std::max(maxUploaded, r.uploadedBytes);
+                        occluded.push_back(double(r.occluded));
                     }
+                    // The error used: this run's FLIP over the polygonal tree's own on the same frame.
+                    const std::size_t f = std::size_t(&r - run.frames.data());
+                    if (reference && &run != reference && f < reference->frames.size() && std::isfinite(r.flip))
+                        if (const double own = reference->frames[f].flip; std::isfinite(own))
+                            used.push_back(r.flip - own);
                     flips.push_back(r.flip);
                     rmse.push_back(r.msRmse);
                     noise.push_back(r.temporalNoise);
@@ -534,6 +540,12 @@ namespace TreeLod
                                    {"temporalNoise", num(statsOf(noise).mean)},
                                    {"referenceTemporalNoise", num(statsOf(refNoise).mean)},
                                    {"motion", motionJson(run, reference)},
+                                   {"occludedTrees", num(statsOf(occluded).mean)},
+                                   {"occlusion", run.occlusion},
+                                   {"errorBudget", num(run.errorBudget)},
+                                   {"sceneError", {{"used", num(statsOf(used).mean)},
+                                                   {"allowed", SCENE_ERROR_MARGIN},
+                                                   {"frames", used.size()}}},
                                    {"assetBytes", run.assetBytes},
                                    {"gpu", {{"peakBytes", run.peakGpuBytes},
                                             {"residentLevels", run.residentLevels >= 0 ? json(run.residentLevels) : json(nullptr)},

@@ -71,6 +71,7 @@ namespace TreeLod
             std::string skipped; ///< why the frame was not timed or not compared
             FrameTiming timing;
             std::uint32_t visible = 0;
+            std::uint32_t occluded = 0;        ///< trees in view not drawn, hidden by others (Forest::setOcclusion)
             std::vector<std::uint32_t> levels; ///< visible instances per level index, all species summed
             std::uint64_t uploadedBytes = 0;   ///< levels made resident in this frame (Forest upload budget)
             std::uint64_t gpuBytes = 0;        ///< GPU bytes after the frame (levels and instance buffers)
@@ -100,6 +101,8 @@ namespace TreeLod
             std::int64_t residentLevels = -1;
             std::uint64_t plannedGpuBytes = 0, memoryBudgetBytes = 0;
             std::string binding;
+            double errorBudget = NAN; ///< the budgeted species' error budget at the end (NaN: none)
+            bool occlusion = false;   ///< the Forest estimated occlusion (Forest::setOcclusion)
             std::uint64_t instanceBytes = 0; ///< the Forest's instance store on the CPU
             double rssMiB = NAN, peakRssMiB = NAN; ///< treelod_frames' resident memory after the run
             double bakeSeconds = 0.0;

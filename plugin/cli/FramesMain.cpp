@@ -365,6 +365,7 @@ namespace TreeLod
                                 if (!baseline)
                                 {
                                     row["visible"] = stats.visibleInstances;
+                                    row["occluded"] = stats.occludedInstances;
                                     row["levels"] = levelHistogram(scene->getForest());
                                     row["cullMs"] = stats.cullMilliseconds;
                                     row["uploadedBytes"] = stats.uploadedBytes;
@@ -459,7 +460,11 @@ namespace TreeLod
                             for (std::uint32_t s = 0; s < forest.getSpeciesCount(); ++s)
                                 budgeted = budgeted || forest.isBudgeted(s);
                             if (budgeted)
+                            {
                                 run["binding"] = toString(forest.getBindingBudget());
+                                run["errorBudget"] = forest.getErrorBudget();
+                            }
+                            run["occlusion"] = forest.getOcclusion();
                         }
                         run["instanceBytes"] = scene->getForest().getInstances().getMemoryBytes();
                         run["rssMiB"] = rss;

@@ -240,6 +240,8 @@ namespace TreeLod
         std::snprintf(cull, sizeof cull, "%.2f ms", s.cullMilliseconds);
         std::vector<std::pair<std::string, std::string>> stats;
         stats.emplace_back("Trees shown", formatCount(s.visibleInstances) + " of " + formatCount(s.instances));
+        if (s.occludedInstances > 0)
+            stats.emplace_back("Hidden by trees", formatCount(s.occludedInstances));
         if (mLodTransition > 0.0f)
             stats.emplace_back("In a transition", formatCount(s.transitionInstances));
         stats.emplace_back("Batches (frame)", std::to_string(mCamera->_getNumRenderedBatches()));

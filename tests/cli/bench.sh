@@ -192,6 +192,37 @@ for row in csv.DictReader(open(sys.argv[2])):
 print("\n".join(bad[:10]))
 sys.exit(1 if bad else 0)
 EOF
+# The error used: each run's FLIP over the mesh's own on the same sampled frames, against the margin;
+# the budget and occlusion of the Forest's budgeted runs.
+python3 - "$out/single/summary.json" "$out/single/frames.csv" <<'EOF' || fail "error used above"
+import csv, json, sys
+summary = json.load(open(sys.argv[1]))
+flips = {}
+for row in csv.DictReader(open(sys.argv[2])):
+    if row["flip"]:
+        flips.setdefault((row["technique"], float(row["lod_bias"])), {})[row["frame"]] = float(row["flip"])
+mesh = flips[("mesh", 1.0)]
+bad = []
+for r in summary["results"]:
+    key, scene = (r["technique"], float(r["lodBias"])), r["sceneError"]
+    if scene["allowed"] != 0.02:
+        bad.append(f"{key}: allowed {scene['allowed']}")
+    if key == ("mesh", 1.0):
+        if scene["used"] is not None or scene["frames"] != 0:
+            bad.append(f"the mesh against itself: {scene}")
+        continue
+    used = [flips[key][f] - mesh[f] for f in flips[key] if f in mesh]
+    if scene["frames"] != len(used) or not used or abs(scene["used"] - sum(used) / len(used)) > 1e-5:
+        bad.append(f"{key}: error used {scene}, the frames' FLIP give {used}")
+    auto = key[0].startswith("auto")
+    if auto != (r["errorBudget"] is not None) or (auto and not r["occlusion"]):
+        bad.append(f"{key}: error budget {r['errorBudget']}, occlusion {r['occlusion']}")
+auto = [r for r in summary["results"] if r["technique"] == "auto" and r["lodBias"] == 1][0]
+print(f"error used by auto: {auto['sceneError']['used']:.4f} of {auto['sceneError']['allowed']} "
+      f"(per-tree budget {auto['errorBudget']}), trees hidden per frame {auto['occludedTrees']}")
+print("\n".join(bad))
+sys.exit(1 if bad else 0)
+EOF
 plot "$out/single" motion 30 # the frame-time plot's runs, 5 motion frames each
 plot "$out/single" pops 15   # the Forest's among them
 python3 - "$out/single/summary.json" <<'EOF' || fail "motion figures above"

@@ -95,6 +95,14 @@ namespace TreeLod
         EXPECT_EQ(vis.getOccludedCount(), 1u);
         EXPECT_EQ(vis.getVisibleCount() + vis.getOccludedCount() + vis.getCulledCount(), forest.size());
 
+        // The same wall seen on a 10-pixel viewport (its square 4.5 px tall) hides nothing: a few
+        // pixels of leaves draw less than their area.
+        camera.viewportHeight = 10.0f;
+        ASSERT_TRUE(forest.cull(camera, 1.0f, vis));
+        EXPECT_FLOAT_EQ(vis.getVisibility(h), 1.0f);
+        EXPECT_EQ(drawnLevel(vis, h), 0);
+        camera.viewportHeight = 800.0f;
+
         // Off: both drawn, nothing estimated.
         camera.occlusion = false;
         ASSERT_TRUE(forest.cull(camera, 1.0f, vis));

@@ -443,7 +443,10 @@ namespace TreeLod
 
         // The same levels added as fixed: the picture a budgeted species must give. A frame budget
         // has nothing to plan there: the error budget stays.
+        // Occlusion off in both: it would draw the budgeted species' partly hidden trees coarser
+        // than the fixed levels (ForestOcclusion tests that).
         Forest* fixed = placeForest();
+        fixed->setOcclusion(false);
         fixed->addSpecies(asset, planned);
         fixed->addInstances(trees);
         EXPECT_FALSE(fixed->isBudgeted(0));
@@ -456,6 +459,7 @@ namespace TreeLod
         EXPECT_TRUE(sameLevels(fixed->getLevels(0), planned));
 
         Forest* forest = placeForest();
+        forest->setOcclusion(false);
         EXPECT_EQ(forest->getErrorBudget(), DEFAULT_ERROR_BUDGET);
         EXPECT_EQ(forest->getShadowErrorBudget(), DEFAULT_SHADOW_ERROR_BUDGET);
         try

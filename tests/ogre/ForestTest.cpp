@@ -213,6 +213,7 @@ namespace TreeLod
         forest->addSpecies(tree.asset,
                            Forest::levelsForBands(*tree.asset, {{"billboard-cloud", 40.0f}, {"impostor", 0.0f}}));
         forest->addInstances(grid(12, 1.5f * h));
+        forest->setOcclusion(false); // compared with a cull that does not estimate it
         // Standing inside the forest, looking along -Z: the trees behind are not drawn.
         const glm::vec3 eye(0.0f, 0.5f * h, 0.0f);
         const CameraSpec view = look(eye, eye + glm::vec3(0.3f, -0.05f, -1.0f), 60.0f);
@@ -248,6 +249,39 @@ namespace TreeLod
         EXPECT_EQ(forest->getStats().batches, 0u);
         for (std::uint32_t count : flatCounts(*forest))
             EXPECT_EQ(count, 0u);
+    }
+
+    TEST(Forest, treesHiddenBehindTreesAreNotDrawnAndThePictureStays)
+    {
+        // Looking into a dense wood from its edge, level with the crowns: most trees stand behind
+        // others. With occlusion the hidden ones are not drawn; the picture is what it was.
+        const ForestTree& tree = oak();
+        OffscreenRenderer& r = OgreEnvironment::renderer();
+        const float h = treeHeight(tree.model);
+        const glm::vec3 eye(0.0f, 0.5f * h, 8.0f * h);
+        const CameraSpec view = look(eye, glm::vec3(0.0f, 0.45f * h, 0.0f), 50.0f);
+        Forest* forest = placeForest();
+        EXPECT_TRUE(forest->getOcclusion()) << "on by default";
+        forest->addSpecies(tree.asset, {ForestLevel{"mesh", 0, false, 0.0f}});
+        forest->addInstances(grid(20, 0.7f * h));
+        const Image on = toImage(r.render(view, 256, 192, 1));
+        const ForestStats occluded = forest->getStats();
+        forest->setOcclusion(false);
+        const Image off = toImage(r.render(view, 256, 192, 1));
+        const ForestStats all = forest->getStats();
+        const double error = flipMean(off, on);
+        std::printf("occlusion: %u of %u trees in view drawn, %u hidden; triangles %llu of %llu; FLIP %.5f\n",
+                    occluded.visibleInstances, all.visibleInstances, occluded.occludedInstances,
+                    static_cast<unsigned long long>(occluded.triangles), static_cast<unsigned long long>(all.triangles),
+                    error);
+        writePng(OgreEnvironment::outDir() + "/forest-occlusion-on-off.png", sideBySide({on, off}));
+        EXPECT_EQ(all.occludedInstances, 0u);
+        EXPECT_EQ(occluded.visibleInstances + occluded.occludedInstances, all.visibleInstances);
+        EXPECT_GT(occluded.occludedInstances, all.visibleInstances / 4) << "most of the wood is behind its edge";
+        EXPECT_LT(occluded.triangles, all.triangles);
+        EXPECT_GT(treeCoverage(on, BACKGROUND), 0.3);
+        EXPECT_LT(error, 0.01) << "a hidden tree drew visible pixels";
+        compareWithGolden(on, "forest-occlusion", 0.02);
     }
 
     TEST(Forest, drawsDoNotGrowWithTheInstanceCount)

@@ -156,6 +156,7 @@ namespace TreeLod
         state.camera.viewProjection = glm::mat4(localToClip);
         state.camera.projectionScale = glm::vec2(float(camera->getProjectionMatrix()[0][0]),
                                                  float(camera->getProjectionMatrix()[1][1]));
+        state.camera.viewportHeight = camera->getViewport() ? float(camera->getViewport()->getActualHeight()) : 0.0f;
         // LoD: the LoD camera (the viewer's, for shadow cameras), unless frozen.
         if (!mLodFrozen || !state.hasLod)
         {

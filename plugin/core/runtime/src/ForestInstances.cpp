@@ -98,6 +98,7 @@ namespace TreeLod
         camera.lodOrthographic = projection[3][3] != 0.0f;
         camera.viewProjection = projection * view;
         camera.projectionScale = glm::vec2(projection[0][0], projection[1][1]);
+        camera.viewportHeight = viewportHeight;
         return camera;
     }
 
@@ -690,7 +691,8 @@ namespace TreeLod
                     const float cx = clip.x / clip.w, cy = clip.y / clip.w;
                     const float rx = sphere.w * std::abs(camera.projectionScale.x) / clip.w;
                     const float ry = sphere.w * std::abs(camera.projectionScale.y) / clip.w;
-                    share = out.mGrid.addTree(mKinds[kind].occlusionMask.get(), cx - rx, cy - ry, cx + rx, cy + ry);
+                    share = out.mGrid.addTree(mKinds[kind].occlusionMask.get(), cx - rx, cy - ry, cx + rx, cy + ry,
+                                              ry * camera.viewportHeight >= OCCLUSION_MIN_OCCLUDER_PX);
                 }
                 out.mVisibility[i] = share;
                 if (share < OCCLUSION_HIDDEN)

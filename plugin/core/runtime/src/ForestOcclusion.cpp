@@ -210,7 +210,7 @@ namespace TreeLod
         mCells.assign(std::size_t(mColumns) * std::size_t(mRows), 1.0f);
     }
 
-    float OcclusionGrid::addTree(const OcclusionMask* mask, float x0, float y0, float x1, float y1)
+    float OcclusionGrid::addTree(const OcclusionMask* mask, float x0, float y0, float x1, float y1, bool occludes)
     {
         // Grid units: cell (i, j) is [i, i + 1] x [j, j + 1].
         const float gx0 = (x0 + 1.0f) * 0.5f * float(mColumns), gx1 = (x1 + 1.0f) * 0.5f * float(mColumns);
@@ -237,7 +237,7 @@ namespace TreeLod
                 const float w = a * m;
                 weighted += double(w) * double(t);
                 weights += double(w);
-                if (mask)
+                if (mask && occludes)
                     t *= 1.0f - std::min(w, 1.0f);
             }
         }

@@ -120,6 +120,7 @@ namespace TreeLod
         bool occlusion = false;
         glm::mat4 viewProjection{1.0f};
         glm::vec2 projectionScale{1.0f};
+        float viewportHeight = 0.0f; ///< pixels (OCCLUSION_MIN_OCCLUDER_PX)
 
         /// Planes of an OpenGL-convention clip space (clip = viewProjection * world, inside where
         /// -w <= x, y, z <= w), normalised (Gribb & Hartmann's extraction, in double). The far

@@ -14,7 +14,10 @@
 // statistical estimate, not a depth test, good for what it is used for, the error a level adds
 // where a tree is partly hidden (LevelSelection.h, occlusionHeightScale), and for skipping trees of
 // which less than OCCLUSION_HIDDEN is visible. A tree whose sphere reaches the camera's plane is
-// taken as visible and occludes nothing (its square is unbounded).
+// taken as visible and occludes nothing (its square is unbounded); so does a tree whose square is
+// under OCCLUSION_MIN_OCCLUDER_PX tall: a few pixels of alpha-tested leaves draw far less than their
+// area (an alpha test on mipmapped alpha drops most of them), and behind a thousand such trees the
+// estimate would hide trees that show through.
 #pragma once
 
 #include "TreeLod/ModelChunk.h"
@@ -33,6 +36,8 @@ namespace TreeLod
     constexpr float OCCLUSION_HIDDEN = 1.0f / 64.0f;
     /// Columns of a camera's OcclusionGrid (rows by its aspect ratio).
     constexpr int OCCLUSION_GRID_COLUMNS = 128;
+    /// The smallest tree that hides others: its bounding sphere's square this many pixels tall.
+    constexpr float OCCLUSION_MIN_OCCLUDER_PX = 16.0f;
 
     /// A tree's silhouette seen from the side: coverage in [0, 1] of each cell of its bounding
     /// sphere's square (x across, y up; cell (0, 0) at the bottom left).
@@ -64,9 +69,9 @@ namespace TreeLod
         int getColumns() const { return mColumns; }
         int getRows() const { return mRows; }
         /// The share of a tree whose square spans [x0, x1] x [y0, y1] (normalised device
-        /// coordinates, -1..1, y up) that is visible, in [0, 1]; then the tree occludes (a null
-        /// mask: weighed evenly, occludes nothing). A square outside the screen: 1.
-        float addTree(const OcclusionMask* mask, float x0, float y0, float x1, float y1);
+        /// coordinates, -1..1, y up) that is visible, in [0, 1]; then the tree occludes, where
+        /// `occludes` (a null mask: weighed evenly, occludes nothing). A square outside the screen: 1.
+        float addTree(const OcclusionMask* mask, float x0, float y0, float x1, float y1, bool occludes = true);
         /// Transmittance of cell (column, row), row 0 at the bottom.
         float getTransmittance(int column, int row) const { return mCells[std::size_t(row * mColumns + column)]; }
 
