@@ -388,8 +388,12 @@ namespace TreeLod
                                 {
                                     if (double(referenceCost) <= imageBudget)
                                     {
+                                        // Every tree in view: the truth hides nothing by estimate.
+                                        const bool occlusion = scene->getForest().getOcclusion();
+                                        scene->getForest().setOcclusion(false);
                                         save(renderer.render(frameAt(time), width, height, 2), stem + "-ref");
                                         save(renderer.render(nextCamera(f), width, height, 2), stem + "-ref-next");
+                                        scene->getForest().setOcclusion(occlusion);
                                         row["referenceImage"] = stem + "-ref";
                                     }
                                     else

@@ -137,7 +137,6 @@ namespace TreeLod
         kind.boundsRadius = radius;
         kind.thresholds = kindThresholds(*species, levels);
         kind.hardSwitches = kindHardSwitches(*species, levels);
-        kind.occlusionMask = occlusionMask(*asset, kind.boundsCentre, kind.boundsRadius);
         Result<std::uint32_t> added = mInstances.addKind(kind);
         if (!added)
             invalid(label + added.error().message(), source);
@@ -278,12 +277,35 @@ namespace TreeLod
 
     void Forest::setOcclusion(bool occlusion) { mOcclusion = occlusion; }
 
-    std::shared_ptr<const OcclusionMask> Forest::occlusionMask(TreeAsset& asset, const glm::vec3& centre, float radius)
+    void Forest::makeOcclusionMasks()
     {
-        // The reference's polygons (a tree baked from photographs has none: it hides nothing).
-        if (!hasPolygons(asset.getReference().model))
-            return nullptr;
-        return std::make_shared<const OcclusionMask>(makeOcclusionMask(asset.getReference(), centre, radius));
+        // Made when a viewer first culls with occlusion (a Forest that never does, such as the
+        // one-tree Forests that measure levels, decodes nothing for it), from the reference's
+        // polygons (a tree baked from photographs has none: it hides nothing).
+        for (std::uint32_t s = 0; s < mSpecies.size(); ++s)
+        {
+            Species& species = *mSpecies[s];
+            if (species.occlusionMaskMade)
+                continue;
+            species.occlusionMaskMade = true;
+            const ForestKind& kind = mInstances.getKind(s);
+            std::shared_ptr<const OcclusionMask> mask;
+            try
+            {
+                const ReferenceChunk& reference = species.asset->getReference();
+                if (hasPolygons(reference.model))
+                    mask = std::make_shared<const OcclusionMask>(
+                        makeOcclusionMask(reference, kind.boundsCentre, kind.boundsRadius));
+            }
+            catch (const Ogre::Exception& e)
+            {
+                Ogre::LogManager::getSingleton().logWarning(speciesLabel(s, species.asset.get()) +
+                                                            "no silhouette for occlusion (it hides nothing): " +
+                                                            e.getDescription());
+            }
+            if (Result<void> set = mInstances.setKindOcclusion(s, mask, kind.occlusionHeightScales); !set)
+                invalid(speciesLabel(s, species.asset.get()) + set.error().message(), "Forest::makeOcclusionMasks");
+        }
     }
 
     void Forest::updateOcclusionScales(std::uint32_t s)

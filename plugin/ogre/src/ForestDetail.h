@@ -323,6 +323,7 @@ namespace TreeLod
         std::vector<Residency> residency;                     ///< per level
         std::vector<std::uint32_t> shadowLevels;              ///< per level: what its shadow casters draw
         std::unique_ptr<BudgetPlan> budget;                   ///< budgeted species only
+        bool occlusionMaskMade = false; ///< Forest::makeOcclusionMasks
         /// (kind radius / reference radius)^2: the kind's LoD values per reference-sphere value.
         double kindUnit = 1.0;
         /// Tree height on screen (px) per square root of the kind's LoD value.

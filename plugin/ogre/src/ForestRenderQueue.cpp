@@ -157,6 +157,8 @@ namespace TreeLod
         state.camera.projectionScale = glm::vec2(float(camera->getProjectionMatrix()[0][0]),
                                                  float(camera->getProjectionMatrix()[1][1]));
         state.camera.viewportHeight = camera->getViewport() ? float(camera->getViewport()->getActualHeight()) : 0.0f;
+        if (state.camera.occlusion)
+            makeOcclusionMasks();
         // LoD: the LoD camera (the viewer's, for shadow cameras), unless frozen.
         if (!mLodFrozen || !state.hasLod)
         {

@@ -297,6 +297,7 @@ void main()
             OGRE_EXCEPT(Ogre::Exception::ERR_ITEM_NOT_FOUND, "asset '" + asset.getName() + "' is not TreeAssetManager's",
                         "createLevelForest");
         auto* forest = static_cast<Forest*>(sceneManager.createMovableObject(name, ForestFactory::FACTORY_TYPE_NAME));
+        forest->setOcclusion(false); // a level's cost and error are measured on every tree
         try
         {
             ForestLevel only = level;

@@ -326,8 +326,8 @@ namespace TreeLod
         void updateShadowLevels(std::uint32_t species);
         /// The kind's occlusion height scales from its plan (1 for fixed levels).
         void updateOcclusionScales(std::uint32_t species);
-        /// The silhouette of `asset` in the sphere (centre, radius) for occlusion; null without polygons.
-        static std::shared_ptr<const OcclusionMask> occlusionMask(TreeAsset& asset, const glm::vec3& centre, float radius);
+        /// Each species' silhouette for occlusion (ForestKind::occlusionMask), where not made yet.
+        void makeOcclusionMasks();
         /// The kind's table of `levels` of `species`, within setMeshLodBias's limits.
         std::vector<float> kindThresholds(const Species& species, const std::vector<ForestLevel>& levels) const;
         /// ForestKind::hardSwitches of `levels`: the switches below the transitions' smallest height.
