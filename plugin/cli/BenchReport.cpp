@@ -468,6 +468,13 @@ namespace TreeLod
                 std::printf("peak resident memory: frame timer %.0f MiB, bench %.0f MiB\n", framesPeakMiB,
                             benchPeakMiB);
             json results = json::array();
+            // Per tree count, the budgeted runs' error used against their budgets (the calibration below).
+            struct BudgetPoint
+            {
+                std::string name;
+                double budget, used, speedup;
+            };
+            std::map<std::uint32_t, std::vector<BudgetPoint>> budgetPoints;
             for (std::size_t i = 0; i < runs.size(); ++i)
             {
                 const Run& run = runs[i];
@@ -519,6 +526,9 @@ namespace TreeLod
                         for (const Run& other : runs)
                             if (other.count == run.count && other.technique == c.technique)
                                 ratios[c.technique] = num(frameStats.median / medianOver(other, nullptr));
+                if (std::isfinite(run.errorBudget) && !used.empty())
+                    budgetPoints[run.count].push_back(
+                        {runName(run), run.errorBudget, statsOf(used).mean, referenceOnShared / techniqueOnShared});
                 results.push_back({{"trees", run.count},
                                    {"technique", run.technique},
                                    {"lodBias", run.lodBias},
@@ -559,6 +569,34 @@ namespace TreeLod
                                    {"skipped", skipped}});
             }
             summary["results"] = results;
+            // The calibration step: of the budgeted runs, the largest per-tree error budget whose error
+            // used stays within the margin (bench.md, "Error used"); run several (auto@0.04,auto@0.08)
+            // to choose a scene's "lod" maxError.
+            json calibration = json::array();
+            for (auto& [count, points] : budgetPoints)
+            {
+                std::sort(points.begin(), points.end(),
+                          [](const BudgetPoint& a, const BudgetPoint& b) { return a.budget < b.budget; });
+                json tried = json::array();
+                const BudgetPoint* best = nullptr;
+                std::string line;
+                for (const BudgetPoint& p : points)
+                {
+                    tried.push_back({{"run", p.name}, {"errorBudget", p.budget}, {"used", p.used}, {"speedupVsReference", num(p.speedup)}});
+                    if (p.used <= SCENE_ERROR_MARGIN && (!best || p.budget > best->budget))
+                        best = &p;
+                    line += (line.empty() ? "" : ", ") + p.name + " " + number(p.used, 2);
+                }
+                calibration.push_back({{"trees", count},
+                                       {"allowed", SCENE_ERROR_MARGIN},
+                                       {"tried", tried},
+                                       {"largestWithinMargin", best ? json(best->budget) : json(nullptr)}});
+                if (!args.quiet)
+                    std::printf("error used (%s) of %g allowed: %s; the largest budget within it: %s\n",
+                                treesText(count).c_str(), double(SCENE_ERROR_MARGIN), line.c_str(),
+                                best ? number(best->budget, 2).c_str() : "none");
+            }
+            summary["budgetCalibration"] = calibration;
             if (Result<void> w = writeText(args.output + "/summary.json", summary.dump(2) + "\n"); !w)
                 return printError(w.error()), false;
             if (args.json)

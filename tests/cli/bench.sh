@@ -217,6 +217,13 @@ for r in summary["results"]:
     auto = key[0].startswith("auto")
     if auto != (r["errorBudget"] is not None) or (auto and not r["occlusion"]):
         bad.append(f"{key}: error budget {r['errorBudget']}, occlusion {r['occlusion']}")
+# The calibration step: the largest tried budget whose error used is within the margin.
+for c in summary["budgetCalibration"]:
+    within = [t["errorBudget"] for t in c["tried"] if t["used"] <= c["allowed"]]
+    if len(c["tried"]) != 2 or c["largestWithinMargin"] != (max(within) if within else None):
+        bad.append(f"budget calibration {c}")
+if len(summary["budgetCalibration"]) != 1:
+    bad.append(f"budget calibrations: {summary['budgetCalibration']}")
 auto = [r for r in summary["results"] if r["technique"] == "auto" and r["lodBias"] == 1][0]
 print(f"error used by auto: {auto['sceneError']['used']:.4f} of {auto['sceneError']['allowed']} "
       f"(per-tree budget {auto['errorBudget']}), trees hidden per frame {auto['occludedTrees']}")

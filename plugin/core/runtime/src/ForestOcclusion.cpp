@@ -44,6 +44,17 @@ namespace TreeLod
         return std::clamp(sum / area, 0.0f, 1.0f);
     }
 
+    float OcclusionMask::minOver(float u0, float v0, float u1, float v1) const
+    {
+        const int i0 = std::clamp(int(std::floor(u0)), 0, SIZE - 1), i1 = std::clamp(int(std::ceil(u1)), i0 + 1, SIZE);
+        const int j0 = std::clamp(int(std::floor(v0)), 0, SIZE - 1), j1 = std::clamp(int(std::ceil(v1)), j0 + 1, SIZE);
+        float least = 1.0f;
+        for (int j = j0; j < j1; ++j)
+            for (int i = i0; i < i1; ++i)
+                least = std::min(least, coverage[std::size_t(j * SIZE + i)]);
+        return least;
+    }
+
     namespace
     {
         /// The share of texels of `texture` (decoded) within [uvMin, uvMax] whose alpha passes
@@ -232,13 +243,14 @@ namespace TreeLod
                 if (!(a > 0.0f))
                     continue;
                 float& t = mCells[std::size_t(j * mColumns + i)];
-                const float m = mask ? mask->meanOver((xa - gx0) * su, (ya - gy0) * sv, (xb - gx0) * su, (yb - gy0) * sv)
-                                     : 1.0f;
+                const float u0 = (xa - gx0) * su, v0 = (ya - gy0) * sv, u1 = (xb - gx0) * su, v1 = (yb - gy0) * sv;
+                const float m = mask ? mask->meanOver(u0, v0, u1, v1) : 1.0f;
                 const float w = a * m;
                 weighted += double(w) * double(t);
                 weights += double(w);
-                if (mask && occludes)
-                    t *= 1.0f - std::min(w, 1.0f);
+                // Occluders conservative: only cells inside the square, by the least coverage there.
+                if (mask && occludes && a >= 1.0f - 1e-4f)
+                    t *= 1.0f - mask->minOver(u0, v0, u1, v1);
             }
         }
         return weights > 0.0 ? float(std::clamp(weighted / weights, 0.0, 1.0)) : 1.0f;

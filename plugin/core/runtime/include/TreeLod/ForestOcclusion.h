@@ -8,9 +8,12 @@
 // area, overlaps multiplying transmittance; the two views averaged). A camera's OcclusionGrid is a coarse grid over the screen (OCCLUSION_GRID_COLUMNS
 // columns) of transmittance T, 1 where nothing is in front. Trees are added near first: the share
 // of a tree that is visible is the mask-weighted mean of T over the cells its square covers, and
-// the tree then multiplies each cell's T by 1 - a m (a: the share of the cell its square covers,
-// m: its mask's mean over that part). Trees in front are taken as independent random occluders
-// within a cell, as the canopy-gap models of forestry do (Beer-Lambert through the crowns): a
+// the tree then multiplies the T of each cell inside its square by 1 - m (m: the least coverage of
+// its mask there). Trees in front are taken as independent random occluders within a cell, as the
+// canopy-gap models of forestry do (Beer-Lambert through the crowns), and as conservative ones:
+// a cell the square covers in part, or a mask cell of the part that is open, hides nothing, since
+// such edges line up from tree to tree (the crowns' lower edges of a stand on flat ground, seen
+// from the height of the trunks) where independence would close the gap below them. A
 // statistical estimate, not a depth test, good for what it is used for, the error a level adds
 // where a tree is partly hidden (LevelSelection.h, occlusionHeightScale), and for skipping trees of
 // which less than OCCLUSION_HIDDEN is visible. A tree whose sphere reaches the camera's plane is
@@ -53,6 +56,8 @@ namespace TreeLod
         void finish();
         /// Mean coverage over [u0, u1] x [v0, v1] (mask cells, 0..SIZE; empty: 0).
         float meanOver(float u0, float v0, float u1, float v1) const;
+        /// The least coverage of the cells [u0, u1] x [v0, v1] touches (at least one cell).
+        float minOver(float u0, float v0, float u1, float v1) const;
     };
 
     /// The mask of `reference`'s tree in the square of the sphere (`centre`, `radius`), as above
