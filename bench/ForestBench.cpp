@@ -10,7 +10,10 @@
 //               the fill pass writes a matrix for each);
 //   2 random:   64 cameras (seed 2), one per iteration in turn: anywhere over the square, 2 m to
 //               1.5 km high, any heading, pitch 0 to -60 degrees, far clip 5-20 km.
-// Counters: visible (instances drawn per frame, the mean over the cameras); items = instances culled and selected.
+// The second argument: occlusion off (0) or on (1: ForestOcclusion.h; each kind a crown of coverage
+// 0.7 over a trunk, the trees' squares on a 128-column grid).
+// Counters: visible (instances drawn per frame, the mean over the cameras), occluded (hidden by
+// trees in front, not drawn); items = instances culled and selected.
 // Run: build/bin/treelod_core_bench --benchmark_filter=Forest --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 #include "TreeLod/ForestInstances.h"
 
@@ -19,6 +22,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -29,9 +34,27 @@ namespace
     constexpr std::size_t kInstances = 1000000;
     constexpr float kHalfExtent = 5000.0f;
 
+    /// A tree's silhouette: a crown of coverage 0.7 (a disc in the square's upper part), a trunk below.
+    std::shared_ptr<const OcclusionMask> crownMask()
+    {
+        auto mask = std::make_shared<OcclusionMask>();
+        constexpr int S = OcclusionMask::SIZE;
+        for (int y = 0; y < S; ++y)
+            for (int x = 0; x < S; ++x)
+            {
+                const float u = (float(x) + 0.5f) / S - 0.5f, v = (float(y) + 0.5f) / S;
+                const bool crown = u * u / 0.09f + (v - 0.6f) * (v - 0.6f) / 0.09f < 1.0f;
+                mask->coverage[std::size_t(y * S + x)] = crown ? 0.7f : (std::abs(u) < 0.04f && v < 0.4f ? 1.0f : 0.0f);
+            }
+        mask->finish();
+        return mask;
+    }
+
     ForestKind kind(const char* name, float height, ForestLodMode mode, std::vector<float> thresholds)
     {
         ForestKind k;
+        k.occlusionMask = crownMask();
+        k.occlusionHeightScales = {1.0f, 0.84f, 0.71f, 0.59f, 0.5f, 0.5f};
         k.name = name;
         k.boundsCentre = glm::vec3(0.0f, 0.5f * height, 0.0f);
         k.boundsRadius = 0.6f * height;
@@ -121,6 +144,8 @@ namespace
                     height));
             }
         }
+        for (CullCamera& camera : cameras)
+            camera.occlusion = state.range(1) != 0;
         ForestVisibility visibility;
         for (const CullCamera& camera : cameras) // warm-up: arrays reach their size
             if (Result<void> r = forest->cull(camera, 1.0f, visibility); !r)
@@ -129,7 +154,7 @@ namespace
                 return;
             }
         std::size_t next = 0;
-        double visible = 0.0;
+        double visible = 0.0, occluded = 0.0;
         for (auto _ : state)
         {
             const CullCamera& camera = cameras[next++ % cameras.size()];
@@ -138,10 +163,15 @@ namespace
             benchmark::DoNotOptimize(visibility.getTransforms());
             benchmark::ClobberMemory();
             visible += double(visibility.getVisibleCount());
+            occluded += double(visibility.getOccludedCount());
         }
         state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(forest->size()));
         state.counters["visible"] = visible / double(std::max<benchmark::IterationCount>(state.iterations(), 1));
+        state.counters["occluded"] = occluded / double(std::max<benchmark::IterationCount>(state.iterations(), 1));
     }
 }
 
-BENCHMARK(BM_ForestCullAndSelect)->ArgName("camera")->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ForestCullAndSelect)
+    ->ArgNames({"camera", "occlusion"})
+    ->ArgsProduct({{0, 1, 2}, {0, 1}})
+    ->Unit(benchmark::kMillisecond);

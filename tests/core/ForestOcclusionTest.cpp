@@ -20,6 +20,7 @@ namespace TreeLod
         {
             auto mask = std::make_shared<OcclusionMask>();
             mask->coverage.fill(coverage);
+            mask->solid.fill(coverage);
             mask->finish();
             return mask;
         }
@@ -65,6 +66,7 @@ namespace TreeLod
         auto open = std::make_shared<OcclusionMask>();
         open->coverage.fill(1.0f);
         open->coverage[0] = 0.0f; // bottom-left
+        open->solid = open->coverage;
         open->finish();
         grid.clear(2, 2);
         grid.addTree(open.get(), -1.0f, -1.0f, 1.0f, 1.0f);
@@ -228,11 +230,24 @@ namespace TreeLod
                 const float c = mask.coverage[std::size_t(y * S + x)];
                 const float expected = x < H && y < H ? 1.0f : x >= H && y >= H ? 0.25f : 0.0f;
                 EXPECT_NEAR(c, expected, 1e-5f) << "cell " << x << ", " << y;
+                EXPECT_NEAR(mask.solid[std::size_t(y * S + x)], expected, 1e-5f) << "cell " << x << ", " << y;
             }
         EXPECT_NEAR(mask.mean, (1.0f + 0.25f) / 4.0f, 1e-5f);
         EXPECT_NEAR(mask.meanOver(0.0f, 0.0f, float(S), float(S)), mask.mean, 1e-5f);
         EXPECT_NEAR(mask.meanOver(4.0f, 4.0f, 12.0f, 12.0f), (1.0f + 0.25f) / 4.0f, 1e-5f);
         EXPECT_NEAR(mask.meanOver(0.5f, 0.5f, 1.5f, 1.5f), 1.0f, 1e-5f);
+
+        // An edge across a cell: a quad to y = 0.0625 m, half of the lowest row of cells (and of
+        // their 4 x 4 blocks, two rows of four samples each), seen along z only. The mean counts the
+        // covered half of each view's samples, the blocks' least is an open block.
+        ReferenceChunk edge;
+        quad(edge.model.barkVertices, edge.model.barkIndices, {-1, 0, 0}, {1, 0, 0}, {1, 0.0625f, 0}, {-1, 0.0625f, 0});
+        edge.model.barkTriangleMaterial.assign(2, 0);
+        edge.model.materials.resize(1);
+        const OcclusionMask edged = makeOcclusionMask(edge, glm::vec3(0.0f, 1.0f, 0.0f), 1.0f);
+        EXPECT_NEAR(edged.coverage[0], 0.25f, 1e-5f);
+        EXPECT_NEAR(edged.solid[0], 0.0f, 1e-5f);
+        EXPECT_NEAR(edged.coverage[std::size_t(S)], 0.0f, 1e-5f);
 
         // Nothing to cover: an empty mask.
         const OcclusionMask empty = makeOcclusionMask(ReferenceChunk{}, glm::vec3(0.0f), 1.0f);

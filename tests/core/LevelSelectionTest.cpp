@@ -103,6 +103,20 @@ namespace TreeLod
             EXPECT_NE(c.curveLevel, 1u);
     }
 
+    TEST(LevelSelection, aLevelDearerThanTheMeshWhereItIsDrawnLargeStepsAside)
+    {
+        // LoDF within the budget everywhere, half the mesh's cost when small but 9 ms against the
+        // mesh's 8 at 256 px (as at 1280x720, where its full level costs more than the mesh): the
+        // plan draws it where it pays and the mesh above.
+        Fixture f;
+        f.costs[1] = cost("lodf", 1, {0.5f, 1.0f, 9.0f});
+        Result<std::vector<LevelChoice>> plan = chooseLevels(f.curves, f.costs, 0.02f);
+        ASSERT_TRUE(plan) << plan.error().message();
+        EXPECT_EQ((*plan)[choiceAt(*plan, 256.0f)].curveLevel, 0u) << "the mesh, cheaper there";
+        EXPECT_EQ((*plan)[choiceAt(*plan, 4096.0f)].curveLevel, 0u);
+        EXPECT_EQ((*plan)[choiceAt(*plan, 64.0f)].curveLevel, 1u) << "LoDF, half the mesh's cost there";
+    }
+
     TEST(LevelSelection, occlusionScalesTheHeightAsFarAsTheBudgetOverTheVisibleShareAllows)
     {
         Fixture f;

@@ -111,6 +111,31 @@ namespace TreeLod
         }
     }
 
+    TEST(LodPolicy, occlusionOffOrOnFollowsAnyChoice)
+    {
+        Result<LodPolicy> off = LodPolicy::parse("auto+occ0");
+        ASSERT_TRUE(off.ok());
+        EXPECT_TRUE(off->isAuto());
+        EXPECT_EQ(off->occlusion, 0.0f);
+        EXPECT_TRUE(std::isnan(LodPolicy::parse("auto")->occlusion)) << "the script's";
+        Result<LodPolicy> all = LodPolicy::parse("impostor+occ1+mem3+fade0.1");
+        ASSERT_TRUE(all.ok());
+        EXPECT_EQ(all->technique, "impostor");
+        EXPECT_EQ(all->occlusion, 1.0f);
+        EXPECT_EQ(all->memoryBudgetMB, 3.0f);
+        EXPECT_EQ(all->transition, 0.1f);
+        EXPECT_EQ(*LodPolicy::parse(all->toString()), *all) << all->toString();
+        EXPECT_EQ(off->toString(), "auto+occ0");
+        EXPECT_NE(*off, *LodPolicy::parse("auto"));
+        for (const char* bad : {"auto+occ", "auto+occ0.5", "auto+occ2", "auto+occyes"})
+        {
+            Result<LodPolicy> policy = LodPolicy::parse(bad, "--techniques");
+            ASSERT_FALSE(policy.ok()) << bad;
+            EXPECT_NE(policy.error().message().find("occlusion after '+occ' must be 0 (off) or 1 (on)"), std::string::npos)
+                << policy.error().message();
+        }
+    }
+
     TEST(LodPolicy, writesBackWhatItParses)
     {
         for (const char* text : {"", "auto", "auto@0.05", "auto@0", "auto@1", "auto~40", "auto~16.5", "lodf",

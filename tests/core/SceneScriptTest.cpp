@@ -411,6 +411,9 @@ namespace TreeLod
         EXPECT_EQ(parsed(replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"lod\": {\"memoryBudgetMB\": 48.5}"))
                       .lod.memoryBudgetMB,
                   48.5f);
+        // Occlusion, on unless turned off.
+        EXPECT_TRUE(parsed(MINIMAL).lod.occlusion);
+        EXPECT_FALSE(parsed(replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"lod\": {\"occlusion\": false}")).lod.occlusion);
         // Level transitions.
         EXPECT_EQ(parsed(MINIMAL).lod.transition, ForestInstances::DEFAULT_TRANSITION);
         EXPECT_EQ(parsed(replaced(MINIMAL, "\"frames\": 2", "\"frames\": 2, \"lod\": {\"transition\": 0.3}")).lod.transition,
@@ -422,7 +425,8 @@ namespace TreeLod
                                       {"{\"frameBudgetMs\": -1}", "/lod/frameBudgetMs"},
                                       {"{\"frameBudgetMs\": \"fast\"}", "/lod/frameBudgetMs"},
                                       {"{\"memoryBudgetMB\": -5}", "/lod/memoryBudgetMB"},
-                                      {"{\"memoryBudgetMB\": 2e9}", "/lod/memoryBudgetMB"}})
+                                      {"{\"memoryBudgetMB\": 2e9}", "/lod/memoryBudgetMB"},
+                                      {"{\"occlusion\": 1}", "/lod/occlusion"}})
         {
             const std::string message =
                 errorOf(replaced(MINIMAL, "\"frames\": 2", std::string("\"frames\": 2, \"lod\": ") + bad));

@@ -51,7 +51,7 @@ namespace TreeLod
         float least = 1.0f;
         for (int j = j0; j < j1; ++j)
             for (int i = i0; i < i1; ++i)
-                least = std::min(least, coverage[std::size_t(j * SIZE + i)]);
+                least = std::min(least, solid[std::size_t(j * SIZE + i)]);
         return least;
     }
 
@@ -198,17 +198,27 @@ namespace TreeLod
                             model.leafVertices[model.leafIndices[k + 1]].position,
                             model.leafVertices[model.leafIndices[k + 2]].position, opacity);
         }
-        // Coverage per mask cell: the mean over its samples and the two views of 1 - T.
-        constexpr int F = SideView::RES / OcclusionMask::SIZE;
+        // Per mask cell, the mean over its samples and the two views of 1 - T (coverage), and the
+        // least such mean over its 4 x 4 blocks (solid).
+        constexpr int F = SideView::RES / OcclusionMask::SIZE, B = F / 4;
         for (int y = 0; y < OcclusionMask::SIZE; ++y)
             for (int x = 0; x < OcclusionMask::SIZE; ++x)
             {
-                double sum = 0.0;
-                for (const SideView& view : views)
-                    for (int dy = 0; dy < F; ++dy)
-                        for (int dx = 0; dx < F; ++dx)
-                            sum += 1.0 - double(view.transmittance[std::size_t((y * F + dy) * SideView::RES + x * F + dx)]);
+                double sum = 0.0, least = 1.0;
+                for (int by = 0; by < 4; ++by)
+                    for (int bx = 0; bx < 4; ++bx)
+                    {
+                        double block = 0.0;
+                        for (const SideView& view : views)
+                            for (int dy = 0; dy < B; ++dy)
+                                for (int dx = 0; dx < B; ++dx)
+                                    block += 1.0 - double(view.transmittance[std::size_t(
+                                                       (y * F + by * B + dy) * SideView::RES + x * F + bx * B + dx)]);
+                        sum += block;
+                        least = std::min(least, block / double(2 * B * B));
+                    }
                 mask.coverage[std::size_t(y * OcclusionMask::SIZE + x)] = float(sum / double(2 * F * F));
+                mask.solid[std::size_t(y * OcclusionMask::SIZE + x)] = float(least);
             }
         mask.finish();
         return mask;

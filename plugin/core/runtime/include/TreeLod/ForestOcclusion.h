@@ -8,11 +8,11 @@
 // area, overlaps multiplying transmittance; the two views averaged). A camera's OcclusionGrid is a coarse grid over the screen (OCCLUSION_GRID_COLUMNS
 // columns) of transmittance T, 1 where nothing is in front. Trees are added near first: the share
 // of a tree that is visible is the mask-weighted mean of T over the cells its square covers, and
-// the tree then multiplies the T of each cell inside its square by 1 - m (m: the least coverage of
-// its mask there). Trees in front are taken as independent random occluders within a cell, as the
+// the tree then multiplies the T of each cell inside its square by 1 - m (m: the least of its
+// mask's `solid` there, each mask cell's least coverage over its 4 x 4 blocks). Trees in front are taken as independent random occluders within a cell, as the
 // canopy-gap models of forestry do (Beer-Lambert through the crowns), and as conservative ones:
-// a cell the square covers in part, or a mask cell of the part that is open, hides nothing, since
-// such edges line up from tree to tree (the crowns' lower edges of a stand on flat ground, seen
+// a cell the square covers in part, or a mask cell an edge of the silhouette crosses, hides
+// little or nothing, since such edges line up from tree to tree (the crowns' lower edges of a stand on flat ground, seen
 // from the height of the trunks) where independence would close the gap below them. A
 // statistical estimate, not a depth test, good for what it is used for, the error a level adds
 // where a tree is partly hidden (LevelSelection.h, occlusionHeightScale), and for skipping trees of
@@ -38,7 +38,7 @@ namespace TreeLod
     /// A tree of which less is visible is not drawn.
     constexpr float OCCLUSION_HIDDEN = 1.0f / 64.0f;
     /// Columns of a camera's OcclusionGrid (rows by its aspect ratio).
-    constexpr int OCCLUSION_GRID_COLUMNS = 128;
+    constexpr int OCCLUSION_GRID_COLUMNS = 256;
     /// The smallest tree that hides others: its bounding sphere's square this many pixels tall.
     constexpr float OCCLUSION_MIN_OCCLUDER_PX = 16.0f;
 
@@ -48,6 +48,9 @@ namespace TreeLod
     {
         static constexpr int SIZE = 16;
         std::array<float, SIZE * SIZE> coverage{};
+        /// What the tree is trusted to hide behind each cell: the least coverage of the cell's 4 x 4
+        /// blocks (makeOcclusionMask), so that a cell an edge crosses hides little.
+        std::array<float, SIZE * SIZE> solid{};
         /// Summed-area table of `coverage`, (SIZE + 1)^2, made by finish().
         std::array<float, (SIZE + 1) * (SIZE + 1)> sums{};
         /// Mean coverage of the square.
@@ -56,7 +59,7 @@ namespace TreeLod
         void finish();
         /// Mean coverage over [u0, u1] x [v0, v1] (mask cells, 0..SIZE; empty: 0).
         float meanOver(float u0, float v0, float u1, float v1) const;
-        /// The least coverage of the cells [u0, u1] x [v0, v1] touches (at least one cell).
+        /// The least `solid` of the cells [u0, u1] x [v0, v1] touches (at least one cell).
         float minOver(float u0, float v0, float u1, float v1) const;
     };
 
