@@ -51,18 +51,29 @@ namespace TreeLod
         OcclusionGrid grid;
         grid.clear(4, 4); // cells of 0.5 x 0.5 in NDC
         // An opaque square over cell (0, 0) and half of cell (1, 0): seen whole, then hides the cell
-        // inside it, not the one it covers in part.
-        EXPECT_FLOAT_EQ(grid.addTree(uniformMask(1.0f).get(), -1.0f, -1.0f, -0.25f, -0.5f), 1.0f);
+        // inside it, and half of the other by estimate, none of it conservatively.
+        const OcclusionShare first = grid.addTree(uniformMask(1.0f).get(), -1.0f, -1.0f, -0.25f, -0.5f);
+        EXPECT_FLOAT_EQ(first.estimate, 1.0f);
+        EXPECT_FLOAT_EQ(first.conservative, 1.0f);
         EXPECT_FLOAT_EQ(grid.getTransmittance(0, 0), 0.0f);
-        EXPECT_FLOAT_EQ(grid.getTransmittance(1, 0), 1.0f);
+        EXPECT_FLOAT_EQ(grid.getTransmittance(1, 0), 0.5f);
         EXPECT_FLOAT_EQ(grid.getTransmittance(2, 0), 1.0f);
-        // A tree over cells (0, 0) .. (3, 0) evenly: (0 + 1 + 1 + 1) / 4 of it is visible.
-        EXPECT_NEAR(grid.addTree(uniformMask(0.5f).get(), -1.0f, -1.0f, 1.0f, -0.5f), 0.75f, 1e-6f);
+        EXPECT_FLOAT_EQ(grid.getConservativeTransmittance(0, 0), 0.0f);
+        EXPECT_FLOAT_EQ(grid.getConservativeTransmittance(1, 0), 1.0f);
+        // A tree over cells (0, 0) .. (3, 0) evenly: (0 + 0.5 + 1 + 1) / 4 of it is visible by
+        // estimate, (0 + 1 + 1 + 1) / 4 conservatively.
+        const OcclusionShare second = grid.addTree(uniformMask(0.5f).get(), -1.0f, -1.0f, 1.0f, -0.5f);
+        EXPECT_NEAR(second.estimate, 0.625f, 1e-6f);
+        EXPECT_NEAR(second.conservative, 0.75f, 1e-6f);
         EXPECT_NEAR(grid.getTransmittance(3, 0), 0.5f, 1e-6f);
+        EXPECT_NEAR(grid.getConservativeTransmittance(3, 0), 0.5f, 1e-6f);
         // A null mask is weighed evenly and hides nothing.
-        EXPECT_NEAR(grid.addTree(nullptr, -1.0f, -1.0f, 1.0f, -0.5f), (0.0f + 0.5f + 0.5f + 0.5f) / 4.0f, 1e-6f);
+        const OcclusionShare third = grid.addTree(nullptr, -1.0f, -1.0f, 1.0f, -0.5f);
+        EXPECT_NEAR(third.estimate, (0.0f + 0.25f + 0.5f + 0.5f) / 4.0f, 1e-6f);
+        EXPECT_NEAR(third.conservative, (0.0f + 0.5f + 0.5f + 0.5f) / 4.0f, 1e-6f);
         EXPECT_NEAR(grid.getTransmittance(3, 0), 0.5f, 1e-6f);
-        // A mask open in one of its cells hides nothing where a grid cell takes it in.
+        // A mask open in one of its cells: by estimate a grid cell that takes it in hides by the
+        // mean, conservatively nothing.
         auto open = std::make_shared<OcclusionMask>();
         open->coverage.fill(1.0f);
         open->coverage[0] = 0.0f; // bottom-left
@@ -70,14 +81,15 @@ namespace TreeLod
         open->finish();
         grid.clear(2, 2);
         grid.addTree(open.get(), -1.0f, -1.0f, 1.0f, 1.0f);
-        EXPECT_FLOAT_EQ(grid.getTransmittance(0, 0), 1.0f);
-        EXPECT_FLOAT_EQ(grid.getTransmittance(1, 0), 0.0f);
-        EXPECT_FLOAT_EQ(grid.getTransmittance(1, 1), 0.0f);
+        EXPECT_FLOAT_EQ(grid.getTransmittance(0, 0), 1.0f / 64.0f);
+        EXPECT_FLOAT_EQ(grid.getConservativeTransmittance(0, 0), 1.0f);
+        EXPECT_FLOAT_EQ(grid.getConservativeTransmittance(1, 0), 0.0f);
+        EXPECT_FLOAT_EQ(grid.getConservativeTransmittance(1, 1), 0.0f);
         EXPECT_FLOAT_EQ(open->minOver(0.0f, 0.0f, 8.0f, 8.0f), 0.0f);
         EXPECT_FLOAT_EQ(open->minOver(1.0f, 0.0f, 8.0f, 8.0f), 1.0f);
         // Off the screen, or empty: visible.
-        EXPECT_FLOAT_EQ(grid.addTree(uniformMask(1.0f).get(), 2.0f, 2.0f, 3.0f, 3.0f), 1.0f);
-        EXPECT_FLOAT_EQ(grid.addTree(uniformMask(0.0f).get(), -1.0f, -1.0f, 1.0f, 1.0f), 1.0f);
+        EXPECT_FLOAT_EQ(grid.addTree(uniformMask(1.0f).get(), 2.0f, 2.0f, 3.0f, 3.0f).estimate, 1.0f);
+        EXPECT_FLOAT_EQ(grid.addTree(uniformMask(0.0f).get(), -1.0f, -1.0f, 1.0f, 1.0f).conservative, 1.0f);
     }
 
     TEST(ForestOcclusion, aTreeBehindAWallIsHiddenAndOneBesideItSeenWhole)

@@ -685,17 +685,18 @@ namespace TreeLod
             {
                 const glm::vec4 sphere = getWorldSphere(i);
                 const glm::vec4 clip = vp * glm::vec4(glm::vec3(sphere), 1.0f);
-                float share = 1.0f;
+                OcclusionShare visibleShare;
                 if (clip.w > sphere.w) // in front of the camera's plane
                 {
                     const float cx = clip.x / clip.w, cy = clip.y / clip.w;
                     const float rx = sphere.w * std::abs(camera.projectionScale.x) / clip.w;
                     const float ry = sphere.w * std::abs(camera.projectionScale.y) / clip.w;
-                    share = out.mGrid.addTree(mKinds[kind].occlusionMask.get(), cx - rx, cy - ry, cx + rx, cy + ry,
+                    visibleShare = out.mGrid.addTree(mKinds[kind].occlusionMask.get(), cx - rx, cy - ry, cx + rx, cy + ry,
                                               ry * camera.viewportHeight >= OCCLUSION_MIN_OCCLUDER_PX);
                 }
+                const float share = visibleShare.estimate;
                 out.mVisibility[i] = share;
-                if (share < OCCLUSION_HIDDEN)
+                if (visibleShare.conservative < OCCLUSION_HIDDEN)
                 {
                     ++occludedCount;
                     continue;

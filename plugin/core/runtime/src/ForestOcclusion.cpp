@@ -229,20 +229,22 @@ namespace TreeLod
         mColumns = std::max(columns, 1);
         mRows = std::max(rows, 1);
         mCells.assign(std::size_t(mColumns) * std::size_t(mRows), 1.0f);
+        mSolidCells.assign(mCells.size(), 1.0f);
     }
 
-    float OcclusionGrid::addTree(const OcclusionMask* mask, float x0, float y0, float x1, float y1, bool occludes)
+    OcclusionShare OcclusionGrid::addTree(const OcclusionMask* mask, float x0, float y0, float x1, float y1,
+                                          bool occludes)
     {
         // Grid units: cell (i, j) is [i, i + 1] x [j, j + 1].
         const float gx0 = (x0 + 1.0f) * 0.5f * float(mColumns), gx1 = (x1 + 1.0f) * 0.5f * float(mColumns);
         const float gy0 = (y0 + 1.0f) * 0.5f * float(mRows), gy1 = (y1 + 1.0f) * 0.5f * float(mRows);
         if (!(gx1 > gx0) || !(gy1 > gy0) || !std::isfinite(gx0 + gx1 + gy0 + gy1))
-            return 1.0f;
+            return {};
         const int i0 = std::max(int(std::floor(gx0)), 0), i1 = std::min(int(std::ceil(gx1)), mColumns);
         const int j0 = std::max(int(std::floor(gy0)), 0), j1 = std::min(int(std::ceil(gy1)), mRows);
         // Grid units to mask cells.
         const float su = float(OcclusionMask::SIZE) / (gx1 - gx0), sv = float(OcclusionMask::SIZE) / (gy1 - gy0);
-        double weighted = 0.0, weights = 0.0;
+        double weighted = 0.0, weightedSolid = 0.0, weights = 0.0;
         for (int j = j0; j < j1; ++j)
         {
             const float ya = std::max(gy0, float(j)), yb = std::min(gy1, float(j + 1));
@@ -252,17 +254,26 @@ namespace TreeLod
                 const float a = (xb - xa) * (yb - ya);
                 if (!(a > 0.0f))
                     continue;
-                float& t = mCells[std::size_t(j * mColumns + i)];
+                const std::size_t cell = std::size_t(j * mColumns + i);
+                float& t = mCells[cell];
+                float& solid = mSolidCells[cell];
                 const float u0 = (xa - gx0) * su, v0 = (ya - gy0) * sv, u1 = (xb - gx0) * su, v1 = (yb - gy0) * sv;
                 const float m = mask ? mask->meanOver(u0, v0, u1, v1) : 1.0f;
                 const float w = a * m;
                 weighted += double(w) * double(t);
+                weightedSolid += double(w) * double(solid);
                 weights += double(w);
-                // Occluders conservative: only cells inside the square, by the least coverage there.
-                if (mask && occludes && a >= 1.0f - 1e-4f)
-                    t *= 1.0f - mask->minOver(u0, v0, u1, v1);
+                if (mask && occludes)
+                {
+                    t *= 1.0f - std::min(w, 1.0f);
+                    // Only cells inside the square, by the least solid coverage there.
+                    if (a >= 1.0f - 1e-4f)
+                        solid *= 1.0f - mask->minOver(u0, v0, u1, v1);
+                }
             }
         }
-        return weights > 0.0 ? float(std::clamp(weighted / weights, 0.0, 1.0)) : 1.0f;
+        if (!(weights > 0.0))
+            return {};
+        return {float(std::clamp(weighted / weights, 0.0, 1.0)), float(std::clamp(weightedSolid / weights, 0.0, 1.0))};
     }
 }

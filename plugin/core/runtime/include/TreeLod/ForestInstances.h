@@ -39,8 +39,8 @@
 //
 // Occlusion (a CullCamera with `occlusion` set; ForestOcclusion.h): the visible instances, near
 // first, are added to the camera's OcclusionGrid with their kind's mask, which gives the share v of
-// each that the trees in front leave visible. An instance with v < OCCLUSION_HIDDEN is not drawn
-// (getOccludedCount). Its kind's occlusionHeightScales (s_c for v = 2^-c, LevelSelection.h's
+// each that the trees in front leave visible, estimated and conservative. An instance whose
+// conservative share is below OCCLUSION_HIDDEN is not drawn (getOccludedCount). Its kind's occlusionHeightScales (s_c for v = 2^-c, LevelSelection.h's
 // occlusionHeightScale; 1 for none) scale its screen size before its level is picked: s
 // interpolated in log2 between the classes (so that v moving smoothly moves no level by a jump),
 // its value times s^2 (a distance table: its squared distance over s^2).
@@ -196,8 +196,9 @@ namespace TreeLod
         /// Visible instances not drawn because occlusion found less than OCCLUSION_HIDDEN of them
         /// visible (0 without occlusion). Not counted in getVisibleCount.
         std::uint32_t getOccludedCount() const { return mOccludedCount; }
-        /// The visible share occlusion found for the instance at a dense index in the last cull, in
-        /// [0, 1]; -1 where it was not estimated (outside the frustum, occlusion off).
+        /// The visible share occlusion estimated for the instance at a dense index in the last cull
+        /// (OcclusionShare::estimate), in [0, 1]; -1 where it was not estimated (outside the
+        /// frustum, occlusion off).
         float getVisibility(std::size_t index) const
         {
             return index < mVisibility.size() && mVisibilityValid ? mVisibility[index] : -1.0f;

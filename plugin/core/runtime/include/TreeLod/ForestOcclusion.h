@@ -5,22 +5,27 @@
 // bounding sphere's square, seen from the side, that the tree covers (makeOcclusionMask: leaves and
 // bark rasterised along x and along z on 256 x 256 samples, each leaf's opacity the share of its
 // texture rectangle the alpha test keeps, a triangle under two samples put at its centroid as its
-// area, overlaps multiplying transmittance; the two views averaged). A camera's OcclusionGrid is a coarse grid over the screen (OCCLUSION_GRID_COLUMNS
-// columns) of transmittance T, 1 where nothing is in front. Trees are added near first: the share
-// of a tree that is visible is the mask-weighted mean of T over the cells its square covers, and
-// the tree then multiplies the T of each cell inside its square by 1 - m (m: the least of its
-// mask's `solid` there, each mask cell's least coverage over its 4 x 4 blocks). Trees in front are taken as independent random occluders within a cell, as the
-// canopy-gap models of forestry do (Beer-Lambert through the crowns), and as conservative ones:
-// a cell the square covers in part, or a mask cell an edge of the silhouette crosses, hides
-// little or nothing, since such edges line up from tree to tree (the crowns' lower edges of a stand on flat ground, seen
-// from the height of the trunks) where independence would close the gap below them. A
-// statistical estimate, not a depth test, good for what it is used for, the error a level adds
-// where a tree is partly hidden (LevelSelection.h, occlusionHeightScale), and for skipping trees of
-// which less than OCCLUSION_HIDDEN is visible. A tree whose sphere reaches the camera's plane is
-// taken as visible and occludes nothing (its square is unbounded); so does a tree whose square is
-// under OCCLUSION_MIN_OCCLUDER_PX tall: a few pixels of alpha-tested leaves draw far less than their
-// area (an alpha test on mipmapped alpha drops most of them), and behind a thousand such trees the
-// estimate would hide trees that show through.
+// area, overlaps multiplying transmittance; the two views averaged), and per cell its `solid`
+// coverage, the least over the cell's 4 x 4 blocks.
+// A camera's OcclusionGrid holds two transmittances T over a grid of OCCLUSION_GRID_COLUMNS
+// columns on the screen, 1 where nothing is in front. Trees are added near first; the share of a
+// tree that is visible is the mask-weighted mean of T over the cells its square covers, then the
+// tree occludes:
+//   - estimated: each cell's T times 1 - a m (a: the share of the cell its square covers, m: its
+//     mask's mean there). The trees in front as independent random occluders within a cell, as
+//     the canopy-gap models of forestry take them (Beer-Lambert through the crowns). This share
+//     weighs the error a level adds where a tree is partly hidden (LevelSelection.h,
+//     occlusionHeightScale).
+//   - conservative: only the cells inside its square, each times 1 - the least `solid` of its
+//     mask there. Edges line up from tree to tree (the lower edges of a stand's crowns on flat
+//     ground seen from the trunks' height all fall on the horizon), where independence closes the
+//     gap below them; a cell an edge crosses hides nothing here. A tree of which this share is
+//     below OCCLUSION_HIDDEN is not drawn.
+// A statistical estimate, not a depth test. A tree whose sphere reaches the camera's plane is taken
+// as visible and occludes nothing (its square is unbounded); so does a tree whose square is under
+// OCCLUSION_MIN_OCCLUDER_PX tall: a few pixels of alpha-tested leaves draw far less than their area
+// (an alpha test on mipmapped alpha drops most of them), and behind a thousand such trees the
+// estimate hid trees that showed through.
 #pragma once
 
 #include "TreeLod/ModelChunk.h"
@@ -68,7 +73,14 @@ namespace TreeLod
     /// empty mask (occludes nothing).
     OcclusionMask makeOcclusionMask(const ReferenceChunk& reference, const glm::vec3& centre, float radius);
 
-    /// A camera's transmittance over its screen, as above.
+    /// The share of a tree that the trees in front leave visible (OcclusionGrid::addTree).
+    struct OcclusionShare
+    {
+        float estimate = 1.0f;     ///< independent occluders by their mean coverage: the plan's weight
+        float conservative = 1.0f; ///< conservative occluders: below OCCLUSION_HIDDEN the tree is not drawn
+    };
+
+    /// A camera's transmittance over its screen, as above, twice: estimated and conservative.
     class OcclusionGrid
     {
     public:
@@ -77,14 +89,19 @@ namespace TreeLod
         int getColumns() const { return mColumns; }
         int getRows() const { return mRows; }
         /// The share of a tree whose square spans [x0, x1] x [y0, y1] (normalised device
-        /// coordinates, -1..1, y up) that is visible, in [0, 1]; then the tree occludes, where
-        /// `occludes` (a null mask: weighed evenly, occludes nothing). A square outside the screen: 1.
-        float addTree(const OcclusionMask* mask, float x0, float y0, float x1, float y1, bool occludes = true);
-        /// Transmittance of cell (column, row), row 0 at the bottom.
+        /// coordinates, -1..1, y up) that is visible, both ways, in [0, 1]; then the tree occludes,
+        /// where `occludes` (a null mask: weighed evenly, occludes nothing). A square outside the
+        /// screen: 1.
+        OcclusionShare addTree(const OcclusionMask* mask, float x0, float y0, float x1, float y1, bool occludes = true);
+        /// Estimated and conservative transmittance of cell (column, row), row 0 at the bottom.
         float getTransmittance(int column, int row) const { return mCells[std::size_t(row * mColumns + column)]; }
+        float getConservativeTransmittance(int column, int row) const
+        {
+            return mSolidCells[std::size_t(row * mColumns + column)];
+        }
 
     private:
         int mColumns = 0, mRows = 0;
-        std::vector<float> mCells;
+        std::vector<float> mCells, mSolidCells;
     };
 }
