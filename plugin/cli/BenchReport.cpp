@@ -94,6 +94,9 @@ namespace TreeLod
             return args.referenceImageBudget > 0.0 ? args.referenceImageBudget : args.referenceBudget;
         }
 
+        /// A budget kept as a float (0.04f) as the decimal it was written as (to 1e-6).
+        double decimal(double v) { return std::round(v * 1e6) / 1e6; }
+
         std::string treesText(std::uint32_t count) { return std::to_string(count) + (count == 1 ? " tree" : " trees"); }
 
         Result<void> writeText(const std::string& path, const std::string& text)
@@ -552,9 +555,9 @@ namespace TreeLod
                                    {"motion", motionJson(run, reference)},
                                    {"occludedTrees", num(statsOf(occluded).mean)},
                                    {"occlusion", run.occlusion},
-                                   {"errorBudget", num(run.errorBudget)},
+                                   {"errorBudget", num(decimal(run.errorBudget))},
                                    {"sceneError", {{"used", num(statsOf(used).mean)},
-                                                   {"allowed", SCENE_ERROR_MARGIN},
+                                                   {"allowed", decimal(SCENE_ERROR_MARGIN)},
                                                    {"frames", used.size()}}},
                                    {"assetBytes", run.assetBytes},
                                    {"gpu", {{"peakBytes", run.peakGpuBytes},
@@ -582,15 +585,18 @@ namespace TreeLod
                 std::string line;
                 for (const BudgetPoint& p : points)
                 {
-                    tried.push_back({{"run", p.name}, {"errorBudget", p.budget}, {"used", p.used}, {"speedupVsReference", num(p.speedup)}});
+                    tried.push_back({{"run", p.name},
+                                     {"errorBudget", decimal(p.budget)},
+                                     {"used", p.used},
+                                     {"speedupVsReference", num(p.speedup)}});
                     if (p.used <= SCENE_ERROR_MARGIN && (!best || p.budget > best->budget))
                         best = &p;
                     line += (line.empty() ? "" : ", ") + p.name + " " + number(p.used, 2);
                 }
                 calibration.push_back({{"trees", count},
-                                       {"allowed", SCENE_ERROR_MARGIN},
+                                       {"allowed", decimal(SCENE_ERROR_MARGIN)},
                                        {"tried", tried},
-                                       {"largestWithinMargin", best ? json(best->budget) : json(nullptr)}});
+                                       {"largestWithinMargin", best ? json(decimal(best->budget)) : json(nullptr)}});
                 if (!args.quiet)
                     std::printf("error used (%s) of %g allowed: %s; the largest budget within it: %s\n",
                                 treesText(count).c_str(), double(SCENE_ERROR_MARGIN), line.c_str(),

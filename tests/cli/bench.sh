@@ -205,7 +205,7 @@ mesh = flips[("mesh", 1.0)]
 bad = []
 for r in summary["results"]:
     key, scene = (r["technique"], float(r["lodBias"])), r["sceneError"]
-    if scene["allowed"] != 0.02:
+    if abs(scene["allowed"] - 0.02) > 1e-9:
         bad.append(f"{key}: allowed {scene['allowed']}")
     if key == ("mesh", 1.0):
         if scene["used"] is not None or scene["frames"] != 0:

@@ -1245,10 +1245,11 @@ namespace TreeLod
             ForestVisibility vis;
             ASSERT_TRUE(forest.cull(camera, 1.0f, vis));
             EXPECT_EQ(vis.getVisibleCount(), MILLION);
-            // per visible tree: transform, indices, distance class, transition code (and its scratch);
-            // per tree (all visible here): its last level
-            const std::size_t perVisible = (ForestVisibility::TRANSFORM_FLOATS + 2) * sizeof(float) +
-                                           4 * sizeof(std::uint32_t) + 2 * sizeof(std::uint8_t);
+            // per visible tree: transform, LoD key, transition code (and its scratch); index, its place
+            // near first, the draw's instance, bucket and index; distance class; per tree (all
+            // visible here): its last level
+            const std::size_t perVisible = (ForestVisibility::TRANSFORM_FLOATS + 3) * sizeof(float) +
+                                           5 * sizeof(std::uint32_t) + 2 * sizeof(std::uint8_t);
             const std::size_t visibilityBound = MILLION * perVisible +
                                                 forest.getBucketCount() * (sizeof(ForestBucket) + sizeof(std::uint32_t));
             EXPECT_LE(vis.getCapacityBytes(), visibilityBound);
