@@ -242,8 +242,12 @@ namespace TreeLod
             return {};
         const int i0 = std::max(int(std::floor(gx0)), 0), i1 = std::min(int(std::ceil(gx1)), mColumns);
         const int j0 = std::max(int(std::floor(gy0)), 0), j1 = std::min(int(std::ceil(gy1)), mRows);
-        // Grid units to mask cells.
+        // Grid units to mask cells. A square of at least a mask cell per grid cell (a near tree)
+        // reads its mask cell by cell (a grid cell touches at most 2 x 2 of them); a smaller one by
+        // its summed-area table.
         const float su = float(OcclusionMask::SIZE) / (gx1 - gx0), sv = float(OcclusionMask::SIZE) / (gy1 - gy0);
+        const bool fine = mask && su <= 1.0f && sv <= 1.0f;
+        constexpr int S = OcclusionMask::SIZE;
         double weighted = 0.0, weightedSolid = 0.0, weights = 0.0;
         for (int j = j0; j < j1; ++j)
         {
@@ -258,7 +262,19 @@ namespace TreeLod
                 float& t = mCells[cell];
                 float& solid = mSolidCells[cell];
                 const float u0 = (xa - gx0) * su, v0 = (ya - gy0) * sv, u1 = (xb - gx0) * su, v1 = (yb - gy0) * sv;
-                const float m = mask ? mask->meanOver(u0, v0, u1, v1) : 1.0f;
+                int mu0 = 0, mv0 = 0, mu1 = 0, mv1 = 0;
+                float m = 1.0f;
+                if (fine)
+                {
+                    mu0 = std::min(int(u0), S - 1);
+                    mv0 = std::min(int(v0), S - 1);
+                    mu1 = std::clamp(int(std::ceil(u1)) - 1, mu0, S - 1);
+                    mv1 = std::clamp(int(std::ceil(v1)) - 1, mv0, S - 1);
+                    m = mask->coverage[std::size_t(std::min(int(0.5f * (v0 + v1)), S - 1) * S +
+                                                   std::min(int(0.5f * (u0 + u1)), S - 1))];
+                }
+                else if (mask)
+                    m = mask->meanOver(u0, v0, u1, v1);
                 const float w = a * m;
                 weighted += double(w) * double(t);
                 weightedSolid += double(w) * double(solid);
@@ -268,7 +284,15 @@ namespace TreeLod
                     t *= 1.0f - std::min(w, 1.0f);
                     // Only cells inside the square, by the least solid coverage there.
                     if (a >= 1.0f - 1e-4f)
-                        solid *= 1.0f - mask->minOver(u0, v0, u1, v1);
+                    {
+                        float least = mask->solid[std::size_t(mv0 * S + mu0)];
+                        if (fine)
+                            least = std::min({least, mask->solid[std::size_t(mv0 * S + mu1)],
+                                              mask->solid[std::size_t(mv1 * S + mu0)], mask->solid[std::size_t(mv1 * S + mu1)]});
+                        else
+                            least = mask->minOver(u0, v0, u1, v1);
+                        solid *= 1.0f - least;
+                    }
                 }
             }
         }

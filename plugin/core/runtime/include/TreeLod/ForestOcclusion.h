@@ -43,7 +43,7 @@ namespace TreeLod
     /// A tree of which less is visible is not drawn.
     constexpr float OCCLUSION_HIDDEN = 1.0f / 64.0f;
     /// Columns of a camera's OcclusionGrid (rows by its aspect ratio).
-    constexpr int OCCLUSION_GRID_COLUMNS = 256;
+    constexpr int OCCLUSION_GRID_COLUMNS = 128;
     /// The smallest tree that hides others: its bounding sphere's square this many pixels tall.
     constexpr float OCCLUSION_MIN_OCCLUDER_PX = 16.0f;
 
