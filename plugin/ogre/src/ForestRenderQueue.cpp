@@ -154,8 +154,10 @@ namespace TreeLod
         // Occlusion: the viewer's own cull only (Forest.h, setOcclusion).
         state.camera.occlusion = mOcclusion && viewer;
         state.camera.viewProjection = glm::mat4(localToClip);
-        state.camera.projectionScale = glm::vec2(float(camera->getProjectionMatrix()[0][0]),
-                                                 float(camera->getProjectionMatrix()[1][1]));
+        // Radii are local: the node's (uniform) scale takes them to the view's units.
+        const float nodeScale = Ogre::Vector3(world[0][0], world[1][0], world[2][0]).length();
+        state.camera.projectionScale = nodeScale * glm::vec2(float(camera->getProjectionMatrix()[0][0]),
+                                                             float(camera->getProjectionMatrix()[1][1]));
         state.camera.viewportHeight = camera->getViewport() ? float(camera->getViewport()->getActualHeight()) : 0.0f;
         if (state.camera.occlusion)
             makeOcclusionMasks();

@@ -114,7 +114,8 @@ namespace TreeLod
         float lodPixelScale = 0.0f;   ///< W * H * P00 * P11 of the LoD camera (pixels)
         bool lodOrthographic = false; ///< value does not fall with distance
         /// Occlusion (the file comment): the culling camera's world-to-clip matrix and its
-        /// projection's P00, P11 place each tree's square on its OcclusionGrid. Off by default
+        /// projection's P00, P11 (times the scale from the instances' space to the view's, where
+        /// the world matrix scales) place each tree's square on its OcclusionGrid. Off by default
         /// (fromMatrices fills the matrices, not the flag); shadow cameras keep it off: what the
         /// viewer does not see still casts shadows it sees.
         bool occlusion = false;
