@@ -231,13 +231,10 @@ namespace TreeLod
         if (Result<void> valid = checkThresholds(changed, "kind " + std::to_string(kind) + " '" + changed.name + "'");
             !valid)
             return valid;
-        if (changed.occlusionHeightScales != mKinds[kind].occlusionHeightScales)
-        {
-            mKinds[kind] = std::move(changed);
+        const bool scalesChanged = changed.occlusionHeightScales != mKinds[kind].occlusionHeightScales;
+        mKinds[kind] = std::move(changed);
+        if (scalesChanged) // the table's key factors; a new mask alone keeps the remembered levels
             writeKindTable(kind);
-        }
-        else
-            mKinds[kind] = std::move(changed);
         return {};
     }
 
